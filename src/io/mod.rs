@@ -1,0 +1,3 @@
+//! File formats: MagicaVoxel .vox in and out.
+
+pub mod vox;

@@ -1,0 +1,1 @@
+//! MagicaVoxel .vox loading and saving (to be written).

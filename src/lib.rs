@@ -1,0 +1,7 @@
+//! octovox: an editable voxel sandbox that ray-traces a sparse voxel octree.
+//!
+//! The engine (scene, octree, edits, .vox I/O, replay) knows nothing of
+//! windows; `gpu` holds the wgpu passes and `app` the winit/egui front end.
+
+pub mod io;
+pub mod scene;

@@ -1,0 +1,35 @@
+//! The scene model: palette, materials and the voxels themselves.
+
+pub mod palette;
+
+pub use palette::{Material, MaterialKind, Palette};
+
+use glam::IVec3;
+
+/// One solid voxel: world position (y up) and palette index (1..=255).
+pub type Voxel = (IVec3, u8);
+
+/// What a loader yields: a flat list of solid voxels in world coordinates
+/// plus the palette, before any octree is built.
+#[derive(Clone, Debug, Default)]
+pub struct VoxelModel {
+    pub palette: Palette,
+    pub voxels: Vec<Voxel>,
+    /// Number of models (shapes placed by the scene graph) the file held.
+    pub models: usize,
+}
+
+impl VoxelModel {
+    /// Inclusive min and max corner of the voxels, or `None` when empty.
+    pub fn bounds(&self) -> Option<(IVec3, IVec3)> {
+        bounds_of(self.voxels.iter().map(|v| v.0))
+    }
+}
+
+/// Inclusive bounding box of a set of positions, or `None` when empty.
+pub fn bounds_of(points: impl Iterator<Item = IVec3>) -> Option<(IVec3, IVec3)> {
+    points.fold(None, |acc, p| match acc {
+        None => Some((p, p)),
+        Some((lo, hi)) => Some((lo.min(p), hi.max(p))),
+    })
+}
