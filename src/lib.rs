@@ -5,3 +5,5 @@
 
 pub mod io;
 pub mod scene;
+pub mod edit;
+pub mod gpu_pool;

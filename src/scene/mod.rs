@@ -1,8 +1,16 @@
 //! The scene model: palette, materials and the voxels themselves.
 
+pub mod apply;
+pub mod build;
+pub mod octree;
 pub mod palette;
+pub mod shape;
 
+pub use apply::{EditError, Patch};
+pub use build::BuildError;
+pub use octree::Octree;
 pub use palette::{Material, MaterialKind, Palette};
+pub use shape::{Op, Overlap, Shape};
 
 use glam::IVec3;
 

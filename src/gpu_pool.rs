@@ -1,0 +1,249 @@
+//! The node pool: the octree's storage, laid out exactly as the GPU reads it.
+//!
+//! CPU node *i* is GPU node slot *i* (and likewise for bricks), so the list of
+//! slots an edit touched is the list of byte ranges to write. Nothing here
+//! knows wgpu: [`NodePool::flush`] yields `(offset, bytes)` ranges and the
+//! renderer hands them to `queue.write_buffer`. The layout is described in
+//! `docs/node-format.md`.
+
+/// Words in an interior node: one child word per octant.
+pub const NODE_WORDS: usize = 8;
+/// Bytes of one interior node slot on the GPU.
+pub const NODE_BYTES: u64 = 32;
+/// Bytes of one brick slot (2×2×2 palette indices) on the GPU.
+pub const BRICK_BYTES: u64 = 8;
+
+/// Child-word bit marking a pointer; the low 31 bits are a slot index.
+/// Without it, the word is a uniform palette index (0 = empty).
+pub const POINTER_BIT: u32 = 0x8000_0000;
+
+/// An interior node: eight child words, octant `x | y << 1 | z << 2`.
+pub type Node = [u32; NODE_WORDS];
+/// A leaf brick: eight palette indices, octant `x | y << 1 | z << 2`.
+pub type Brick = [u8; 8];
+
+/// True when a child word points at a node or brick slot.
+pub fn is_pointer(word: u32) -> bool {
+    word & POINTER_BIT != 0
+}
+
+/// The slot index a pointer word refers to.
+pub fn slot_of(word: u32) -> u32 {
+    word & !POINTER_BIT
+}
+
+/// A pointer word for `slot`.
+pub fn pointer_to(slot: u32) -> u32 {
+    slot | POINTER_BIT
+}
+
+/// Slot state: whether the GPU copy is stale, and whether it is in use at all.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum SlotState {
+    Clean,
+    Dirty,
+    Free,
+}
+
+/// A growable array of fixed-size slots with a free list and dirty tracking.
+#[derive(Clone, Debug)]
+pub struct SlotArena<T> {
+    items: Vec<T>,
+    state: Vec<SlotState>,
+    free: Vec<u32>,
+    dirty: Vec<u32>,
+    /// Slots the GPU buffer can hold; `None` before the first flush.
+    gpu_capacity: Option<usize>,
+}
+
+impl<T> Default for SlotArena<T> {
+    fn default() -> Self {
+        SlotArena { items: Vec::new(), state: Vec::new(), free: Vec::new(), dirty: Vec::new(), gpu_capacity: None }
+    }
+}
+
+impl<T: bytemuck::Pod> SlotArena<T> {
+    /// Stores `item` in a free slot (reusing freed ones first) and marks it dirty.
+    pub fn alloc(&mut self, item: T) -> u32 {
+        if let Some(slot) = self.free.pop() {
+            self.items[slot as usize] = item;
+            self.state[slot as usize] = SlotState::Clean;
+            self.mark_dirty(slot);
+            return slot;
+        }
+        let slot = u32::try_from(self.items.len()).unwrap_or(u32::MAX);
+        assert!(slot < POINTER_BIT, "node pool exhausted (2^31 slots)");
+        self.items.push(item);
+        self.state.push(SlotState::Clean);
+        self.mark_dirty(slot);
+        slot
+    }
+
+    /// Returns a slot to the free list. Its GPU bytes are left as they are:
+    /// nothing points at them any more.
+    pub fn free(&mut self, slot: u32) {
+        debug_assert!(self.state[slot as usize] != SlotState::Free, "double free of slot {slot}");
+        self.state[slot as usize] = SlotState::Free;
+        self.free.push(slot);
+    }
+
+    pub fn get(&self, slot: u32) -> &T {
+        &self.items[slot as usize]
+    }
+
+    /// Overwrites a slot and marks it dirty.
+    pub fn set(&mut self, slot: u32, item: T) {
+        self.items[slot as usize] = item;
+        self.mark_dirty(slot);
+    }
+
+    fn mark_dirty(&mut self, slot: u32) {
+        if self.state[slot as usize] == SlotState::Clean {
+            self.state[slot as usize] = SlotState::Dirty;
+            self.dirty.push(slot);
+        }
+    }
+
+    /// Slots in use.
+    pub fn live(&self) -> usize {
+        self.items.len() - self.free.len()
+    }
+
+    /// Slots ever allocated (the high-water mark the GPU buffer must hold).
+    pub fn len(&self) -> usize {
+        self.items.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.items.is_empty()
+    }
+
+    pub fn is_free(&self, slot: u32) -> bool {
+        self.state.get(slot as usize).is_none_or(|s| *s == SlotState::Free)
+    }
+
+    /// All slots as one byte slice, in GPU layout.
+    pub fn bytes(&self) -> &[u8] {
+        bytemuck::cast_slice(&self.items)
+    }
+
+    /// Takes the dirty slots, coalesced into runs of consecutive slots, and
+    /// decides whether the GPU buffer must grow.
+    fn take_dirty(&mut self) -> Region {
+        let mut slots = std::mem::take(&mut self.dirty);
+        slots.sort_unstable();
+        let mut runs: Vec<(u32, u32)> = Vec::new();
+        for slot in slots {
+            if self.state[slot as usize] != SlotState::Dirty {
+                continue; // freed after it was dirtied: nobody reads it
+            }
+            self.state[slot as usize] = SlotState::Clean;
+            match runs.last_mut() {
+                Some((_, end)) if *end == slot => *end += 1,
+                _ => runs.push((slot, slot + 1)),
+            }
+        }
+        let grow_to = match self.gpu_capacity {
+            Some(cap) if cap >= self.items.len() => None,
+            _ => {
+                // Grow by half again so a long session does not grow on every edit.
+                let cap = (self.items.len() + self.items.len() / 2).max(1024);
+                self.gpu_capacity = Some(cap);
+                Some(cap)
+            }
+        };
+        Region { slot_bytes: std::mem::size_of::<T>() as u64, grow_to_slots: grow_to, runs }
+    }
+}
+
+/// What one arena needs written after a flush.
+#[derive(Clone, Debug, Default)]
+pub struct Region {
+    slot_bytes: u64,
+    /// New capacity in slots when the buffer must be re-created (copy the old
+    /// contents across, then write the runs).
+    pub grow_to_slots: Option<usize>,
+    /// Half-open slot ranges whose bytes changed.
+    runs: Vec<(u32, u32)>,
+}
+
+impl Region {
+    /// `(byte offset, bytes)` for each changed range.
+    pub fn ranges<'a, T: bytemuck::Pod>(&'a self, arena: &'a SlotArena<T>) -> impl Iterator<Item = (u64, &'a [u8])> + 'a {
+        self.runs.iter().map(move |&(start, end)| {
+            let bytes = bytemuck::cast_slice(&arena.items[start as usize..end as usize]);
+            (u64::from(start) * self.slot_bytes, bytes)
+        })
+    }
+
+    /// Bytes the ranges cover.
+    pub fn byte_count(&self) -> u64 {
+        self.runs.iter().map(|&(s, e)| u64::from(e - s) * self.slot_bytes).sum()
+    }
+
+    pub fn range_count(&self) -> usize {
+        self.runs.len()
+    }
+
+    pub fn grow_to_bytes(&self) -> Option<u64> {
+        self.grow_to_slots.map(|slots| slots as u64 * self.slot_bytes)
+    }
+}
+
+/// The changes of one flush: a region per arena.
+#[derive(Clone, Debug, Default)]
+pub struct Upload {
+    pub nodes: Region,
+    pub bricks: Region,
+}
+
+impl Upload {
+    pub fn byte_count(&self) -> u64 {
+        self.nodes.byte_count() + self.bricks.byte_count()
+    }
+}
+
+/// Counters shown in the stats panel and read by tests and `expect written`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PoolStats {
+    pub last_flush_bytes: u64,
+    pub total_bytes: u64,
+    pub last_flush_ranges: usize,
+    pub flushes: u64,
+    /// Times a GPU buffer had to be re-created larger.
+    pub growths: u64,
+}
+
+/// Interior nodes and leaf bricks, each in its own arena (and GPU buffer).
+#[derive(Clone, Debug, Default)]
+pub struct NodePool {
+    pub nodes: SlotArena<Node>,
+    pub bricks: SlotArena<Brick>,
+    pub stats: PoolStats,
+}
+
+impl NodePool {
+    /// Takes every change since the last flush. The caller writes each range
+    /// (after re-creating a buffer that must grow) and nothing else.
+    pub fn flush(&mut self) -> Upload {
+        let upload = Upload { nodes: self.nodes.take_dirty(), bricks: self.bricks.take_dirty() };
+        let bytes = upload.byte_count();
+        self.stats.last_flush_bytes = bytes;
+        self.stats.total_bytes += bytes;
+        self.stats.last_flush_ranges = upload.nodes.range_count() + upload.bricks.range_count();
+        self.stats.flushes += 1;
+        self.stats.growths +=
+            u64::from(upload.nodes.grow_to_slots.is_some()) + u64::from(upload.bricks.grow_to_slots.is_some());
+        upload
+    }
+
+    /// Bytes of the live slots (what the tree needs, not counting free slots).
+    pub fn live_bytes(&self) -> u64 {
+        self.nodes.live() as u64 * NODE_BYTES + self.bricks.live() as u64 * BRICK_BYTES
+    }
+
+    /// Bytes of every allocated slot, free ones included (what the GPU holds).
+    pub fn allocated_bytes(&self) -> u64 {
+        self.nodes.len() as u64 * NODE_BYTES + self.bricks.len() as u64 * BRICK_BYTES
+    }
+}

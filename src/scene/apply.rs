@@ -1,0 +1,269 @@
+//! Applying edits to the octree: brushes, restoring saved cells (undo), and
+//! growing or shrinking the root.
+//!
+//! Every path visits only the cells a shape overlaps: a cell fully inside
+//! becomes one uniform word, a cell outside is returned untouched. Every
+//! replaced cell's old content goes into a [`Patch`], which is itself an edit.
+
+use glam::IVec3;
+
+use super::octree::{MAX_DEPTH, Octree, WORLD_LIMIT, octant_offset};
+use super::shape::{Op, Overlap, Shape};
+use crate::gpu_pool::{Brick, Node, is_pointer, pointer_to};
+
+/// Why an edit was refused. The tree is unchanged when one is returned.
+#[derive(Debug, thiserror::Error, Clone, PartialEq, Eq)]
+pub enum EditError {
+    #[error("edit at {min}..{max} is outside the world (coordinates must stay within ±{WORLD_LIMIT})")]
+    OutsideWorld { min: IVec3, max: IVec3 },
+    #[error("edit at {min}..{max} would make the world wider than 2^{MAX_DEPTH} voxels")]
+    TooWide { min: IVec3, max: IVec3 },
+    #[error("invalid brush: {0}")]
+    Brush(String),
+    #[error("palette index 0 means empty; use remove, or a colour in 1..=255")]
+    ZeroColor,
+}
+
+/// Serialized-subtree tag for a node: eight child subtrees follow.
+const NODE_TAG: u32 = 0x8000_0000;
+/// Serialized-subtree tag for a brick: two little-endian words of values follow.
+const BRICK_TAG: u32 = 0x8000_0001;
+
+/// The previous contents of the cells an edit replaced, plus the root cube
+/// before it; applying it restores them. Cells are disjoint.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Patch {
+    /// (min corner, level, start of its subtree in `words`).
+    cells: Vec<(IVec3, u32, usize)>,
+    /// Subtrees in preorder: a uniform value, or a tag and its contents.
+    words: Vec<u32>,
+    root_before: (IVec3, u32),
+}
+
+impl Patch {
+    fn new(tree: &Octree) -> Patch {
+        Patch { cells: Vec::new(), words: Vec::new(), root_before: (tree.origin, tree.depth) }
+    }
+
+    /// Number of cells recorded.
+    pub fn cell_count(&self) -> usize {
+        self.cells.len()
+    }
+
+    /// Approximate heap size in bytes (history memory accounting).
+    pub fn heap_bytes(&self) -> usize {
+        self.cells.len() * std::mem::size_of::<(IVec3, u32, usize)>() + self.words.len() * 4
+    }
+
+    fn subtree(&self, cell: usize) -> &[u32] {
+        let start = self.cells[cell].2;
+        let end = self.cells.get(cell + 1).map_or(self.words.len(), |c| c.2);
+        &self.words[start..end]
+    }
+}
+
+impl Octree {
+    /// Applies a brush. Grows the root first if the shape reaches outside it.
+    /// Returns the patch that undoes the edit.
+    pub fn apply_brush(&mut self, shape: &Shape, op: Op) -> Result<Patch, EditError> {
+        shape.validate().map_err(EditError::Brush)?;
+        if op.color() == Some(0) {
+            return Err(EditError::ZeroColor);
+        }
+        let (lo, hi) = shape.bounds();
+        let mut patch = Patch::new(self);
+        self.grow_to_contain(lo, hi)?;
+        self.root = self.brush_word(self.root, self.origin, self.depth, shape, op, &mut patch);
+        Ok(patch)
+    }
+
+    /// Restores the cells a patch holds. Returns the patch that undoes this.
+    pub fn apply_patch(&mut self, patch: &Patch) -> Result<Patch, EditError> {
+        let mut inverse = Patch::new(self);
+        for (i, &(min, level, _)) in patch.cells.iter().enumerate() {
+            self.grow_to_contain(min, min + IVec3::splat((1 << level) - 1))?;
+            let mut cursor = patch.subtree(i).iter().copied();
+            self.root = self.replace_cell(self.root, self.origin, self.depth, (min, level), &mut cursor, &mut inverse);
+        }
+        let (origin, depth) = patch.root_before;
+        self.shrink_to(origin, depth);
+        Ok(inverse)
+    }
+
+    fn brush_word(&mut self, word: u32, min: IVec3, level: u32, shape: &Shape, op: Op, patch: &mut Patch) -> u32 {
+        let overlap = shape.overlap(min, 1 << level);
+        if overlap == Overlap::Outside {
+            return word;
+        }
+        if level == 1 {
+            return self.brush_brick(word, min, shape, op, patch);
+        }
+        if !is_pointer(word) {
+            let new = u32::from(op.apply(word as u8));
+            if new == word {
+                return word;
+            }
+            if overlap == Overlap::Inside {
+                return self.replace_with(word, min, level, new, patch);
+            }
+            // Partly covered uniform cell: split it, then edit the parts.
+            let split = pointer_to(self.pool.nodes.alloc([word; 8]));
+            return self.brush_children(split, min, level, shape, op, patch);
+        }
+        match op {
+            Op::Place(v) if overlap == Overlap::Inside => self.replace_with(word, min, level, u32::from(v), patch),
+            Op::Remove if overlap == Overlap::Inside => self.replace_with(word, min, level, 0, patch),
+            _ => self.brush_children(word, min, level, shape, op, patch),
+        }
+    }
+
+    fn brush_children(&mut self, node: u32, min: IVec3, level: u32, shape: &Shape, op: Op, patch: &mut Patch) -> u32 {
+        let mut children: Node = *self.node(node);
+        let half = 1 << (level - 1);
+        for (octant, child) in children.iter_mut().enumerate() {
+            *child = self.brush_word(*child, min + octant_offset(octant) * half, level - 1, shape, op, patch);
+        }
+        self.make_node(children, Some(node))
+    }
+
+    fn brush_brick(&mut self, word: u32, min: IVec3, shape: &Shape, op: Op, patch: &mut Patch) -> u32 {
+        let old: Brick = if is_pointer(word) { *self.brick(word) } else { [word as u8; 8] };
+        let mut new = old;
+        for (octant, value) in new.iter_mut().enumerate() {
+            if shape.contains(min + octant_offset(octant)) {
+                *value = op.apply(*value);
+            }
+        }
+        if new == old {
+            return word;
+        }
+        self.record(patch, min, 1, word);
+        let solid = |b: &Brick| b.iter().filter(|v| **v != 0).count() as u64;
+        self.solid_voxels = self.solid_voxels + solid(&new) - solid(&old);
+        self.make_brick(new, is_pointer(word).then_some(word))
+    }
+
+    /// Replaces a whole cell by a uniform word, recording the old content.
+    fn replace_with(&mut self, old: u32, min: IVec3, level: u32, new: u32, patch: &mut Patch) -> u32 {
+        self.record(patch, min, level, old);
+        self.solid_voxels = self.solid_voxels - self.count_word(old, level) + self.count_word(new, level);
+        self.release(old, level);
+        new
+    }
+
+    /// Appends a cell's current subtree to a patch.
+    fn record(&self, patch: &mut Patch, min: IVec3, level: u32, word: u32) {
+        patch.cells.push((min, level, patch.words.len()));
+        self.serialize(word, level, &mut patch.words);
+    }
+
+    fn serialize(&self, word: u32, level: u32, out: &mut Vec<u32>) {
+        if !is_pointer(word) {
+            out.push(word);
+        } else if level == 1 {
+            let b = self.brick(word);
+            out.extend([BRICK_TAG, u32::from_le_bytes([b[0], b[1], b[2], b[3]]), u32::from_le_bytes([b[4], b[5], b[6], b[7]])]);
+        } else {
+            out.push(NODE_TAG);
+            for child in *self.node(word) {
+                self.serialize(child, level - 1, out);
+            }
+        }
+    }
+
+    /// Rebuilds a serialized subtree in the pool. A truncated stream reads as
+    /// empty cells rather than panicking.
+    fn deserialize(&mut self, words: &mut impl Iterator<Item = u32>, level: u32) -> u32 {
+        match words.next().unwrap_or(0) {
+            NODE_TAG if level >= 2 => {
+                let mut children: Node = [0; 8];
+                for child in &mut children {
+                    *child = self.deserialize(words, level - 1);
+                }
+                self.make_node(children, None)
+            }
+            BRICK_TAG if level == 1 => {
+                let lo = words.next().unwrap_or(0).to_le_bytes();
+                let hi = words.next().unwrap_or(0).to_le_bytes();
+                self.make_brick([lo[0], lo[1], lo[2], lo[3], hi[0], hi[1], hi[2], hi[3]], None)
+            }
+            value if value <= 255 => value,
+            _ => 0,
+        }
+    }
+
+    /// Walks down to the target cell (splitting uniform cells on the way),
+    /// swaps in the serialized subtree, and collapses on the way back up.
+    fn replace_cell(
+        &mut self,
+        word: u32,
+        min: IVec3,
+        level: u32,
+        target: (IVec3, u32),
+        subtree: &mut impl Iterator<Item = u32>,
+        inverse: &mut Patch,
+    ) -> u32 {
+        if level <= target.1 {
+            self.record(inverse, min, level, word);
+            let new = self.deserialize(subtree, level);
+            self.solid_voxels = self.solid_voxels - self.count_word(word, level) + self.count_word(new, level);
+            self.release(word, level);
+            return new;
+        }
+        let node = if is_pointer(word) { word } else { pointer_to(self.pool.nodes.alloc([word; 8])) };
+        let half = 1 << (level - 1);
+        let rel = (target.0 - min) / half;
+        let octant = (rel.x | rel.y << 1 | rel.z << 2) as usize;
+        let mut children: Node = *self.node(node);
+        children[octant] =
+            self.replace_cell(children[octant], min + octant_offset(octant) * half, level - 1, target, subtree, inverse);
+        self.make_node(children, Some(node))
+    }
+
+    /// Adds root levels until the root cube holds `lo..=hi`.
+    pub fn grow_to_contain(&mut self, lo: IVec3, hi: IVec3) -> Result<(), EditError> {
+        if lo.min_element() <= -WORLD_LIMIT || hi.max_element() >= WORLD_LIMIT {
+            return Err(EditError::OutsideWorld { min: lo, max: hi });
+        }
+        while !(self.contains(lo) && self.contains(hi)) {
+            if self.depth >= MAX_DEPTH {
+                return Err(EditError::TooWide { min: lo, max: hi });
+            }
+            let size = 1 << self.depth;
+            // The old root becomes the child on the side away from the edit.
+            let below = lo.cmplt(self.origin);
+            let octant = usize::from(below.x) | usize::from(below.y) << 1 | usize::from(below.z) << 2;
+            let mut children: Node = [0; 8];
+            children[octant] = self.root;
+            self.root = if self.root == 0 { 0 } else { self.make_node(children, None) };
+            self.origin -= octant_offset(octant) * size;
+            self.depth += 1;
+        }
+        Ok(())
+    }
+
+    /// Drops root levels down to the cube (`origin`, `depth`) while everything
+    /// outside it is empty; undo uses this to take back a growth.
+    fn shrink_to(&mut self, origin: IVec3, depth: u32) {
+        while self.depth > depth {
+            let half = 1 << (self.depth - 1);
+            let rel = (origin - self.origin) / half;
+            if rel.cmplt(IVec3::ZERO).any() || rel.cmpgt(IVec3::ONE).any() {
+                return; // not a sub-cube of the current root
+            }
+            let octant = (rel.x | rel.y << 1 | rel.z << 2) as usize;
+            if is_pointer(self.root) {
+                let children = *self.node(self.root);
+                if children.iter().enumerate().any(|(i, c)| i != octant && *c != 0) {
+                    return;
+                }
+                self.pool.nodes.free(crate::gpu_pool::slot_of(self.root));
+                self.root = children[octant];
+            } else if self.root != 0 {
+                return;
+            }
+            self.origin += octant_offset(octant) * half;
+            self.depth -= 1;
+        }
+    }
+}

@@ -1,0 +1,319 @@
+//! The CPU sparse voxel octree: an arena of nodes and bricks (the [`NodePool`])
+//! under one root word.
+//!
+//! A cell of level `l` is a cube of `2^l` voxels. Its content is one child
+//! word (see [`crate::gpu_pool`]): a uniform palette index (0 = empty) or a
+//! pointer. A pointer at level 1 is a brick of 2×2×2 voxels; at level ≥ 2 it
+//! is a node of eight level `l - 1` cells. Uniform regions always collapse:
+//! no node holds eight equal uniform words and no brick eight equal values,
+//! so the tree for a given set of voxels is unique.
+
+use glam::IVec3;
+
+use crate::gpu_pool::{self, Brick, Node, NodePool, is_pointer, pointer_to, slot_of};
+
+/// Smallest root: a 4³ cube (the root is then a node of bricks).
+pub const MIN_DEPTH: u32 = 2;
+/// Largest root: 2^20 voxels per side; edits beyond it are refused.
+pub const MAX_DEPTH: u32 = 20;
+/// World coordinates must stay within ±2^24 so they are exact in f32.
+pub const WORLD_LIMIT: i32 = 1 << 24;
+
+/// Octant index of child offset bits: `x | y << 1 | z << 2`.
+pub fn octant_offset(octant: usize) -> IVec3 {
+    IVec3::new((octant & 1) as i32, ((octant >> 1) & 1) as i32, ((octant >> 2) & 1) as i32)
+}
+
+/// A sparse voxel octree over palette indices.
+#[derive(Clone, Debug)]
+pub struct Octree {
+    pub(crate) pool: NodePool,
+    pub(crate) root: u32,
+    pub(crate) origin: IVec3,
+    pub(crate) depth: u32,
+    pub(crate) solid_voxels: u64,
+}
+
+impl Default for Octree {
+    fn default() -> Octree {
+        Octree::empty(IVec3::ZERO, MIN_DEPTH)
+    }
+}
+
+impl Octree {
+    /// An empty tree whose root cube starts at `origin` with `2^depth` voxels per side.
+    pub fn empty(origin: IVec3, depth: u32) -> Octree {
+        Octree {
+            pool: NodePool::default(),
+            root: 0,
+            origin,
+            depth: depth.clamp(MIN_DEPTH, MAX_DEPTH),
+            solid_voxels: 0,
+        }
+    }
+
+    pub fn pool(&self) -> &NodePool {
+        &self.pool
+    }
+
+    pub fn pool_mut(&mut self) -> &mut NodePool {
+        &mut self.pool
+    }
+
+    /// The root child word (uniform value or pointer to a node).
+    pub fn root_word(&self) -> u32 {
+        self.root
+    }
+
+    /// Min corner of the root cube.
+    pub fn origin(&self) -> IVec3 {
+        self.origin
+    }
+
+    /// Level of the root: the root cube is `2^depth` voxels wide.
+    pub fn depth(&self) -> u32 {
+        self.depth
+    }
+
+    pub fn size(&self) -> i32 {
+        1 << self.depth
+    }
+
+    /// Number of solid voxels.
+    pub fn solid_voxels(&self) -> u64 {
+        self.solid_voxels
+    }
+
+    pub fn node_count(&self) -> usize {
+        self.pool.nodes.live()
+    }
+
+    pub fn brick_count(&self) -> usize {
+        self.pool.bricks.live()
+    }
+
+    pub(crate) fn node(&self, word: u32) -> &Node {
+        self.pool.nodes.get(slot_of(word))
+    }
+
+    pub(crate) fn brick(&self, word: u32) -> &Brick {
+        self.pool.bricks.get(slot_of(word))
+    }
+
+    /// True when `p` lies inside the root cube.
+    pub fn contains(&self, p: IVec3) -> bool {
+        let rel = p.as_i64vec3() - self.origin.as_i64vec3();
+        rel.cmpge(glam::I64Vec3::ZERO).all() && rel.cmplt(glam::I64Vec3::splat(1 << self.depth)).all()
+    }
+
+    /// Palette index at `p` (0 when empty or outside the root).
+    pub fn get(&self, p: IVec3) -> u8 {
+        if !self.contains(p) {
+            return 0;
+        }
+        let rel = p - self.origin;
+        let mut word = self.root;
+        let mut level = self.depth;
+        while is_pointer(word) {
+            let bit = level - 1;
+            let octant = (((rel.x >> bit) & 1) | (((rel.y >> bit) & 1) << 1) | (((rel.z >> bit) & 1) << 2)) as usize;
+            if level == 1 {
+                return self.brick(word)[octant];
+            }
+            word = self.node(word)[octant];
+            level -= 1;
+        }
+        word as u8
+    }
+
+    /// Visits every maximal uniform solid cell as (min corner, size, value).
+    pub fn for_each_solid_cell(&self, mut f: impl FnMut(IVec3, i32, u8)) {
+        self.visit_cells(self.root, self.origin, self.depth, &mut f);
+    }
+
+    fn visit_cells(&self, word: u32, min: IVec3, level: u32, f: &mut impl FnMut(IVec3, i32, u8)) {
+        if !is_pointer(word) {
+            if word != 0 {
+                f(min, 1 << level, word as u8);
+            }
+            return;
+        }
+        let half = 1 << (level - 1);
+        for octant in 0..8 {
+            let child_min = min + octant_offset(octant) * half;
+            if level == 1 {
+                let v = self.brick(word)[octant];
+                if v != 0 {
+                    f(child_min, 1, v);
+                }
+            } else {
+                self.visit_cells(self.node(word)[octant], child_min, level - 1, f);
+            }
+        }
+    }
+
+    /// Every solid voxel as (position, palette index), uniform cells expanded.
+    pub fn voxels(&self) -> Vec<(IVec3, u8)> {
+        let mut out = Vec::with_capacity(usize::try_from(self.solid_voxels).unwrap_or(0));
+        self.for_each_solid_cell(|min, size, v| {
+            for z in 0..size {
+                for y in 0..size {
+                    for x in 0..size {
+                        out.push((min + IVec3::new(x, y, z), v));
+                    }
+                }
+            }
+        });
+        out
+    }
+
+    /// Inclusive bounds of the solid voxels, or `None` for an empty tree.
+    pub fn solid_bounds(&self) -> Option<(IVec3, IVec3)> {
+        let mut bounds: Option<(IVec3, IVec3)> = None;
+        self.for_each_solid_cell(|min, size, _| {
+            let max = min + IVec3::splat(size - 1);
+            bounds = Some(match bounds {
+                None => (min, max),
+                Some((lo, hi)) => (lo.min(min), hi.max(max)),
+            });
+        });
+        bounds
+    }
+
+    /// Solid voxels under a child word of the given level.
+    pub(crate) fn count_word(&self, word: u32, level: u32) -> u64 {
+        if !is_pointer(word) {
+            return if word == 0 { 0 } else { 1u64 << (3 * level) };
+        }
+        if level == 1 {
+            return self.brick(word).iter().filter(|v| **v != 0).count() as u64;
+        }
+        self.node(word).iter().map(|&w| self.count_word(w, level - 1)).sum()
+    }
+
+    /// Frees every slot under `word`.
+    pub(crate) fn release(&mut self, word: u32, level: u32) {
+        if !is_pointer(word) {
+            return;
+        }
+        if level == 1 {
+            self.pool.bricks.free(slot_of(word));
+            return;
+        }
+        let node = *self.node(word);
+        self.pool.nodes.free(slot_of(word));
+        for child in node {
+            self.release(child, level - 1);
+        }
+    }
+
+    /// Word for eight voxel values: uniform if all equal, else a brick.
+    /// `reuse` is an existing brick word to overwrite in place.
+    pub(crate) fn make_brick(&mut self, values: Brick, reuse: Option<u32>) -> u32 {
+        if values.iter().all(|v| *v == values[0]) {
+            if let Some(old) = reuse {
+                self.pool.bricks.free(slot_of(old));
+            }
+            return u32::from(values[0]);
+        }
+        match reuse {
+            Some(old) => {
+                self.pool.bricks.set(slot_of(old), values);
+                old
+            }
+            None => pointer_to(self.pool.bricks.alloc(values)),
+        }
+    }
+
+    /// Word for eight child words: collapsed if all are the same uniform value.
+    /// `reuse` is an existing node word to overwrite in place.
+    pub(crate) fn make_node(&mut self, children: Node, reuse: Option<u32>) -> u32 {
+        if !is_pointer(children[0]) && children.iter().all(|c| *c == children[0]) {
+            if let Some(old) = reuse {
+                self.pool.nodes.free(slot_of(old));
+            }
+            return children[0];
+        }
+        match reuse {
+            Some(old) => {
+                if self.node(old) != &children {
+                    self.pool.nodes.set(slot_of(old), children);
+                }
+                old
+            }
+            None => pointer_to(self.pool.nodes.alloc(children)),
+        }
+    }
+
+    /// Checks the structural invariants: collapse, no dangling or leaked
+    /// slots, and the cached voxel count. Returns a description of the first
+    /// violation. Used by tests after every edit.
+    pub fn check_invariants(&self) -> Result<(), String> {
+        let mut reached = (0usize, 0usize);
+        self.check_word(self.root, self.depth, &mut reached)?;
+        if reached != (self.pool.nodes.live(), self.pool.bricks.live()) {
+            return Err(format!(
+                "reachable nodes/bricks {reached:?} != live {:?}",
+                (self.pool.nodes.live(), self.pool.bricks.live())
+            ));
+        }
+        let counted = self.count_word(self.root, self.depth);
+        if counted != self.solid_voxels {
+            return Err(format!("cached voxel count {} != counted {counted}", self.solid_voxels));
+        }
+        Ok(())
+    }
+
+    fn check_word(&self, word: u32, level: u32, reached: &mut (usize, usize)) -> Result<(), String> {
+        if !is_pointer(word) {
+            return if word <= 255 { Ok(()) } else { Err(format!("bad uniform word {word:#x}")) };
+        }
+        if level == 0 {
+            return Err("pointer below level 1".into());
+        }
+        if level == 1 {
+            if self.pool.bricks.is_free(slot_of(word)) {
+                return Err(format!("brick {} is free but referenced", slot_of(word)));
+            }
+            reached.1 += 1;
+            let b = self.brick(word);
+            return if b.iter().all(|v| *v == b[0]) { Err(format!("uncollapsed brick {b:?}")) } else { Ok(()) };
+        }
+        if self.pool.nodes.is_free(slot_of(word)) {
+            return Err(format!("node {} is free but referenced", slot_of(word)));
+        }
+        reached.0 += 1;
+        let node = *self.node(word);
+        if !is_pointer(node[0]) && node.iter().all(|c| *c == node[0]) {
+            return Err(format!("uncollapsed node {node:?} at level {level}"));
+        }
+        node.iter().try_for_each(|&c| self.check_word(c, level - 1, reached))
+    }
+}
+
+/// Reads voxels back from raw GPU-layout bytes exactly as the shader walks
+/// them. Tests use it on a mirror buffer fed only by flushed ranges.
+pub fn decode_from_bytes(nodes: &[u8], bricks: &[u8], root: u32, origin: IVec3, depth: u32, p: IVec3) -> u8 {
+    let rel = p - origin;
+    if rel.cmplt(IVec3::ZERO).any() || rel.cmpge(IVec3::splat(1 << depth)).any() {
+        return 0;
+    }
+    let word_at = |bytes: &[u8], index: usize| -> u32 {
+        let at = index * 4;
+        bytes.get(at..at + 4).map_or(0xdead_beef, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+    };
+    let mut word = root;
+    let mut level = depth;
+    while is_pointer(word) {
+        let bit = level - 1;
+        let octant = (((rel.x >> bit) & 1) | (((rel.y >> bit) & 1) << 1) | (((rel.z >> bit) & 1) << 2)) as usize;
+        let slot = slot_of(word) as usize;
+        if level == 1 {
+            let packed = word_at(bricks, slot * 2 + octant / 4);
+            return (packed >> (8 * (octant % 4))) as u8;
+        }
+        word = word_at(nodes, slot * gpu_pool::NODE_WORDS + octant);
+        level -= 1;
+    }
+    word as u8
+}
