@@ -3,7 +3,10 @@
 //! The engine (scene, octree, edits, .vox I/O, replay) knows nothing of
 //! windows; `gpu` holds the wgpu passes and `app` the winit/egui front end.
 
-pub mod io;
-pub mod scene;
+pub mod camera;
 pub mod edit;
 pub mod gpu_pool;
+pub mod io;
+pub mod scene;
+pub mod settings;
+pub mod trace;

@@ -1,0 +1,76 @@
+//! A pinhole camera and the per-pixel ray basis that the CPU tracers and the
+//! GPU shaders share.
+
+use glam::{DVec3, IVec3, Vec3};
+
+/// Eye, target and vertical field of view, in world coordinates (y up).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    pub eye: DVec3,
+    pub target: DVec3,
+    pub fov_y_deg: f32,
+}
+
+impl Default for Camera {
+    fn default() -> Camera {
+        Camera { eye: DVec3::new(40.0, 30.0, 50.0), target: DVec3::ZERO, fov_y_deg: 50.0 }
+    }
+}
+
+impl Camera {
+    /// A camera looking at the box `min..=max` (voxel corners) from the
+    /// front-right-top so that all of it is in view.
+    pub fn framing(min: IVec3, max: IVec3, fov_y_deg: f32) -> Camera {
+        let lo = min.as_dvec3();
+        let hi = max.as_dvec3() + DVec3::ONE;
+        let center = (lo + hi) * 0.5;
+        let radius = ((hi - lo).length() * 0.5).max(1.0);
+        let half_fov = f64::from(fov_y_deg.clamp(5.0, 170.0)).to_radians() * 0.5;
+        let distance = radius / half_fov.sin() * 1.05;
+        let dir = DVec3::new(0.55, 0.45, 0.7).normalize();
+        Camera { eye: center + dir * distance, target: center, fov_y_deg }
+    }
+
+    /// Ray basis for a viewport, with the eye relative to `origin` (the tree's
+    /// origin) so that far-away cameras keep f32 precision.
+    pub fn basis(&self, width: u32, height: u32, origin: IVec3) -> RayBasis {
+        let forward = (self.target - self.eye).try_normalize().unwrap_or(DVec3::NEG_Z);
+        let world_up = if forward.y.abs() > 0.999 { DVec3::Z } else { DVec3::Y };
+        let right = forward.cross(world_up).normalize();
+        let up = right.cross(forward);
+        let tan_half = (f64::from(self.fov_y_deg.clamp(1.0, 179.0)).to_radians() * 0.5).tan();
+        let aspect = f64::from(width.max(1)) / f64::from(height.max(1));
+        RayBasis {
+            eye: (self.eye - origin.as_dvec3()).as_vec3(),
+            forward: forward.as_vec3(),
+            right: (right * tan_half * aspect).as_vec3(),
+            up: (up * tan_half).as_vec3(),
+            width: width.max(1),
+            height: height.max(1),
+        }
+    }
+}
+
+/// Everything needed to make the ray of any pixel, in tree-local coordinates.
+/// The WGSL twin is the camera part of `FrameUniforms` in `shaders/common.wgsl`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayBasis {
+    pub eye: Vec3,
+    pub forward: Vec3,
+    /// Right vector scaled by tan(fov/2) · aspect.
+    pub right: Vec3,
+    /// Up vector scaled by tan(fov/2).
+    pub up: Vec3,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl RayBasis {
+    /// Origin and (unnormalised) direction through the centre of pixel (x, y),
+    /// with (0, 0) the top-left pixel. Same arithmetic as `pixel_ray` in WGSL.
+    pub fn ray(&self, x: u32, y: u32) -> (Vec3, Vec3) {
+        let ndc_x = 2.0 * (x as f32 + 0.5) / self.width as f32 - 1.0;
+        let ndc_y = 1.0 - 2.0 * (y as f32 + 0.5) / self.height as f32;
+        (self.eye, self.forward + self.right * ndc_x + self.up * ndc_y)
+    }
+}

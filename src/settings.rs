@@ -1,0 +1,59 @@
+//! Render settings: plain data shared by the window, `render` and replay.
+
+/// Which structure the rays walk.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum TraceMode {
+    /// Sparse voxel octree, stack traversal.
+    #[default]
+    Svo,
+    /// Dense grid, Amanatides–Woo DDA (the report's baseline).
+    Grid,
+}
+
+/// What each pixel shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum View {
+    /// Palette colour, Lambert sun light, sky gradient.
+    #[default]
+    Shaded,
+    /// Heatmap of traversal steps per ray.
+    Iterations,
+    /// Level of the octree cell that was hit (bigger cells warmer).
+    Depth,
+    /// Face normals.
+    Normals,
+}
+
+impl View {
+    /// Code the shaders switch on (`FrameUniforms::view`).
+    pub fn code(self) -> u32 {
+        match self {
+            View::Shaded => 0,
+            View::Iterations => 1,
+            View::Depth => 2,
+            View::Normals => 3,
+        }
+    }
+
+    pub const ALL: [View; 4] = [View::Shaded, View::Iterations, View::Depth, View::Normals];
+}
+
+/// Knobs of the renderer, edited by the UI.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderSettings {
+    pub mode: TraceMode,
+    pub view: View,
+    /// Trace a shadow ray toward the sun for every hit.
+    pub shadows: bool,
+    /// Fraction of the window's pixels traced per axis (0.25..=1).
+    pub render_scale: f32,
+}
+
+impl Default for RenderSettings {
+    fn default() -> RenderSettings {
+        RenderSettings { mode: TraceMode::Svo, view: View::Shaded, shadows: true, render_scale: 1.0 }
+    }
+}
+
+/// Direction toward the sun (normalised), shared with the shaders.
+pub const SUN_DIR: [f32; 3] = [0.454_858_8, 0.796_002_9, 0.398_001_5];

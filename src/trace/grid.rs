@@ -1,0 +1,95 @@
+//! The report's baseline: a dense 3D grid (`x + nx·(y + ny·z)`) walked with
+//! Amanatides–Woo DDA. `shaders/trace_grid.wgsl` is its twin.
+
+use glam::{IVec3, UVec3, Vec3};
+
+use super::{Hit, MAX_ITERATIONS, NO_AXIS, Ray, argmin};
+use crate::scene::Octree;
+
+/// The scene's solid bounding box as a flat array of palette indices.
+#[derive(Clone, Debug, Default)]
+pub struct DenseGrid {
+    /// Min corner in tree-local coordinates.
+    pub min: IVec3,
+    pub dims: UVec3,
+    pub data: Vec<u8>,
+}
+
+impl DenseGrid {
+    /// Rasterizes the tree's solid voxels (tree-local coordinates).
+    pub fn from_octree(tree: &Octree) -> DenseGrid {
+        let Some((lo, hi)) = tree.solid_bounds() else {
+            return DenseGrid::default();
+        };
+        let min = lo - tree.origin();
+        let dims = (hi - lo + IVec3::ONE).as_uvec3();
+        let mut data = vec![0u8; dims.x as usize * dims.y as usize * dims.z as usize];
+        let index = |p: IVec3| (p.x as usize) + dims.x as usize * (p.y as usize + dims.y as usize * p.z as usize);
+        tree.for_each_solid_cell(|cell_min, size, value| {
+            let base = cell_min - lo;
+            for z in 0..size {
+                for y in 0..size {
+                    let row = index(base + IVec3::new(0, y, z));
+                    data[row..row + size as usize].fill(value);
+                }
+            }
+        });
+        DenseGrid { min, dims, data }
+    }
+
+    /// Value at a tree-local position (0 outside).
+    pub fn at(&self, p: IVec3) -> u8 {
+        let rel = p - self.min;
+        if rel.cmplt(IVec3::ZERO).any() || rel.as_uvec3().cmpge(self.dims).any() {
+            return 0;
+        }
+        self.data[rel.x as usize + self.dims.x as usize * (rel.y as usize + self.dims.y as usize * rel.z as usize)]
+    }
+
+    pub fn bytes(&self) -> u64 {
+        self.data.len() as u64
+    }
+}
+
+/// The first solid voxel along `ray` (tree-local coordinates).
+pub fn trace(grid: &DenseGrid, ray: &Ray) -> Hit {
+    if grid.data.is_empty() {
+        return Hit::default();
+    }
+    let lo = grid.min;
+    let hi = grid.min + grid.dims.as_ivec3() - IVec3::ONE;
+    let (t_enter, t_exit, entry_axis) = ray.slab(lo.as_vec3(), (hi + IVec3::ONE).as_vec3());
+    if t_enter > t_exit || t_exit < 0.0 {
+        return Hit::default();
+    }
+    let t = t_enter.max(0.0);
+    let mut axis = if t_enter >= 0.0 { entry_axis } else { NO_AXIS };
+    let mut voxel = IVec3::ZERO;
+    for b in 0..3 {
+        voxel[b] = if b == axis {
+            if ray.dir[b] > 0.0 { lo[b] } else { hi[b] }
+        } else {
+            ray.voxel_on_axis(b, t, axis).clamp(lo[b], hi[b])
+        };
+    }
+    let step = IVec3::select(ray.dir.cmpgt(Vec3::ZERO), IVec3::ONE, IVec3::NEG_ONE);
+    let far_offset = Vec3::select(ray.dir.cmpgt(Vec3::ZERO), Vec3::ONE, Vec3::ZERO);
+    let mut iterations = 0;
+    while iterations < MAX_ITERATIONS {
+        iterations += 1;
+        let value = grid.at(voxel);
+        if value != 0 {
+            let normal = if axis == NO_AXIS { IVec3::ZERO } else { ray.entry_normal(axis) };
+            return Hit { value, voxel, normal, cell_level: 0, iterations };
+        }
+        // Exit t of each plane, recomputed from the plane (not accumulated).
+        let exits = (voxel.as_vec3() + far_offset - ray.origin) * ray.inv;
+        let a = argmin(exits);
+        voxel[a] += step[a];
+        axis = a;
+        if voxel[a] < lo[a] || voxel[a] > hi[a] {
+            break;
+        }
+    }
+    Hit { iterations, ..Hit::default() }
+}

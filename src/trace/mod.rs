@@ -1,0 +1,184 @@
+//! CPU reference tracers: the SVO stack traversal (the same algorithm as
+//! `shaders/trace_svo.wgsl`) and Amanatides–Woo DDA over a dense grid (ground
+//! truth, and the report's baseline). Both work in tree-local coordinates.
+
+pub mod grid;
+pub mod render;
+pub mod svo;
+
+use glam::{IVec3, Vec3};
+
+/// Hard bound on traversal steps per ray (SVO and grid alike).
+pub const MAX_ITERATIONS: u32 = 4096;
+
+/// Entry axis of a ray that starts inside a cell (no face entered).
+pub const NO_AXIS: usize = 3;
+
+/// Direction components smaller than this are clamped to ±this, so no
+/// division by zero can happen and slabs stay ordered.
+pub const MIN_DIRECTION: f32 = 1.0 / 8_388_608.0; // 2^-23
+
+/// What a ray found. `voxel` is tree-local; `normal` is the entered face
+/// (zero when the ray starts inside a solid voxel).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct Hit {
+    pub value: u8,
+    pub voxel: IVec3,
+    pub normal: IVec3,
+    /// Level of the uniform cell that was hit (0 = a single voxel); the
+    /// node-depth debug view shows it.
+    pub cell_level: u32,
+    pub iterations: u32,
+}
+
+impl Hit {
+    pub fn is_hit(&self) -> bool {
+        self.value != 0
+    }
+
+    /// Packs normal, value and iterations the way the shader's hit record does.
+    pub fn pack_info(&self) -> u32 {
+        u32::from(self.value)
+            | normal_code(self.normal) << 8
+            | self.cell_level.min(31) << 11
+            | self.iterations.min(0xffff) << 16
+    }
+
+    /// Inverse of the shader's hit record `[x, y, z, info]`.
+    pub fn from_record(record: [u32; 4]) -> Hit {
+        let info = record[3];
+        Hit {
+            value: info as u8,
+            voxel: IVec3::new(record[0] as i32, record[1] as i32, record[2] as i32),
+            normal: normal_from_code((info >> 8) & 7),
+            cell_level: (info >> 11) & 31,
+            iterations: info >> 16,
+        }
+    }
+}
+
+/// 0 = none, 1..=6 = +x, −x, +y, −y, +z, −z.
+pub fn normal_code(n: IVec3) -> u32 {
+    for axis in 0..3 {
+        if n[axis] > 0 {
+            return 1 + 2 * axis as u32;
+        }
+        if n[axis] < 0 {
+            return 2 + 2 * axis as u32;
+        }
+    }
+    0
+}
+
+pub fn normal_from_code(code: u32) -> IVec3 {
+    if code == 0 || code > 6 {
+        return IVec3::ZERO;
+    }
+    let axis = ((code - 1) / 2) as usize;
+    let mut n = IVec3::ZERO;
+    n[axis] = if code % 2 == 1 { 1 } else { -1 };
+    n
+}
+
+/// A ray prepared for traversal: tiny components clamped, reciprocal ready.
+#[derive(Clone, Copy, Debug)]
+pub struct Ray {
+    pub origin: Vec3,
+    pub dir: Vec3,
+    pub inv: Vec3,
+}
+
+impl Ray {
+    pub fn new(origin: Vec3, dir: Vec3) -> Ray {
+        let clamp = |d: f32| {
+            if d.is_nan() {
+                MIN_DIRECTION
+            } else if d.abs() < MIN_DIRECTION {
+                MIN_DIRECTION.copysign(d)
+            } else {
+                d
+            }
+        };
+        let dir = Vec3::new(clamp(dir.x), clamp(dir.y), clamp(dir.z));
+        Ray { origin, dir, inv: Vec3::ONE / dir }
+    }
+
+    /// Parameter t where the ray crosses the plane `coord` on `axis`.
+    pub fn plane_t(&self, axis: usize, coord: f32) -> f32 {
+        (coord - self.origin[axis]) * self.inv[axis]
+    }
+
+    /// Entry and exit t of the box `min..max` and the axis of the entry
+    /// plane (of planes crossed at the same t, the last one: see [`argmin`]).
+    pub fn slab(&self, min: Vec3, max: Vec3) -> (f32, f32, usize) {
+        let t0 = (min - self.origin) * self.inv;
+        let t1 = (max - self.origin) * self.inv;
+        let near = t0.min(t1);
+        let far = t0.max(t1);
+        let axis = if near.z >= near.x && near.z >= near.y {
+            2
+        } else if near.y >= near.x {
+            1
+        } else {
+            0
+        };
+        (near.max_element(), far.min_element(), axis)
+    }
+
+    /// Whether the ray, at `t` and having just entered a cell through a plane
+    /// on `entry_axis` (3 when it started inside), is past the plane `coord`
+    /// on `axis`. Planes crossed at the same t count as crossed in x, y, z
+    /// order, so a plane tied with the entry plane is past only if its axis
+    /// comes first. Every tracer decides cells with this one rule.
+    pub fn crossed(&self, axis: usize, coord: f32, t: f32, entry_axis: usize) -> bool {
+        let t_plane = self.plane_t(axis, coord);
+        if axis <= entry_axis { t_plane <= t } else { t_plane < t }
+    }
+
+    /// The voxel coordinate on `axis` where the ray is at `t`: the last voxel
+    /// whose entry plane it has crossed (rounding corrected with [`Ray::crossed`]).
+    pub fn voxel_on_axis(&self, axis: usize, t: f32, entry_axis: usize) -> i32 {
+        let p = self.origin[axis] + self.dir[axis] * t;
+        let crossed = |k: i32| self.crossed(axis, k as f32, t, entry_axis);
+        if self.dir[axis] > 0.0 {
+            // Voxel k is entered through plane k.
+            let k = p.floor() as i32;
+            if !crossed(k) {
+                k - 1
+            } else if crossed(k + 1) {
+                k + 1
+            } else {
+                k
+            }
+        } else {
+            // Voxel k is entered through plane k + 1.
+            let k = p.ceil() as i32 - 1;
+            if !crossed(k + 1) {
+                k + 1
+            } else if crossed(k) {
+                k - 1
+            } else {
+                k
+            }
+        }
+    }
+
+    /// Face normal of the plane entered along `axis`.
+    pub fn entry_normal(&self, axis: usize) -> IVec3 {
+        let mut n = IVec3::ZERO;
+        n[axis] = if self.dir[axis] > 0.0 { -1 } else { 1 };
+        n
+    }
+}
+
+/// Index of the smallest component; ties go to x, then y (the DDA's rule,
+/// shared by every tracer so they step in the same order).
+pub fn argmin(t: Vec3) -> usize {
+    if t.x <= t.y && t.x <= t.z {
+        0
+    } else if t.y <= t.z {
+        1
+    } else {
+        2
+    }
+}

@@ -1,0 +1,107 @@
+//! Whole images on the CPU: trace every pixel (rows in parallel) and shade
+//! the hits the same way `shaders/common.wgsl` does.
+
+use glam::{IVec3, Vec3};
+use rayon::prelude::*;
+
+use super::grid::{self, DenseGrid};
+use super::{Hit, Ray, svo};
+use crate::camera::RayBasis;
+use crate::scene::{Octree, Palette};
+use crate::settings::{SUN_DIR, View};
+
+/// The structure a CPU render walks.
+#[derive(Clone, Copy)]
+pub enum Tracer<'a> {
+    Svo(&'a Octree),
+    Grid(&'a DenseGrid),
+}
+
+impl Tracer<'_> {
+    pub fn trace(&self, ray: &Ray) -> Hit {
+        match self {
+            Tracer::Svo(tree) => svo::trace(tree, ray),
+            Tracer::Grid(grid) => grid::trace(grid, ray),
+        }
+    }
+}
+
+/// Hit records of every pixel, row-major from the top-left.
+pub fn trace_image(tracer: Tracer, basis: &RayBasis) -> Vec<Hit> {
+    (0..basis.height)
+        .into_par_iter()
+        .flat_map_iter(|y| {
+            (0..basis.width).map(move |x| {
+                let (origin, dir) = basis.ray(x, y);
+                tracer.trace(&Ray::new(origin, dir))
+            })
+        })
+        .collect()
+}
+
+/// Colours hit records into RGBA8 pixels. `shadow` says, per pixel, whether
+/// the sun is blocked (all false when shadows are off).
+pub fn shade_image(hits: &[Hit], basis: &RayBasis, palette: &Palette, view: View, shadow: &[bool]) -> Vec<[u8; 4]> {
+    hits.par_iter()
+        .enumerate()
+        .map(|(i, hit)| {
+            let x = i as u32 % basis.width;
+            let y = i as u32 / basis.width;
+            let dir = basis.ray(x, y).1;
+            shade(hit, dir, palette, view, shadow.get(i).copied().unwrap_or(false))
+        })
+        .collect()
+}
+
+/// The ray toward the sun from a hit: it starts at the centre of the empty
+/// voxel in front of the entered face, so it never starts inside the surface
+/// (shadows are per face, which suits voxels). Mirrors `shadow_origin` in WGSL.
+pub fn shadow_ray(hit: &Hit) -> Option<Ray> {
+    if !hit.is_hit() || hit.normal == IVec3::ZERO {
+        return None;
+    }
+    let origin = (hit.voxel + hit.normal).as_vec3() + Vec3::splat(0.5);
+    Some(Ray::new(origin, Vec3::from(SUN_DIR)))
+}
+
+/// One pixel's colour; mirrors `shade` in `shaders/common.wgsl`.
+pub fn shade(hit: &Hit, dir: Vec3, palette: &Palette, view: View, in_shadow: bool) -> [u8; 4] {
+    let rgb = match view {
+        View::Shaded if hit.is_hit() => {
+            let c = palette.color(hit.value);
+            let albedo = Vec3::new(f32::from(c[0]), f32::from(c[1]), f32::from(c[2])) / 255.0;
+            let lambert = hit.normal.as_vec3().dot(Vec3::from(SUN_DIR)).max(0.0);
+            let sun = if in_shadow { 0.0 } else { lambert };
+            let sky = if hit.normal == IVec3::ZERO { 0.0 } else { 0.5 + 0.5 * hit.normal.y as f32 };
+            albedo * (0.25 + 0.15 * sky + 0.6 * sun)
+        }
+        View::Shaded => sky_color(dir),
+        View::Iterations => heat(hit.iterations as f32 / 160.0),
+        View::Depth if hit.is_hit() => heat((hit.cell_level as f32 + 1.0) / 8.0),
+        View::Depth => Vec3::ZERO,
+        View::Normals if hit.is_hit() => hit.normal.as_vec3() * 0.5 + Vec3::splat(0.5),
+        View::Normals => Vec3::ZERO,
+    };
+    let to_byte = |v: f32| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+    [to_byte(rgb.x), to_byte(rgb.y), to_byte(rgb.z), 255]
+}
+
+/// Background: horizon to zenith by the ray's elevation.
+pub fn sky_color(dir: Vec3) -> Vec3 {
+    let up = (dir.normalize_or_zero().y * 0.5 + 0.5).clamp(0.0, 1.0);
+    Vec3::new(0.86, 0.89, 0.95).lerp(Vec3::new(0.32, 0.5, 0.82), up)
+}
+
+/// Blue → cyan → green → yellow → red for 0..=1.
+pub fn heat(x: f32) -> Vec3 {
+    let x = x.clamp(0.0, 1.0) * 4.0;
+    let stops = [
+        Vec3::new(0.05, 0.05, 0.45),
+        Vec3::new(0.0, 0.6, 0.9),
+        Vec3::new(0.1, 0.8, 0.2),
+        Vec3::new(0.95, 0.9, 0.1),
+        Vec3::new(0.9, 0.1, 0.05),
+    ];
+    let i = (x.floor() as usize).min(3);
+    stops[i].lerp(stops[i + 1], x - i as f32)
+}

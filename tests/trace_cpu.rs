@@ -1,0 +1,137 @@
+//! The CPU SVO traversal against the CPU grid DDA, on a sculpted scene and on
+//! the traversal's known hard cases.
+
+mod common;
+
+use common::{Agreement, cameras_for, sculpture};
+use glam::{DVec3, IVec3, Vec3};
+use octovox::camera::Camera;
+use octovox::scene::{Octree, Op, Shape};
+use octovox::trace::grid::{self, DenseGrid};
+use octovox::trace::render::{Tracer, trace_image};
+use octovox::trace::{MAX_ITERATIONS, Ray, svo};
+
+fn compare(tree: &Octree, cameras: &[Camera], size: (u32, u32)) -> Agreement {
+    let grid = DenseGrid::from_octree(tree);
+    let mut agreement = Agreement::default();
+    for camera in cameras {
+        let basis = camera.basis(size.0, size.1, tree.origin());
+        let a = trace_image(Tracer::Svo(tree), &basis);
+        let b = trace_image(Tracer::Grid(&grid), &basis);
+        assert!(a.iter().chain(&b).all(|h| h.iterations <= MAX_ITERATIONS));
+        agreement.add(&a, &b);
+    }
+    agreement
+}
+
+#[test]
+fn svo_matches_grid_on_sculpture() {
+    let tree = sculpture();
+    let (lo, hi) = tree.solid_bounds().unwrap();
+    let agreement = compare(&tree, &cameras_for(lo, hi), (160, 120));
+    agreement.assert_good("sculpture");
+    assert!(agreement.exact > 0);
+}
+
+fn single(tree: &Octree, origin: Vec3, dir: Vec3) -> (octovox::trace::Hit, octovox::trace::Hit) {
+    let ray = Ray::new(origin - tree.origin().as_vec3(), dir);
+    (svo::trace(tree, &ray), grid::trace(&DenseGrid::from_octree(tree), &ray))
+}
+
+fn wall() -> Octree {
+    let mut tree = Octree::default();
+    tree.apply_brush(&Shape::Box { min: IVec3::new(0, 0, 0), max: IVec3::new(31, 31, 0) }, Op::Place(9)).unwrap();
+    tree
+}
+
+#[test]
+fn axis_parallel_rays_along_faces() {
+    let tree = wall();
+    for d in [0.0f32, 1e-30, -1e-30] {
+        // Straight at the wall, exactly along voxel face planes (x = 4, y = 7).
+        let (a, b) = single(&tree, Vec3::new(4.0, 7.0, -10.0), Vec3::new(d, d, 1.0));
+        assert!(a.is_hit() && b.is_hit(), "{d}: {a:?} {b:?}");
+        assert_eq!(a.voxel.z, 0);
+        assert!((a.voxel - b.voxel).abs().max_element() <= 1);
+        // Along the wall's front face plane z = 0: grazing, must not produce NaN.
+        let (a, b) = single(&tree, Vec3::new(-5.0, 3.5, 0.0), Vec3::new(1.0, d, d));
+        assert!(a.iterations <= MAX_ITERATIONS && b.iterations <= MAX_ITERATIONS);
+    }
+}
+
+#[test]
+fn diagonals_through_edges_and_corners() {
+    let tree = sculpture();
+    let mut agreement = Agreement::default();
+    for x in -6..6 {
+        for y in 0..6 {
+            for dir in [Vec3::new(1.0, 1.0, 0.0), Vec3::new(1.0, -1.0, 1.0), Vec3::new(-1.0, 1.0, -1.0), Vec3::new(0.0, -1.0, 1.0)] {
+                let origin = Vec3::new(x as f32 * 4.0, y as f32 * 5.0 + 20.0, -30.0 + x as f32);
+                let (a, b) = single(&tree, origin, dir);
+                agreement.add(&[a], &[b]);
+            }
+        }
+    }
+    // Exact corner crossings may pick either of the touching voxels.
+    assert_eq!(agreement.other, 0, "{agreement:?}");
+}
+
+#[test]
+fn camera_inside_a_solid_voxel_and_on_a_boundary() {
+    let tree = sculpture();
+    let (a, b) = single(&tree, Vec3::new(0.5, 5.5, 0.5), Vec3::new(0.3, 0.2, 1.0));
+    assert_eq!((a.value, a.voxel, a.normal), (b.value, b.voxel, b.normal));
+    assert_eq!(a.voxel, IVec3::new(0, 5, 0) - tree.origin());
+    assert_eq!(a.normal, IVec3::ZERO);
+    let (a, b) = single(&tree, Vec3::new(0.0, 25.0, 0.0), Vec3::new(0.01, -1.0, 0.02));
+    assert!(a.is_hit() && b.is_hit());
+    assert!((a.voxel - b.voxel).abs().max_element() <= 1);
+}
+
+#[test]
+fn far_camera_and_deep_sparse_tree() {
+    let mut tree = Octree::default();
+    let far = IVec3::new(40_000, -20_000, 50_000);
+    tree.apply_brush(&Shape::Voxel(IVec3::ZERO), Op::Place(4)).unwrap();
+    tree.apply_brush(&Shape::Voxel(far), Op::Place(5)).unwrap();
+    assert!(tree.depth() >= 16);
+    let camera = Camera { eye: far.as_dvec3() + DVec3::new(0.5, 100_000.0, 0.5), target: far.as_dvec3() + DVec3::splat(0.5), fov_y_deg: 0.01 };
+    let basis = camera.basis(9, 9, tree.origin());
+    let hits = trace_image(Tracer::Svo(&tree), &basis);
+    let center = hits[4 * 9 + 4];
+    assert_eq!(center.value, 5, "{center:?}");
+    assert_eq!(center.voxel + tree.origin(), far);
+    assert!(hits.iter().all(|h| h.iterations <= MAX_ITERATIONS));
+}
+
+#[test]
+fn empty_and_full_scenes() {
+    let empty = Octree::default();
+    let (a, b) = single(&empty, Vec3::new(-3.0, 1.0, 2.0), Vec3::new(1.0, 0.1, 0.0));
+    assert!(!a.is_hit() && !b.is_hit());
+    let mut full = Octree::empty(IVec3::ZERO, 4);
+    full.apply_brush(&Shape::Box { min: IVec3::ZERO, max: IVec3::splat(15) }, Op::Place(2)).unwrap();
+    assert!(!octovox::gpu_pool::is_pointer(full.root_word()));
+    let (a, b) = single(&full, Vec3::new(-3.0, 5.5, 7.25), Vec3::new(1.0, 0.1, 0.0));
+    assert_eq!((a.value, a.voxel, a.normal), (b.value, b.voxel, b.normal));
+    assert_eq!(a.normal, IVec3::new(-1, 0, 0));
+}
+
+#[test]
+fn flat_wall_has_no_holes_from_random_directions() {
+    let tree = wall();
+    let mut seed = 12345u64;
+    let mut rand = move || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((seed >> 33) as f64 / (1u64 << 31) as f64) as f32
+    };
+    for _ in 0..100 {
+        // A direction in the front hemisphere, aimed at points well inside the wall.
+        let dir = Vec3::new(rand() - 0.5, rand() - 0.5, 0.2 + rand()).normalize();
+        let target = Vec3::new(2.0 + rand() * 28.0, 2.0 + rand() * 28.0, 0.0);
+        let origin = target - dir * (5.0 + rand() * 60.0);
+        let (a, b) = single(&tree, origin, dir);
+        assert!(a.is_hit() && b.is_hit(), "hole at {origin} {dir}: {a:?} {b:?}");
+        assert_eq!(a.normal, IVec3::new(0, 0, -1));
+    }
+}
