@@ -5,6 +5,7 @@
 
 pub mod camera;
 pub mod edit;
+pub mod gpu;
 pub mod gpu_pool;
 pub mod io;
 pub mod scene;

@@ -6,6 +6,10 @@ use glam::{IVec3, UVec3, Vec3};
 use super::{Hit, MAX_ITERATIONS, NO_AXIS, Ray, argmin};
 use crate::scene::Octree;
 
+/// Largest dense grid built (1 GiB): the baseline is for comparison, and a
+/// sparse scene's bounding box can be far bigger than any memory.
+pub const MAX_GRID_CELLS: u64 = 1 << 30;
+
 /// The scene's solid bounding box as a flat array of palette indices.
 #[derive(Clone, Debug, Default)]
 pub struct DenseGrid {
@@ -16,13 +20,17 @@ pub struct DenseGrid {
 }
 
 impl DenseGrid {
-    /// Rasterizes the tree's solid voxels (tree-local coordinates).
-    pub fn from_octree(tree: &Octree) -> DenseGrid {
+    /// Rasterizes the tree's solid voxels (tree-local coordinates), or
+    /// `None` when the bounding box holds more than [`MAX_GRID_CELLS`].
+    pub fn from_octree(tree: &Octree) -> Option<DenseGrid> {
         let Some((lo, hi)) = tree.solid_bounds() else {
-            return DenseGrid::default();
+            return Some(DenseGrid::default());
         };
         let min = lo - tree.origin();
         let dims = (hi - lo + IVec3::ONE).as_uvec3();
+        if dims.as_u64vec3().element_product() > MAX_GRID_CELLS {
+            return None;
+        }
         let mut data = vec![0u8; dims.x as usize * dims.y as usize * dims.z as usize];
         let index = |p: IVec3| (p.x as usize) + dims.x as usize * (p.y as usize + dims.y as usize * p.z as usize);
         tree.for_each_solid_cell(|cell_min, size, value| {
@@ -34,7 +42,7 @@ impl DenseGrid {
                 }
             }
         });
-        DenseGrid { min, dims, data }
+        Some(DenseGrid { min, dims, data })
     }
 
     /// Value at a tree-local position (0 outside).

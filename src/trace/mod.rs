@@ -90,11 +90,12 @@ pub struct Ray {
 
 impl Ray {
     pub fn new(origin: Vec3, dir: Vec3) -> Ray {
+        // -0.0 counts as positive, as `select` does in WGSL.
         let clamp = |d: f32| {
             if d.is_nan() {
                 MIN_DIRECTION
             } else if d.abs() < MIN_DIRECTION {
-                MIN_DIRECTION.copysign(d)
+                if d >= 0.0 { MIN_DIRECTION } else { -MIN_DIRECTION }
             } else {
                 d
             }

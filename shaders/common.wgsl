@@ -1,0 +1,241 @@
+// Shared by trace_svo.wgsl and trace_grid.wgsl: uniforms, bindings, rays,
+// the plane-crossing rule, hit records and shading. The CPU twins live in
+// src/trace/mod.rs and src/trace/render.rs.
+
+// Twin of `FrameUniforms` in src/gpu/trace_pass.rs.
+struct FrameUniforms {
+    eye: vec3<f32>,
+    root: u32,
+    forward: vec3<f32>,
+    depth: u32,
+    right: vec3<f32>,
+    view: u32,
+    up: vec3<f32>,
+    width: u32,
+    grid_min: vec3<i32>,
+    height: u32,
+    grid_dims: vec3<u32>,
+    highlight_on: u32,
+    highlight_min: vec3<i32>,
+    _pad0: u32,
+    highlight_max: vec3<i32>,
+    _pad1: u32,
+}
+
+@group(0) @binding(0) var<uniform> u: FrameUniforms;
+@group(0) @binding(1) var<storage, read> nodes: array<u32>;
+@group(0) @binding(2) var<storage, read> bricks: array<u32>;
+@group(0) @binding(3) var<storage, read> palette: array<u32>;
+@group(0) @binding(4) var<storage, read> grid: array<u32>;
+@group(0) @binding(5) var out_color: texture_storage_2d<rgba8unorm, write>;
+@group(0) @binding(6) var<storage, read_write> hit_records: array<vec4<u32>>;
+
+// Sun shadows are compiled in only when the scene and settings ask for them.
+override SHADOWS: bool = true;
+
+const MAX_ITERATIONS: u32 = 4096u;
+const NO_AXIS: u32 = 3u;
+const MIN_DIRECTION: f32 = 1.1920929e-7; // 2^-23
+const POINTER_BIT: u32 = 0x80000000u;
+const SUN_DIR: vec3<f32> = vec3<f32>(0.4548588, 0.7960029, 0.3980015);
+
+struct Ray {
+    o: vec3<f32>,
+    d: vec3<f32>,
+    inv: vec3<f32>,
+}
+
+struct Hit {
+    value: u32,
+    voxel: vec3<i32>,
+    normal_code: u32, // 0 none, 1..6 = +x -x +y -y +z -z
+    level: u32,
+    iterations: u32,
+}
+
+struct Slab {
+    t_enter: f32,
+    t_exit: f32,
+    axis: u32,
+}
+
+fn clamp_component(d: f32) -> f32 {
+    if (abs(d) < MIN_DIRECTION) {
+        return select(-MIN_DIRECTION, MIN_DIRECTION, d >= 0.0);
+    }
+    return d;
+}
+
+fn make_ray(o: vec3<f32>, d_in: vec3<f32>) -> Ray {
+    let d = vec3<f32>(clamp_component(d_in.x), clamp_component(d_in.y), clamp_component(d_in.z));
+    return Ray(o, d, vec3<f32>(1.0) / d);
+}
+
+fn pixel_ray(px: vec2<u32>) -> Ray {
+    let ndc_x = 2.0 * (f32(px.x) + 0.5) / f32(u.width) - 1.0;
+    let ndc_y = 1.0 - 2.0 * (f32(px.y) + 0.5) / f32(u.height);
+    return make_ray(u.eye, u.forward + u.right * ndc_x + u.up * ndc_y);
+}
+
+fn plane_t(r: Ray, axis: u32, coord: f32) -> f32 {
+    return (coord - r.o[axis]) * r.inv[axis];
+}
+
+// Entry axis among ties is the last one crossed (x, y, z order).
+fn slab(r: Ray, mn: vec3<f32>, mx: vec3<f32>) -> Slab {
+    let t0 = (mn - r.o) * r.inv;
+    let t1 = (mx - r.o) * r.inv;
+    let near = min(t0, t1);
+    let far = max(t0, t1);
+    var axis = 0u;
+    if (near.z >= near.x && near.z >= near.y) {
+        axis = 2u;
+    } else if (near.y >= near.x) {
+        axis = 1u;
+    }
+    return Slab(max(max(near.x, near.y), near.z), min(min(far.x, far.y), far.z), axis);
+}
+
+// Smallest component; ties go to x, then y.
+fn argmin3(t: vec3<f32>) -> u32 {
+    if (t.x <= t.y && t.x <= t.z) {
+        return 0u;
+    }
+    if (t.y <= t.z) {
+        return 1u;
+    }
+    return 2u;
+}
+
+// The one plane-crossing rule of every tracer (see Ray::crossed).
+fn crossed(r: Ray, axis: u32, coord: f32, t: f32, entry_axis: u32) -> bool {
+    let tp = plane_t(r, axis, coord);
+    if (axis <= entry_axis) {
+        return tp <= t;
+    }
+    return tp < t;
+}
+
+fn voxel_on_axis(r: Ray, axis: u32, t: f32, entry_axis: u32) -> i32 {
+    let p = r.o[axis] + r.d[axis] * t;
+    if (r.d[axis] > 0.0) {
+        let k = i32(floor(p));
+        if (!crossed(r, axis, f32(k), t, entry_axis)) {
+            return k - 1;
+        }
+        if (crossed(r, axis, f32(k + 1), t, entry_axis)) {
+            return k + 1;
+        }
+        return k;
+    }
+    let k = i32(ceil(p)) - 1;
+    if (!crossed(r, axis, f32(k + 1), t, entry_axis)) {
+        return k + 1;
+    }
+    if (crossed(r, axis, f32(k), t, entry_axis)) {
+        return k - 1;
+    }
+    return k;
+}
+
+fn entry_normal_code(r: Ray, axis: u32) -> u32 {
+    if (axis == NO_AXIS) {
+        return 0u;
+    }
+    // Entering through the min face means the normal points to -axis.
+    return 1u + 2u * axis + select(0u, 1u, r.d[axis] > 0.0);
+}
+
+// The hit inside a uniform cell: the voxel where the ray is at t.
+fn hit_cell(r: Ray, value: u32, mn: vec3<i32>, level: u32, t: f32, axis: u32, iterations: u32) -> Hit {
+    var hit: Hit;
+    hit.iterations = iterations;
+    if (value == 0u) {
+        return hit;
+    }
+    let mx = mn + vec3<i32>((1 << level) - 1);
+    for (var b = 0u; b < 3u; b++) {
+        if (b == axis) {
+            hit.voxel[b] = select(mx[b], mn[b], r.d[b] > 0.0);
+        } else {
+            hit.voxel[b] = clamp(voxel_on_axis(r, b, t, axis), mn[b], mx[b]);
+        }
+    }
+    hit.value = value;
+    hit.normal_code = entry_normal_code(r, axis);
+    hit.level = level;
+    return hit;
+}
+
+fn normal_vector(code: u32) -> vec3<f32> {
+    if (code == 0u || code > 6u) {
+        return vec3<f32>(0.0);
+    }
+    var n = vec3<f32>(0.0);
+    n[(code - 1u) / 2u] = select(-1.0, 1.0, code % 2u == 1u);
+    return n;
+}
+
+// The shadow ray starts in the empty voxel in front of the entered face.
+fn shadow_ray(hit: Hit) -> Ray {
+    let o = vec3<f32>(hit.voxel) + normal_vector(hit.normal_code) + vec3<f32>(0.5);
+    return make_ray(o, SUN_DIR);
+}
+
+fn sky_color(d: vec3<f32>) -> vec3<f32> {
+    let up = clamp(normalize(d).y * 0.5 + 0.5, 0.0, 1.0);
+    return mix(vec3<f32>(0.86, 0.89, 0.95), vec3<f32>(0.32, 0.5, 0.82), up);
+}
+
+fn heat(x_in: f32) -> vec3<f32> {
+    let x = clamp(x_in, 0.0, 1.0) * 4.0;
+    var stops = array<vec3<f32>, 5>(
+        vec3<f32>(0.05, 0.05, 0.45),
+        vec3<f32>(0.0, 0.6, 0.9),
+        vec3<f32>(0.1, 0.8, 0.2),
+        vec3<f32>(0.95, 0.9, 0.1),
+        vec3<f32>(0.9, 0.1, 0.05),
+    );
+    let i = min(u32(floor(x)), 3u);
+    return mix(stops[i], stops[i + 1u], x - f32(i));
+}
+
+fn in_highlight(hit: Hit) -> bool {
+    return u.highlight_on != 0u && hit.value != 0u && all(hit.voxel >= u.highlight_min) && all(hit.voxel <= u.highlight_max);
+}
+
+// Twin of `shade` in src/trace/render.rs.
+fn shade(hit: Hit, d: vec3<f32>, in_shadow: bool) -> vec3<f32> {
+    let n = normal_vector(hit.normal_code);
+    switch (u.view) {
+        case 1u: {
+            return heat(f32(hit.iterations) / 160.0);
+        }
+        case 2u: {
+            return select(vec3<f32>(0.0), heat((f32(hit.level) + 1.0) / 8.0), hit.value != 0u);
+        }
+        case 3u: {
+            return select(vec3<f32>(0.0), n * 0.5 + vec3<f32>(0.5), hit.value != 0u);
+        }
+        default: {
+            if (hit.value == 0u) {
+                return sky_color(d);
+            }
+            let albedo = unpack4x8unorm(palette[hit.value]).rgb;
+            let lambert = max(dot(n, SUN_DIR), 0.0);
+            let sun = select(lambert, 0.0, in_shadow);
+            let sky = select(0.5 + 0.5 * n.y, 0.0, hit.normal_code == 0u);
+            return albedo * (0.25 + 0.15 * sky + 0.6 * sun);
+        }
+    }
+}
+
+fn write_pixel(px: vec2<u32>, hit: Hit, d: vec3<f32>, in_shadow: bool) {
+    var rgb = shade(hit, d, in_shadow);
+    if (in_highlight(hit)) {
+        rgb = mix(rgb, vec3<f32>(1.0, 0.85, 0.2), 0.45);
+    }
+    textureStore(out_color, vec2<i32>(px), vec4<f32>(rgb, 1.0));
+    let info = hit.value | (hit.normal_code << 8u) | (min(hit.level, 31u) << 11u) | (min(hit.iterations, 0xffffu) << 16u);
+    hit_records[px.y * u.width + px.x] = vec4<u32>(bitcast<u32>(hit.voxel.x), bitcast<u32>(hit.voxel.y), bitcast<u32>(hit.voxel.z), info);
+}

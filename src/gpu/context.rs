@@ -1,0 +1,106 @@
+//! The one place that owns the wgpu instance, adapter, device and queue.
+
+use std::sync::Arc;
+
+/// Why no usable GPU device could be made.
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    #[error("no GPU adapter found (install a Vulkan driver, e.g. Debian's mesa-vulkan-drivers): {0}")]
+    NoAdapter(#[from] wgpu::RequestAdapterError),
+    #[error("the GPU refused to create a device: {0}")]
+    NoDevice(#[from] wgpu::RequestDeviceError),
+    #[error("shader {name} failed to compile: {message}")]
+    Shader { name: String, message: String },
+    #[error("could not create a surface for the window: {0}")]
+    Surface(#[from] wgpu::CreateSurfaceError),
+    #[error("GPU readback failed: {0}")]
+    Readback(String),
+}
+
+/// Instance, adapter, device and queue, plus what the rest of the program
+/// needs to know about them.
+pub struct GpuContext {
+    pub instance: wgpu::Instance,
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    /// E.g. "llvmpipe (LLVM 15.0.6, 256 bits)" or "NVIDIA GeForce RTX 3080".
+    pub adapter_name: String,
+    /// GPU timestamp queries are available (else frame times are wall time).
+    pub timestamps: bool,
+}
+
+impl GpuContext {
+    /// A device without a window (render, replay, bench, tests).
+    pub fn headless() -> Result<GpuContext, GpuError> {
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        desc.backends = wgpu::Backends::VULKAN | wgpu::Backends::GL;
+        let instance = wgpu::Instance::new(desc.with_env());
+        pollster::block_on(Self::with_instance(instance, None))
+    }
+
+    /// An instance able to make surfaces for windows of this display.
+    pub fn window_instance(display: Box<dyn wgpu::wgt::WgpuHasDisplayHandle>) -> wgpu::Instance {
+        let mut desc = wgpu::InstanceDescriptor::new_with_display_handle(display);
+        desc.backends = wgpu::Backends::VULKAN | wgpu::Backends::GL;
+        wgpu::Instance::new(desc.with_env())
+    }
+
+    /// Picks an adapter (compatible with `surface` if given) and opens a device.
+    pub async fn with_instance(
+        instance: wgpu::Instance,
+        surface: Option<&wgpu::Surface<'_>>,
+    ) -> Result<GpuContext, GpuError> {
+        let adapter = instance
+            .request_adapter(&wgpu::RequestAdapterOptions {
+                power_preference: wgpu::PowerPreference::HighPerformance,
+                compatible_surface: surface,
+                ..Default::default()
+            })
+            .await?;
+        let info = adapter.get_info();
+        let adapter_name = info.name.clone();
+        log::info!("GPU adapter: {adapter_name} ({:?}, {:?})", info.backend, info.device_type);
+        let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
+        let supported = adapter.limits();
+        // Big scenes need big storage buffers (the dense grid of a 10 M-voxel
+        // model is ~80 MB); ask for what the adapter has.
+        let limits = wgpu::Limits {
+            max_storage_buffer_binding_size: supported.max_storage_buffer_binding_size,
+            max_buffer_size: supported.max_buffer_size,
+            ..wgpu::Limits::default()
+        };
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("octovox device"),
+                required_features: features,
+                required_limits: limits,
+                ..Default::default()
+            })
+            .await?;
+        device.on_uncaptured_error(Arc::new(|e: wgpu::Error| log::error!("wgpu: {e}")));
+        Ok(GpuContext { instance, adapter, device, queue, adapter_name, timestamps: !features.is_empty() })
+    }
+
+    /// Compiles WGSL inside a validation error scope, so a bad shader is an
+    /// error value instead of a crash.
+    pub fn shader(&self, name: &str, source: &str) -> Result<wgpu::ShaderModule, GpuError> {
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let module = self.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(name),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
+        match pollster::block_on(scope.pop()) {
+            Some(err) => Err(GpuError::Shader { name: name.to_string(), message: err.to_string() }),
+            None => Ok(module),
+        }
+    }
+
+    /// Blocks until the GPU has finished all submitted work.
+    pub fn wait(&self) -> Result<(), GpuError> {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map(|_| ())
+            .map_err(|e| GpuError::Readback(e.to_string()))
+    }
+}

@@ -1,0 +1,14 @@
+//! Everything that talks to wgpu: device setup, the scene's GPU buffers, the
+//! trace pass, timing and readback. The engine modules never import this.
+
+pub mod context;
+pub mod readback;
+pub mod renderer;
+pub mod scene_buffers;
+pub mod timer;
+pub mod trace_pass;
+
+pub use context::{GpuContext, GpuError};
+pub use renderer::Renderer;
+pub use scene_buffers::SceneBuffers;
+pub use trace_pass::{FrameUniforms, TracePass};

@@ -1,0 +1,78 @@
+//! A scene renderer without a window: device, scene buffers and the trace
+//! pass together. `render`, `replay`, `bench` and the GPU tests use it; the
+//! window uses the same parts with a surface.
+
+use glam::IVec3;
+
+use super::scene_buffers::UploadStats;
+use super::timer::PassTimer;
+use super::{FrameUniforms, GpuContext, GpuError, SceneBuffers, TracePass};
+use crate::camera::Camera;
+use crate::scene::{Octree, Palette};
+use crate::settings::RenderSettings;
+use crate::trace::Hit;
+use crate::trace::grid::DenseGrid;
+
+pub struct Renderer {
+    pub gpu: GpuContext,
+    pub buffers: SceneBuffers,
+    pub pass: TracePass,
+    timer: PassTimer,
+}
+
+impl Renderer {
+    pub fn new(gpu: GpuContext) -> Result<Renderer, GpuError> {
+        let buffers = SceneBuffers::new(&gpu.device);
+        let pass = TracePass::new(&gpu, &buffers, 1, 1)?;
+        let timer = PassTimer::new(&gpu);
+        Ok(Renderer { gpu, buffers, pass, timer })
+    }
+
+    /// A renderer on the default headless adapter.
+    pub fn headless() -> Result<Renderer, GpuError> {
+        Renderer::new(GpuContext::headless()?)
+    }
+
+    /// Sends the pool's changes since the last call and the palette.
+    pub fn sync(&mut self, tree: &mut Octree, palette: &Palette) -> UploadStats {
+        self.buffers.upload_palette(&self.gpu.queue, palette);
+        self.buffers.upload_pool(&self.gpu.device, &self.gpu.queue, tree)
+    }
+
+    /// Uploads the dense grid the grid tracer walks.
+    pub fn set_grid(&mut self, grid: &DenseGrid) {
+        self.buffers.upload_grid(&self.gpu.device, &self.gpu.queue, grid);
+    }
+
+    /// Traces one frame and waits for it; returns the pass's milliseconds.
+    /// `highlight` is an inclusive world-space voxel box to tint.
+    pub fn render(
+        &mut self,
+        tree: &Octree,
+        camera: &Camera,
+        size: (u32, u32),
+        settings: &RenderSettings,
+        highlight: Option<(IVec3, IVec3)>,
+    ) -> Result<f64, GpuError> {
+        self.pass.resize(&self.gpu.device, &self.buffers, size.0, size.1);
+        let basis = camera.basis(size.0.max(1), size.1.max(1), tree.origin());
+        let local = highlight.map(|(lo, hi)| (lo - tree.origin(), hi - tree.origin()));
+        let uniforms = FrameUniforms::new(&basis, tree, &self.buffers, settings.view, local);
+        self.pass.prepare(&self.gpu.device, &self.gpu.queue, &self.buffers, &uniforms);
+        let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        self.pass.encode(&mut encoder, settings, self.timer.pass_writes());
+        self.timer.resolve(&mut encoder);
+        self.timer.submit_and_measure(&self.gpu, encoder)
+    }
+
+    pub fn read_hits(&self) -> Result<Vec<Hit>, GpuError> {
+        self.pass.read_hits(&self.gpu)
+    }
+
+    /// The last frame as an RGBA image.
+    pub fn read_image(&self) -> Result<image::RgbaImage, GpuError> {
+        let (w, h) = self.pass.size();
+        let bytes = self.pass.read_color(&self.gpu)?;
+        image::RgbaImage::from_raw(w, h, bytes).ok_or_else(|| GpuError::Readback("texture size mismatch".into()))
+    }
+}

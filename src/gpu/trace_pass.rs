@@ -1,0 +1,280 @@
+//! The ray tracing compute pass: one thread per pixel walks the SVO (or the
+//! dense grid) and writes a colour texture plus a hit record per pixel.
+
+use bytemuck::{Pod, Zeroable};
+use glam::IVec3;
+
+use super::readback::{read_buffer, read_texture_rgba8, staging_buffer};
+use super::{GpuContext, GpuError, SceneBuffers};
+use crate::camera::RayBasis;
+use crate::scene::Octree;
+use crate::settings::{RenderSettings, TraceMode, View};
+use crate::trace::Hit;
+
+const COMMON_WGSL: &str = include_str!("../../shaders/common.wgsl");
+const SVO_WGSL: &str = include_str!("../../shaders/trace_svo.wgsl");
+const GRID_WGSL: &str = include_str!("../../shaders/trace_grid.wgsl");
+
+/// Twin of `FrameUniforms` in `shaders/common.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct FrameUniforms {
+    pub eye: [f32; 3],
+    pub root: u32,
+    pub forward: [f32; 3],
+    pub depth: u32,
+    pub right: [f32; 3],
+    pub view: u32,
+    pub up: [f32; 3],
+    pub width: u32,
+    pub grid_min: [i32; 3],
+    pub height: u32,
+    pub grid_dims: [u32; 3],
+    pub highlight_on: u32,
+    pub highlight_min: [i32; 3],
+    pub _pad0: u32,
+    pub highlight_max: [i32; 3],
+    pub _pad1: u32,
+}
+
+impl FrameUniforms {
+    /// Uniforms for a frame: camera basis, tree root and grid placement.
+    /// `highlight` is an inclusive tree-local voxel box to tint.
+    pub fn new(basis: &RayBasis, tree: &Octree, buffers: &SceneBuffers, view: View, highlight: Option<(IVec3, IVec3)>) -> FrameUniforms {
+        let (lo, hi) = highlight.unwrap_or((IVec3::ZERO, IVec3::NEG_ONE));
+        FrameUniforms {
+            eye: basis.eye.into(),
+            root: tree.root_word(),
+            forward: basis.forward.into(),
+            depth: tree.depth(),
+            right: basis.right.into(),
+            view: view.code(),
+            up: basis.up.into(),
+            width: basis.width,
+            grid_min: buffers.grid_min.into(),
+            height: basis.height,
+            grid_dims: buffers.grid_dims.into(),
+            highlight_on: u32::from(highlight.is_some()),
+            highlight_min: lo.into(),
+            _pad0: 0,
+            highlight_max: hi.into(),
+            _pad1: 0,
+        }
+    }
+}
+
+/// Size-dependent outputs: the colour texture and the hit records.
+struct Target {
+    texture: wgpu::Texture,
+    view: wgpu::TextureView,
+    hits_buf: wgpu::Buffer,
+    width: u32,
+    height: u32,
+}
+
+/// Pipelines are compiled per tracer and per shadow setting (an override
+/// constant), so a scene rendered without shadows pays nothing for them.
+pub struct TracePass {
+    layout: wgpu::BindGroupLayout,
+    /// [svo without shadows, svo with, grid without, grid with].
+    pipelines: [wgpu::ComputePipeline; 4],
+    uniform_buf: wgpu::Buffer,
+    target: Target,
+    bind_group: wgpu::BindGroup,
+    bound_generation: u64,
+}
+
+fn buffer_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+impl TracePass {
+    pub fn new(gpu: &GpuContext, buffers: &SceneBuffers, width: u32, height: u32) -> Result<TracePass, GpuError> {
+        let device = &gpu.device;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("trace bind group layout"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: wgpu::BufferSize::new(std::mem::size_of::<FrameUniforms>() as u64),
+                    },
+                    count: None,
+                },
+                buffer_entry(1, true),
+                buffer_entry(2, true),
+                buffer_entry(3, true),
+                buffer_entry(4, true),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 5,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format: wgpu::TextureFormat::Rgba8Unorm,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                    },
+                    count: None,
+                },
+                buffer_entry(6, false),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("trace pipeline layout"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let svo = gpu.shader("trace_svo.wgsl", &format!("{COMMON_WGSL}\n{SVO_WGSL}"))?;
+        let grid = gpu.shader("trace_grid.wgsl", &format!("{COMMON_WGSL}\n{GRID_WGSL}"))?;
+        let pipeline = |module: &wgpu::ShaderModule, shadows: bool, label: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(label),
+                layout: Some(&pipeline_layout),
+                module,
+                entry_point: Some("main"),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &[("SHADOWS", if shadows { 1.0 } else { 0.0 })],
+                    zero_initialize_workgroup_memory: false,
+                },
+                cache: None,
+            })
+        };
+        let pipelines = [
+            pipeline(&svo, false, "trace svo"),
+            pipeline(&svo, true, "trace svo + shadows"),
+            pipeline(&grid, false, "trace grid"),
+            pipeline(&grid, true, "trace grid + shadows"),
+        ];
+        let uniform_buf = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("frame uniforms"),
+            size: std::mem::size_of::<FrameUniforms>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let target = Self::make_target(device, width, height);
+        let bind_group = Self::make_bind_group(device, &layout, &uniform_buf, buffers, &target);
+        Ok(TracePass { layout, pipelines, uniform_buf, target, bind_group, bound_generation: buffers.generation })
+    }
+
+    fn make_target(device: &wgpu::Device, width: u32, height: u32) -> Target {
+        let (width, height) = (width.max(1), height.max(1));
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("trace output"),
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba8Unorm,
+            usage: wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+        let hits_buf = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("hit records"),
+            size: u64::from(width) * u64::from(height) * 16,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        Target { texture, view, hits_buf, width, height }
+    }
+
+    fn make_bind_group(
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        uniform_buf: &wgpu::Buffer,
+        buffers: &SceneBuffers,
+        target: &Target,
+    ) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("trace bind group"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: uniform_buf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: buffers.nodes_buf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: buffers.bricks_buf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: buffers.palette_buf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: buffers.grid_buf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&target.view) },
+                wgpu::BindGroupEntry { binding: 6, resource: target.hits_buf.as_entire_binding() },
+            ],
+        })
+    }
+
+    /// Re-creates the outputs for a new size (never zero).
+    pub fn resize(&mut self, device: &wgpu::Device, buffers: &SceneBuffers, width: u32, height: u32) {
+        if (width.max(1), height.max(1)) == (self.target.width, self.target.height) {
+            return;
+        }
+        self.target = Self::make_target(device, width, height);
+        self.bind_group = Self::make_bind_group(device, &self.layout, &self.uniform_buf, buffers, &self.target);
+        self.bound_generation = buffers.generation;
+    }
+
+    pub fn size(&self) -> (u32, u32) {
+        (self.target.width, self.target.height)
+    }
+
+    /// The colour output, for the blit to the window.
+    pub fn output_view(&self) -> &wgpu::TextureView {
+        &self.target.view
+    }
+
+    /// Writes this frame's uniforms and rebinds buffers that were re-created.
+    pub fn prepare(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, buffers: &SceneBuffers, uniforms: &FrameUniforms) {
+        if buffers.generation != self.bound_generation {
+            self.bind_group = Self::make_bind_group(device, &self.layout, &self.uniform_buf, buffers, &self.target);
+            self.bound_generation = buffers.generation;
+        }
+        queue.write_buffer(&self.uniform_buf, 0, bytemuck::bytes_of(uniforms));
+    }
+
+    /// Records the dispatch.
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        settings: &RenderSettings,
+        timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>,
+    ) {
+        let index = match settings.mode {
+            TraceMode::Svo => 0,
+            TraceMode::Grid => 2,
+        } + usize::from(settings.shadows);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("trace"),
+            timestamp_writes: timestamps,
+        });
+        pass.set_pipeline(&self.pipelines[index]);
+        pass.set_bind_group(0, &self.bind_group, &[]);
+        pass.dispatch_workgroups(self.target.width.div_ceil(8), self.target.height.div_ceil(8), 1);
+    }
+
+    /// Reads back the hit record of every pixel.
+    pub fn read_hits(&self, gpu: &GpuContext) -> Result<Vec<Hit>, GpuError> {
+        let size = self.target.hits_buf.size();
+        let staging = staging_buffer(&gpu.device, "hit readback", size);
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("hits") });
+        encoder.copy_buffer_to_buffer(&self.target.hits_buf, 0, &staging, 0, size);
+        gpu.queue.submit([encoder.finish()]);
+        let bytes = read_buffer(gpu, &staging)?;
+        let words: &[[u32; 4]] = bytemuck::cast_slice(&bytes);
+        Ok(words.iter().map(|r| Hit::from_record(*r)).collect())
+    }
+
+    /// Reads back the colour output as tightly packed RGBA8 rows.
+    pub fn read_color(&self, gpu: &GpuContext) -> Result<Vec<u8>, GpuError> {
+        read_texture_rgba8(gpu, &self.target.texture)
+    }
+}
