@@ -10,7 +10,8 @@ use std::sync::Once;
 use dot_vox::DotVoxData;
 use glam::IVec3;
 
-use super::scene::{self, Placement, Transform};
+use super::scene;
+use super::transform::{Placement, Transform};
 use super::validate::{self, Layout};
 use super::{MAX_FILE_BYTES, VoxError};
 use crate::scene::{Material, MaterialKind, Palette, Voxel, VoxelModel};

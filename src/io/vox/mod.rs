@@ -3,17 +3,19 @@
 //! Loading runs in three steps: [`validate`] walks the raw chunk structure and
 //! rejects anything that could make `dot_vox` panic, recurse without bound or
 //! allocate far more than the file holds; `dot_vox::load_bytes` then parses the
-//! file (inside `catch_unwind`); [`scene`] walks the scene graph and places each
-//! model the way MagicaVoxel shows it. Saving writes a version-200 file with a
+//! file (inside `catch_unwind`); [`scene`] walks the scene graph and
+//! [`transform`] places each model voxel the way MagicaVoxel shows it. Saving writes a version-200 file with a
 //! small scene graph, splitting scenes wider than 256 voxels into several models.
 //!
 //! Axes: MagicaVoxel is z up, octovox is y up, both right-handed. A voxel at
 //! MagicaVoxel scene position (x, y, z) (after its scene-graph transforms) is
 //! octovox world voxel (x, z, −y). `docs/vox.md` has the details.
 
+mod chunk;
 mod load;
 mod save;
 mod scene;
+mod transform;
 mod validate;
 
 use std::path::PathBuf;

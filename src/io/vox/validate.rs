@@ -14,12 +14,11 @@
 use std::collections::BTreeMap;
 
 use super::VoxError;
+use super::chunk::{Chunk, Cursor, le_u32, read_chunk_header, widen};
 use crate::scene::{Material, MaterialKind};
 
 /// "VOX " plus the version number.
 const FILE_HEADER_BYTES: usize = 8;
-/// Chunk id, content size, children size.
-const CHUNK_HEADER_BYTES: usize = 12;
 /// MagicaVoxel's largest model edge, in voxels.
 pub(super) const MAX_MODEL_EDGE: u32 = 256;
 /// Bytes of an RGBA chunk: 256 colours of 4 bytes.
@@ -47,7 +46,7 @@ pub(super) fn check(bytes: &[u8]) -> Result<Layout, VoxError> {
     let version = check_file_header(bytes)?;
     let main = read_chunk_header(bytes, FILE_HEADER_BYTES, bytes.len())?;
     if &main.id != b"MAIN" {
-        return Err(main.fail("where the MAIN chunk should be"));
+        return Err(main.fail("stands where the MAIN chunk should be"));
     }
     let mut layout = Layout {
         version,
@@ -79,77 +78,6 @@ fn check_file_header(bytes: &[u8]) -> Result<u32, VoxError> {
     Ok(version)
 }
 
-/// A chunk header and where its parts lie in the file.
-struct Chunk {
-    id: [u8; 4],
-    offset: usize,
-    content_start: usize,
-    content_end: usize,
-    children_bytes: usize,
-    /// One past its last byte (content and children).
-    end: usize,
-}
-
-impl Chunk {
-    fn name(&self) -> String {
-        self.id.escape_ascii().to_string()
-    }
-
-    fn fail(&self, problem: impl Into<String>) -> VoxError {
-        VoxError::BadChunk {
-            id: self.name(),
-            offset: self.offset,
-            problem: problem.into(),
-        }
-    }
-
-    fn content_len(&self) -> usize {
-        self.content_end - self.content_start
-    }
-}
-
-/// Reads the chunk header at `offset`; the chunk must end by `limit`.
-fn read_chunk_header(bytes: &[u8], offset: usize, limit: usize) -> Result<Chunk, VoxError> {
-    if limit - offset < CHUNK_HEADER_BYTES {
-        return Err(if limit == bytes.len() {
-            VoxError::Truncated(format!(
-                "file ends at byte {limit} inside the header of the chunk at byte {offset}"
-            ))
-        } else {
-            VoxError::Truncated(format!(
-                "MAIN's children end with {} stray bytes at byte {offset}",
-                limit - offset
-            ))
-        });
-    }
-    let mut id = [0u8; 4];
-    id.copy_from_slice(&bytes[offset..offset + 4]);
-    let content_bytes = le_u32(bytes, offset + 4).map_or(0, widen);
-    let children_bytes = le_u32(bytes, offset + 8).map_or(0, widen);
-    let content_start = offset + CHUNK_HEADER_BYTES;
-    let chunk = Chunk {
-        id,
-        offset,
-        content_start,
-        content_end: content_start.saturating_add(content_bytes),
-        children_bytes,
-        end: content_start
-            .saturating_add(content_bytes)
-            .saturating_add(children_bytes),
-    };
-    if !id.iter().all(|b| b.is_ascii_graphic() || *b == b' ') {
-        return Err(chunk.fail("has an id that is not ASCII text"));
-    }
-    let room = limit - content_start;
-    if content_bytes > room || children_bytes > room - content_bytes {
-        return Err(chunk.fail(format!(
-            "claims {content_bytes} content bytes and {children_bytes} child bytes but only {room} bytes follow its header{}",
-            if limit == bytes.len() { " (truncated file?)" } else { " inside MAIN" }
-        )));
-    }
-    Ok(chunk)
-}
-
 /// Checks one child of MAIN and records what [`Layout`] keeps of it.
 fn check_chunk(
     bytes: &[u8],
@@ -163,11 +91,7 @@ fn check_chunk(
             chunk.children_bytes
         )));
     }
-    let mut cursor = Cursor {
-        bytes,
-        pos: chunk.content_start,
-        chunk,
-    };
+    let mut cursor = Cursor::new(bytes, chunk);
     match &chunk.id {
         b"SIZE" => *size = Some(check_size(&mut cursor)?),
         b"XYZI" => check_voxels(&mut cursor, *size, layout)?,
@@ -329,76 +253,4 @@ fn read_matt(cursor: &mut Cursor<'_>) -> Result<(u8, Material), VoxError> {
         }
     }
     Ok((index, material))
-}
-
-/// Reads little-endian values from one chunk's content, failing with the
-/// chunk's name and offset when the content ends too early.
-struct Cursor<'a> {
-    bytes: &'a [u8],
-    pos: usize,
-    chunk: &'a Chunk,
-}
-
-impl<'a> Cursor<'a> {
-    fn remaining(&self) -> usize {
-        self.chunk.content_end - self.pos
-    }
-
-    fn take(&mut self, n: usize, what: &str) -> Result<&'a [u8], VoxError> {
-        if n > self.remaining() {
-            return Err(self.chunk.fail(format!(
-                "ends inside its {what}: byte {} needs {n} more bytes but the content ends at byte {}",
-                self.pos, self.chunk.content_end
-            )));
-        }
-        let start = self.pos;
-        self.pos += n;
-        Ok(&self.bytes[start..self.pos])
-    }
-
-    fn u32(&mut self, what: &str) -> Result<u32, VoxError> {
-        let b = self.take(4, what)?;
-        Ok(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-    }
-
-    fn f32(&mut self, what: &str) -> Result<f32, VoxError> {
-        self.u32(what).map(f32::from_bits)
-    }
-
-    fn skip_string(&mut self, what: &str) -> Result<(), VoxError> {
-        let len = widen(self.u32(what)?);
-        let at = self.pos;
-        let text = self.take(len, what)?;
-        if std::str::from_utf8(text).is_err() {
-            return Err(self
-                .chunk
-                .fail(format!("has a {what} at byte {at} that is not UTF-8 text")));
-        }
-        Ok(())
-    }
-
-    fn skip_dict(&mut self, what: &str) -> Result<(), VoxError> {
-        let entries = widen(self.u32(what)?);
-        let held = self.remaining();
-        if entries > held / 8 {
-            return Err(self.chunk.fail(format!(
-                "claims {entries} {what} entries but holds {held} bytes"
-            )));
-        }
-        for _ in 0..entries {
-            self.skip_string(what)?;
-            self.skip_string(what)?;
-        }
-        Ok(())
-    }
-}
-
-fn le_u32(bytes: &[u8], at: usize) -> Option<u32> {
-    let b = bytes.get(at..at.checked_add(4)?)?;
-    Some(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-}
-
-/// `u32` to `usize`; lossless on the 32- and 64-bit targets octovox builds for.
-fn widen(n: u32) -> usize {
-    usize::try_from(n).unwrap_or(usize::MAX)
 }
