@@ -1,5 +1,8 @@
 //! One module per subcommand; `run` dispatches.
 
+mod convert;
+mod info;
+
 use std::process::ExitCode;
 
 use crate::cli::{Cli, Command};
@@ -7,8 +10,11 @@ use crate::cli::{Cli, Command};
 pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         None => anyhow::bail!("the sandbox window is not built yet; try `octovox info FILE`"),
-        Some(Command::Info { .. }) | Some(Command::Convert { .. }) => {
-            anyhow::bail!("not implemented yet")
-        }
+        Some(Command::Info { file, json, frame }) => info::run(&file, json, frame),
+        Some(Command::Convert {
+            input,
+            output,
+            frame,
+        }) => convert::run(&input, &output, frame),
     }
 }

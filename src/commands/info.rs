@@ -1,0 +1,114 @@
+//! `octovox info FILE [--json] [--frame N]`: what a .vox file holds.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::Path;
+use std::process::ExitCode;
+
+use anyhow::Context;
+use octovox::io::vox::load_vox_file;
+use octovox::scene::{MaterialKind, VoxelModel};
+
+/// Loads `file` and prints its summary, as JSON when `json` is set.
+pub fn run(file: &Path, json: bool, frame: usize) -> anyhow::Result<ExitCode> {
+    let model =
+        load_vox_file(file, frame).with_context(|| format!("loading {}", file.display()))?;
+    let summary = Summary::of(&model);
+    if json {
+        println!("{}", serde_json::to_string_pretty(&summary.to_json(file))?);
+    } else {
+        print!("{}", summary.to_text(file));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The numbers `info` reports.
+struct Summary {
+    models: usize,
+    voxels: usize,
+    /// Inclusive corners in world axes (y up); `None` for an empty scene.
+    bounds: Option<([i32; 3], [i32; 3])>,
+    palette_entries: usize,
+    /// Kind → number of used palette entries of that kind.
+    materials: BTreeMap<MaterialKind, usize>,
+}
+
+impl Summary {
+    fn of(model: &VoxelModel) -> Summary {
+        let used: BTreeSet<u8> = model.voxels.iter().map(|&(_, index)| index).collect();
+        let mut materials = BTreeMap::new();
+        for &index in &used {
+            *materials
+                .entry(model.palette.material(index).kind)
+                .or_insert(0) += 1;
+        }
+        Summary {
+            models: model.models,
+            voxels: model.voxels.len(),
+            bounds: model
+                .bounds()
+                .map(|(lo, hi)| (lo.to_array(), hi.to_array())),
+            palette_entries: used.len(),
+            materials,
+        }
+    }
+
+    /// max − min + 1 per axis, zero when empty.
+    fn extent(&self) -> [i64; 3] {
+        self.bounds.map_or([0; 3], |(lo, hi)| {
+            [0, 1, 2].map(|i| i64::from(hi[i]) - i64::from(lo[i]) + 1)
+        })
+    }
+
+    fn material_names(&self) -> impl Iterator<Item = (&'static str, usize)> + '_ {
+        self.materials
+            .iter()
+            .map(|(kind, &count)| (kind.vox_name().trim_start_matches('_'), count))
+    }
+
+    fn to_json(&self, file: &Path) -> serde_json::Value {
+        let materials: serde_json::Map<String, serde_json::Value> = self
+            .material_names()
+            .map(|(name, count)| (name.to_owned(), count.into()))
+            .collect();
+        serde_json::json!({
+            "file": file.display().to_string(),
+            "models": self.models,
+            "voxels": self.voxels,
+            "extent": self.extent(),
+            "min": self.bounds.map(|(lo, _)| lo),
+            "max": self.bounds.map(|(_, hi)| hi),
+            "palette_entries": self.palette_entries,
+            "materials": materials,
+        })
+    }
+
+    fn to_text(&self, file: &Path) -> String {
+        let [ex, ey, ez] = self.extent();
+        let corner =
+            |c: Option<[i32; 3]>| c.map_or("-".to_owned(), |[x, y, z]| format!("{x} {y} {z}"));
+        let materials: Vec<String> = self
+            .material_names()
+            .map(|(name, count)| format!("{name} {count}"))
+            .collect();
+        let rows = [
+            ("file", file.display().to_string()),
+            ("models", self.models.to_string()),
+            ("voxels", self.voxels.to_string()),
+            ("extent", format!("{ex} x {ey} x {ez}  (x, y up, z)")),
+            ("min", corner(self.bounds.map(|(lo, _)| lo))),
+            ("max", corner(self.bounds.map(|(_, hi)| hi))),
+            ("palette entries", self.palette_entries.to_string()),
+            (
+                "materials",
+                if materials.is_empty() {
+                    "-".to_owned()
+                } else {
+                    materials.join(", ")
+                },
+            ),
+        ];
+        rows.iter()
+            .map(|(key, value)| format!("{key:<16} {value}\n"))
+            .collect()
+    }
+}

@@ -1,1 +1,0 @@
-//! MagicaVoxel .vox loading and saving (to be written).

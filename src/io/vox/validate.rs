@@ -1,0 +1,256 @@
+//! Validating pre-pass over the raw chunk structure of a `.vox` file.
+//!
+//! `dot_vox` 5.2 checks element counts against the bytes left before it
+//! allocates, but it recurses into the children of *any* chunk (a file of
+//! nested chunk headers overflows the stack, which `catch_unwind` cannot
+//! catch), silently drops chunks it fails to parse (which shifts model and
+//! scene-node indices), stops reading at the first chunk id that is not UTF-8,
+//! turns a stored colour index 0 into index 1, and accepts any SIZE. This pass
+//! rejects all of that with a message naming the chunk and its byte offset, so
+//! that what reaches `dot_vox` parses the way we expect. It also collects what
+//! `dot_vox` does not keep: scene-node ids, old MATT materials, and voxels
+//! stored with colour index 0.
+
+use std::collections::BTreeMap;
+
+use super::VoxError;
+use super::chunk::{Chunk, Cursor, le_u32, read_chunk_header, widen};
+use crate::scene::{Material, MaterialKind};
+
+/// "VOX " plus the version number.
+const FILE_HEADER_BYTES: usize = 8;
+/// MagicaVoxel's largest model edge, in voxels.
+pub(super) const MAX_MODEL_EDGE: u32 = 256;
+/// Bytes of an RGBA chunk: 256 colours of 4 bytes.
+const PALETTE_BYTES: usize = 1024;
+
+/// What the pre-pass learned about a file it accepted.
+#[derive(Debug, Default)]
+pub(super) struct Layout {
+    /// The file's version (150 or 200).
+    pub version: u32,
+    /// Number of voxels of each model (XYZI chunk), in file order.
+    pub model_voxels: Vec<usize>,
+    /// Node id of each nTRN/nGRP/nSHP chunk, in file order; `dot_vox` keeps
+    /// the nodes in this order but drops their ids.
+    pub node_ids: Vec<u32>,
+    /// (model, voxel ordinal) of each voxel stored with colour index 0, which
+    /// means "empty"; `dot_vox` would report it as index 1.
+    pub zero_index_voxels: Vec<(usize, usize)>,
+    /// Materials of old MATT chunks, by palette index.
+    pub matt: BTreeMap<u8, Material>,
+}
+
+/// Checks the whole chunk structure of `bytes`.
+pub(super) fn check(bytes: &[u8]) -> Result<Layout, VoxError> {
+    let version = check_file_header(bytes)?;
+    let main = read_chunk_header(bytes, FILE_HEADER_BYTES, bytes.len())?;
+    if &main.id != b"MAIN" {
+        return Err(main.fail("stands where the MAIN chunk should be"));
+    }
+    let mut layout = Layout {
+        version,
+        ..Layout::default()
+    };
+    let mut size = None;
+    let mut pos = main.content_end;
+    while pos < main.end {
+        let chunk = read_chunk_header(bytes, pos, main.end)?;
+        check_chunk(bytes, &chunk, &mut size, &mut layout)?;
+        pos = chunk.end;
+    }
+    Ok(layout)
+}
+
+fn check_file_header(bytes: &[u8]) -> Result<u32, VoxError> {
+    if bytes.len() < 4 || &bytes[..4] != b"VOX " {
+        return Err(VoxError::NotVox);
+    }
+    let version = le_u32(bytes, 4).ok_or_else(|| {
+        VoxError::Truncated(format!(
+            "file ends at byte {} inside its 8-byte header",
+            bytes.len()
+        ))
+    })?;
+    if version != 150 && version != 200 {
+        return Err(VoxError::UnsupportedVersion(version));
+    }
+    Ok(version)
+}
+
+/// Checks one child of MAIN and records what [`Layout`] keeps of it.
+fn check_chunk(
+    bytes: &[u8],
+    chunk: &Chunk,
+    size: &mut Option<[u32; 3]>,
+    layout: &mut Layout,
+) -> Result<(), VoxError> {
+    if chunk.children_bytes != 0 {
+        return Err(chunk.fail(format!(
+            "has {} bytes of child chunks; only MAIN may have children",
+            chunk.children_bytes
+        )));
+    }
+    let mut cursor = Cursor::new(bytes, chunk);
+    match &chunk.id {
+        b"SIZE" => *size = Some(check_size(&mut cursor)?),
+        b"XYZI" => check_voxels(&mut cursor, *size, layout)?,
+        b"RGBA" if chunk.content_len() != PALETTE_BYTES => {
+            return Err(chunk.fail(format!(
+                "has {} bytes; a palette has {PALETTE_BYTES} (256 RGBA colours)",
+                chunk.content_len()
+            )));
+        }
+        b"MATL" => {
+            cursor.u32("material id")?;
+            cursor.skip_dict("material properties")?;
+        }
+        b"MATT" => {
+            let (index, material) = read_matt(&mut cursor)?;
+            layout.matt.insert(index, material);
+        }
+        b"nTRN" => layout.node_ids.push(check_transform_node(&mut cursor)?),
+        b"nGRP" => layout.node_ids.push(check_group_node(&mut cursor)?),
+        b"nSHP" => layout.node_ids.push(check_shape_node(&mut cursor)?),
+        // LAYR, IMAP, PACK, rOBJ, rCAM, NOTE and unknown chunks are not used.
+        _ => {}
+    }
+    Ok(())
+}
+
+fn check_size(cursor: &mut Cursor<'_>) -> Result<[u32; 3], VoxError> {
+    let len = cursor.chunk.content_len();
+    if len != 12 {
+        return Err(cursor.chunk.fail(format!("has {len} bytes; SIZE holds 12")));
+    }
+    let size = [
+        cursor.u32("x size")?,
+        cursor.u32("y size")?,
+        cursor.u32("z size")?,
+    ];
+    if size.iter().any(|&s| s == 0 || s > MAX_MODEL_EDGE) {
+        return Err(cursor.chunk.fail(format!(
+            "gives model size {}x{}x{}; each edge must be 1..={MAX_MODEL_EDGE}",
+            size[0], size[1], size[2]
+        )));
+    }
+    Ok(size)
+}
+
+fn check_voxels(
+    cursor: &mut Cursor<'_>,
+    size: Option<[u32; 3]>,
+    layout: &mut Layout,
+) -> Result<(), VoxError> {
+    let chunk = cursor.chunk;
+    let size = size.ok_or_else(|| chunk.fail("comes before any SIZE chunk"))?;
+    let count = widen(cursor.u32("voxel count")?);
+    let held = cursor.remaining();
+    if count > held / 4 {
+        return Err(chunk.fail(format!("claims {count} voxels but holds {held} bytes")));
+    }
+    let model = layout.model_voxels.len();
+    let data = cursor.take(count * 4, "voxels")?;
+    for (ordinal, voxel) in data.chunks_exact(4).enumerate() {
+        let inside = voxel[..3]
+            .iter()
+            .zip(size)
+            .all(|(&c, edge)| u32::from(c) < edge);
+        if !inside {
+            return Err(chunk.fail(format!(
+                "has voxel {ordinal} at ({}, {}, {}) outside the model size {}x{}x{}",
+                voxel[0], voxel[1], voxel[2], size[0], size[1], size[2]
+            )));
+        }
+        if voxel[3] == 0 {
+            layout.zero_index_voxels.push((model, ordinal));
+        }
+    }
+    layout.model_voxels.push(count);
+    Ok(())
+}
+
+fn check_transform_node(cursor: &mut Cursor<'_>) -> Result<u32, VoxError> {
+    let id = cursor.u32("node id")?;
+    cursor.skip_dict("node attributes")?;
+    cursor.u32("child node id")?;
+    cursor.u32("reserved id")?;
+    cursor.u32("layer id")?;
+    let frames = cursor.u32("frame count")?;
+    for _ in 0..frames {
+        cursor.skip_dict("frame attributes")?;
+    }
+    Ok(id)
+}
+
+fn check_group_node(cursor: &mut Cursor<'_>) -> Result<u32, VoxError> {
+    let id = cursor.u32("node id")?;
+    cursor.skip_dict("node attributes")?;
+    let children = widen(cursor.u32("child count")?);
+    let held = cursor.remaining();
+    if children > held / 4 {
+        return Err(cursor
+            .chunk
+            .fail(format!("claims {children} children but holds {held} bytes")));
+    }
+    cursor.take(children * 4, "child ids")?;
+    Ok(id)
+}
+
+fn check_shape_node(cursor: &mut Cursor<'_>) -> Result<u32, VoxError> {
+    let id = cursor.u32("node id")?;
+    cursor.skip_dict("node attributes")?;
+    let models = cursor.u32("model count")?;
+    for _ in 0..models {
+        cursor.u32("model id")?;
+        cursor.skip_dict("model attributes")?;
+    }
+    Ok(id)
+}
+
+/// Property names of a MATT chunk's property bits 0..=6, in bit order.
+/// Bit 7 ("total power") carries no value and is not kept.
+const MATT_PROPERTIES: [&str; 7] = [
+    "_plastic", "_rough", "_spec", "_ior", "_att", "_flux", "_glow",
+];
+
+/// Reads an old (MagicaVoxel 0.98) MATT chunk into a [`Material`], the way
+/// opengametools' ogt_vox does: the type gives the kind, the weight becomes
+/// `_weight` and also `_metal`/`_trans`/`_emit` for metal/glass/emissive.
+fn read_matt(cursor: &mut Cursor<'_>) -> Result<(u8, Material), VoxError> {
+    // MagicaVoxel numbers materials 1..=256, where 256 is palette index 0.
+    let index = cursor.u32("material id")?.to_le_bytes()[0];
+    let kind = match cursor.u32("material type")? {
+        0 => MaterialKind::Diffuse,
+        1 => MaterialKind::Metal,
+        2 => MaterialKind::Glass,
+        3 => MaterialKind::Emit,
+        other => {
+            return Err(cursor
+                .chunk
+                .fail(format!("has unknown material type {other}")));
+        }
+    };
+    let weight = cursor.f32("material weight")?;
+    let bits = cursor.u32("property bits")?;
+    let mut material = Material::new(kind);
+    material
+        .params
+        .insert("_weight".to_owned(), weight.to_string());
+    let weight_key = match kind {
+        MaterialKind::Metal => Some("_metal"),
+        MaterialKind::Glass => Some("_trans"),
+        MaterialKind::Emit => Some("_emit"),
+        MaterialKind::Diffuse | MaterialKind::Media => None,
+    };
+    if let Some(key) = weight_key {
+        material.params.insert(key.to_owned(), weight.to_string());
+    }
+    for (bit, key) in MATT_PROPERTIES.iter().enumerate() {
+        if bits & (1 << bit) != 0 {
+            let value = cursor.f32(key)?;
+            material.params.insert((*key).to_owned(), value.to_string());
+        }
+    }
+    Ok((index, material))
+}

@@ -1,0 +1,183 @@
+//! `octovox info` on the shared assets, through the real binary.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+/// `../shared/assets/vox` beside the project root.
+fn asset(relative: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/assets/vox")
+        .join(relative)
+}
+
+fn octovox(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_octovox"))
+        .args(args)
+        .output()
+        .expect("run octovox")
+}
+
+/// Runs `octovox info --json` on an asset and parses what it prints.
+fn info_json(relative: &str, extra: &[&str]) -> Value {
+    let path = asset(relative);
+    let path = path.to_str().expect("UTF-8 asset path");
+    let output = octovox(&[&["info", path, "--json"], extra].concat());
+    assert!(
+        output.status.success(),
+        "octovox info {relative} failed: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    serde_json::from_slice(&output.stdout).expect("info --json prints JSON")
+}
+
+fn extent(info: &Value) -> [i64; 3] {
+    let axis = |i: usize| info["extent"][i].as_i64().expect("extent is [x, y, z]");
+    [axis(0), axis(1), axis(2)]
+}
+
+#[test]
+fn torus64_matches_the_report() {
+    let info = info_json("seed/torus64.vox", &[]);
+    assert_eq!(info["voxels"], 41_032);
+    assert_eq!(extent(&info), [64, 18, 64]);
+    assert_eq!(info["models"], 1);
+}
+
+/// Six 79×85×125 models placed by nTRN translations. The report gives the
+/// bounds as 158×125×255; the voxels themselves span 254 along z.
+#[test]
+fn teapot256_places_six_models() {
+    let info = info_json("seed/teapot256.vox", &[]);
+    assert_eq!(info["voxels"], 101_683);
+    assert_eq!(info["models"], 6);
+    assert_eq!(extent(&info), [158, 125, 254]);
+}
+
+/// 15 models under nested groups; some shapes are placed by several
+/// transforms, so 19 placements.
+#[test]
+fn test_groups_walks_nested_groups() {
+    let info = info_json("format/test_groups.vox", &[]);
+    assert_eq!(info["voxels"], 1_754);
+    assert_eq!(info["models"], 19);
+}
+
+#[test]
+fn axes_version_200_with_groups() {
+    let info = info_json("format/axes.vox", &[]);
+    assert_eq!(info["voxels"], 12_452);
+    assert_eq!(info["models"], 10);
+}
+
+#[test]
+fn trex_loads_one_animation_frame() {
+    let info = info_json("magicavoxel/T-Rex.vox", &[]);
+    assert_eq!(info["voxels"], 1_272);
+    assert_eq!(info["models"], 1);
+    // Frame 2 is the third model of the file (1,287 voxels).
+    assert_eq!(
+        info_json("magicavoxel/T-Rex.vox", &["--frame", "2"])["voxels"],
+        1_287
+    );
+}
+
+#[test]
+fn json_has_every_documented_key() {
+    let info = info_json("format/metal-material.vox", &[]);
+    for key in [
+        "voxels",
+        "extent",
+        "min",
+        "max",
+        "models",
+        "materials",
+        "palette_entries",
+    ] {
+        assert!(info.get(key).is_some(), "missing key {key} in {info}");
+    }
+    assert_eq!(info["materials"], serde_json::json!({ "metal": 1 }));
+    assert_eq!(info["palette_entries"], 1);
+    // max − min + 1 = extent on every axis.
+    for axis in 0..3 {
+        let span =
+            info["max"][axis].as_i64().unwrap_or(0) - info["min"][axis].as_i64().unwrap_or(0);
+        assert_eq!(span + 1, extent(&info)[axis]);
+    }
+}
+
+#[test]
+fn human_output_is_aligned_lines() {
+    let path = asset("seed/torus64.vox");
+    let output = octovox(&["info", path.to_str().expect("UTF-8 asset path")]);
+    assert!(output.status.success());
+    let text = String::from_utf8(output.stdout).expect("UTF-8 output");
+    assert!(text.contains("voxels           41032"), "{text}");
+    assert!(text.contains("extent           64 x 18 x 64"), "{text}");
+}
+
+#[test]
+fn not_a_vox_exits_nonzero_with_the_reason() {
+    let path = asset("format/not_a.vox");
+    let output = octovox(&["info", path.to_str().expect("UTF-8 asset path"), "--json"]);
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("not a .vox file (missing 'VOX ' magic)"),
+        "stderr: {stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "stderr: {stderr}");
+    assert!(output.stdout.is_empty());
+}
+
+#[test]
+fn missing_file_and_bad_frame_are_errors() {
+    let output = octovox(&["info", "/nonexistent/x.vox"]);
+    assert!(!output.status.success());
+    assert!(String::from_utf8_lossy(&output.stderr).contains("cannot read /nonexistent/x.vox"));
+
+    let path = asset("magicavoxel/T-Rex.vox");
+    let output = octovox(&[
+        "info",
+        path.to_str().expect("UTF-8 asset path"),
+        "--frame",
+        "8",
+    ]);
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("frame 8 requested but file has 8 models"),
+        "stderr: {stderr}"
+    );
+}
+
+#[test]
+fn convert_writes_a_file_that_loads_the_same() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = dir.path().join("teapot.vox");
+    let input = asset("seed/teapot256.vox");
+    let output = octovox(&[
+        "convert",
+        input.to_str().expect("UTF-8 asset path"),
+        out.to_str().expect("UTF-8 temp path"),
+    ]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let before = info_json("seed/teapot256.vox", &[]);
+    let after = octovox(&["info", out.to_str().expect("UTF-8 temp path"), "--json"]);
+    let after: Value = serde_json::from_slice(&after.stdout).expect("JSON");
+    for key in [
+        "voxels",
+        "extent",
+        "min",
+        "max",
+        "palette_entries",
+        "materials",
+    ] {
+        assert_eq!(before[key], after[key], "{key}");
+    }
+}
