@@ -26,7 +26,7 @@ impl Camera {
         let center = (lo + hi) * 0.5;
         let radius = ((hi - lo).length() * 0.5).max(1.0);
         let half_fov = f64::from(fov_y_deg.clamp(5.0, 170.0)).to_radians() * 0.5;
-        let distance = radius / half_fov.sin() * 1.05;
+        let distance = radius / half_fov.sin() * 0.85;
         let dir = DVec3::new(0.55, 0.45, 0.7).normalize();
         Camera { eye: center + dir * distance, target: center, fov_y_deg }
     }

@@ -2,13 +2,32 @@
 
 use std::path::PathBuf;
 
-use clap::{Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
+use glam::DVec3;
+
+use octovox::camera::Camera;
+use octovox::settings::{TraceMode, View};
 
 #[derive(Parser, Debug)]
 #[command(name = "octovox", version, about = "Voxel sandbox with a GPU sparse-voxel-octree ray tracer")]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Option<Command>,
+    #[command(flatten)]
+    pub window: WindowArgs,
+}
+
+/// Options of the sandbox window (`octovox [FILE]`).
+#[derive(Args, Debug, Default)]
+pub struct WindowArgs {
+    /// A .vox file to open; without it, the built-in demo scene.
+    pub file: Option<PathBuf>,
+    /// Window size in pixels.
+    #[arg(long, value_parser = parse_size, default_value = "1280x720")]
+    pub size: (u32, u32),
+    /// Initial camera as EX,EY,EZ:TX,TY,TZ (eye and target, world voxels).
+    #[arg(long, value_parser = parse_camera)]
+    pub camera: Option<(DVec3, DVec3)>,
 }
 
 #[derive(Subcommand, Debug)]
@@ -30,4 +49,101 @@ pub enum Command {
         #[arg(long, default_value_t = 0)]
         frame: usize,
     },
+    /// Ray-trace a scene to a PNG (GPU, or the CPU reference with --cpu).
+    Render(RenderArgs),
+    /// Measure build, edit and render speed and memory; writes docs/bench/.
+    Bench(BenchArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// A .vox file; without it, the built-in demo scene.
+    pub file: Option<PathBuf>,
+    #[arg(short, long)]
+    pub output: PathBuf,
+    #[arg(long, value_parser = parse_size, default_value = "1280x720")]
+    pub size: (u32, u32),
+    /// EX,EY,EZ:TX,TY,TZ; without it, a camera that frames the whole model.
+    #[arg(long, value_parser = parse_camera)]
+    pub camera: Option<(DVec3, DVec3)>,
+    /// Vertical field of view in degrees.
+    #[arg(long, default_value_t = 50.0)]
+    pub fov: f32,
+    #[arg(long, value_enum, default_value_t = TraceMode::Svo)]
+    pub mode: TraceMode,
+    #[arg(long, value_enum, default_value_t = View::Shaded)]
+    pub view: View,
+    /// Use the CPU reference tracer instead of the GPU.
+    #[arg(long)]
+    pub cpu: bool,
+    /// Turn sun shadows off.
+    #[arg(long)]
+    pub no_shadows: bool,
+    #[arg(long, default_value_t = 0)]
+    pub frame: usize,
+}
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// What to measure.
+    #[arg(value_enum)]
+    pub what: BenchKind,
+    /// Folder for the markdown and JSON results.
+    #[arg(long, default_value = "docs/bench")]
+    pub out: PathBuf,
+    /// Fewer repetitions and smaller images (a smoke run).
+    #[arg(long)]
+    pub quick: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum BenchKind {
+    /// Octree build time and memory, dense grid memory.
+    Build,
+    /// Edit latency: apply + flush for one voxel and spheres.
+    Edit,
+    /// Grid DDA vs SVO frame time at 1700×900.
+    Render,
+}
+
+/// Parses "WxH".
+pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("size '{s}' is not WxH, e.g. 1280x720"))?;
+    let parse = |v: &str| v.trim().parse::<u32>().map_err(|_| format!("size '{s}': '{v}' is not a whole number"));
+    let (w, h) = (parse(w)?, parse(h)?);
+    if !(1..=16384).contains(&w) || !(1..=16384).contains(&h) {
+        return Err(format!("size '{s}' must be between 1x1 and 16384x16384"));
+    }
+    Ok((w, h))
+}
+
+/// Parses "EX,EY,EZ:TX,TY,TZ".
+pub fn parse_camera(s: &str) -> Result<(DVec3, DVec3), String> {
+    let (eye, target) = s.split_once(':').ok_or_else(|| format!("camera '{s}' is not EX,EY,EZ:TX,TY,TZ"))?;
+    let vec = |part: &str| -> Result<DVec3, String> {
+        let v: Vec<f64> = part
+            .split(',')
+            .map(|c| c.trim().parse::<f64>().map_err(|_| format!("camera '{s}': '{c}' is not a number")))
+            .collect::<Result<_, _>>()?;
+        match v[..] {
+            [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(DVec3::new(x, y, z)),
+            _ => Err(format!("camera '{s}': '{part}' needs three finite numbers")),
+        }
+    };
+    let (eye, target) = (vec(eye)?, vec(target)?);
+    if eye == target {
+        return Err(format!("camera '{s}': eye and target are the same point"));
+    }
+    Ok((eye, target))
+}
+
+/// The camera given on the command line, or one framing the scene.
+pub fn camera_or_framing(camera: Option<(DVec3, DVec3)>, fov: f32, scene: &octovox::scene::Scene) -> Camera {
+    match camera {
+        Some((eye, target)) => Camera { eye, target, fov_y_deg: fov },
+        None => match scene.tree.solid_bounds() {
+            Some((lo, hi)) => Camera::framing(lo, hi, fov),
+            None => Camera { fov_y_deg: fov, ..Camera::default() },
+        },
+    }
 }

@@ -2,6 +2,7 @@
 
 mod convert;
 mod info;
+pub mod render;
 
 use std::process::ExitCode;
 
@@ -16,5 +17,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             output,
             frame,
         }) => convert::run(&input, &output, frame),
+        Some(Command::Render(args)) => render::run(&args),
+        Some(Command::Bench(_)) => anyhow::bail!("bench is not built yet"),
     }
 }

@@ -34,7 +34,7 @@ impl GpuContext {
     /// A device without a window (render, replay, bench, tests).
     pub fn headless() -> Result<GpuContext, GpuError> {
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
-        desc.backends = wgpu::Backends::VULKAN | wgpu::Backends::GL;
+        desc.backends = wgpu::Backends::PRIMARY;
         let instance = wgpu::Instance::new(desc.with_env());
         pollster::block_on(Self::with_instance(instance, None))
     }
@@ -42,7 +42,7 @@ impl GpuContext {
     /// An instance able to make surfaces for windows of this display.
     pub fn window_instance(display: Box<dyn wgpu::wgt::WgpuHasDisplayHandle>) -> wgpu::Instance {
         let mut desc = wgpu::InstanceDescriptor::new_with_display_handle(display);
-        desc.backends = wgpu::Backends::VULKAN | wgpu::Backends::GL;
+        desc.backends = wgpu::Backends::PRIMARY;
         wgpu::Instance::new(desc.with_env())
     }
 

@@ -2,6 +2,7 @@
 
 pub mod apply;
 pub mod build;
+pub mod demo;
 pub mod octree;
 pub mod palette;
 pub mod shape;
@@ -40,4 +41,18 @@ pub fn bounds_of(points: impl Iterator<Item = IVec3>) -> Option<(IVec3, IVec3)> 
         None => Some((p, p)),
         Some((lo, hi)) => Some((lo.min(p), hi.max(p))),
     })
+}
+
+/// What the sandbox edits: a palette and an octree of palette indices.
+#[derive(Clone, Debug, Default)]
+pub struct Scene {
+    pub palette: Palette,
+    pub tree: Octree,
+}
+
+impl Scene {
+    /// Builds the octree of a loaded model.
+    pub fn from_model(model: &VoxelModel) -> Result<Scene, BuildError> {
+        Ok(Scene { palette: model.palette.clone(), tree: Octree::from_voxels(&model.voxels)? })
+    }
 }
