@@ -9,5 +9,7 @@ pub mod gpu;
 pub mod gpu_pool;
 pub mod io;
 pub mod scene;
+pub mod replay;
 pub mod settings;
+pub mod tool;
 pub mod trace;

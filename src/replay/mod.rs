@@ -1,0 +1,97 @@
+//! The replay language: scripts of edits, camera moves, renders and
+//! expectations, run headless by `octovox replay` and played or recorded by
+//! the window. `docs/replay.md` describes it.
+
+mod parse;
+mod run;
+
+use std::fmt;
+use std::path::PathBuf;
+
+use glam::{DVec3, IVec3};
+
+use crate::tool::{Brush, Tool};
+
+pub use parse::{ScriptError, parse_script};
+pub use run::{Failure, Runner, RunnerMode, ScriptReport};
+
+/// One line of a script.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Command {
+    Load(PathBuf),
+    New,
+    Camera { eye: DVec3, target: DVec3, fov: Option<f32> },
+    Viewport(u32, u32),
+    Brush(Brush),
+    Color(u8),
+    Place(IVec3),
+    Remove(IVec3),
+    Paint(IVec3),
+    Click { x: u32, y: u32, tool: Tool },
+    Undo(u32),
+    Redo(u32),
+    Save(PathBuf),
+    Render(PathBuf),
+    ExpectVoxel(IVec3, u8),
+    ExpectCount(u64),
+    ExpectWritten(u64),
+    ExpectImage(PathBuf, f64),
+}
+
+/// A parsed command with its 1-based line number.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Line {
+    pub number: usize,
+    pub command: Command,
+}
+
+/// A parsed script: its file (for messages and relative paths) and lines.
+#[derive(Clone, Debug)]
+pub struct Script {
+    pub path: PathBuf,
+    pub lines: Vec<Line>,
+}
+
+/// Writes a command back as a script line (what `--record` produces).
+impl fmt::Display for Command {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let v = |p: IVec3| format!("{} {} {}", p.x, p.y, p.z);
+        match self {
+            Command::Load(path) => write!(f, "load {}", path.display()),
+            Command::New => write!(f, "new"),
+            Command::Camera { eye, target, fov } => {
+                write!(f, "camera {} {} {} {} {} {}", eye.x, eye.y, eye.z, target.x, target.y, target.z)?;
+                match fov {
+                    Some(fov) => write!(f, " {fov}"),
+                    None => Ok(()),
+                }
+            }
+            Command::Viewport(w, h) => write!(f, "viewport {w} {h}"),
+            Command::Brush(Brush::Voxel) => write!(f, "brush voxel"),
+            Command::Brush(Brush::Sphere(r)) => write!(f, "brush sphere {r}"),
+            Command::Brush(Brush::Box(s)) => write!(f, "brush box {}", v(*s)),
+            Command::Color(c) => write!(f, "color {c}"),
+            Command::Place(p) => write!(f, "place {}", v(*p)),
+            Command::Remove(p) => write!(f, "remove {}", v(*p)),
+            Command::Paint(p) => write!(f, "paint {}", v(*p)),
+            Command::Click { x, y, tool } => write!(f, "click {x} {y} {}", tool.name()),
+            Command::Undo(n) => write!(f, "undo {n}"),
+            Command::Redo(n) => write!(f, "redo {n}"),
+            Command::Save(path) => write!(f, "save {}", path.display()),
+            Command::Render(path) => write!(f, "render {}", path.display()),
+            Command::ExpectVoxel(p, n) => write!(f, "expect voxel {} {n}", v(*p)),
+            Command::ExpectCount(n) => write!(f, "expect count {n}"),
+            Command::ExpectWritten(n) => write!(f, "expect written <= {n}"),
+            Command::ExpectImage(path, tol) => write!(f, "expect image {} {tol}", path.display()),
+        }
+    }
+}
+
+/// The edit a `place`/`remove`/`paint` line (or a recorded click) becomes.
+pub fn edit_command(tool: Tool, at: IVec3) -> Command {
+    match tool {
+        Tool::Attach => Command::Place(at),
+        Tool::Erase => Command::Remove(at),
+        Tool::Paint => Command::Paint(at),
+    }
+}

@@ -1,0 +1,86 @@
+//! Editing tools and brushes: how a click on a voxel face becomes an
+//! [`Edit`]. The window and the replay `click` command both use this.
+
+use glam::IVec3;
+
+use crate::edit::Edit;
+use crate::scene::{Op, Shape};
+
+/// What a click does (MagicaVoxel's names and keys: T, R, G).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Tool {
+    /// Place voxels on the face that was clicked.
+    #[default]
+    Attach,
+    /// Remove the clicked voxels.
+    Erase,
+    /// Recolour the clicked voxels.
+    Paint,
+}
+
+impl Tool {
+    pub const ALL: [Tool; 3] = [Tool::Attach, Tool::Erase, Tool::Paint];
+
+    /// The word the replay language uses.
+    pub fn name(self) -> &'static str {
+        match self {
+            Tool::Attach => "attach",
+            Tool::Erase => "erase",
+            Tool::Paint => "paint",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<Tool> {
+        Tool::ALL.into_iter().find(|t| t.name() == name)
+    }
+}
+
+/// The brush shape, centred on the cell a click picks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Brush {
+    Voxel,
+    /// Cells with dx² + dy² + dz² ≤ r².
+    Sphere(i32),
+    /// `size` cells per axis, from `center - size / 2`.
+    Box(IVec3),
+}
+
+impl Default for Brush {
+    fn default() -> Brush {
+        Brush::Voxel
+    }
+}
+
+impl Brush {
+    pub fn shape_at(&self, center: IVec3) -> Shape {
+        match *self {
+            Brush::Voxel => Shape::Voxel(center),
+            Brush::Sphere(radius) => Shape::Sphere { center, radius },
+            Brush::Box(size) => Shape::centered_box(center, size),
+        }
+    }
+}
+
+/// The cell a click with `tool` acts on, given the picked voxel and the
+/// normal of the face hit: Attach works in front of the face.
+pub fn click_target(tool: Tool, voxel: IVec3, normal: IVec3) -> IVec3 {
+    match tool {
+        Tool::Attach => voxel + normal,
+        Tool::Erase | Tool::Paint => voxel,
+    }
+}
+
+/// The operation a tool performs with a colour.
+pub fn tool_op(tool: Tool, color: u8) -> Op {
+    match tool {
+        Tool::Attach => Op::Place(color),
+        Tool::Erase => Op::Remove,
+        Tool::Paint => Op::Paint(color),
+    }
+}
+
+/// The edit of a click on (world) `voxel` through the face with `normal`.
+pub fn click_edit(tool: Tool, brush: &Brush, color: u8, voxel: IVec3, normal: IVec3) -> (IVec3, Edit) {
+    let center = click_target(tool, voxel, normal);
+    (center, Edit::Brush { shape: brush.shape_at(center), op: tool_op(tool, color) })
+}
