@@ -338,6 +338,12 @@ fn other_structural_errors_name_the_chunk() {
     assert_err_contains(&orphan, "chunk XYZI at byte 20 comes before any SIZE chunk");
     let palette = vox_file(&[chunk(b"RGBA", &[0; 12])]);
     assert_err_contains(&palette, "has 12 bytes; a palette has 1024");
+    let mut stray = vox_file(&[size(1, 1, 1), vec![0; 5]]);
+    stray.extend([0; 7]); // bytes after MAIN are ignored, as dot_vox does
+    assert_err_contains(
+        &stray,
+        "chunk MAIN at byte 8 ends with 5 stray bytes at byte 44",
+    );
     let mut version = vox_file(&[]);
     version[4] = 151;
     assert_err_contains(&version, "unsupported .vox version 151");

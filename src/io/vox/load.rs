@@ -76,7 +76,8 @@ pub fn load_vox(bytes: &[u8], frame: usize) -> Result<VoxelModel, VoxError> {
 }
 
 thread_local! {
-    /// Set while this thread runs `dot_vox`, so the panic hook stays quiet.
+    /// Set while this thread is inside [`catch_quietly`], so the panic hook
+    /// stays quiet.
     static QUIET_PANICS: Cell<bool> = const { Cell::new(false) };
 }
 
