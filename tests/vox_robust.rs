@@ -78,6 +78,17 @@ fn transform(id: u32, child: u32, frame: &[(&str, &str)]) -> Vec<u8> {
     chunk(b"nTRN", &content)
 }
 
+fn animated_transform(id: u32, child: u32, frames: &[&[(&str, &str)]]) -> Vec<u8> {
+    let mut content = words(&[id]);
+    content.extend(dict(&[]));
+    let count = u32::try_from(frames.len()).expect("few frames");
+    content.extend(words(&[child, u32::MAX, 0, count]));
+    for frame in frames {
+        content.extend(dict(frame));
+    }
+    chunk(b"nTRN", &content)
+}
+
 fn group(id: u32, children: &[u32]) -> Vec<u8> {
     let mut content = words(&[id]);
     content.extend(dict(&[]));
@@ -129,6 +140,52 @@ fn hand_built_files_load() {
     let model = load_vox(&vox_file(&scene), 0).expect("scene");
     // Scene (5, 6, 7) → world (5, 7, −6).
     assert_eq!(model.voxels[0].0.to_array(), [5, 7, -6]);
+}
+
+/// `--frame` picks the last keyframe at or before it (no interpolation).
+#[test]
+fn keyframes_follow_the_requested_frame() {
+    let mut chunks = one_voxel_model();
+    chunks.push(animated_transform(
+        0,
+        1,
+        &[
+            &[("_t", "0 0 0")],
+            &[("_f", "5"), ("_t", "10 0 0")],
+            &[("_f", "8"), ("_t", "20 0 0")],
+        ],
+    ));
+    chunks.push(shape(1, 0));
+    let bytes = vox_file(&chunks);
+    for (frame, x) in [(0, 0), (4, 0), (5, 10), (7, 10), (8, 20), (100, 20)] {
+        let model = load_vox(&bytes, frame).expect("animated scene");
+        assert_eq!(model.voxels[0].0.x, x, "frame {frame}");
+    }
+}
+
+/// 8,192 placements of a full 256×256 layer would be 2^29 voxels, twice
+/// `MAX_VOXELS`: refused before any voxel is placed.
+#[test]
+fn the_voxel_cap_is_checked_before_building() {
+    let layer: Vec<[u8; 4]> = (0..=255u8)
+        .flat_map(|x| (0..=255u8).map(move |y| [x, y, 0, 1]))
+        .collect();
+    let mut chunks = vec![size(256, 256, 1), xyzi(65_536, &layer)];
+    chunks.push(transform(0, 1, &[]));
+    // Thirteen levels of groups with two children each: 2^13 shapes.
+    for level in 0..13 {
+        chunks.push(group(1 + 2 * level, &[2 + 2 * level, 2 + 2 * level]));
+        chunks.push(transform(2 + 2 * level, 3 + 2 * level, &[]));
+    }
+    chunks.push(shape(27, 0));
+    let start = Instant::now();
+    let err = load_err(&vox_file(&chunks));
+    assert!(matches!(err, VoxError::TooManyVoxels { .. }), "{err:?}");
+    assert!(
+        start.elapsed() < Duration::from_secs(2),
+        "took {:?}",
+        start.elapsed()
+    );
 }
 
 #[test]
@@ -281,6 +338,12 @@ fn other_structural_errors_name_the_chunk() {
     assert_err_contains(&orphan, "chunk XYZI at byte 20 comes before any SIZE chunk");
     let palette = vox_file(&[chunk(b"RGBA", &[0; 12])]);
     assert_err_contains(&palette, "has 12 bytes; a palette has 1024");
+    let mut stray = vox_file(&[size(1, 1, 1), vec![0; 5]]);
+    stray.extend([0; 7]); // bytes after MAIN are ignored, as dot_vox does
+    assert_err_contains(
+        &stray,
+        "chunk MAIN at byte 8 ends with 5 stray bytes at byte 44",
+    );
     let mut version = vox_file(&[]);
     version[4] = 151;
     assert_err_contains(&version, "unsupported .vox version 151");

@@ -115,6 +115,8 @@ fn synthetic_palette() -> Palette {
         .insert("_unknown_key".to_owned(), "kept verbatim".to_owned());
     palette.materials[255] = glass;
     palette.materials[7] = Material::new(MaterialKind::Emit);
+    // Index 0 is written as MATL 256, MagicaVoxel's number for it.
+    palette.materials[0] = Material::new(MaterialKind::Metal);
     palette
 }
 
@@ -280,4 +282,50 @@ fn knight_feet_are_below_its_head() {
         .collect();
     let loaded: BTreeSet<[i32; 3]> = model.voxels.iter().map(|(p, _)| p.to_array()).collect();
     assert!(raw_set == loaded, "world = (x, z, −y) of the stored voxels");
+}
+
+/// A save that fails leaves the previous file as it was and no temporary
+/// file behind; one that succeeds replaces it.
+#[test]
+fn saving_is_atomic() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("scene.vox");
+    save_vox(&path, &Palette::default(), &tripod()).expect("first save");
+    let before = std::fs::read(&path).expect("read");
+
+    let bad = [(IVec3::ZERO, 1), (IVec3::ONE, 0)];
+    assert!(save_vox(&path, &Palette::default(), &bad).is_err());
+    assert_eq!(
+        std::fs::read(&path).expect("read"),
+        before,
+        "a failed save changed the file"
+    );
+
+    let single = [(IVec3::new(3, 4, 5), 9)];
+    save_vox(&path, &Palette::default(), &single).expect("second save");
+    let loaded = load_vox_file(&path, 0).expect("load");
+    assert_eq!(loaded.voxels, single.to_vec());
+
+    // Renaming onto a directory fails after the bytes were written.
+    let blocked = dir.path().join("blocked.vox");
+    std::fs::create_dir(&blocked).expect("mkdir");
+    let err = save_vox(&blocked, &Palette::default(), &single).expect_err("target is a directory");
+    assert!(err.to_string().contains("blocked.vox"), "{err}");
+
+    let names: Vec<String> = std::fs::read_dir(dir.path())
+        .expect("list")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names.len(), 2, "leftover files: {names:?}");
+}
+
+#[cfg(unix)]
+#[test]
+fn saved_files_are_world_readable() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("scene.vox");
+    save_vox(&path, &Palette::default(), &tripod()).expect("save");
+    let mode = std::fs::metadata(&path).expect("stat").permissions().mode();
+    assert_eq!(mode & 0o777, 0o644);
 }

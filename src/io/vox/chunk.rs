@@ -47,10 +47,15 @@ pub(super) fn read_chunk_header(
                 "file ends at byte {limit} inside the header of the chunk at byte {offset}"
             ))
         } else {
-            VoxError::Truncated(format!(
-                "MAIN's children end with {} stray bytes at byte {offset}",
-                limit - offset
-            ))
+            // Only MAIN's children are read with a limit short of the file's end.
+            VoxError::BadChunk {
+                id: "MAIN".to_owned(),
+                offset: 8,
+                problem: format!(
+                    "ends with {} stray bytes at byte {offset} after its last child",
+                    limit - offset
+                ),
+            }
         });
     }
     let mut id = [0u8; 4];

@@ -76,17 +76,29 @@ pub fn load_vox(bytes: &[u8], frame: usize) -> Result<VoxelModel, VoxError> {
 }
 
 thread_local! {
-    /// Set while this thread runs `dot_vox`, so the panic hook stays quiet.
+    /// Set while this thread is inside [`catch_quietly`], so the panic hook
+    /// stays quiet.
     static QUIET_PANICS: Cell<bool> = const { Cell::new(false) };
 }
 
 /// Runs `dot_vox::load_bytes`, turning a panic into [`VoxError::ParserPanic`].
 ///
 /// The pre-pass should leave `dot_vox` nothing to panic on; this is the
-/// second line of defence. A panic hook that skips panics on threads inside
-/// this call (and passes every other panic to the previous hook) keeps the
-/// caught panic from printing.
+/// second line of defence.
 fn parse_guarded(bytes: &[u8]) -> Result<DotVoxData, VoxError> {
+    match catch_quietly(|| dot_vox::load_bytes(bytes)) {
+        Ok(parsed) => parsed.map_err(VoxError::Parser),
+        Err(message) => Err(VoxError::ParserPanic(message)),
+    }
+}
+
+/// Runs `f`, returning a panic's message as `Err` instead of unwinding.
+///
+/// A panic hook, installed once, skips panics raised on a thread while it is
+/// inside this function and passes every other panic to the hook it
+/// replaced, so the caught panic does not print while other threads' panics
+/// still do.
+fn catch_quietly<T>(f: impl FnOnce() -> T) -> Result<T, String> {
     static INSTALL_HOOK: Once = Once::new();
     INSTALL_HOOK.call_once(|| {
         let previous = panic::take_hook();
@@ -96,21 +108,17 @@ fn parse_guarded(bytes: &[u8]) -> Result<DotVoxData, VoxError> {
             }
         }));
     });
-    QUIET_PANICS.set(true);
-    // `bytes` is only read, so no broken invariant can leak out of a panic.
-    let result = panic::catch_unwind(AssertUnwindSafe(|| dot_vox::load_bytes(bytes)));
-    QUIET_PANICS.set(false);
-    match result {
-        Ok(parsed) => parsed.map_err(VoxError::Parser),
-        Err(payload) => {
-            let message = payload
-                .downcast_ref::<&str>()
-                .map(|s| (*s).to_owned())
-                .or_else(|| payload.downcast_ref::<String>().cloned())
-                .unwrap_or_else(|| "unknown panic".to_owned());
-            Err(VoxError::ParserPanic(message))
-        }
-    }
+    let was_quiet = QUIET_PANICS.replace(true);
+    // Callers only read shared data, so no broken invariant leaks out of a panic.
+    let result = panic::catch_unwind(AssertUnwindSafe(f));
+    QUIET_PANICS.set(was_quiet);
+    result.map_err(|payload| {
+        payload
+            .downcast_ref::<&str>()
+            .map(|s| (*s).to_owned())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "unknown panic".to_owned())
+    })
 }
 
 /// `dot_vox` must have seen the same models and nodes as the pre-pass, or
@@ -241,4 +249,18 @@ fn material_from_properties(properties: &dot_vox::Dict) -> Material {
         .map(|(key, value)| (key.clone(), value.clone()))
         .collect();
     Material { kind, params }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn panics_become_errors() {
+        assert_eq!(catch_quietly(|| 7), Ok(7));
+        let boom: Result<(), String> = catch_quietly(|| panic!("boom {}", 1));
+        assert_eq!(boom, Err("boom 1".to_owned()));
+        // The thread is loud again afterwards.
+        assert!(!QUIET_PANICS.get());
+    }
 }

@@ -9,7 +9,7 @@
 
 use std::collections::HashMap;
 
-use dot_vox::{Dict, SceneNode};
+use dot_vox::{Dict, SceneNode, ShapeModel};
 
 use super::transform::{Placement, Rotation, Transform};
 use super::{MAX_INSTANCES, MAX_NODE_VISITS, MAX_VOXELS, VoxError};
@@ -25,68 +25,99 @@ pub(super) fn placements(
     model_voxels: &[usize],
     frame: usize,
 ) -> Result<Vec<Placement>, VoxError> {
-    let index_of = index_nodes(node_ids)?;
-    let lookup = |id: u32, parent: Option<u32>| {
-        index_of.get(&id).copied().ok_or_else(|| {
+    let walk = Walk {
+        nodes,
+        index_of: index_nodes(node_ids)?,
+        model_voxels,
+        frame,
+        on_path: vec![false; nodes.len()],
+        stack: vec![Step::Enter {
+            id: 0,
+            parent: None,
+            transform: Transform::IDENTITY,
+        }],
+        visits: 0,
+        voxels: 0,
+        out: Vec::new(),
+    };
+    walk.run()
+}
+
+/// One entry of the explicit depth-first stack.
+enum Step {
+    /// Visit node `id`, reached from `parent`, under the accumulated `transform`.
+    Enter {
+        id: u32,
+        parent: Option<u32>,
+        transform: Transform,
+    },
+    /// All of node `index`'s descendants are done: it leaves the current path.
+    Leave { index: usize },
+}
+
+/// State of one scene-graph walk.
+struct Walk<'a> {
+    nodes: &'a [SceneNode],
+    index_of: HashMap<u32, usize>,
+    model_voxels: &'a [usize],
+    frame: usize,
+    /// Nodes on the path from the root to the node being visited.
+    on_path: Vec<bool>,
+    stack: Vec<Step>,
+    visits: usize,
+    /// Voxels of all placements so far.
+    voxels: usize,
+    out: Vec<Placement>,
+}
+
+impl Walk<'_> {
+    fn run(mut self) -> Result<Vec<Placement>, VoxError> {
+        while let Some(step) = self.stack.pop() {
+            match step {
+                Step::Leave { index } => self.on_path[index] = false,
+                Step::Enter {
+                    id,
+                    parent,
+                    transform,
+                } => self.enter(id, parent, transform)?,
+            }
+        }
+        Ok(self.out)
+    }
+
+    fn enter(
+        &mut self,
+        id: u32,
+        parent: Option<u32>,
+        transform: Transform,
+    ) -> Result<(), VoxError> {
+        let index = self.index_of.get(&id).copied().ok_or_else(|| {
             VoxError::BadSceneGraph(match parent {
                 Some(parent) => format!("node {parent} refers to missing node {id}"),
                 None => "there is no root node 0".to_owned(),
             })
-        })
-    };
-
-    enum Step {
-        Enter {
-            id: u32,
-            parent: Option<u32>,
-            transform: Transform,
-        },
-        Leave {
-            index: usize,
-        },
-    }
-    let mut on_path = vec![false; nodes.len()];
-    let mut stack = vec![Step::Enter {
-        id: 0,
-        parent: None,
-        transform: Transform::IDENTITY,
-    }];
-    let mut visits = 0usize;
-    let mut voxels = 0usize;
-    let mut out = Vec::new();
-    while let Some(step) = stack.pop() {
-        let (id, parent, transform) = match step {
-            Step::Leave { index } => {
-                on_path[index] = false;
-                continue;
-            }
-            Step::Enter {
-                id,
-                parent,
-                transform,
-            } => (id, parent, transform),
-        };
-        let index = lookup(id, parent)?;
-        if on_path[index] {
+        })?;
+        if self.on_path[index] {
             return Err(VoxError::SceneCycle(id));
         }
-        visits += 1;
-        if visits > MAX_NODE_VISITS {
+        self.visits += 1;
+        if self.visits > MAX_NODE_VISITS {
             return Err(VoxError::BadSceneGraph(format!(
                 "more than {MAX_NODE_VISITS} node visits (nodes shared along too many paths)"
             )));
         }
-        on_path[index] = true;
-        stack.push(Step::Leave { index });
+        self.on_path[index] = true;
+        self.stack.push(Step::Leave { index });
+        let nodes = self.nodes;
         match &nodes[index] {
             SceneNode::Transform { frames, child, .. } => {
-                let picked = pick_keyframe(frames.iter().map(|f| &f.attributes), frame, id)?;
+                let picked = pick_keyframe(frames.iter().map(|f| &f.attributes), self.frame, id)?;
                 let local = match picked {
                     Some(k) => parse_transform(&frames[k].attributes, id)?,
                     None => Transform::IDENTITY,
                 };
                 let transform = transform.compose(local);
-                stack.push(Step::Enter {
+                self.stack.push(Step::Enter {
                     id: *child,
                     parent: Some(id),
                     transform,
@@ -95,44 +126,52 @@ pub(super) fn placements(
             SceneNode::Group { children, .. } => {
                 // Reversed so that children are visited in file order.
                 for &child in children.iter().rev() {
-                    stack.push(Step::Enter {
+                    self.stack.push(Step::Enter {
                         id: child,
                         parent: Some(id),
                         transform,
                     });
                 }
             }
-            SceneNode::Shape { models, .. } => {
-                let picked = pick_keyframe(models.iter().map(|m| &m.attributes), frame, id)?;
-                let Some(k) = picked else { continue };
-                let model = usize::try_from(models[k].model_id).unwrap_or(usize::MAX);
-                let count = model_voxels.get(model).copied().ok_or_else(|| {
-                    VoxError::BadSceneGraph(format!(
-                        "shape node {id} uses model {model} but the file has {} models",
-                        model_voxels.len()
-                    ))
-                })?;
-                voxels = voxels.saturating_add(count);
-                if voxels > MAX_VOXELS {
-                    return Err(VoxError::TooManyVoxels {
-                        limit: MAX_VOXELS,
-                        found: voxels,
-                    });
-                }
-                if out.len() >= MAX_INSTANCES {
-                    return Err(VoxError::BadSceneGraph(format!(
-                        "more than {MAX_INSTANCES} model placements"
-                    )));
-                }
-                out.push(Placement {
-                    model,
-                    transform,
-                    centred: true,
-                });
-            }
+            SceneNode::Shape { models, .. } => self.place_shape(id, models, transform)?,
         }
+        Ok(())
     }
-    Ok(out)
+
+    fn place_shape(
+        &mut self,
+        id: u32,
+        models: &[ShapeModel],
+        transform: Transform,
+    ) -> Result<(), VoxError> {
+        let picked = pick_keyframe(models.iter().map(|m| &m.attributes), self.frame, id)?;
+        let Some(k) = picked else { return Ok(()) };
+        let model = usize::try_from(models[k].model_id).unwrap_or(usize::MAX);
+        let count = self.model_voxels.get(model).copied().ok_or_else(|| {
+            VoxError::BadSceneGraph(format!(
+                "shape node {id} uses model {model} but the file has {} models",
+                self.model_voxels.len()
+            ))
+        })?;
+        self.voxels = self.voxels.saturating_add(count);
+        if self.voxels > MAX_VOXELS {
+            return Err(VoxError::TooManyVoxels {
+                limit: MAX_VOXELS,
+                found: self.voxels,
+            });
+        }
+        if self.out.len() >= MAX_INSTANCES {
+            return Err(VoxError::BadSceneGraph(format!(
+                "more than {MAX_INSTANCES} model placements"
+            )));
+        }
+        self.out.push(Placement {
+            model,
+            transform,
+            centred: true,
+        });
+        Ok(())
+    }
 }
 
 fn index_nodes(node_ids: &[u32]) -> Result<HashMap<u32, usize>, VoxError> {
