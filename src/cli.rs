@@ -53,6 +53,14 @@ pub enum Command {
     Render(RenderArgs),
     /// Measure build, edit and render speed and memory; writes docs/bench/.
     Bench(BenchArgs),
+    /// Run edit scripts headless and check their expectations (docs/replay.md).
+    Replay {
+        #[arg(required = true)]
+        scripts: Vec<PathBuf>,
+        /// Run without a GPU: flushes are counted, renders use the CPU tracer.
+        #[arg(long)]
+        cpu: bool,
+    },
 }
 
 #[derive(Args, Debug)]

@@ -3,10 +3,16 @@
 mod convert;
 mod info;
 pub mod render;
+mod replay;
 
 use std::process::ExitCode;
 
 use crate::cli::{Cli, Command};
+
+/// `OCTOVOX_UPDATE_IMAGES=1` makes `expect image` write its reference.
+fn update_images() -> bool {
+    std::env::var_os("OCTOVOX_UPDATE_IMAGES").is_some_and(|v| v == "1")
+}
 
 pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
@@ -19,5 +25,6 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         }) => convert::run(&input, &output, frame),
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Bench(_)) => anyhow::bail!("bench is not built yet"),
+        Some(Command::Replay { scripts, cpu }) => replay::run(&scripts, cpu, update_images()),
     }
 }

@@ -1,5 +1,6 @@
 //! File formats: MagicaVoxel .vox in and out.
 
+pub mod png;
 pub mod vox;
 
 use std::path::Path;

@@ -12,8 +12,8 @@ use glam::{DVec3, IVec3};
 
 use crate::tool::{Brush, Tool};
 
-pub use parse::{ScriptError, parse_script};
-pub use run::{Failure, Runner, RunnerMode, ScriptReport};
+pub use parse::{ScriptError, load_script, parse_script};
+pub use run::{Failure, Runner, RunnerMode, ScriptReport, StepResult};
 
 /// One line of a script.
 #[derive(Clone, Debug, PartialEq)]

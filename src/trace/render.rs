@@ -6,9 +6,9 @@ use rayon::prelude::*;
 
 use super::grid::{self, DenseGrid};
 use super::{Hit, Ray, svo};
-use crate::camera::RayBasis;
-use crate::scene::{Octree, Palette};
-use crate::settings::{SUN_DIR, View};
+use crate::camera::{Camera, RayBasis};
+use crate::scene::{Octree, Palette, Scene};
+use crate::settings::{RenderSettings, SUN_DIR, View};
 
 /// The structure a CPU render walks.
 #[derive(Clone, Copy)]
@@ -104,4 +104,29 @@ pub fn heat(x: f32) -> Vec3 {
     ];
     let i = (x.floor() as usize).min(3);
     stops[i].lerp(stops[i + 1], x - i as f32)
+}
+
+/// A whole image on the CPU: the reference for `render --cpu` and replay's
+/// `--cpu` mode. `grid` selects the DDA baseline instead of the SVO.
+pub fn render_scene_cpu(
+    scene: &Scene,
+    grid: Option<&DenseGrid>,
+    camera: &Camera,
+    size: (u32, u32),
+    settings: &RenderSettings,
+) -> image::RgbaImage {
+    let tracer = match grid {
+        Some(grid) => Tracer::Grid(grid),
+        None => Tracer::Svo(&scene.tree),
+    };
+    let basis = camera.basis(size.0, size.1, scene.tree.origin());
+    let hits = trace_image(tracer, &basis);
+    let shadows: Vec<bool> = if settings.shadows {
+        hits.par_iter().map(|hit| shadow_ray(hit).is_some_and(|ray| tracer.trace(&ray).is_hit())).collect()
+    } else {
+        Vec::new()
+    };
+    let bytes: Vec<u8> = shade_image(&hits, &basis, &scene.palette, settings.view, &shadows).into_iter().flatten().collect();
+    // shade_image yields exactly width * height pixels, so this cannot fail.
+    image::RgbaImage::from_raw(basis.width, basis.height, bytes).unwrap_or_default()
 }

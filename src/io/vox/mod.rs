@@ -24,7 +24,7 @@ pub use load::{load_vox, load_vox_file};
 pub use save::{encode_vox, save_vox};
 
 /// Most voxels one load may produce (after scene-graph instancing).
-pub const MAX_VOXELS: usize = 1 << 28;
+pub const MAX_VOXELS: usize = 1 << 26;
 
 /// Largest `.vox` file octovox reads.
 pub const MAX_FILE_BYTES: u64 = 1 << 30;

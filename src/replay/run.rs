@@ -1,0 +1,241 @@
+//! Running scripts: every edit goes through [`History`] (the same `Edit` path
+//! as the mouse), then the pool is flushed, to the GPU when there is one.
+
+use std::path::{Path, PathBuf};
+
+use glam::IVec3;
+
+use super::{Command, Line, Script};
+use crate::camera::Camera;
+use crate::edit::{Edit, History};
+use crate::gpu::Renderer;
+use crate::io::png::{differing_fraction, load_png, save_png};
+use crate::scene::{Op, Scene};
+use crate::settings::RenderSettings;
+use crate::tool::{Brush, click_edit};
+use crate::trace::render::render_scene_cpu;
+use crate::trace::{Ray, svo};
+
+/// Where renders and pool flushes go.
+pub enum RunnerMode {
+    /// Headless GPU: flushes are real `write_buffer` calls, renders use WGSL.
+    Gpu(Box<Renderer>),
+    /// No GPU: flushes are counted only, renders use the CPU tracer.
+    Cpu,
+}
+
+/// An expectation that did not hold, or a line that could not run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Failure {
+    pub file: PathBuf,
+    pub line: usize,
+    pub expected: String,
+    pub got: String,
+}
+
+impl std::fmt::Display for Failure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}:{}: expected {}, got {}", self.file.display(), self.line, self.expected, self.got)
+    }
+}
+
+/// Expectations passed and failures of one script.
+#[derive(Clone, Debug, Default)]
+pub struct ScriptReport {
+    pub passed: usize,
+    pub failures: Vec<Failure>,
+}
+
+/// The state a script drives: scene, history, camera, brush and colour.
+pub struct Runner {
+    pub scene: Scene,
+    pub history: History,
+    pub camera: Camera,
+    pub viewport: (u32, u32),
+    pub brush: Brush,
+    pub color: u8,
+    pub settings: RenderSettings,
+    /// Bytes the pool flush after the last edit line wrote.
+    pub last_written: Option<u64>,
+    last_render: Option<image::RgbaImage>,
+    mode: RunnerMode,
+    /// Write missing or different reference images instead of failing.
+    pub update_images: bool,
+}
+
+/// What one line did, for callers that show progress.
+#[derive(Debug, PartialEq)]
+pub enum StepResult {
+    Done,
+    Passed,
+    Failed { expected: String, got: String },
+}
+
+impl Runner {
+    pub fn new(mode: RunnerMode) -> Runner {
+        Runner {
+            scene: Scene::default(),
+            history: History::default(),
+            camera: Camera::default(),
+            viewport: (640, 480),
+            brush: Brush::Voxel,
+            color: 1,
+            settings: RenderSettings::default(),
+            last_written: None,
+            last_render: None,
+            mode,
+            update_images: false,
+        }
+    }
+
+    /// Gives back the renderer, to reuse it for the next script.
+    pub fn into_mode(self) -> RunnerMode {
+        self.mode
+    }
+
+    /// Runs every line; an error stops the script and counts as a failure.
+    pub fn run(&mut self, script: &Script) -> ScriptReport {
+        let base = script.path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        let mut report = ScriptReport::default();
+        for line in &script.lines {
+            let fail = |expected: String, got: String| Failure { file: script.path.clone(), line: line.number, expected, got };
+            match self.step(&base, line) {
+                Ok(StepResult::Done) => {}
+                Ok(StepResult::Passed) => report.passed += 1,
+                Ok(StepResult::Failed { expected, got }) => report.failures.push(fail(expected, got)),
+                Err(message) => {
+                    report.failures.push(fail(format!("'{}' to run", line.command), format!("error: {message}")));
+                    break;
+                }
+            }
+        }
+        report
+    }
+
+    /// Runs one line. `Err` is an error that stops the script.
+    pub fn step(&mut self, base: &Path, line: &Line) -> Result<StepResult, String> {
+        let resolve = |p: &Path| base.join(p);
+        match &line.command {
+            Command::Load(path) => {
+                let path = resolve(path);
+                self.set_scene(crate::io::load_scene(&path, 0).map_err(|e| e.to_string())?);
+            }
+            Command::New => self.set_scene(Scene::default()),
+            Command::Camera { eye, target, fov } => {
+                self.camera = Camera { eye: *eye, target: *target, fov_y_deg: fov.unwrap_or(self.camera.fov_y_deg) };
+            }
+            Command::Viewport(w, h) => self.viewport = (*w, *h),
+            Command::Brush(brush) => self.brush = *brush,
+            Command::Color(c) => self.color = *c,
+            Command::Place(p) => self.brush_edit(*p, Op::Place(self.color))?,
+            Command::Remove(p) => self.brush_edit(*p, Op::Remove)?,
+            Command::Paint(p) => self.brush_edit(*p, Op::Paint(self.color))?,
+            Command::Click { x, y, tool } => {
+                let Some((voxel, normal)) = self.pick(*x, *y) else {
+                    return Ok(StepResult::Failed {
+                        expected: format!("pixel ({x}, {y}) to hit a voxel"),
+                        got: "no voxel under it".into(),
+                    });
+                };
+                let (_, edit) = click_edit(*tool, &self.brush, self.color, voxel, normal);
+                self.apply(edit)?;
+            }
+            Command::Undo(n) => self.repeat(*n, true)?,
+            Command::Redo(n) => self.repeat(*n, false)?,
+            Command::Save(path) => crate::io::save_scene(&resolve(path), &self.scene).map_err(|e| e.to_string())?,
+            Command::Render(path) => {
+                let image = self.render()?;
+                save_png(&image, &resolve(path)).map_err(|e| e.to_string())?;
+                self.last_render = Some(image);
+            }
+            Command::ExpectVoxel(p, want) => {
+                return Ok(check(self.scene.tree.get(*p) == *want, format!("voxel {p} = {want}"), || {
+                    format!("{}", self.scene.tree.get(*p))
+                }));
+            }
+            Command::ExpectCount(want) => {
+                let got = self.scene.tree.solid_voxels();
+                return Ok(check(got == *want, format!("{want} voxels"), || got.to_string()));
+            }
+            Command::ExpectWritten(limit) => {
+                let got = self.last_written.ok_or("'expect written' needs an edit line before it")?;
+                return Ok(check(got <= *limit, format!("at most {limit} bytes written"), || format!("{got} bytes")));
+            }
+            Command::ExpectImage(path, tolerance) => return self.expect_image(&resolve(path), *tolerance),
+        }
+        Ok(StepResult::Done)
+    }
+
+    fn set_scene(&mut self, scene: Scene) {
+        self.scene = scene;
+        self.history.clear();
+        self.last_written = None;
+        self.flush();
+    }
+
+    /// The world voxel and face normal under a pixel (what the mouse picks).
+    pub fn pick(&self, x: u32, y: u32) -> Option<(IVec3, IVec3)> {
+        let basis = self.camera.basis(self.viewport.0, self.viewport.1, self.scene.tree.origin());
+        let (origin, dir) = basis.ray(x, y);
+        let hit = svo::trace(&self.scene.tree, &Ray::new(origin, dir));
+        hit.is_hit().then(|| (hit.voxel + self.scene.tree.origin(), hit.normal))
+    }
+
+    fn brush_edit(&mut self, at: IVec3, op: Op) -> Result<(), String> {
+        self.apply(Edit::Brush { shape: self.brush.shape_at(at), op })
+    }
+
+    /// The one edit path: history → octree → pool flush (→ GPU).
+    pub fn apply(&mut self, edit: Edit) -> Result<(), String> {
+        self.history.apply(&mut self.scene.tree, edit).map_err(|e| e.to_string())?;
+        self.last_written = Some(self.flush());
+        Ok(())
+    }
+
+    fn repeat(&mut self, n: u32, undo: bool) -> Result<(), String> {
+        for _ in 0..n {
+            let tree = &mut self.scene.tree;
+            let did = if undo { self.history.undo(tree) } else { self.history.redo(tree) };
+            if !did.map_err(|e| e.to_string())? {
+                return Err(format!("nothing to {}", if undo { "undo" } else { "redo" }));
+            }
+        }
+        self.last_written = Some(self.flush());
+        Ok(())
+    }
+
+    /// Sends the pool's dirty ranges; returns the bytes written.
+    fn flush(&mut self) -> u64 {
+        match &mut self.mode {
+            RunnerMode::Gpu(renderer) => renderer.sync(&mut self.scene.tree, &self.scene.palette).bytes,
+            RunnerMode::Cpu => self.scene.tree.pool_mut().flush().byte_count(),
+        }
+    }
+
+    fn render(&mut self) -> Result<image::RgbaImage, String> {
+        match &mut self.mode {
+            RunnerMode::Gpu(renderer) => {
+                renderer.render(&self.scene.tree, &self.camera, self.viewport, &self.settings, None).map_err(|e| e.to_string())?;
+                renderer.read_image().map_err(|e| e.to_string())
+            }
+            RunnerMode::Cpu => Ok(render_scene_cpu(&self.scene, None, &self.camera, self.viewport, &self.settings)),
+        }
+    }
+
+    fn expect_image(&mut self, path: &Path, tolerance: f64) -> Result<StepResult, String> {
+        let image = self.last_render.as_ref().ok_or("'expect image' needs a render line before it")?;
+        if self.update_images {
+            save_png(image, path).map_err(|e| e.to_string())?;
+            return Ok(StepResult::Passed);
+        }
+        let reference = load_png(path).map_err(|e| format!("{e} (OCTOVOX_UPDATE_IMAGES=1 writes it)"))?;
+        let fraction = differing_fraction(image, &reference);
+        Ok(check(fraction <= tolerance, format!("at most {tolerance} of pixels differing from {}", path.display()), || {
+            format!("{fraction:.5}")
+        }))
+    }
+}
+
+fn check(ok: bool, expected: String, got: impl FnOnce() -> String) -> StepResult {
+    if ok { StepResult::Passed } else { StepResult::Failed { expected, got: got() } }
+}

@@ -1,0 +1,98 @@
+//! `octovox replay` as a user runs it: every script in tests/replays passes,
+//! failures name their line, bad scripts get clear errors and no panic.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn octovox(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_octovox")).args(args).output().expect("run octovox")
+}
+
+fn stdout(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+fn replays() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/replays")
+}
+
+fn scripts() -> Vec<String> {
+    let mut scripts: Vec<String> = std::fs::read_dir(replays())
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ovr"))
+        .map(|p| p.display().to_string())
+        .collect();
+    scripts.sort();
+    assert!(scripts.len() >= 8, "{scripts:?}");
+    scripts
+}
+
+#[test]
+fn every_script_passes_on_the_gpu() {
+    std::fs::create_dir_all(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/out")).unwrap();
+    let scripts = scripts();
+    let mut args = vec!["replay"];
+    args.extend(scripts.iter().map(String::as_str));
+    let out = octovox(&args);
+    let text = stdout(&out);
+    assert!(out.status.success(), "{text}\n{}", String::from_utf8_lossy(&out.stderr));
+    assert!(text.lines().last().unwrap().ends_with(" 0 failed"), "{text}");
+}
+
+#[test]
+fn every_script_passes_on_the_cpu() {
+    std::fs::create_dir_all(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/out")).unwrap();
+    let scripts = scripts();
+    let mut args = vec!["replay", "--cpu"];
+    args.extend(scripts.iter().map(String::as_str));
+    let out = octovox(&args);
+    assert!(out.status.success(), "{}", stdout(&out));
+}
+
+fn run_script(text: &str) -> (Output, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bad.ovr");
+    std::fs::write(&path, text).unwrap();
+    let out = octovox(&["replay", "--cpu", path.to_str().unwrap()]);
+    let text = stdout(&out) + &String::from_utf8_lossy(&out.stderr);
+    (out, text)
+}
+
+#[test]
+fn a_failing_expectation_names_its_line_and_fails_the_run() {
+    let (out, text) = run_script("new\ncolor 4\nplace 1 2 3\nexpect voxel 1 2 3 5\nexpect count 1\n");
+    assert!(!out.status.success());
+    assert!(text.contains("bad.ovr:4: expected voxel [1, 2, 3] = 5, got 4"), "{text}");
+    assert!(text.contains("replay: 1 passed, 1 failed"), "{text}");
+}
+
+#[test]
+fn bad_scripts_get_clear_errors_with_the_line() {
+    let cases = [
+        ("new\nplcae 1 2 3\n", "unknown command 'plcae' at", ":2:1"),
+        ("place 1 2\n", "missing Z at", ":1:10"),
+        ("color 0\n", "palette index 0 is outside 1..=255", ":1:7"),
+        ("color 300\n", "palette index 300 is outside 1..=255", ":1:7"),
+        ("brush sphere -1\n", "sphere radius -1 is outside 0..=4096", ":1:14"),
+        ("brush sphere 1000000000\n", "sphere radius 1000000000 is outside", ":1:14"),
+        ("load does-not-exist.vox\n", "does-not-exist.vox", ":1"),
+        ("new\nplace 99999999 0 0\n", "X 99999999 is outside", ":2:7"),
+        ("new\nundo\n", "nothing to undo", ":2"),
+        ("new\nexpect written <= 10\n", "needs an edit line", ":2"),
+    ];
+    for (script, message, place) in cases {
+        let (out, text) = run_script(script);
+        assert!(!out.status.success(), "{script:?} should fail");
+        assert!(text.contains(message) && text.contains(place), "{script:?}: {text}");
+        assert!(!text.contains("panicked"), "{script:?}: {text}");
+    }
+}
+
+#[test]
+fn a_missing_script_file_is_an_error_not_a_panic() {
+    let out = octovox(&["replay", "--cpu", "/nonexistent/script.ovr"]);
+    let text = stdout(&out);
+    assert!(!out.status.success());
+    assert!(text.contains("cannot read script"), "{text}");
+}
