@@ -1,5 +1,6 @@
 //! One module per subcommand; `run` dispatches.
 
+mod bench;
 mod convert;
 mod info;
 pub mod render;
@@ -24,7 +25,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             frame,
         }) => convert::run(&input, &output, frame),
         Some(Command::Render(args)) => render::run(&args),
-        Some(Command::Bench(_)) => anyhow::bail!("bench is not built yet"),
+        Some(Command::Bench(args)) => bench::run(&args),
         Some(Command::Replay { scripts, cpu }) => replay::run(&scripts, cpu, update_images()),
     }
 }

@@ -5,6 +5,7 @@ pub mod build;
 pub mod demo;
 pub mod octree;
 pub mod palette;
+pub mod sculpture;
 pub mod shape;
 
 pub use apply::{EditError, Patch};
