@@ -107,35 +107,23 @@ fn argmin3(t: vec3<f32>) -> u32 {
     return 2u;
 }
 
-// The one plane-crossing rule of every tracer (see Ray::crossed).
-fn crossed(r: Ray, axis: u32, coord: f32, t: f32, entry_axis: u32) -> bool {
-    let tp = plane_t(r, axis, coord);
-    if (axis <= entry_axis) {
-        return tp <= t;
-    }
-    return tp < t;
-}
-
-fn voxel_on_axis(r: Ray, axis: u32, t: f32, entry_axis: u32) -> i32 {
-    let p = r.o[axis] + r.d[axis] * t;
-    if (r.d[axis] > 0.0) {
-        let k = i32(floor(p));
-        if (!crossed(r, axis, f32(k), t, entry_axis)) {
-            return k - 1;
-        }
-        if (crossed(r, axis, f32(k + 1), t, entry_axis)) {
-            return k + 1;
-        }
-        return k;
-    }
-    let k = i32(ceil(p)) - 1;
-    if (!crossed(r, axis, f32(k + 1), t, entry_axis)) {
-        return k + 1;
-    }
-    if (crossed(r, axis, f32(k), t, entry_axis)) {
-        return k - 1;
-    }
-    return k;
+// The voxel where the ray is at t, on every axis at once: `Ray::voxel_on_axis`
+// of src/trace/mod.rs in vector form, with the same plane-crossing rule
+// (`Ray::crossed`: planes crossed at the same t count in x, y, z order) (dynamic vector indexing is slow on some
+// drivers, so the shaders avoid it on hot paths).
+fn voxel_at(r: Ray, t: f32, entry_axis: u32) -> vec3<i32> {
+    let p = r.o + r.d * t;
+    let positive = r.d > vec3<f32>(0.0);
+    let k = vec3<i32>(select(ceil(p) - vec3<f32>(1.0), floor(p), positive));
+    let tie_counts = vec3<u32>(0u, 1u, 2u) <= vec3<u32>(entry_axis);
+    let t_k = (vec3<f32>(k) - r.o) * r.inv;
+    let t_k1 = (vec3<f32>(k + vec3<i32>(1)) - r.o) * r.inv;
+    let crossed_k = select(t_k < vec3<f32>(t), t_k <= vec3<f32>(t), tie_counts);
+    let crossed_k1 = select(t_k1 < vec3<f32>(t), t_k1 <= vec3<f32>(t), tie_counts);
+    // Moving up, voxel k is entered through plane k; moving down, through k + 1.
+    let up = select(select(vec3<i32>(0), vec3<i32>(1), crossed_k1), vec3<i32>(-1), !crossed_k);
+    let down = select(select(vec3<i32>(0), vec3<i32>(-1), crossed_k), vec3<i32>(1), !crossed_k1);
+    return k + select(down, up, positive);
 }
 
 fn entry_normal_code(r: Ray, axis: u32) -> u32 {
@@ -154,13 +142,9 @@ fn hit_cell(r: Ray, value: u32, mn: vec3<i32>, level: u32, t: f32, axis: u32, it
         return hit;
     }
     let mx = mn + vec3<i32>((1 << level) - 1);
-    for (var b = 0u; b < 3u; b++) {
-        if (b == axis) {
-            hit.voxel[b] = select(mx[b], mn[b], r.d[b] > 0.0);
-        } else {
-            hit.voxel[b] = clamp(voxel_on_axis(r, b, t, axis), mn[b], mx[b]);
-        }
-    }
+    let on_face = select(mx, mn, r.d > vec3<f32>(0.0));
+    let is_entry = vec3<u32>(0u, 1u, 2u) == vec3<u32>(axis);
+    hit.voxel = select(clamp(voxel_at(r, t, axis), mn, mx), on_face, is_entry);
     hit.value = value;
     hit.normal_code = entry_normal_code(r, axis);
     hit.level = level;

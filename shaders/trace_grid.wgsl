@@ -23,14 +23,9 @@ fn trace_grid(r: Ray) -> Hit {
     }
     let t = max(s.t_enter, 0.0);
     var axis = select(NO_AXIS, s.axis, s.t_enter >= 0.0);
-    var voxel = vec3<i32>(0);
-    for (var b = 0u; b < 3u; b++) {
-        if (b == axis) {
-            voxel[b] = select(hi[b], lo[b], r.d[b] > 0.0);
-        } else {
-            voxel[b] = clamp(voxel_on_axis(r, b, t, axis), lo[b], hi[b]);
-        }
-    }
+    let on_face = select(hi, lo, r.d > vec3<f32>(0.0));
+    let is_entry = vec3<u32>(0u, 1u, 2u) == vec3<u32>(axis);
+    var voxel = select(clamp(voxel_at(r, t, axis), lo, hi), on_face, is_entry);
     let step = select(vec3<i32>(-1), vec3<i32>(1), r.d > vec3<f32>(0.0));
     let far_offset = select(vec3<f32>(0.0), vec3<f32>(1.0), r.d > vec3<f32>(0.0));
     var iterations = 0u;

@@ -15,15 +15,15 @@ fn child_word(word: u32, level: u32, octant: u32) -> u32 {
     return nodes[slot * 8u + octant];
 }
 
+// Per axis: has the ray crossed the mid-plane (the rule of `crossed`, in
+// vector form: no dynamic vector indexing, which is slow on some drivers)?
 fn first_octant(r: Ray, mn: vec3<i32>, level: u32, t: f32, entry_axis: u32) -> u32 {
     let mid = vec3<f32>(mn + vec3<i32>(1 << (level - 1u)));
-    var octant = 0u;
-    for (var a = 0u; a < 3u; a++) {
-        let c = crossed(r, a, mid[a], t, entry_axis);
-        let upper = select(!c, c, r.d[a] > 0.0);
-        octant |= select(0u, 1u, upper) << a;
-    }
-    return octant;
+    let t_mid = (mid - r.o) * r.inv;
+    let tie_counts = vec3<u32>(0u, 1u, 2u) <= vec3<u32>(entry_axis);
+    let c = select(t_mid < vec3<f32>(t), t_mid <= vec3<f32>(t), tie_counts);
+    let upper = select(!c, c, r.d > vec3<f32>(0.0));
+    return select(0u, 1u, upper.x) | select(0u, 2u, upper.y) | select(0u, 4u, upper.z);
 }
 
 fn trace_svo(r: Ray) -> Hit {
@@ -39,11 +39,15 @@ fn trace_svo(r: Ray) -> Hit {
     if ((u.root & POINTER_BIT) == 0u) {
         return hit_cell(r, u.root, vec3<i32>(0), depth, t, axis, 1u);
     }
-    var words: array<u32, 21>;
-    var octants: array<u32, 21>;
+    // The stack: the octant taken at every level, 3 bits a level, in two
+    // registers. Node words above the current one are fetched again from the
+    // root after a pop (no per-thread array: those are slow, very slow on
+    // CPU-emulated GPUs like lavapipe).
+    var path_low = 0u;
+    var path_high = 0u;
     var level = depth;
+    var node = u.root;
     var node_min = vec3<i32>(0);
-    words[level] = u.root;
     var octant = first_octant(r, node_min, level, t, axis);
     var iterations = 0u;
     loop {
@@ -53,11 +57,16 @@ fn trace_svo(r: Ray) -> Hit {
         iterations += 1u;
         let half = 1 << (level - 1u);
         let child_min = node_min + octant_offset(octant) * half;
-        let word = child_word(words[level], level, octant);
+        let word = child_word(node, level, octant);
         if ((word & POINTER_BIT) != 0u) {
-            octants[level] = octant;
+            let i = level - 1u;
+            if (i < 10u) {
+                path_low = (path_low & ~(7u << (3u * i))) | (octant << (3u * i));
+            } else {
+                path_high = (path_high & ~(7u << (3u * (i - 10u)))) | (octant << (3u * (i - 10u)));
+            }
             level -= 1u;
-            words[level] = word;
+            node = word;
             node_min = child_min;
             octant = first_octant(r, node_min, level, t, axis);
             continue;
@@ -69,12 +78,15 @@ fn trace_svo(r: Ray) -> Hit {
         let far = vec3<f32>(child_min) + select(vec3<f32>(0.0), vec3<f32>(f32(half)), r.d > vec3<f32>(0.0));
         let exits = (far - r.o) * r.inv;
         let a = argmin3(exits);
-        t = exits[a];
+        t = min(min(exits.x, exits.y), exits.z);
         axis = a;
         let bit = 1u << a;
+        let positive = r.d > vec3<f32>(0.0);
+        let forward = select(select(positive.z, positive.y, a == 1u), positive.x, a == 0u);
+        let start_level = level;
         var left_root = false;
         loop {
-            let leaving = select((octant & bit) == 0u, (octant & bit) != 0u, r.d[a] > 0.0);
+            let leaving = select((octant & bit) == 0u, (octant & bit) != 0u, forward);
             if (!leaving) {
                 octant ^= bit;
                 break;
@@ -84,15 +96,30 @@ fn trace_svo(r: Ray) -> Hit {
                 break;
             }
             level += 1u;
-            octant = octants[level];
+            octant = path_octant(path_low, path_high, level);
             node_min -= octant_offset(octant) * (1 << (level - 1u));
         }
         if (left_root) {
             break;
         }
+        if (level != start_level) {
+            // Fetch the node word at the new level along the path.
+            node = u.root;
+            for (var l = depth; l > level; l--) {
+                node = child_word(node, l, path_octant(path_low, path_high, l));
+            }
+        }
     }
     miss.iterations = iterations;
     return miss;
+}
+
+fn path_octant(low: u32, high: u32, level: u32) -> u32 {
+    let i = level - 1u;
+    if (i < 10u) {
+        return (low >> (3u * i)) & 7u;
+    }
+    return (high >> (3u * (i - 10u))) & 7u;
 }
 
 @compute @workgroup_size(8, 8)

@@ -97,7 +97,6 @@ struct BuildRow {
     bytes_per_voxel: f64,
     report_svo_bytes: f64,
     dense_grid_bytes: u64,
-    report_grid_bytes: f64,
     build_ms: f64,
     report_build_ms: f64,
 }
@@ -125,13 +124,12 @@ fn bench_build(quick: bool) -> anyhow::Result<(String, String)> {
             bytes_per_voxel: tree.pool().live_bytes() as f64 / solid.max(1) as f64,
             report_svo_bytes: model.report.0 * 1e6,
             dense_grid_bytes: grid.bytes(),
-            report_grid_bytes: 0.0,
             build_ms: median(times),
             report_build_ms: model.report.3 * 1e3,
         });
     }
     let mut md = header("Octree build and memory");
-    md += "| model | solid voxels | nodes | bricks | pool bytes | bytes/voxel | report SVO bytes | pool / report | dense grid bytes (u8) | build ms (median) | report build ms | speed-up |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    md += "| model | solid voxels | nodes | bricks | pool bytes | bytes/voxel | report SVO bytes | pool / report | dense grid bytes (cube, u8) | build ms (median) | report build ms | speed-up |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for r in &rows {
         md += &format!(
             "| {} | {} | {} | {} | {} | {:.3} | {:.0} | {:.2} | {} | {:.1} | {:.0} | {:.0}× |\n",
@@ -238,19 +236,27 @@ fn bench_render(quick: bool) -> anyhow::Result<(String, String)> {
         let (lo, hi) = scene.tree.solid_bounds().context("empty model")?;
         let camera = Camera::framing(lo, hi, 50.0);
         let frames = if quick { 2 } else { 5 };
-        let mut measure = |mode: TraceMode| -> anyhow::Result<(f64, f64)> {
-            let settings = RenderSettings { mode, view: View::Shaded, shadows: false, render_scale: 1.0 };
-            renderer.render(&scene.tree, &camera, (width, height), &settings, None)?; // warm-up
-            let mut times = Vec::new();
-            for _ in 0..frames {
-                times.push(renderer.render(&scene.tree, &camera, (width, height), &settings, None)?);
+        let settings = |mode| RenderSettings { mode, view: View::Shaded, shadows: false, render_scale: 1.0 };
+        let modes = [TraceMode::Grid, TraceMode::Svo];
+        // Warm up both, then alternate frames so machine noise hits both alike.
+        for mode in modes {
+            renderer.render(&scene.tree, &camera, (width, height), &settings(mode), None)?;
+        }
+        let mut times = [Vec::new(), Vec::new()];
+        for _ in 0..frames {
+            for (i, mode) in modes.into_iter().enumerate() {
+                times[i].push(renderer.render(&scene.tree, &camera, (width, height), &settings(mode), None)?);
             }
+        }
+        let mut mean_iterations = [0.0; 2];
+        for (i, mode) in modes.into_iter().enumerate() {
+            renderer.render(&scene.tree, &camera, (width, height), &settings(mode), None)?;
             let hits = renderer.read_hits()?;
-            let mean_iterations = hits.iter().map(|h| f64::from(h.iterations)).sum::<f64>() / hits.len().max(1) as f64;
-            Ok((median(times), mean_iterations))
-        };
-        let (grid_ms, grid_iter) = measure(TraceMode::Grid)?;
-        let (svo_ms, svo_iter) = measure(TraceMode::Svo)?;
+            mean_iterations[i] = hits.iter().map(|h| f64::from(h.iterations)).sum::<f64>() / hits.len().max(1) as f64;
+        }
+        let [grid_times, svo_times] = times;
+        let (grid_ms, svo_ms) = (median(grid_times), median(svo_times));
+        let [grid_iter, svo_iter] = mean_iterations;
         rows.push(RenderRow {
             model: model.name,
             adapter: renderer.gpu.adapter_name.clone(),

@@ -1,4 +1,5 @@
-//! The report's baseline: a dense 3D grid (`x + nx·(y + ny·z)`) walked with
+//! The report's baseline: a dense cubic grid indexed `x + size·y + size²·z`
+//! (the report's layout; one byte per voxel here, four there) walked with
 //! Amanatides–Woo DDA. `shaders/trace_grid.wgsl` is its twin.
 
 use glam::{IVec3, UVec3, Vec3};
@@ -10,7 +11,8 @@ use crate::scene::Octree;
 /// sparse scene's bounding box can be far bigger than any memory.
 pub const MAX_GRID_CELLS: u64 = 1 << 30;
 
-/// The scene's solid bounding box as a flat array of palette indices.
+/// The cube of side `max extent` at the scene's min corner, as a flat array
+/// of palette indices (`dims` is that side on every axis).
 #[derive(Clone, Debug, Default)]
 pub struct DenseGrid {
     /// Min corner in tree-local coordinates.
@@ -27,7 +29,7 @@ impl DenseGrid {
             return Some(DenseGrid::default());
         };
         let min = lo - tree.origin();
-        let dims = (hi - lo + IVec3::ONE).as_uvec3();
+        let dims = UVec3::splat((hi - lo + IVec3::ONE).max_element() as u32);
         if dims.as_u64vec3().element_product() > MAX_GRID_CELLS {
             return None;
         }

@@ -3,8 +3,8 @@
 //!
 //! Per ray: descend into the child containing the current point, step to the
 //! next sibling across the nearest exit plane (by t, never by nudging the
-//! position), pop when the step leaves the node. The stack holds the node
-//! word and the octant taken at every level.
+//! position), pop when the step leaves the node. The stack holds the octant
+//! taken at every level (see `OctantPath`).
 
 use glam::{IVec3, Vec3};
 
@@ -12,7 +12,8 @@ use super::{Hit, MAX_ITERATIONS, NO_AXIS, Ray, argmin};
 use crate::gpu_pool::{is_pointer, slot_of};
 use crate::scene::octree::{MAX_DEPTH, Octree, octant_offset};
 
-const STACK: usize = MAX_DEPTH as usize + 1;
+// The octant path holds 20 levels of 3 bits in two words.
+const _: () = assert!(MAX_DEPTH <= 20);
 
 /// The first solid voxel along `ray` (tree-local coordinates).
 pub fn trace(tree: &Octree, ray: &Ray) -> Hit {
@@ -29,22 +30,26 @@ pub fn trace(tree: &Octree, ray: &Ray) -> Hit {
     if !is_pointer(root) {
         return hit_cell(ray, root as u8, IVec3::ZERO, depth, t, axis, 1);
     }
-    let mut words = [0u32; STACK];
-    let mut octants = [0usize; STACK];
+    // The stack: the octant taken at every level, 3 bits a level, in two
+    // words (registers on a GPU, unlike an array). The node words above the
+    // current one are not kept: after a pop they are fetched again from the
+    // root along the octant path, which is cheaper on GPUs (and far cheaper on
+    // CPU-emulated ones) than a per-thread array.
+    let mut path = OctantPath::default();
     let mut level = depth;
+    let mut node = root;
     let mut node_min = IVec3::ZERO;
-    words[level as usize] = root;
     let mut octant = first_octant(ray, node_min, level, t, axis);
     let mut iterations = 0;
     while iterations < MAX_ITERATIONS {
         iterations += 1;
         let half = 1 << (level - 1);
         let child_min = node_min + octant_offset(octant) * half;
-        let word = child_word(tree, words[level as usize], level, octant);
+        let word = child_word(tree, node, level, octant);
         if is_pointer(word) {
-            octants[level as usize] = octant;
+            path.set(level, octant);
             level -= 1;
-            words[level as usize] = word;
+            node = word;
             node_min = child_min;
             octant = first_octant(ray, node_min, level, t, axis);
             continue;
@@ -59,6 +64,7 @@ pub fn trace(tree: &Octree, ray: &Ray) -> Hit {
         t = exits[a];
         axis = a;
         let bit = 1 << a;
+        let start_level = level;
         loop {
             let leaving = if ray.dir[a] > 0.0 { octant & bit != 0 } else { octant & bit == 0 };
             if !leaving {
@@ -69,11 +75,45 @@ pub fn trace(tree: &Octree, ray: &Ray) -> Hit {
                 return Hit { iterations, ..Hit::default() };
             }
             level += 1;
-            octant = octants[level as usize];
+            octant = path.get(level);
             node_min -= octant_offset(octant) * (1 << (level - 1));
+        }
+        if level != start_level {
+            node = refetch(tree, root, depth, level, &path);
         }
     }
     Hit { iterations, ..Hit::default() }
+}
+
+/// Octants taken at levels 1..=20, 3 bits each (`octant_path_*` in WGSL).
+#[derive(Default, Clone, Copy)]
+struct OctantPath {
+    low: u32,
+    high: u32,
+}
+
+impl OctantPath {
+    fn get(&self, level: u32) -> usize {
+        let i = level - 1;
+        (if i < 10 { self.low >> (3 * i) } else { self.high >> (3 * (i - 10)) } & 7) as usize
+    }
+
+    fn set(&mut self, level: u32, octant: usize) {
+        let i = level - 1;
+        let (word, shift) = if i < 10 { (&mut self.low, 3 * i) } else { (&mut self.high, 3 * (i - 10)) };
+        *word = (*word & !(7 << shift)) | (octant as u32) << shift;
+    }
+}
+
+/// The node word at `level` on the current path, fetched from the root.
+fn refetch(tree: &Octree, root: u32, depth: u32, level: u32, path: &OctantPath) -> u32 {
+    let mut word = root;
+    let mut l = depth;
+    while l > level {
+        word = child_word(tree, word, l, path.get(l));
+        l -= 1;
+    }
+    word
 }
 
 /// Child word of a node (level ≥ 2) or voxel value of a brick (level 1).
