@@ -120,3 +120,52 @@ fn gpu_flat_wall_has_no_holes() {
         assert!(hits.iter().all(|h| h.is_hit() && h.normal == IVec3::new(0, 0, -1)), "hole from {camera:?}");
     }
 }
+
+/// Every shared .vox model, at least 8 cameras each (outside, inside the
+/// bounding box, grazing): GPU SVO = CPU SVO = CPU grid = GPU grid.
+#[test]
+fn gpu_matches_cpu_on_every_shared_model() {
+    let mut models = Vec::new();
+    for dir in ["seed", "magicavoxel", "format"] {
+        for entry in std::fs::read_dir(common::assets().join("vox").join(dir)).unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().is_some_and(|e| e == "vox") && !path.ends_with("not_a.vox") {
+                models.push(path);
+            }
+        }
+    }
+    assert!(models.len() >= 14, "{models:?}");
+    for path in models {
+        let mut scene = octovox::io::load_scene(&path, 0).unwrap();
+        let (lo, hi) = scene.tree.solid_bounds().unwrap();
+        let cameras = cameras_for(lo, hi);
+        assert!(cameras.len() >= 8);
+        eprintln!("{}", path.display());
+        check_scene(&mut scene.tree, &cameras, (64, 48));
+    }
+}
+
+/// The shaded teapot is a picture (not blank, not one colour), and the
+/// iteration counts show the SVO taking fewer steps than the grid.
+#[test]
+fn teapot_picture_and_iteration_counts() {
+    let path = common::assets().join("vox/seed/teapot256.vox");
+    let mut scene = octovox::io::load_scene(&path, 0).unwrap();
+    let mut renderer = renderer_for(&mut scene.tree);
+    let (lo, hi) = scene.tree.solid_bounds().unwrap();
+    let camera = Camera::framing(lo, hi, 50.0);
+    let settings = RenderSettings { mode: TraceMode::Svo, view: View::Shaded, shadows: true, render_scale: 1.0 };
+    renderer.render(&scene.tree, &camera, (200, 150), &settings, None).unwrap();
+    let image = renderer.read_image().unwrap();
+    let distinct: std::collections::HashSet<[u8; 4]> = image.pixels().map(|p| p.0).collect();
+    let teapot_pixels = renderer.read_hits().unwrap().iter().filter(|h| h.is_hit()).count();
+    assert!(distinct.len() > 20, "only {} colours", distinct.len());
+    assert!(teapot_pixels > 200 * 150 / 10, "teapot covers {teapot_pixels} pixels");
+    let mut mean = |mode| {
+        let hits = gpu_hits(&mut renderer, &scene.tree, &camera, (200, 150), mode);
+        hits.iter().map(|h| f64::from(h.iterations)).sum::<f64>() / hits.len() as f64
+    };
+    let (svo, grid) = (mean(TraceMode::Svo), mean(TraceMode::Grid));
+    eprintln!("mean iterations per pixel: SVO {svo:.1}, grid {grid:.1}");
+    assert!(svo < grid, "SVO {svo} vs grid {grid}");
+}
