@@ -1,6 +1,7 @@
 //! Criterion benchmarks of the octree: build from a voxel list and from a
 //! dense array, and edit latency (apply + flush). `octovox bench` prints the
 //! same quantities as tables for docs/bench/.
+#![allow(clippy::unwrap_used)] // in tests a panic is the failure report
 
 use std::hint::black_box;
 use std::path::Path;
@@ -25,7 +26,9 @@ fn build(c: &mut Criterion) {
             u8::from(p.length_squared() < 60 * 60)
         })
         .collect();
-    c.bench_function("build 128³ ball from dense", |b| b.iter(|| Octree::from_dense(dims, IVec3::ZERO, black_box(&dense))));
+    c.bench_function("build 128³ ball from dense", |b| {
+        b.iter(|| Octree::from_dense(dims, IVec3::ZERO, black_box(&dense)))
+    });
 }
 
 fn edit(c: &mut Criterion) {

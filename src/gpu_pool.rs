@@ -169,7 +169,10 @@ pub struct Region {
 
 impl Region {
     /// `(byte offset, bytes)` for each changed range.
-    pub fn ranges<'a, T: bytemuck::Pod>(&'a self, arena: &'a SlotArena<T>) -> impl Iterator<Item = (u64, &'a [u8])> + 'a {
+    pub fn ranges<'a, T: bytemuck::Pod>(
+        &'a self,
+        arena: &'a SlotArena<T>,
+    ) -> impl Iterator<Item = (u64, &'a [u8])> + 'a {
         self.runs.iter().map(move |&(start, end)| {
             let bytes = bytemuck::cast_slice(&arena.items[start as usize..end as usize]);
             (u64::from(start) * self.slot_bytes, bytes)

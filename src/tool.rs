@@ -36,19 +36,14 @@ impl Tool {
 }
 
 /// The brush shape, centred on the cell a click picks.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Brush {
+    #[default]
     Voxel,
     /// Cells with dx² + dy² + dz² ≤ r².
     Sphere(i32),
     /// `size` cells per axis, from `center - size / 2`.
     Box(IVec3),
-}
-
-impl Default for Brush {
-    fn default() -> Brush {
-        Brush::Voxel
-    }
 }
 
 impl Brush {

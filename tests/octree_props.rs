@@ -1,5 +1,6 @@
 //! Property tests of the CPU octree, its edits, undo data and the node pool's
 //! dirty ranges.
+#![allow(clippy::unwrap_used)] // in tests a panic is the failure report
 
 use std::collections::HashMap;
 
@@ -78,14 +79,8 @@ fn check_all(tree: &Octree, reference: &HashMap<IVec3, u8>, mirror: &Mirror) {
                 let p = IVec3::new(x, y, z);
                 let want = reference.get(&p).copied().unwrap_or(0);
                 assert_eq!(tree.get(p), want, "octree at {p}");
-                let gpu = decode_from_bytes(
-                    &mirror.nodes,
-                    &mirror.bricks,
-                    tree.root_word(),
-                    tree.origin(),
-                    tree.depth(),
-                    p,
-                );
+                let gpu =
+                    decode_from_bytes(&mirror.nodes, &mirror.bricks, tree.root_word(), tree.origin(), tree.depth(), p);
                 assert_eq!(gpu, want, "mirror buffer at {p}");
             }
         }
@@ -154,7 +149,11 @@ fn build_from_list_and_dense_agree() {
     for z in 0..dims.z as i32 {
         for y in 0..dims.y as i32 {
             for x in 0..dims.x as i32 {
-                let v = if (x - 18).pow(2) + (y - 10).pow(2) * 3 + (z - 22).pow(2) < 300 { ((x / 4 + z / 8) % 3 + 1) as u8 } else { 0 };
+                let v = if (x - 18).pow(2) + (y - 10).pow(2) * 3 + (z - 22).pow(2) < 300 {
+                    ((x / 4 + z / 8) % 3 + 1) as u8
+                } else {
+                    0
+                };
                 dense[(x + 37 * (y + 21 * z)) as usize] = v;
                 if v != 0 {
                     list.push((IVec3::new(x, y, z) + IVec3::new(-5, 7, 100), v));
@@ -205,4 +204,27 @@ fn bad_edits_are_refused_without_change() {
     let radius = Edit::Brush { shape: Shape::Sphere { center: IVec3::ZERO, radius: 1_000_000_000 }, op: Op::Remove };
     assert!(radius.apply(&mut tree).unwrap_err().to_string().contains("radius"));
     assert_eq!(tree.voxels(), vec![(IVec3::ZERO, 5)]);
+}
+
+/// Edits on the report's teapot write bytes for the slots they touch, not
+/// for the tree: one voxel ≤ 1 KiB, a radius-8 sphere a small fraction.
+#[test]
+fn teapot_edits_write_only_what_they_touch() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/vox/seed/teapot256.vox");
+    let model = octovox::io::vox::load_vox_file(&path, 0).unwrap();
+    let mut tree = Octree::from_voxels(&model.voxels).unwrap();
+    let whole = tree.pool_mut().flush().byte_count();
+    assert_eq!(whole, tree.pool().live_bytes());
+    let wall = (-200..200).map(|x| IVec3::new(x, 0, 0)).find(|p| tree.get(*p) != 0).unwrap();
+    for (shape, limit) in [
+        (Shape::Voxel(wall), 1024),
+        (Shape::Voxel(wall + IVec3::new(-1, 0, 0)), 1024),
+        (Shape::Sphere { center: wall, radius: 8 }, whole / 100),
+    ] {
+        for op in [Op::Remove, Op::Place(3), Op::Paint(4)] {
+            Edit::Brush { shape, op }.apply(&mut tree).unwrap();
+            let written = tree.pool_mut().flush().byte_count();
+            assert!(written <= limit, "{shape:?} {op:?} wrote {written} bytes of {whole}");
+        }
+    }
 }

@@ -1,5 +1,6 @@
 //! `octovox replay` as a user runs it: every script in tests/replays passes,
 //! failures name their line, bad scripts get clear errors and no panic.
+#![allow(clippy::unwrap_used)] // in tests a panic is the failure report
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

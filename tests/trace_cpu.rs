@@ -1,5 +1,6 @@
 //! The CPU SVO traversal against the CPU grid DDA, on a sculpted scene and on
 //! the traversal's known hard cases.
+#![allow(clippy::unwrap_used)] // in tests a panic is the failure report
 
 mod common;
 
@@ -65,7 +66,12 @@ fn diagonals_through_edges_and_corners() {
     let mut agreement = Agreement::default();
     for x in -6..6 {
         for y in 0..6 {
-            for dir in [Vec3::new(1.0, 1.0, 0.0), Vec3::new(1.0, -1.0, 1.0), Vec3::new(-1.0, 1.0, -1.0), Vec3::new(0.0, -1.0, 1.0)] {
+            for dir in [
+                Vec3::new(1.0, 1.0, 0.0),
+                Vec3::new(1.0, -1.0, 1.0),
+                Vec3::new(-1.0, 1.0, -1.0),
+                Vec3::new(0.0, -1.0, 1.0),
+            ] {
                 let origin = Vec3::new(x as f32 * 4.0, y as f32 * 5.0 + 20.0, -30.0 + x as f32);
                 let (a, b) = single(&tree, origin, dir);
                 agreement.add(&[a], &[b]);
@@ -95,7 +101,11 @@ fn far_camera_and_deep_sparse_tree() {
     tree.apply_brush(&Shape::Voxel(IVec3::ZERO), Op::Place(4)).unwrap();
     tree.apply_brush(&Shape::Voxel(far), Op::Place(5)).unwrap();
     assert!(tree.depth() >= 16);
-    let camera = Camera { eye: far.as_dvec3() + DVec3::new(0.5, 100_000.0, 0.5), target: far.as_dvec3() + DVec3::splat(0.5), fov_y_deg: 0.01 };
+    let camera = Camera {
+        eye: far.as_dvec3() + DVec3::new(0.5, 100_000.0, 0.5),
+        target: far.as_dvec3() + DVec3::splat(0.5),
+        fov_y_deg: 0.01,
+    };
     let basis = camera.basis(9, 9, tree.origin());
     let hits = trace_image(Tracer::Svo(&tree), &basis);
     let center = hits[4 * 9 + 4];

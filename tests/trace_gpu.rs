@@ -1,5 +1,6 @@
 //! The WGSL tracers on the real GPU path (lavapipe on CI) against the CPU
 //! references: same hit records, same hard cases.
+#![allow(clippy::unwrap_used)] // in tests a panic is the failure report
 
 mod common;
 
@@ -22,7 +23,13 @@ fn renderer_for(tree: &mut Octree) -> Renderer {
     renderer
 }
 
-fn gpu_hits(renderer: &mut Renderer, tree: &Octree, camera: &Camera, size: (u32, u32), mode: TraceMode) -> Vec<octovox::trace::Hit> {
+fn gpu_hits(
+    renderer: &mut Renderer,
+    tree: &Octree,
+    camera: &Camera,
+    size: (u32, u32),
+    mode: TraceMode,
+) -> Vec<octovox::trace::Hit> {
     let settings = RenderSettings { mode, view: View::Shaded, shadows: true, render_scale: 1.0 };
     renderer.render(tree, camera, size, &settings, None).unwrap();
     renderer.read_hits().unwrap()
@@ -82,7 +89,11 @@ fn gpu_far_camera_deep_tree_empty_and_full() {
     let far = IVec3::new(40_000, -20_000, 50_000);
     tree.apply_brush(&Shape::Voxel(IVec3::ZERO), Op::Place(4)).unwrap();
     tree.apply_brush(&Shape::Voxel(far), Op::Place(5)).unwrap();
-    let camera = Camera { eye: far.as_dvec3() + DVec3::new(0.5, 100_000.0, 0.5), target: far.as_dvec3() + DVec3::splat(0.5), fov_y_deg: 0.01 };
+    let camera = Camera {
+        eye: far.as_dvec3() + DVec3::new(0.5, 100_000.0, 0.5),
+        target: far.as_dvec3() + DVec3::splat(0.5),
+        fov_y_deg: 0.01,
+    };
     let mut renderer = renderer_for(&mut tree);
     let hits = gpu_hits(&mut renderer, &tree, &camera, (9, 9), TraceMode::Svo);
     assert_eq!(hits[4 * 9 + 4].value, 5);

@@ -2,10 +2,8 @@
 //!
 //! This test binary counts heap bytes with a wrapping global allocator, so it
 //! holds a single test: nothing else allocates while it measures.
-#![expect(
-    unsafe_code,
-    reason = "a GlobalAlloc that forwards to System needs unsafe impl"
-)]
+#![allow(clippy::unwrap_used)] // in tests a panic is the failure report
+#![expect(unsafe_code, reason = "a GlobalAlloc that forwards to System needs unsafe impl")]
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -66,33 +64,12 @@ fn peak_while_failing(bytes: &[u8]) -> usize {
 
 #[test]
 fn hostile_headers_allocate_almost_nothing() {
-    let one_voxel = words(&[1])
-        .into_iter()
-        .chain([0, 0, 0, 1])
-        .collect::<Vec<u8>>();
+    let one_voxel = words(&[1]).into_iter().chain([0, 0, 0, 1]).collect::<Vec<u8>>();
     let cases: Vec<(&str, Vec<u8>)> = vec![
-        (
-            "SIZE 2^31",
-            vox_file(&[
-                (b"SIZE", words(&[1 << 31, 1 << 31, 1 << 31])),
-                (b"XYZI", one_voxel),
-            ]),
-        ),
-        (
-            "XYZI claiming 2^31 voxels",
-            vox_file(&[
-                (b"SIZE", words(&[8, 8, 8])),
-                (b"XYZI", words(&[1 << 31, 0, 0])),
-            ]),
-        ),
-        (
-            "nGRP claiming 2^30 children",
-            vox_file(&[(b"nGRP", words(&[0, 0, 1 << 30, 1, 2]))]),
-        ),
-        (
-            "dictionary claiming 2^31 entries",
-            vox_file(&[(b"MATL", words(&[1, 1 << 31, 4, 0]))]),
-        ),
+        ("SIZE 2^31", vox_file(&[(b"SIZE", words(&[1 << 31, 1 << 31, 1 << 31])), (b"XYZI", one_voxel)])),
+        ("XYZI claiming 2^31 voxels", vox_file(&[(b"SIZE", words(&[8, 8, 8])), (b"XYZI", words(&[1 << 31, 0, 0]))])),
+        ("nGRP claiming 2^30 children", vox_file(&[(b"nGRP", words(&[0, 0, 1 << 30, 1, 2]))])),
+        ("dictionary claiming 2^31 entries", vox_file(&[(b"MATL", words(&[1, 1 << 31, 4, 0]))])),
     ];
     for (name, bytes) in cases {
         let peak = peak_while_failing(&bytes);

@@ -1,4 +1,5 @@
 //! `octovox info` on the shared assets, through the real binary.
+#![allow(clippy::unwrap_used)] // in tests a panic is the failure report
 
 use std::path::PathBuf;
 use std::process::{Command, Output};
@@ -7,16 +8,11 @@ use serde_json::Value;
 
 /// `../shared/assets/vox` beside the project root.
 fn asset(relative: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/assets/vox")
-        .join(relative)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/vox").join(relative)
 }
 
 fn octovox(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_octovox"))
-        .args(args)
-        .output()
-        .expect("run octovox")
+    Command::new(env!("CARGO_BIN_EXE_octovox")).args(args).output().expect("run octovox")
 }
 
 /// Runs `octovox info --json` on an asset and parses what it prints.
@@ -24,11 +20,7 @@ fn info_json(relative: &str, extra: &[&str]) -> Value {
     let path = asset(relative);
     let path = path.to_str().expect("UTF-8 asset path");
     let output = octovox(&[&["info", path, "--json"], extra].concat());
-    assert!(
-        output.status.success(),
-        "octovox info {relative} failed: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
+    assert!(output.status.success(), "octovox info {relative} failed: {}", String::from_utf8_lossy(&output.stderr));
     serde_json::from_slice(&output.stdout).expect("info --json prints JSON")
 }
 
@@ -77,32 +69,20 @@ fn trex_loads_one_animation_frame() {
     assert_eq!(info["voxels"], 1_272);
     assert_eq!(info["models"], 1);
     // Frame 2 is the third model of the file (1,287 voxels).
-    assert_eq!(
-        info_json("magicavoxel/T-Rex.vox", &["--frame", "2"])["voxels"],
-        1_287
-    );
+    assert_eq!(info_json("magicavoxel/T-Rex.vox", &["--frame", "2"])["voxels"], 1_287);
 }
 
 #[test]
 fn json_has_every_documented_key() {
     let info = info_json("format/metal-material.vox", &[]);
-    for key in [
-        "voxels",
-        "extent",
-        "min",
-        "max",
-        "models",
-        "materials",
-        "palette_entries",
-    ] {
+    for key in ["voxels", "extent", "min", "max", "models", "materials", "palette_entries"] {
         assert!(info.get(key).is_some(), "missing key {key} in {info}");
     }
     assert_eq!(info["materials"], serde_json::json!({ "metal": 1 }));
     assert_eq!(info["palette_entries"], 1);
     // max − min + 1 = extent on every axis.
     for axis in 0..3 {
-        let span =
-            info["max"][axis].as_i64().unwrap_or(0) - info["min"][axis].as_i64().unwrap_or(0);
+        let span = info["max"][axis].as_i64().unwrap_or(0) - info["min"][axis].as_i64().unwrap_or(0);
         assert_eq!(span + 1, extent(&info)[axis]);
     }
 }
@@ -123,10 +103,7 @@ fn not_a_vox_exits_nonzero_with_the_reason() {
     let output = octovox(&["info", path.to_str().expect("UTF-8 asset path"), "--json"]);
     assert!(!output.status.success());
     let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(
-        stderr.contains("not a .vox file (missing 'VOX ' magic)"),
-        "stderr: {stderr}"
-    );
+    assert!(stderr.contains("not a .vox file (missing 'VOX ' magic)"), "stderr: {stderr}");
     assert!(!stderr.contains("panicked"), "stderr: {stderr}");
     assert!(output.stdout.is_empty());
 }
@@ -138,18 +115,10 @@ fn missing_file_and_bad_frame_are_errors() {
     assert!(String::from_utf8_lossy(&output.stderr).contains("cannot read /nonexistent/x.vox"));
 
     let path = asset("magicavoxel/T-Rex.vox");
-    let output = octovox(&[
-        "info",
-        path.to_str().expect("UTF-8 asset path"),
-        "--frame",
-        "8",
-    ]);
+    let output = octovox(&["info", path.to_str().expect("UTF-8 asset path"), "--frame", "8"]);
     assert!(!output.status.success());
     let stderr = String::from_utf8_lossy(&output.stderr);
-    assert!(
-        stderr.contains("frame 8 requested but file has 8 models"),
-        "stderr: {stderr}"
-    );
+    assert!(stderr.contains("frame 8 requested but file has 8 models"), "stderr: {stderr}");
 }
 
 #[test]
@@ -157,27 +126,13 @@ fn convert_writes_a_file_that_loads_the_same() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = dir.path().join("teapot.vox");
     let input = asset("seed/teapot256.vox");
-    let output = octovox(&[
-        "convert",
-        input.to_str().expect("UTF-8 asset path"),
-        out.to_str().expect("UTF-8 temp path"),
-    ]);
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
+    let output =
+        octovox(&["convert", input.to_str().expect("UTF-8 asset path"), out.to_str().expect("UTF-8 temp path")]);
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
     let before = info_json("seed/teapot256.vox", &[]);
     let after = octovox(&["info", out.to_str().expect("UTF-8 temp path"), "--json"]);
     let after: Value = serde_json::from_slice(&after.stdout).expect("JSON");
-    for key in [
-        "voxels",
-        "extent",
-        "min",
-        "max",
-        "palette_entries",
-        "materials",
-    ] {
+    for key in ["voxels", "extent", "min", "max", "palette_entries", "materials"] {
         assert_eq!(before[key], after[key], "{key}");
     }
 }

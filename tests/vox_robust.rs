@@ -1,5 +1,6 @@
 //! Malformed and hostile `.vox` input: always an error naming the problem,
 //! never a panic, a hang or a huge allocation.
+#![allow(clippy::unwrap_used)] // in tests a panic is the failure report
 
 use std::path::PathBuf;
 use std::sync::LazyLock;
@@ -20,11 +21,7 @@ fn read_asset(relative: &str) -> Vec<u8> {
 
 fn chunk(id: &[u8; 4], content: &[u8]) -> Vec<u8> {
     let mut bytes = id.to_vec();
-    bytes.extend(
-        u32::try_from(content.len())
-            .expect("small chunk")
-            .to_le_bytes(),
-    );
+    bytes.extend(u32::try_from(content.len()).expect("small chunk").to_le_bytes());
     bytes.extend(0u32.to_le_bytes());
     bytes.extend(content);
     bytes
@@ -36,11 +33,7 @@ fn vox_file(children: &[Vec<u8>]) -> Vec<u8> {
     bytes.extend(150u32.to_le_bytes());
     bytes.extend(b"MAIN");
     bytes.extend(0u32.to_le_bytes());
-    bytes.extend(
-        u32::try_from(children.len())
-            .expect("small file")
-            .to_le_bytes(),
-    );
+    bytes.extend(u32::try_from(children.len()).expect("small file").to_le_bytes());
     bytes.extend(children);
     bytes
 }
@@ -118,10 +111,7 @@ fn load_err(bytes: &[u8]) -> VoxError {
 
 fn assert_err_contains(bytes: &[u8], needle: &str) {
     let message = load_err(bytes).to_string();
-    assert!(
-        message.contains(needle),
-        "message {message:?} lacks {needle:?}"
-    );
+    assert!(message.contains(needle), "message {message:?} lacks {needle:?}");
 }
 
 // --- the cases --------------------------------------------------------------
@@ -131,11 +121,7 @@ fn hand_built_files_load() {
     let plain = vox_file(&one_voxel_model());
     assert_eq!(load_vox(&plain, 0).expect("plain").voxels.len(), 1);
     let mut scene = one_voxel_model();
-    scene.extend([
-        transform(0, 1, &[]),
-        group(1, &[2]),
-        transform(2, 3, &[("_t", "5 6 7")]),
-    ]);
+    scene.extend([transform(0, 1, &[]), group(1, &[2]), transform(2, 3, &[("_t", "5 6 7")])]);
     scene.push(shape(3, 0));
     let model = load_vox(&vox_file(&scene), 0).expect("scene");
     // Scene (5, 6, 7) → world (5, 7, −6).
@@ -149,11 +135,7 @@ fn keyframes_follow_the_requested_frame() {
     chunks.push(animated_transform(
         0,
         1,
-        &[
-            &[("_t", "0 0 0")],
-            &[("_f", "5"), ("_t", "10 0 0")],
-            &[("_f", "8"), ("_t", "20 0 0")],
-        ],
+        &[&[("_t", "0 0 0")], &[("_f", "5"), ("_t", "10 0 0")], &[("_f", "8"), ("_t", "20 0 0")]],
     ));
     chunks.push(shape(1, 0));
     let bytes = vox_file(&chunks);
@@ -167,9 +149,7 @@ fn keyframes_follow_the_requested_frame() {
 /// `MAX_VOXELS`: refused before any voxel is placed.
 #[test]
 fn the_voxel_cap_is_checked_before_building() {
-    let layer: Vec<[u8; 4]> = (0..=255u8)
-        .flat_map(|x| (0..=255u8).map(move |y| [x, y, 0, 1]))
-        .collect();
+    let layer: Vec<[u8; 4]> = (0..=255u8).flat_map(|x| (0..=255u8).map(move |y| [x, y, 0, 1])).collect();
     let mut chunks = vec![size(256, 256, 1), xyzi(65_536, &layer)];
     chunks.push(transform(0, 1, &[]));
     // Thirteen levels of groups with two children each: 2^13 shapes.
@@ -181,11 +161,7 @@ fn the_voxel_cap_is_checked_before_building() {
     let start = Instant::now();
     let err = load_err(&vox_file(&chunks));
     assert!(matches!(err, VoxError::TooManyVoxels { .. }), "{err:?}");
-    assert!(
-        start.elapsed() < Duration::from_secs(2),
-        "took {:?}",
-        start.elapsed()
-    );
+    assert!(start.elapsed() < Duration::from_secs(2), "took {:?}", start.elapsed());
 }
 
 #[test]
@@ -199,10 +175,7 @@ fn not_a_vox_says_so() {
 fn every_truncation_of_the_knight_is_an_error() {
     let bytes = read_asset("magicavoxel/chr_knight.vox");
     for len in 0..bytes.len() {
-        assert!(
-            load_vox(&bytes[..len], 0).is_err(),
-            "prefix of {len} bytes loaded"
-        );
+        assert!(load_vox(&bytes[..len], 0).is_err(), "prefix of {len} bytes loaded");
     }
     assert!(load_vox(&bytes, 0).is_ok());
 }
@@ -219,11 +192,7 @@ fn huge_claims_fail_fast() {
     let mut huge_chunk = vox_file(&one_voxel_model());
     huge_chunk[24..28].copy_from_slice(&u32::MAX.to_le_bytes()); // SIZE's content size
     assert_err_contains(&huge_chunk, "claims 4294967295 content bytes");
-    assert!(
-        start.elapsed() < Duration::from_secs(1),
-        "took {:?}",
-        start.elapsed()
-    );
+    assert!(start.elapsed() < Duration::from_secs(1), "took {:?}", start.elapsed());
 }
 
 #[test]
@@ -238,17 +207,11 @@ fn scene_graph_cycles_are_errors() {
     chunks.extend([transform(0, 1, &[]), group(1, &[2]), transform(2, 1, &[])]);
     let err = load_err(&vox_file(&chunks));
     assert!(matches!(err, VoxError::SceneCycle(_)), "{err:?}");
-    assert!(
-        err.to_string().starts_with("scene graph cycle at node"),
-        "{err}"
-    );
+    assert!(err.to_string().starts_with("scene graph cycle at node"), "{err}");
 
     let mut self_loop = one_voxel_model();
     self_loop.push(transform(0, 0, &[]));
-    assert_eq!(
-        load_err(&vox_file(&self_loop)).to_string(),
-        "scene graph cycle at node 0"
-    );
+    assert_eq!(load_err(&vox_file(&self_loop)).to_string(), "scene graph cycle at node 0");
 }
 
 /// A node shared by two parents is an instance, not a cycle (test_groups.vox
@@ -257,18 +220,9 @@ fn scene_graph_cycles_are_errors() {
 fn shared_nodes_are_fine_but_exponential_sharing_is_capped() {
     let mut shared = one_voxel_model();
     shared.extend([transform(0, 1, &[]), group(1, &[2, 3])]);
-    shared.extend([
-        transform(2, 4, &[("_t", "0 0 0")]),
-        transform(3, 4, &[("_t", "9 0 0")]),
-    ]);
+    shared.extend([transform(2, 4, &[("_t", "0 0 0")]), transform(3, 4, &[("_t", "9 0 0")])]);
     shared.push(shape(4, 0));
-    assert_eq!(
-        load_vox(&vox_file(&shared), 0)
-            .expect("shared shape")
-            .voxels
-            .len(),
-        2
-    );
+    assert_eq!(load_vox(&vox_file(&shared), 0).expect("shared shape").voxels.len(), 2);
 
     // 40 levels of groups whose two children are the same next group: 2^40 paths.
     let mut bomb = one_voxel_model();
@@ -279,11 +233,7 @@ fn shared_nodes_are_fine_but_exponential_sharing_is_capped() {
     bomb.push(group(41, &[]));
     let start = Instant::now();
     assert_err_contains(&vox_file(&bomb), "node visits");
-    assert!(
-        start.elapsed() < Duration::from_secs(10),
-        "took {:?}",
-        start.elapsed()
-    );
+    assert!(start.elapsed() < Duration::from_secs(10), "took {:?}", start.elapsed());
 }
 
 #[test]
@@ -294,10 +244,7 @@ fn bad_references_are_errors() {
 
     let mut bad_model = one_voxel_model();
     bad_model.extend([transform(0, 1, &[]), shape(1, 3)]);
-    assert_err_contains(
-        &vox_file(&bad_model),
-        "uses model 3 but the file has 1 models",
-    );
+    assert_err_contains(&vox_file(&bad_model), "uses model 3 but the file has 1 models");
 
     let mut no_root = one_voxel_model();
     no_root.push(shape(5, 0));
@@ -340,10 +287,7 @@ fn other_structural_errors_name_the_chunk() {
     assert_err_contains(&palette, "has 12 bytes; a palette has 1024");
     let mut stray = vox_file(&[size(1, 1, 1), vec![0; 5]]);
     stray.extend([0; 7]); // bytes after MAIN are ignored, as dot_vox does
-    assert_err_contains(
-        &stray,
-        "chunk MAIN at byte 8 ends with 5 stray bytes at byte 44",
-    );
+    assert_err_contains(&stray, "chunk MAIN at byte 8 ends with 5 stray bytes at byte 44");
     let mut version = vox_file(&[]);
     version[4] = 151;
     assert_err_contains(&version, "unsupported .vox version 151");
@@ -372,20 +316,13 @@ static SAMPLES: LazyLock<Vec<Vec<u8>>> = LazyLock::new(|| {
         .filter(|path| path.extension().is_some_and(|e| e == "vox"))
         .collect();
     files.sort();
-    files
-        .iter()
-        .map(|path| std::fs::read(path).expect("read asset"))
-        .collect()
+    files.iter().map(|path| std::fs::read(path).expect("read asset")).collect()
 });
 
 /// Where a flip lands: anywhere, or within the first 2 KiB, where the headers,
 /// scene graph and small chunks of most files live.
 fn flip_position(bytes: &[u8], at: prop::sample::Index, near_start: bool) -> usize {
-    let span = if near_start {
-        bytes.len().min(2048)
-    } else {
-        bytes.len()
-    };
+    let span = if near_start { bytes.len().min(2048) } else { bytes.len() };
     at.index(span)
 }
 

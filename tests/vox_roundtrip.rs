@@ -1,5 +1,6 @@
 //! load → encode → load keeps voxels, palette and materials; axes keep their
 //! directions (no mirroring) both when loading and when saving.
+#![allow(clippy::unwrap_used)] // in tests a panic is the failure report
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -21,49 +22,28 @@ fn asset_files() -> Vec<PathBuf> {
             let path = entry.expect("dir entry").path();
             if path.is_dir() {
                 dirs.push(path);
-            } else if path.extension().is_some_and(|e| e == "vox")
-                && path.file_name().is_some_and(|n| n != "not_a.vox")
+            } else if path.extension().is_some_and(|e| e == "vox") && path.file_name().is_some_and(|n| n != "not_a.vox")
             {
                 files.push(path);
             }
         }
     }
     files.sort();
-    assert!(
-        files.len() >= 14,
-        "expected the shared assets, found {files:?}"
-    );
+    assert!(files.len() >= 14, "expected the shared assets, found {files:?}");
     files
 }
 
 fn voxel_set(model: &VoxelModel) -> BTreeSet<([i32; 3], u8)> {
-    model
-        .voxels
-        .iter()
-        .map(|&(p, i)| (p.to_array(), i))
-        .collect()
+    model.voxels.iter().map(|&(p, i)| (p.to_array(), i)).collect()
 }
 
 fn assert_round_trip(name: &str, model: &VoxelModel) -> VoxelModel {
     let bytes = encode_vox(&model.palette, &model.voxels).expect("encode");
     let again = load_vox(&bytes, 0).expect("reload what we wrote");
-    assert_eq!(
-        again.voxels.len(),
-        model.voxels.len(),
-        "{name}: voxel count"
-    );
-    assert!(
-        voxel_set(&again) == voxel_set(model),
-        "{name}: voxels differ"
-    );
-    assert_eq!(
-        again.palette.colors, model.palette.colors,
-        "{name}: colours"
-    );
-    assert_eq!(
-        again.palette.materials, model.palette.materials,
-        "{name}: materials"
-    );
+    assert_eq!(again.voxels.len(), model.voxels.len(), "{name}: voxel count");
+    assert!(voxel_set(&again) == voxel_set(model), "{name}: voxels differ");
+    assert_eq!(again.palette.colors, model.palette.colors, "{name}: colours");
+    assert_eq!(again.palette.materials, model.palette.materials, "{name}: materials");
     again
 }
 
@@ -98,10 +78,7 @@ fn materials_are_read_from_matl_and_matt() {
     let m = trex.palette.material(1);
     assert_eq!(m.kind, MaterialKind::Diffuse);
     assert_eq!(m.params.get("_weight").map(String::as_str), Some("1"));
-    assert!(
-        m.params.contains_key("_rough") && m.params.contains_key("_ior"),
-        "{m:?}"
-    );
+    assert!(m.params.contains_key("_rough") && m.params.contains_key("_ior"), "{m:?}");
 }
 
 fn synthetic_palette() -> Palette {
@@ -110,9 +87,7 @@ fn synthetic_palette() -> Palette {
     palette.colors[0] = [9, 8, 7, 6];
     let mut glass = Material::new(MaterialKind::Glass);
     glass.params.insert("_ior".to_owned(), "0.5".to_owned());
-    glass
-        .params
-        .insert("_unknown_key".to_owned(), "kept verbatim".to_owned());
+    glass.params.insert("_unknown_key".to_owned(), "kept verbatim".to_owned());
     palette.materials[255] = glass;
     palette.materials[7] = Material::new(MaterialKind::Emit);
     // Index 0 is written as MATL 256, MagicaVoxel's number for it.
@@ -132,22 +107,11 @@ fn index_255_and_wide_scenes_round_trip() {
         (IVec3::new(255, 255, 255), 2),
         (IVec3::new(256, 256, 256), 3),
     ];
-    let model = VoxelModel {
-        palette: synthetic_palette(),
-        voxels,
-        models: 1,
-    };
+    let model = VoxelModel { palette: synthetic_palette(), voxels, models: 1 };
     let again = assert_round_trip("synthetic", &model);
-    assert!(
-        again.models >= 4,
-        "expected a split into several models, got {}",
-        again.models
-    );
+    assert!(again.models >= 4, "expected a split into several models, got {}", again.models);
     assert_eq!(again.palette.colors[255], [1, 2, 3, 4]);
-    assert_eq!(
-        again.palette.material(255).params["_unknown_key"],
-        "kept verbatim"
-    );
+    assert_eq!(again.palette.material(255).params["_unknown_key"], "kept verbatim");
 }
 
 #[test]
@@ -179,11 +143,7 @@ fn tripod_keeps_its_arms_through_save_and_load() {
     save_vox(&path, &Palette::default(), &tripod()).expect("save");
     let loaded = load_vox_file(&path, 0).expect("load");
     let expected: BTreeSet<_> = tripod().iter().map(|&(p, i)| (p.to_array(), i)).collect();
-    assert!(
-        voxel_set(&loaded) == expected,
-        "arms moved: {:?}",
-        loaded.voxels
-    );
+    assert!(voxel_set(&loaded) == expected, "arms moved: {:?}", loaded.voxels);
 }
 
 /// In the saved file (read with dot_vox itself, MagicaVoxel's z-up axes) the
@@ -195,11 +155,7 @@ fn saved_tripod_stands_upright_in_magicavoxel_axes() {
     let data = dot_vox::load_bytes(&bytes).expect("dot_vox reads our file");
     assert_eq!(data.models.len(), 1);
     let model = &data.models[0];
-    let origin = model
-        .voxels
-        .iter()
-        .find(|v| v.i + 1 == 1)
-        .expect("origin voxel");
+    let origin = model.voxels.iter().find(|v| v.i + 1 == 1).expect("origin voxel");
     let arm = |index: u8| -> Vec<[i32; 3]> {
         let mut offsets: Vec<[i32; 3]> = model
             .voxels
@@ -216,16 +172,8 @@ fn saved_tripod_stands_upright_in_magicavoxel_axes() {
         offsets.sort_unstable();
         offsets
     };
-    assert_eq!(
-        arm(2),
-        (1..=5).map(|i| [i, 0, 0]).collect::<Vec<_>>(),
-        "world +x → vox +x"
-    );
-    assert_eq!(
-        arm(3),
-        (1..=3).map(|i| [0, 0, i]).collect::<Vec<_>>(),
-        "world +y → vox +z"
-    );
+    assert_eq!(arm(2), (1..=5).map(|i| [i, 0, 0]).collect::<Vec<_>>(), "world +x → vox +x");
+    assert_eq!(arm(3), (1..=3).map(|i| [0, 0, i]).collect::<Vec<_>>(), "world +y → vox +z");
     assert_eq!(arm(4), vec![[0, -2, 0], [0, -1, 0]], "world +z → vox −y");
 }
 
@@ -251,14 +199,8 @@ fn axes_asset_arms_point_the_right_way() {
     };
     let [x_arm, y_arm, z_arm] = [centroid(217), centroid(239), centroid(229)];
     assert!(x_arm[0] > 150 && x_arm[2].abs() < 10, "x arm at {x_arm:?}");
-    assert!(
-        y_arm[2] < -150 && y_arm[0].abs() < 10,
-        "MagicaVoxel y arm at {y_arm:?}"
-    );
-    assert!(
-        z_arm[1] > 100 && z_arm[0].abs() < 10 && z_arm[2].abs() < 10,
-        "z arm at {z_arm:?}"
-    );
+    assert!(y_arm[2] < -150 && y_arm[0].abs() < 10, "MagicaVoxel y arm at {y_arm:?}");
+    assert!(z_arm[1] > 100 && z_arm[0].abs() < 10 && z_arm[2].abs() < 10, "z arm at {z_arm:?}");
 }
 
 /// chr_knight.vox (no scene graph) is loaded in its own grid: the file's
@@ -276,10 +218,7 @@ fn knight_feet_are_below_its_head() {
     let (lo, hi) = model.bounds().expect("voxels");
     assert_eq!(lo.y, i32::from(lowest_z));
     assert_eq!(hi.y, i32::from(highest_z));
-    let raw_set: BTreeSet<[i32; 3]> = raw
-        .iter()
-        .map(|v| [i32::from(v.x), i32::from(v.z), -i32::from(v.y)])
-        .collect();
+    let raw_set: BTreeSet<[i32; 3]> = raw.iter().map(|v| [i32::from(v.x), i32::from(v.z), -i32::from(v.y)]).collect();
     let loaded: BTreeSet<[i32; 3]> = model.voxels.iter().map(|(p, _)| p.to_array()).collect();
     assert!(raw_set == loaded, "world = (x, z, −y) of the stored voxels");
 }
@@ -295,11 +234,7 @@ fn saving_is_atomic() {
 
     let bad = [(IVec3::ZERO, 1), (IVec3::ONE, 0)];
     assert!(save_vox(&path, &Palette::default(), &bad).is_err());
-    assert_eq!(
-        std::fs::read(&path).expect("read"),
-        before,
-        "a failed save changed the file"
-    );
+    assert_eq!(std::fs::read(&path).expect("read"), before, "a failed save changed the file");
 
     let single = [(IVec3::new(3, 4, 5), 9)];
     save_vox(&path, &Palette::default(), &single).expect("second save");

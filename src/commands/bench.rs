@@ -36,7 +36,7 @@ fn assets() -> PathBuf {
 
 /// Source data of a model: a voxel list (.vox) or a dense array.
 enum Source {
-    List(octovox::scene::VoxelModel),
+    List(Box<octovox::scene::VoxelModel>),
     Dense(Vec<u8>),
 }
 
@@ -45,7 +45,9 @@ fn source(model: &Model) -> anyhow::Result<Source> {
         "sculpture10M" => Source::Dense(sculpture::sculpture_dense()),
         name => {
             let path = assets().join(format!("{name}.vox"));
-            Source::List(octovox::io::vox::load_vox_file(&path, 0).with_context(|| format!("cannot load {}", path.display()))?)
+            let model =
+                octovox::io::vox::load_vox_file(&path, 0).with_context(|| format!("cannot load {}", path.display()))?;
+            Source::List(Box::new(model))
         }
     })
 }
@@ -166,7 +168,10 @@ fn bench_edit(quick: bool) -> anyhow::Result<(String, String)> {
     tree.pool_mut().flush();
     // The first solid voxel along +x through the centre: on the teapot's
     // wall, so every edit changes real geometry.
-    let at = (-200..200).map(|x| IVec3::new(x, 0, 0)).find(|p| tree.get(*p) != 0).context("teapot has no wall at y = z = 0")?;
+    let at = (-200..200)
+        .map(|x| IVec3::new(x, 0, 0))
+        .find(|p| tree.get(*p) != 0)
+        .context("teapot has no wall at y = z = 0")?;
     let cases: [(&str, Shape); 3] = [
         ("one voxel", Shape::Voxel(at)),
         ("sphere r = 8", Shape::Sphere { center: at, radius: 8 }),
@@ -193,7 +198,13 @@ fn bench_edit(quick: bool) -> anyhow::Result<(String, String)> {
                 };
             }
         }
-        rows.push(EditRow { edit: name, median_us: median(times), bytes_written: bytes, ranges, cells_recorded: cells });
+        rows.push(EditRow {
+            edit: name,
+            median_us: median(times),
+            bytes_written: bytes,
+            ranges,
+            cells_recorded: cells,
+        });
     }
     let mut md = header(&format!("Edit latency on teapot256.vox, centred on its wall at {at}"));
     md += &format!(
@@ -202,9 +213,13 @@ fn bench_edit(quick: bool) -> anyhow::Result<(String, String)> {
         tree.brick_count(),
         tree.pool().live_bytes()
     );
-    md += "| edit | median µs (apply + flush) | bytes written | ranges | cells in undo patch |\n|---|---|---|---|---|\n";
+    md +=
+        "| edit | median µs (apply + flush) | bytes written | ranges | cells in undo patch |\n|---|---|---|---|---|\n";
     for r in &rows {
-        md += &format!("| {} | {:.1} | {} | {} | {} |\n", r.edit, r.median_us, r.bytes_written, r.ranges, r.cells_recorded);
+        md += &format!(
+            "| {} | {:.1} | {} | {} | {} |\n",
+            r.edit, r.median_us, r.bytes_written, r.ranges, r.cells_recorded
+        );
     }
     Ok((md, serde_json::to_string_pretty(&rows)?))
 }
@@ -280,7 +295,14 @@ fn bench_render(quick: bool) -> anyhow::Result<(String, String)> {
     for r in &rows {
         md += &format!(
             "| {} | {:.2} | {:.2} | {:.2}× | {:.2}× | {:.2} | {:.1} | {:.1} |\n",
-            r.model, r.grid_ms, r.svo_ms, r.grid_over_svo, r.report_grid_over_svo, r.svo_mrays_per_s, r.grid_mean_iterations, r.svo_mean_iterations
+            r.model,
+            r.grid_ms,
+            r.svo_ms,
+            r.grid_over_svo,
+            r.report_grid_over_svo,
+            r.svo_mrays_per_s,
+            r.grid_mean_iterations,
+            r.svo_mean_iterations
         );
     }
     Ok((md, serde_json::to_string_pretty(&rows)?))

@@ -10,8 +10,7 @@ use octovox::scene::{MaterialKind, VoxelModel};
 
 /// Loads `file` and prints its summary, as JSON when `json` is set.
 pub fn run(file: &Path, json: bool, frame: usize) -> anyhow::Result<ExitCode> {
-    let model =
-        load_vox_file(file, frame).with_context(|| format!("loading {}", file.display()))?;
+    let model = load_vox_file(file, frame).with_context(|| format!("loading {}", file.display()))?;
     let summary = Summary::of(&model);
     if json {
         println!("{}", serde_json::to_string_pretty(&summary.to_json(file))?);
@@ -37,16 +36,12 @@ impl Summary {
         let used: BTreeSet<u8> = model.voxels.iter().map(|&(_, index)| index).collect();
         let mut materials = BTreeMap::new();
         for &index in &used {
-            *materials
-                .entry(model.palette.material(index).kind)
-                .or_insert(0) += 1;
+            *materials.entry(model.palette.material(index).kind).or_insert(0) += 1;
         }
         Summary {
             models: model.models,
             voxels: model.voxels.len(),
-            bounds: model
-                .bounds()
-                .map(|(lo, hi)| (lo.to_array(), hi.to_array())),
+            bounds: model.bounds().map(|(lo, hi)| (lo.to_array(), hi.to_array())),
             palette_entries: used.len(),
             materials,
         }
@@ -54,22 +49,16 @@ impl Summary {
 
     /// max − min + 1 per axis, zero when empty.
     fn extent(&self) -> [i64; 3] {
-        self.bounds.map_or([0; 3], |(lo, hi)| {
-            [0, 1, 2].map(|i| i64::from(hi[i]) - i64::from(lo[i]) + 1)
-        })
+        self.bounds.map_or([0; 3], |(lo, hi)| [0, 1, 2].map(|i| i64::from(hi[i]) - i64::from(lo[i]) + 1))
     }
 
     fn material_names(&self) -> impl Iterator<Item = (&'static str, usize)> + '_ {
-        self.materials
-            .iter()
-            .map(|(kind, &count)| (kind.vox_name().trim_start_matches('_'), count))
+        self.materials.iter().map(|(kind, &count)| (kind.vox_name().trim_start_matches('_'), count))
     }
 
     fn to_json(&self, file: &Path) -> serde_json::Value {
-        let materials: serde_json::Map<String, serde_json::Value> = self
-            .material_names()
-            .map(|(name, count)| (name.to_owned(), count.into()))
-            .collect();
+        let materials: serde_json::Map<String, serde_json::Value> =
+            self.material_names().map(|(name, count)| (name.to_owned(), count.into())).collect();
         serde_json::json!({
             "file": file.display().to_string(),
             "models": self.models,
@@ -84,12 +73,8 @@ impl Summary {
 
     fn to_text(&self, file: &Path) -> String {
         let [ex, ey, ez] = self.extent();
-        let corner =
-            |c: Option<[i32; 3]>| c.map_or("-".to_owned(), |[x, y, z]| format!("{x} {y} {z}"));
-        let materials: Vec<String> = self
-            .material_names()
-            .map(|(name, count)| format!("{name} {count}"))
-            .collect();
+        let corner = |c: Option<[i32; 3]>| c.map_or("-".to_owned(), |[x, y, z]| format!("{x} {y} {z}"));
+        let materials: Vec<String> = self.material_names().map(|(name, count)| format!("{name} {count}")).collect();
         let rows = [
             ("file", file.display().to_string()),
             ("models", self.models.to_string()),
@@ -98,17 +83,8 @@ impl Summary {
             ("min", corner(self.bounds.map(|(lo, _)| lo))),
             ("max", corner(self.bounds.map(|(_, hi)| hi))),
             ("palette entries", self.palette_entries.to_string()),
-            (
-                "materials",
-                if materials.is_empty() {
-                    "-".to_owned()
-                } else {
-                    materials.join(", ")
-                },
-            ),
+            ("materials", if materials.is_empty() { "-".to_owned() } else { materials.join(", ") }),
         ];
-        rows.iter()
-            .map(|(key, value)| format!("{key:<16} {value}\n"))
-            .collect()
+        rows.iter().map(|(key, value)| format!("{key:<16} {value}\n")).collect()
     }
 }

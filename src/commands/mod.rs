@@ -19,11 +19,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         None => anyhow::bail!("the sandbox window is not built yet; try `octovox info FILE`"),
         Some(Command::Info { file, json, frame }) => info::run(&file, json, frame),
-        Some(Command::Convert {
-            input,
-            output,
-            frame,
-        }) => convert::run(&input, &output, frame),
+        Some(Command::Convert { input, output, frame }) => convert::run(&input, &output, frame),
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
         Some(Command::Replay { scripts, cpu }) => replay::run(&scripts, cpu, update_images()),

@@ -6,10 +6,10 @@ use anyhow::Context;
 
 use crate::cli::{RenderArgs, camera_or_framing};
 use octovox::gpu::Renderer;
+use octovox::io::png::save_png;
 use octovox::scene::Scene;
 use octovox::settings::{RenderSettings, TraceMode};
 use octovox::trace::grid::DenseGrid;
-use octovox::io::png::save_png;
 use octovox::trace::render::render_scene_cpu;
 
 /// Opens FILE, or the built-in demo scene when there is none.
@@ -25,7 +25,9 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<ExitCode> {
     let camera = camera_or_framing(args.camera, args.fov, &scene);
     let settings = RenderSettings { mode: args.mode, view: args.view, shadows: !args.no_shadows, render_scale: 1.0 };
     let grid = match args.mode {
-        TraceMode::Grid => Some(DenseGrid::from_octree(&scene.tree).context("the scene is too sparse and wide for a dense grid")?),
+        TraceMode::Grid => {
+            Some(DenseGrid::from_octree(&scene.tree).context("the scene is too sparse and wide for a dense grid")?)
+        }
         TraceMode::Svo => None,
     };
     let image = if args.cpu {

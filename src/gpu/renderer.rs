@@ -59,7 +59,8 @@ impl Renderer {
         let local = highlight.map(|(lo, hi)| (lo - tree.origin(), hi - tree.origin()));
         let uniforms = FrameUniforms::new(&basis, tree, &self.buffers, settings.view, local);
         self.pass.prepare(&self.gpu.device, &self.gpu.queue, &self.buffers, &uniforms);
-        let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        let mut encoder =
+            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         self.pass.encode(&mut encoder, settings, self.timer.pass_writes());
         self.timer.resolve(&mut encoder);
         self.timer.submit_and_measure(&self.gpu, encoder)

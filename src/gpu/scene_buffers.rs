@@ -102,7 +102,8 @@ fn write_region<T: bytemuck::Pod>(
     let grew = match region.grow_to_bytes() {
         Some(bytes) if bytes > buffer.size() => {
             let bigger = storage_buffer(device, label, bytes);
-            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pool grow") });
+            let mut encoder =
+                device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pool grow") });
             encoder.copy_buffer_to_buffer(buffer, 0, &bigger, 0, buffer.size());
             // Submitted now: queued writes run at the start of the *next*
             // submit, so they land after this copy, not under it.

@@ -40,7 +40,13 @@ pub struct FrameUniforms {
 impl FrameUniforms {
     /// Uniforms for a frame: camera basis, tree root and grid placement.
     /// `highlight` is an inclusive tree-local voxel box to tint.
-    pub fn new(basis: &RayBasis, tree: &Octree, buffers: &SceneBuffers, view: View, highlight: Option<(IVec3, IVec3)>) -> FrameUniforms {
+    pub fn new(
+        basis: &RayBasis,
+        tree: &Octree,
+        buffers: &SceneBuffers,
+        view: View,
+        highlight: Option<(IVec3, IVec3)>,
+    ) -> FrameUniforms {
         let (lo, hi) = highlight.unwrap_or((IVec3::ZERO, IVec3::NEG_ONE));
         FrameUniforms {
             eye: basis.eye.into(),
@@ -233,7 +239,13 @@ impl TracePass {
     }
 
     /// Writes this frame's uniforms and rebinds buffers that were re-created.
-    pub fn prepare(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, buffers: &SceneBuffers, uniforms: &FrameUniforms) {
+    pub fn prepare(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        buffers: &SceneBuffers,
+        uniforms: &FrameUniforms,
+    ) {
         if buffers.generation != self.bound_generation {
             self.bind_group = Self::make_bind_group(device, &self.layout, &self.uniform_buf, buffers, &self.target);
             self.bound_generation = buffers.generation;
@@ -252,10 +264,8 @@ impl TracePass {
             TraceMode::Svo => 0,
             TraceMode::Grid => 2,
         } + usize::from(settings.shadows);
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("trace"),
-            timestamp_writes: timestamps,
-        });
+        let mut pass = encoder
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("trace"), timestamp_writes: timestamps });
         pass.set_pipeline(&self.pipelines[index]);
         pass.set_bind_group(0, &self.bind_group, &[]);
         pass.dispatch_workgroups(self.target.width.div_ceil(8), self.target.height.div_ceil(8), 1);

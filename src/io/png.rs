@@ -36,6 +36,7 @@ pub fn differing_fraction(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
     if a.dimensions() != b.dimensions() {
         return 1.0;
     }
-    let differing = a.pixels().zip(b.pixels()).filter(|(p, q)| p.0.iter().zip(q.0).any(|(x, y)| x.abs_diff(y) > 2)).count();
+    let differing =
+        a.pixels().zip(b.pixels()).filter(|(p, q)| p.0.iter().zip(q.0).any(|(x, y)| x.abs_diff(y) > 2)).count();
     differing as f64 / (a.width() as f64 * a.height() as f64).max(1.0)
 }

@@ -72,8 +72,10 @@ impl<'a> Cursor<'a> {
 
     fn int_in(&mut self, what: &str, range: std::ops::RangeInclusive<i64>) -> Result<i64, Fail> {
         let token = self.word(what)?;
-        let value: i64 =
-            token.text.parse().map_err(|_| (token.column, format!("expected {what} (an integer), found '{}'", token.text)))?;
+        let value: i64 = token
+            .text
+            .parse()
+            .map_err(|_| (token.column, format!("expected {what} (an integer), found '{}'", token.text)))?;
         if !range.contains(&value) {
             return Err((token.column, format!("{what} {value} is outside {}..={}", range.start(), range.end())));
         }
@@ -122,7 +124,9 @@ pub fn parse_script(file: &Path, text: &str) -> Result<Script, Vec<ScriptError>>
         let mut cursor = Cursor::new(content);
         match parse_command(&mut cursor).and_then(|c| cursor.finish().map(|()| c)) {
             Ok(command) => lines.push(Line { number: index + 1, command }),
-            Err((column, message)) => errors.push(ScriptError { file: file.to_path_buf(), line: index + 1, column, message }),
+            Err((column, message)) => {
+                errors.push(ScriptError { file: file.to_path_buf(), line: index + 1, column, message })
+            }
         }
     }
     if errors.is_empty() { Ok(Script { path: file.to_path_buf(), lines }) } else { Err(errors) }
@@ -175,7 +179,12 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
         }
         "undo" | "redo" => {
             let n = match c.optional() {
-                Some(t) => t.text.parse::<u32>().ok().filter(|n| *n >= 1).ok_or((t.column, format!("expected a count ≥ 1, found '{}'", t.text)))?,
+                Some(t) => t
+                    .text
+                    .parse::<u32>()
+                    .ok()
+                    .filter(|n| *n >= 1)
+                    .ok_or((t.column, format!("expected a count ≥ 1, found '{}'", t.text)))?,
                 None => 1,
             };
             if name.text == "undo" { Command::Undo(n) } else { Command::Redo(n) }
@@ -222,7 +231,12 @@ fn parse_expect(c: &mut Cursor) -> Result<Command, Fail> {
         "image" => {
             let path = c.path()?;
             let tolerance = match c.optional() {
-                Some(t) => t.text.parse::<f64>().ok().filter(|v| (0.0..=1.0).contains(v)).ok_or((t.column, format!("tolerance '{}' must be a fraction in 0..=1", t.text)))?,
+                Some(t) => t
+                    .text
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|v| (0.0..=1.0).contains(v))
+                    .ok_or((t.column, format!("tolerance '{}' must be a fraction in 0..=1", t.text)))?,
                 None => 0.0,
             };
             Command::ExpectImage(path, tolerance)
@@ -232,6 +246,7 @@ fn parse_expect(c: &mut Cursor) -> Result<Command, Fail> {
 }
 
 #[cfg(test)]
+#[allow(clippy::unwrap_used)]
 mod tests {
     use super::*;
 
@@ -247,7 +262,10 @@ mod tests {
         assert_eq!(errors("color 0"), vec!["palette index 0 is outside 1..=255 at build.ovr:1:7"]);
         assert_eq!(errors("color 300"), vec!["palette index 300 is outside 1..=255 at build.ovr:1:7"]);
         assert_eq!(errors("brush sphere -1"), vec!["sphere radius -1 is outside 0..=4096 at build.ovr:1:14"]);
-        assert_eq!(errors("brush sphere 1000000000"), vec!["sphere radius 1000000000 is outside 0..=4096 at build.ovr:1:14"]);
+        assert_eq!(
+            errors("brush sphere 1000000000"),
+            vec!["sphere radius 1000000000 is outside 0..=4096 at build.ovr:1:14"]
+        );
         assert_eq!(errors("expect written < 3"), vec!["expected '<=', found '<' at build.ovr:1:16"]);
         assert_eq!(errors("new extra"), vec!["unexpected 'extra' after the command at build.ovr:1:5"]);
         assert_eq!(errors("click 3 4 smash"), vec!["expected attach, erase or paint, found 'smash' at build.ovr:1:11"]);
@@ -261,7 +279,10 @@ mod tests {
         let script = parse_script(Path::new("t.ovr"), text).unwrap();
         let printed: String = script.lines.iter().map(|l| format!("{}\n", l.command)).collect();
         let again = parse_script(Path::new("t.ovr"), &printed).unwrap();
-        assert_eq!(script.lines.iter().map(|l| &l.command).collect::<Vec<_>>(), again.lines.iter().map(|l| &l.command).collect::<Vec<_>>());
+        assert_eq!(
+            script.lines.iter().map(|l| &l.command).collect::<Vec<_>>(),
+            again.lines.iter().map(|l| &l.command).collect::<Vec<_>>()
+        );
         assert_eq!(script.lines.len(), 20);
     }
 }

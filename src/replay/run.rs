@@ -98,7 +98,8 @@ impl Runner {
         let base = script.path.parent().unwrap_or(Path::new(".")).to_path_buf();
         let mut report = ScriptReport::default();
         for line in &script.lines {
-            let fail = |expected: String, got: String| Failure { file: script.path.clone(), line: line.number, expected, got };
+            let fail =
+                |expected: String, got: String| Failure { file: script.path.clone(), line: line.number, expected, got };
             match self.step(&base, line) {
                 Ok(StepResult::Done) => {}
                 Ok(StepResult::Passed) => report.passed += 1,
@@ -215,7 +216,9 @@ impl Runner {
     fn render(&mut self) -> Result<image::RgbaImage, String> {
         match &mut self.mode {
             RunnerMode::Gpu(renderer) => {
-                renderer.render(&self.scene.tree, &self.camera, self.viewport, &self.settings, None).map_err(|e| e.to_string())?;
+                renderer
+                    .render(&self.scene.tree, &self.camera, self.viewport, &self.settings, None)
+                    .map_err(|e| e.to_string())?;
                 renderer.read_image().map_err(|e| e.to_string())
             }
             RunnerMode::Cpu => Ok(render_scene_cpu(&self.scene, None, &self.camera, self.viewport, &self.settings)),
@@ -230,9 +233,11 @@ impl Runner {
         }
         let reference = load_png(path).map_err(|e| format!("{e} (OCTOVOX_UPDATE_IMAGES=1 writes it)"))?;
         let fraction = differing_fraction(image, &reference);
-        Ok(check(fraction <= tolerance, format!("at most {tolerance} of pixels differing from {}", path.display()), || {
-            format!("{fraction:.5}")
-        }))
+        Ok(check(
+            fraction <= tolerance,
+            format!("at most {tolerance} of pixels differing from {}", path.display()),
+            || format!("{fraction:.5}"),
+        ))
     }
 }
 

@@ -162,7 +162,11 @@ impl Octree {
             out.push(word);
         } else if level == 1 {
             let b = self.brick(word);
-            out.extend([BRICK_TAG, u32::from_le_bytes([b[0], b[1], b[2], b[3]]), u32::from_le_bytes([b[4], b[5], b[6], b[7]])]);
+            out.extend([
+                BRICK_TAG,
+                u32::from_le_bytes([b[0], b[1], b[2], b[3]]),
+                u32::from_le_bytes([b[4], b[5], b[6], b[7]]),
+            ]);
         } else {
             out.push(NODE_TAG);
             for child in *self.node(word) {
@@ -215,8 +219,14 @@ impl Octree {
         let rel = (target.0 - min) / half;
         let octant = (rel.x | rel.y << 1 | rel.z << 2) as usize;
         let mut children: Node = *self.node(node);
-        children[octant] =
-            self.replace_cell(children[octant], min + octant_offset(octant) * half, level - 1, target, subtree, inverse);
+        children[octant] = self.replace_cell(
+            children[octant],
+            min + octant_offset(octant) * half,
+            level - 1,
+            target,
+            subtree,
+            inverse,
+        );
         self.make_node(children, Some(node))
     }
 

@@ -47,11 +47,8 @@ impl Octree {
         };
         let extent = (hi.as_i64vec3() - lo.as_i64vec3()).max_element() + 1;
         let mut tree = Octree::empty(lo, depth_for(extent)?);
-        let mut keyed: Vec<(u64, u8)> = voxels
-            .par_iter()
-            .filter(|v| v.1 != 0)
-            .map(|&(p, v)| (morton((p - lo).as_uvec3()), v))
-            .collect();
+        let mut keyed: Vec<(u64, u8)> =
+            voxels.par_iter().filter(|v| v.1 != 0).map(|&(p, v)| (morton((p - lo).as_uvec3()), v)).collect();
         // Stable, so of two entries for one position the later stays later.
         keyed.par_sort_by_key(|k| k.0);
         let mut level: Vec<(u64, u32)> = Vec::with_capacity(keyed.len() / 2);
@@ -151,11 +148,7 @@ struct Dense<'a> {
 
 impl Dense<'_> {
     fn at(&self, p: IVec3) -> u8 {
-        if p.cmplt(self.dims).all() {
-            self.data[(p.x + self.dims.x * (p.y + self.dims.y * p.z)) as usize]
-        } else {
-            0
-        }
+        if p.cmplt(self.dims).all() { self.data[(p.x + self.dims.x * (p.y + self.dims.y * p.z)) as usize] } else { 0 }
     }
 }
 

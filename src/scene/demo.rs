@@ -89,15 +89,24 @@ fn decorate(tree: &mut Octree) {
     let (sx, sz) = (40, 84);
     let sy = ground(sx, sz) + 9;
     place(Shape::Sphere { center: IVec3::new(sx, sy, sz), radius: 9 }, Op::Place(colors::RED));
-    place(Shape::Box { min: IVec3::new(sx - 10, sy + 4, sz - 10), max: IVec3::new(sx + 10, sy + 10, sz + 10) }, Op::Paint(colors::GOLD));
+    place(
+        Shape::Box { min: IVec3::new(sx - 10, sy + 4, sz - 10), max: IVec3::new(sx + 10, sy + 10, sz + 10) },
+        Op::Paint(colors::GOLD),
+    );
     let (ax, az) = (80, 40);
     let ay = ground(ax, az);
-    place(Shape::Box { min: IVec3::new(ax - 12, ay, az - 3), max: IVec3::new(ax + 12, ay + 22, az + 3) }, Op::Place(colors::WHITE));
+    place(
+        Shape::Box { min: IVec3::new(ax - 12, ay, az - 3), max: IVec3::new(ax + 12, ay + 22, az + 3) },
+        Op::Place(colors::WHITE),
+    );
     place(Shape::Box { min: IVec3::new(ax - 7, ay, az - 4), max: IVec3::new(ax + 7, ay + 15, az + 4) }, Op::Remove);
     // A blue tower with windows.
     let (tx, tz) = (96, 96);
     let ty = ground(tx, tz);
-    place(Shape::Box { min: IVec3::new(tx - 5, ty, tz - 5), max: IVec3::new(tx + 5, ty + 34, tz + 5) }, Op::Place(colors::BLUE));
+    place(
+        Shape::Box { min: IVec3::new(tx - 5, ty, tz - 5), max: IVec3::new(tx + 5, ty + 34, tz + 5) },
+        Op::Place(colors::BLUE),
+    );
     for level in 0..4 {
         let y = ty + 6 + level * 8;
         place(Shape::Box { min: IVec3::new(tx - 6, y, tz - 1), max: IVec3::new(tx + 6, y + 3, tz + 1) }, Op::Remove);
@@ -105,7 +114,10 @@ fn decorate(tree: &mut Octree) {
     // A tree.
     let (rx, rz) = (24, 30);
     let ry = ground(rx, rz);
-    place(Shape::Box { min: IVec3::new(rx - 1, ry, rz - 1), max: IVec3::new(rx + 1, ry + 14, rz + 1) }, Op::Place(colors::TRUNK));
+    place(
+        Shape::Box { min: IVec3::new(rx - 1, ry, rz - 1), max: IVec3::new(rx + 1, ry + 14, rz + 1) },
+        Op::Place(colors::TRUNK),
+    );
     place(Shape::Sphere { center: IVec3::new(rx, ry + 18, rz), radius: 7 }, Op::Place(colors::LEAVES));
 }
 

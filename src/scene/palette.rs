@@ -16,13 +16,8 @@ pub enum MaterialKind {
 }
 
 impl MaterialKind {
-    pub const ALL: [MaterialKind; 5] = [
-        MaterialKind::Diffuse,
-        MaterialKind::Metal,
-        MaterialKind::Glass,
-        MaterialKind::Emit,
-        MaterialKind::Media,
-    ];
+    pub const ALL: [MaterialKind; 5] =
+        [MaterialKind::Diffuse, MaterialKind::Metal, MaterialKind::Glass, MaterialKind::Emit, MaterialKind::Media];
 
     /// The `_type` string MagicaVoxel writes for this kind.
     pub fn vox_name(self) -> &'static str {

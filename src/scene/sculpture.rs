@@ -11,10 +11,10 @@ pub const DIMS: UVec3 = UVec3::new(510, 484, 333);
 /// (centre, semi-axes) of the blobs, in voxels.
 const BLOBS: [(Vec3, Vec3); 5] = [
     (Vec3::new(255.0, 30.0, 166.0), Vec3::new(245.0, 30.0, 155.0)), // plinth
-    (Vec3::new(215.0, 200.0, 160.0), Vec3::new(95.0, 125.0, 85.0)),  // seated body
-    (Vec3::new(215.0, 360.0, 150.0), Vec3::new(50.0, 60.0, 50.0)),   // head
-    (Vec3::new(300.0, 95.0, 195.0), Vec3::new(205.0, 38.0, 50.0)),   // lying figure
-    (Vec3::new(215.0, 430.0, 150.0), Vec3::new(70.0, 40.0, 60.0)),   // veil
+    (Vec3::new(215.0, 200.0, 160.0), Vec3::new(95.0, 125.0, 85.0)), // seated body
+    (Vec3::new(215.0, 360.0, 150.0), Vec3::new(50.0, 60.0, 50.0)),  // head
+    (Vec3::new(300.0, 95.0, 195.0), Vec3::new(205.0, 38.0, 50.0)),  // lying figure
+    (Vec3::new(215.0, 430.0, 150.0), Vec3::new(70.0, 40.0, 60.0)),  // veil
 ];
 
 fn solid(p: Vec3) -> bool {

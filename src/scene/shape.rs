@@ -145,7 +145,7 @@ mod tests {
             Shape::Voxel(IVec3::new(1, 1, 1)),
         ];
         for shape in shapes {
-            for size in [1, 2, 4, 8] {
+            for size in [1i32, 2, 4, 8] {
                 for z in (-8..8).step_by(size as usize) {
                     for y in (-8..8).step_by(size as usize) {
                         for x in (-8..8).step_by(size as usize) {

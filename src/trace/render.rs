@@ -126,7 +126,8 @@ pub fn render_scene_cpu(
     } else {
         Vec::new()
     };
-    let bytes: Vec<u8> = shade_image(&hits, &basis, &scene.palette, settings.view, &shadows).into_iter().flatten().collect();
+    let bytes: Vec<u8> =
+        shade_image(&hits, &basis, &scene.palette, settings.view, &shadows).into_iter().flatten().collect();
     // shade_image yields exactly width * height pixels, so this cannot fail.
     image::RgbaImage::from_raw(basis.width, basis.height, bytes).unwrap_or_default()
 }

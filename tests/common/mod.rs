@@ -49,7 +49,11 @@ pub fn cameras_for(min: IVec3, max: IVec3) -> Vec<Camera> {
         around(DVec3::new(0.0, 1.0, 0.0), r * 2.0),
         around(DVec3::new(1.0, 0.0, 0.0), r * 1.4),
         Camera { eye: c + DVec3::new(0.31, 0.27, 0.23), target: c + DVec3::new(5.0, -1.0, 3.0), fov_y_deg: 90.0 },
-        Camera { eye: DVec3::new(lo.x - 3.0, lo.y + 0.5, c.z + 0.25), target: DVec3::new(hi.x, lo.y + 0.6, c.z), fov_y_deg: 40.0 },
+        Camera {
+            eye: DVec3::new(lo.x - 3.0, lo.y + 0.5, c.z + 0.25),
+            target: DVec3::new(hi.x, lo.y + 0.6, c.z),
+            fov_y_deg: 40.0,
+        },
         Camera { eye: DVec3::new(hi.x + 2.5, hi.y + 1.5, lo.z - 2.0), target: c, fov_y_deg: 70.0 },
     ]
 }

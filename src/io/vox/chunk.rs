@@ -23,11 +23,7 @@ impl Chunk {
     }
 
     pub(super) fn fail(&self, problem: impl Into<String>) -> VoxError {
-        VoxError::BadChunk {
-            id: self.name(),
-            offset: self.offset,
-            problem: problem.into(),
-        }
+        VoxError::BadChunk { id: self.name(), offset: self.offset, problem: problem.into() }
     }
 
     pub(super) fn content_len(&self) -> usize {
@@ -36,25 +32,16 @@ impl Chunk {
 }
 
 /// Reads the chunk header at `offset`; the chunk must end by `limit`.
-pub(super) fn read_chunk_header(
-    bytes: &[u8],
-    offset: usize,
-    limit: usize,
-) -> Result<Chunk, VoxError> {
+pub(super) fn read_chunk_header(bytes: &[u8], offset: usize, limit: usize) -> Result<Chunk, VoxError> {
     if limit - offset < CHUNK_HEADER_BYTES {
         return Err(if limit == bytes.len() {
-            VoxError::Truncated(format!(
-                "file ends at byte {limit} inside the header of the chunk at byte {offset}"
-            ))
+            VoxError::Truncated(format!("file ends at byte {limit} inside the header of the chunk at byte {offset}"))
         } else {
             // Only MAIN's children are read with a limit short of the file's end.
             VoxError::BadChunk {
                 id: "MAIN".to_owned(),
                 offset: 8,
-                problem: format!(
-                    "ends with {} stray bytes at byte {offset} after its last child",
-                    limit - offset
-                ),
+                problem: format!("ends with {} stray bytes at byte {offset} after its last child", limit - offset),
             }
         });
     }
@@ -69,9 +56,7 @@ pub(super) fn read_chunk_header(
         content_start,
         content_end: content_start.saturating_add(content_bytes),
         children_bytes,
-        end: content_start
-            .saturating_add(content_bytes)
-            .saturating_add(children_bytes),
+        end: content_start.saturating_add(content_bytes).saturating_add(children_bytes),
     };
     if !id.iter().all(|b| b.is_ascii_graphic() || *b == b' ') {
         return Err(chunk.fail("has an id that is not ASCII text"));
@@ -98,11 +83,7 @@ pub(super) struct Cursor<'a> {
 impl<'a> Cursor<'a> {
     /// A cursor at the start of `chunk`'s content in `bytes`.
     pub(super) fn new(bytes: &'a [u8], chunk: &'a Chunk) -> Cursor<'a> {
-        Cursor {
-            bytes,
-            pos: chunk.content_start,
-            chunk,
-        }
+        Cursor { bytes, pos: chunk.content_start, chunk }
     }
 
     pub(super) fn remaining(&self) -> usize {
@@ -135,9 +116,7 @@ impl<'a> Cursor<'a> {
         let at = self.pos;
         let text = self.take(len, what)?;
         if std::str::from_utf8(text).is_err() {
-            return Err(self
-                .chunk
-                .fail(format!("has a {what} at byte {at} that is not UTF-8 text")));
+            return Err(self.chunk.fail(format!("has a {what} at byte {at} that is not UTF-8 text")));
         }
         Ok(())
     }
@@ -146,9 +125,7 @@ impl<'a> Cursor<'a> {
         let entries = widen(self.u32(what)?);
         let held = self.remaining();
         if entries > held / 8 {
-            return Err(self.chunk.fail(format!(
-                "claims {entries} entries in its {what} but holds {held} bytes"
-            )));
+            return Err(self.chunk.fail(format!("claims {entries} entries in its {what} but holds {held} bytes")));
         }
         for _ in 0..entries {
             self.skip_string(what)?;

@@ -22,23 +22,15 @@ use crate::scene::{Material, MaterialKind, Palette, Voxel, VoxelModel};
 /// [`VoxError::Read`] (naming the path) when the file cannot be read,
 /// [`VoxError::FileTooLarge`] beyond [`MAX_FILE_BYTES`], else as [`load_vox`].
 pub fn load_vox_file(path: &Path, frame: usize) -> Result<VoxelModel, VoxError> {
-    let read_error = |source| VoxError::Read {
-        path: path.to_owned(),
-        source,
-    };
+    let read_error = |source| VoxError::Read { path: path.to_owned(), source };
     let file = std::fs::File::open(path).map_err(read_error)?;
     let mut bytes = Vec::new();
     // Read one byte past the limit so that a file that grows while we read
     // it is still refused rather than silently cut.
-    file.take(MAX_FILE_BYTES + 1)
-        .read_to_end(&mut bytes)
-        .map_err(read_error)?;
+    file.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes).map_err(read_error)?;
     let len = u64::try_from(bytes.len()).unwrap_or(u64::MAX);
     if len > MAX_FILE_BYTES {
-        return Err(VoxError::FileTooLarge {
-            path: path.to_owned(),
-            bytes: len,
-        });
+        return Err(VoxError::FileTooLarge { path: path.to_owned(), bytes: len });
     }
     load_vox(&bytes, frame)
 }
@@ -68,11 +60,7 @@ pub fn load_vox(bytes: &[u8], frame: usize) -> Result<VoxelModel, VoxError> {
         scene::placements(&data.scenes, &layout.node_ids, &layout.model_voxels, frame)?
     };
     let voxels = place_voxels(&data, &layout, &placements)?;
-    Ok(VoxelModel {
-        palette: palette_of(&data, &layout),
-        voxels,
-        models: placements.len(),
-    })
+    Ok(VoxelModel { palette: palette_of(&data, &layout), voxels, models: placements.len() })
 }
 
 thread_local! {
@@ -140,9 +128,7 @@ fn cross_check(layout: &Layout, data: &DotVoxData) -> Result<(), VoxError> {
         )));
     }
     if data.version != layout.version {
-        return Err(VoxError::Inconsistent(
-            "dot_vox read another version".to_owned(),
-        ));
+        return Err(VoxError::Inconsistent("dot_vox read another version".to_owned()));
     }
     Ok(())
 }
@@ -153,29 +139,15 @@ fn frame_placement(models: usize, frame: usize) -> Result<Vec<Placement>, VoxErr
         return Ok(Vec::new());
     }
     if frame >= models {
-        return Err(VoxError::FrameOutOfRange {
-            requested: frame,
-            models,
-        });
+        return Err(VoxError::FrameOutOfRange { requested: frame, models });
     }
-    Ok(vec![Placement {
-        model: frame,
-        transform: Transform::IDENTITY,
-        centred: false,
-    }])
+    Ok(vec![Placement { model: frame, transform: Transform::IDENTITY, centred: false }])
 }
 
 /// Every placed voxel in world axes, sorted by position, overlaps resolved.
-fn place_voxels(
-    data: &DotVoxData,
-    layout: &Layout,
-    placements: &[Placement],
-) -> Result<Vec<Voxel>, VoxError> {
+fn place_voxels(data: &DotVoxData, layout: &Layout, placements: &[Placement]) -> Result<Vec<Voxel>, VoxError> {
     let empty: HashSet<(usize, usize)> = layout.zero_index_voxels.iter().copied().collect();
-    let total = placements
-        .iter()
-        .map(|p| layout.model_voxels[p.model])
-        .sum();
+    let total = placements.iter().map(|p| layout.model_voxels[p.model]).sum();
     let mut voxels = Vec::with_capacity(total);
     for placement in placements {
         let model = &data.models[placement.model];
@@ -200,11 +172,7 @@ fn place_voxels(
 }
 
 fn to_world(p: [i64; 3]) -> Option<IVec3> {
-    Some(IVec3::new(
-        p[0].try_into().ok()?,
-        p[1].try_into().ok()?,
-        p[2].try_into().ok()?,
-    ))
+    Some(IVec3::new(p[0].try_into().ok()?, p[1].try_into().ok()?, p[2].try_into().ok()?))
 }
 
 /// Sorts by position (x, then y, then z) and keeps the last of equal positions.
@@ -240,9 +208,7 @@ fn palette_of(data: &DotVoxData, layout: &Layout) -> Palette {
 }
 
 fn material_from_properties(properties: &dot_vox::Dict) -> Material {
-    let kind = properties
-        .get("_type")
-        .map_or(MaterialKind::Diffuse, |t| MaterialKind::from_vox_name(t));
+    let kind = properties.get("_type").map_or(MaterialKind::Diffuse, |t| MaterialKind::from_vox_name(t));
     let params: BTreeMap<String, String> = properties
         .iter()
         .filter(|(key, _)| key.as_str() != "_type")

@@ -41,16 +41,10 @@ pub const MAX_NODE_VISITS: usize = 1 << 22;
 pub enum VoxError {
     /// The file could not be opened or read.
     #[error("cannot read {}: {source}", path.display())]
-    Read {
-        path: PathBuf,
-        source: std::io::Error,
-    },
+    Read { path: PathBuf, source: std::io::Error },
     /// The file (or its temporary sibling) could not be written.
     #[error("cannot write {}: {source}", path.display())]
-    Write {
-        path: PathBuf,
-        source: std::io::Error,
-    },
+    Write { path: PathBuf, source: std::io::Error },
     /// The file is larger than [`MAX_FILE_BYTES`].
     #[error("{} is {bytes} bytes; octovox reads .vox files of at most {MAX_FILE_BYTES} bytes", path.display())]
     FileTooLarge { path: PathBuf, bytes: u64 },
@@ -66,11 +60,7 @@ pub enum VoxError {
     /// A chunk whose header or content is inconsistent, e.g.
     /// "chunk XYZI at byte 1234 claims 2147483648 voxels but holds 40 bytes".
     #[error("chunk {id} at byte {offset} {problem}")]
-    BadChunk {
-        id: String,
-        offset: usize,
-        problem: String,
-    },
+    BadChunk { id: String, offset: usize, problem: String },
     /// A scene-graph node reachable from itself.
     #[error("scene graph cycle at node {0}")]
     SceneCycle(u32),
@@ -82,9 +72,7 @@ pub enum VoxError {
     #[error("frame {requested} requested but file has {models} model{}", plural(*models))]
     FrameOutOfRange { requested: usize, models: usize },
     /// The scene would produce more than [`MAX_VOXELS`] voxels.
-    #[error(
-        "the scene holds more than {limit} voxels (at least {found}); octovox loads at most {limit}"
-    )]
+    #[error("the scene holds more than {limit} voxels (at least {found}); octovox loads at most {limit}")]
     TooManyVoxels { limit: usize, found: usize },
     /// `dot_vox` rejected bytes the pre-pass accepted.
     #[error("dot_vox could not parse the file: {0}")]

@@ -34,10 +34,7 @@ pub fn encode_vox(palette: &Palette, voxels: &[Voxel]) -> Result<Vec<u8>, VoxErr
         models.push(block.model);
     }
     if models.is_empty() {
-        models.push(Model {
-            size: Size { x: 1, y: 1, z: 1 },
-            voxels: Vec::new(),
-        });
+        models.push(Model { size: Size { x: 1, y: 1, z: 1 }, voxels: Vec::new() });
         translations.push([0, 0, 0]);
     }
     let data = DotVoxData {
@@ -47,13 +44,10 @@ pub fn encode_vox(palette: &Palette, voxels: &[Voxel]) -> Result<Vec<u8>, VoxErr
         palette: rgba_chunk(palette),
         materials: matl_chunks(palette),
         scenes: scene_graph(&translations),
-        layers: vec![Layer {
-            attributes: dict([("_name", "0".to_owned())]),
-        }],
+        layers: vec![Layer { attributes: dict([("_name", "0".to_owned())]) }],
     };
     let mut bytes = Vec::new();
-    data.write_vox(&mut bytes)
-        .map_err(|e| VoxError::Unsavable(e.to_string()))?;
+    data.write_vox(&mut bytes).map_err(|e| VoxError::Unsavable(e.to_string()))?;
     Ok(bytes)
 }
 
@@ -70,10 +64,7 @@ pub fn save_vox(path: &Path, palette: &Palette, voxels: &[Voxel]) -> Result<(), 
 }
 
 fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), VoxError> {
-    let write_error = |source| VoxError::Write {
-        path: path.to_owned(),
-        source,
-    };
+    let write_error = |source| VoxError::Write { path: path.to_owned(), source };
     let dir = match path.parent() {
         Some(parent) if !parent.as_os_str().is_empty() => parent,
         _ => Path::new("."),
@@ -121,11 +112,8 @@ impl Block {
         let size = [self.model.size.x, self.model.size.y, self.model.size.z];
         let t = [0, 1, 2].map(|axis| self.origin[axis] + i64::from(size[axis] / 2));
         let fit = |c: i64| {
-            i32::try_from(c).map_err(|_| {
-                VoxError::Unsavable(format!(
-                    "a model would sit at {c}, outside the 32-bit range"
-                ))
-            })
+            i32::try_from(c)
+                .map_err(|_| VoxError::Unsavable(format!("a model would sit at {c}, outside the 32-bit range")))
         };
         Ok([fit(t[0])?, fit(t[1])?, fit(t[2])?])
     }
@@ -148,15 +136,8 @@ fn split_into_blocks(voxels: &[Voxel]) -> Result<Vec<Block>, VoxError> {
     }
     let mut unique = voxels.to_vec();
     sort_and_dedup(&mut unique);
-    let scene: Vec<([i64; 3], u8)> = unique
-        .iter()
-        .map(|&(p, index)| (to_scene(p), index))
-        .collect();
-    let Some(low) = scene
-        .iter()
-        .map(|(p, _)| *p)
-        .reduce(|a, b| [0, 1, 2].map(|i| a[i].min(b[i])))
-    else {
+    let scene: Vec<([i64; 3], u8)> = unique.iter().map(|&(p, index)| (to_scene(p), index)).collect();
+    let Some(low) = scene.iter().map(|(p, _)| *p).reduce(|a, b| [0, 1, 2].map(|i| a[i].min(b[i]))) else {
         return Ok(Vec::new());
     };
     let edge = i64::from(MAX_MODEL_EDGE);
@@ -191,15 +172,8 @@ fn crop_block(cell: &[([i64; 3], u8)]) -> Block {
             i: index - 1,
         })
         .collect();
-    let size = Size {
-        x: edge(0),
-        y: edge(1),
-        z: edge(2),
-    };
-    Block {
-        origin: lo,
-        model: Model { size, voxels },
-    }
+    let size = Size { x: edge(0), y: edge(1), z: edge(2) };
+    Block { origin: lo, model: Model { size, voxels } }
 }
 
 /// dot_vox's palette entry k is palette index k + 1 (entry 255 is index 0).
@@ -221,18 +195,10 @@ fn matl_chunks(palette: &Palette) -> Vec<dot_vox::Material> {
         .enumerate()
         .filter(|(_, material)| **material != plain)
         .map(|(index, material)| {
-            let mut properties: Dict = material
-                .params
-                .iter()
-                .map(|(k, v)| (k.clone(), v.clone()))
-                .collect();
+            let mut properties: Dict = material.params.iter().map(|(k, v)| (k.clone(), v.clone())).collect();
             properties.insert("_type".to_owned(), material.kind.vox_name().to_owned());
             // MagicaVoxel numbers materials 1..=256; 256 stands for index 0.
-            let id = if index == 0 {
-                256
-            } else {
-                u32::try_from(index).unwrap_or(0)
-            };
+            let id = if index == 0 { 256 } else { u32::try_from(index).unwrap_or(0) };
             dot_vox::Material { id, properties }
         })
         .collect()
@@ -264,18 +230,12 @@ fn scene_graph(translations: &[[i32; 3]]) -> Vec<SceneNode> {
         });
         nodes.push(SceneNode::Shape {
             attributes: Dict::default(),
-            models: vec![ShapeModel {
-                model_id: u32::try_from(k).unwrap_or(u32::MAX),
-                attributes: Dict::default(),
-            }],
+            models: vec![ShapeModel { model_id: u32::try_from(k).unwrap_or(u32::MAX), attributes: Dict::default() }],
         });
     }
     nodes
 }
 
 fn dict<const N: usize>(entries: [(&str, String); N]) -> Dict {
-    entries
-        .into_iter()
-        .map(|(k, v)| (k.to_owned(), v))
-        .collect()
+    entries.into_iter().map(|(k, v)| (k.to_owned(), v)).collect()
 }

@@ -31,11 +31,7 @@ pub(super) fn placements(
         model_voxels,
         frame,
         on_path: vec![false; nodes.len()],
-        stack: vec![Step::Enter {
-            id: 0,
-            parent: None,
-            transform: Transform::IDENTITY,
-        }],
+        stack: vec![Step::Enter { id: 0, parent: None, transform: Transform::IDENTITY }],
         visits: 0,
         voxels: 0,
         out: Vec::new(),
@@ -46,11 +42,7 @@ pub(super) fn placements(
 /// One entry of the explicit depth-first stack.
 enum Step {
     /// Visit node `id`, reached from `parent`, under the accumulated `transform`.
-    Enter {
-        id: u32,
-        parent: Option<u32>,
-        transform: Transform,
-    },
+    Enter { id: u32, parent: Option<u32>, transform: Transform },
     /// All of node `index`'s descendants are done: it leaves the current path.
     Leave { index: usize },
 }
@@ -75,22 +67,13 @@ impl Walk<'_> {
         while let Some(step) = self.stack.pop() {
             match step {
                 Step::Leave { index } => self.on_path[index] = false,
-                Step::Enter {
-                    id,
-                    parent,
-                    transform,
-                } => self.enter(id, parent, transform)?,
+                Step::Enter { id, parent, transform } => self.enter(id, parent, transform)?,
             }
         }
         Ok(self.out)
     }
 
-    fn enter(
-        &mut self,
-        id: u32,
-        parent: Option<u32>,
-        transform: Transform,
-    ) -> Result<(), VoxError> {
+    fn enter(&mut self, id: u32, parent: Option<u32>, transform: Transform) -> Result<(), VoxError> {
         let index = self.index_of.get(&id).copied().ok_or_else(|| {
             VoxError::BadSceneGraph(match parent {
                 Some(parent) => format!("node {parent} refers to missing node {id}"),
@@ -117,20 +100,12 @@ impl Walk<'_> {
                     None => Transform::IDENTITY,
                 };
                 let transform = transform.compose(local);
-                self.stack.push(Step::Enter {
-                    id: *child,
-                    parent: Some(id),
-                    transform,
-                });
+                self.stack.push(Step::Enter { id: *child, parent: Some(id), transform });
             }
             SceneNode::Group { children, .. } => {
                 // Reversed so that children are visited in file order.
                 for &child in children.iter().rev() {
-                    self.stack.push(Step::Enter {
-                        id: child,
-                        parent: Some(id),
-                        transform,
-                    });
+                    self.stack.push(Step::Enter { id: child, parent: Some(id), transform });
                 }
             }
             SceneNode::Shape { models, .. } => self.place_shape(id, models, transform)?,
@@ -138,12 +113,7 @@ impl Walk<'_> {
         Ok(())
     }
 
-    fn place_shape(
-        &mut self,
-        id: u32,
-        models: &[ShapeModel],
-        transform: Transform,
-    ) -> Result<(), VoxError> {
+    fn place_shape(&mut self, id: u32, models: &[ShapeModel], transform: Transform) -> Result<(), VoxError> {
         let picked = pick_keyframe(models.iter().map(|m| &m.attributes), self.frame, id)?;
         let Some(k) = picked else { return Ok(()) };
         let model = usize::try_from(models[k].model_id).unwrap_or(usize::MAX);
@@ -155,21 +125,12 @@ impl Walk<'_> {
         })?;
         self.voxels = self.voxels.saturating_add(count);
         if self.voxels > MAX_VOXELS {
-            return Err(VoxError::TooManyVoxels {
-                limit: MAX_VOXELS,
-                found: self.voxels,
-            });
+            return Err(VoxError::TooManyVoxels { limit: MAX_VOXELS, found: self.voxels });
         }
         if self.out.len() >= MAX_INSTANCES {
-            return Err(VoxError::BadSceneGraph(format!(
-                "more than {MAX_INSTANCES} model placements"
-            )));
+            return Err(VoxError::BadSceneGraph(format!("more than {MAX_INSTANCES} model placements")));
         }
-        self.out.push(Placement {
-            model,
-            transform,
-            centred: true,
-        });
+        self.out.push(Placement { model, transform, centred: true });
         Ok(())
     }
 }
@@ -178,9 +139,7 @@ fn index_nodes(node_ids: &[u32]) -> Result<HashMap<u32, usize>, VoxError> {
     let mut index_of = HashMap::with_capacity(node_ids.len());
     for (index, &id) in node_ids.iter().enumerate() {
         if index_of.insert(id, index).is_some() {
-            return Err(VoxError::BadSceneGraph(format!(
-                "node id {id} is used twice"
-            )));
+            return Err(VoxError::BadSceneGraph(format!("node id {id} is used twice")));
         }
     }
     Ok(index_of)
@@ -201,11 +160,10 @@ fn pick_keyframe<'a>(
         any = true;
         let at = match attributes.get("_f") {
             None => 0,
-            Some(text) => text.trim().parse::<usize>().map_err(|_| {
-                VoxError::BadSceneGraph(format!(
-                    "node {node} has a malformed frame index _f={text:?}"
-                ))
-            })?,
+            Some(text) => text
+                .trim()
+                .parse::<usize>()
+                .map_err(|_| VoxError::BadSceneGraph(format!("node {node} has a malformed frame index _f={text:?}")))?,
         };
         if at <= frame && best.is_none_or(|(best_at, _)| at > best_at) {
             best = Some((at, k));
@@ -223,28 +181,18 @@ fn parse_transform(attributes: &Dict, node: u32) -> Result<Transform, VoxError> 
             .parse::<u8>()
             .ok()
             .and_then(Rotation::from_byte)
-            .ok_or_else(|| {
-                VoxError::BadSceneGraph(format!("node {node} has an invalid rotation _r={text:?}"))
-            })?,
+            .ok_or_else(|| VoxError::BadSceneGraph(format!("node {node} has an invalid rotation _r={text:?}")))?,
     };
     let translation = match attributes.get("_t") {
         None => [0, 0, 0],
-        Some(text) => parse_translation(text).ok_or_else(|| {
-            VoxError::BadSceneGraph(format!(
-                "node {node} has a malformed translation _t={text:?}"
-            ))
-        })?,
+        Some(text) => parse_translation(text)
+            .ok_or_else(|| VoxError::BadSceneGraph(format!("node {node} has a malformed translation _t={text:?}")))?,
     };
-    Ok(Transform {
-        rotation,
-        translation,
-    })
+    Ok(Transform { rotation, translation })
 }
 
 fn parse_translation(text: &str) -> Option<[i64; 3]> {
-    let mut parts = text
-        .split_ascii_whitespace()
-        .map(|p| p.parse::<i32>().ok().map(i64::from));
+    let mut parts = text.split_ascii_whitespace().map(|p| p.parse::<i32>().ok().map(i64::from));
     let t = [parts.next()??, parts.next()??, parts.next()??];
     parts.next().is_none().then_some(t)
 }

@@ -28,10 +28,7 @@ pub(super) struct Rotation {
 }
 
 impl Rotation {
-    pub(super) const IDENTITY: Rotation = Rotation {
-        axis: [0, 1, 2],
-        sign: [1, 1, 1],
-    };
+    pub(super) const IDENTITY: Rotation = Rotation { axis: [0, 1, 2], sign: [1, 1, 1] };
 
     /// Decodes MagicaVoxel's `_r` byte; `None` when the two stored column
     /// indices are out of range or equal.
@@ -42,10 +39,7 @@ impl Rotation {
             return None;
         }
         let sign = |bit: u8| if byte & (1 << bit) == 0 { 1 } else { -1 };
-        Some(Rotation {
-            axis: [first, second, 3 - first - second],
-            sign: [sign(4), sign(5), sign(6)],
-        })
+        Some(Rotation { axis: [first, second, 3 - first - second], sign: [sign(4), sign(5), sign(6)] })
     }
 
     /// `self · other`: apply `other` first.
@@ -72,10 +66,7 @@ pub(super) struct Transform {
 }
 
 impl Transform {
-    pub(super) const IDENTITY: Transform = Transform {
-        rotation: Rotation::IDENTITY,
-        translation: [0, 0, 0],
-    };
+    pub(super) const IDENTITY: Transform = Transform { rotation: Rotation::IDENTITY, translation: [0, 0, 0] };
 
     /// The transform that applies `child` first, then `self`.
     pub(super) fn compose(self, child: Transform) -> Transform {
@@ -103,24 +94,13 @@ impl Placement {
     /// `size`, by the unit-cube rule in the module documentation.
     pub(super) fn place(&self, v: [u8; 3], size: [u32; 3]) -> [i64; 3] {
         let local = [0, 1, 2].map(|axis| {
-            let pivot = if self.centred {
-                i64::from(size[axis] / 2)
-            } else {
-                0
-            };
+            let pivot = if self.centred { i64::from(size[axis] / 2) } else { 0 };
             i64::from(v[axis]) - pivot
         });
-        let Transform {
-            rotation,
-            translation,
-        } = self.transform;
+        let Transform { rotation, translation } = self.transform;
         [0, 1, 2].map(|row| {
             let along = local[rotation.axis[row]];
-            let offset = if rotation.sign[row] > 0 {
-                along
-            } else {
-                -along - 1
-            };
+            let offset = if rotation.sign[row] > 0 { along } else { -along - 1 };
             translation[row] + offset
         })
     }
@@ -156,18 +136,9 @@ mod tests {
     /// lands at 0 and voxel 2 at -2; a 4-wide one covers [-2, 2) both ways.
     #[test]
     fn flipped_axis_maps_cells_not_corners() {
-        let flip_x = Rotation {
-            axis: [0, 1, 2],
-            sign: [-1, 1, 1],
-        };
-        let placement = Placement {
-            model: 0,
-            transform: Transform {
-                rotation: flip_x,
-                translation: [0, 0, 0],
-            },
-            centred: true,
-        };
+        let flip_x = Rotation { axis: [0, 1, 2], sign: [-1, 1, 1] };
+        let placement =
+            Placement { model: 0, transform: Transform { rotation: flip_x, translation: [0, 0, 0] }, centred: true };
         let size = [3, 1, 1];
         assert_eq!(placement.place([0, 0, 0], size), [0, 0, 0]);
         assert_eq!(placement.place([2, 0, 0], size), [-2, 0, 0]);
@@ -182,16 +153,10 @@ mod tests {
     #[test]
     fn quarter_turn_rotates_cell_centres() {
         // Rows: world x = −v.y, world y = v.x, world z = v.z.
-        let quarter = Rotation {
-            axis: [1, 0, 2],
-            sign: [-1, 1, 1],
-        };
+        let quarter = Rotation { axis: [1, 0, 2], sign: [-1, 1, 1] };
         let placement = Placement {
             model: 0,
-            transform: Transform {
-                rotation: quarter,
-                translation: [10, 20, 30],
-            },
+            transform: Transform { rotation: quarter, translation: [10, 20, 30] },
             centred: true,
         };
         let size = [2, 3, 1];

@@ -48,10 +48,7 @@ pub(super) fn check(bytes: &[u8]) -> Result<Layout, VoxError> {
     if &main.id != b"MAIN" {
         return Err(main.fail("stands where the MAIN chunk should be"));
     }
-    let mut layout = Layout {
-        version,
-        ..Layout::default()
-    };
+    let mut layout = Layout { version, ..Layout::default() };
     let mut size = None;
     let mut pos = main.content_end;
     while pos < main.end {
@@ -66,12 +63,8 @@ fn check_file_header(bytes: &[u8]) -> Result<u32, VoxError> {
     if bytes.len() < 4 || &bytes[..4] != b"VOX " {
         return Err(VoxError::NotVox);
     }
-    let version = le_u32(bytes, 4).ok_or_else(|| {
-        VoxError::Truncated(format!(
-            "file ends at byte {} inside its 8-byte header",
-            bytes.len()
-        ))
-    })?;
+    let version = le_u32(bytes, 4)
+        .ok_or_else(|| VoxError::Truncated(format!("file ends at byte {} inside its 8-byte header", bytes.len())))?;
     if version != 150 && version != 200 {
         return Err(VoxError::UnsupportedVersion(version));
     }
@@ -79,27 +72,19 @@ fn check_file_header(bytes: &[u8]) -> Result<u32, VoxError> {
 }
 
 /// Checks one child of MAIN and records what [`Layout`] keeps of it.
-fn check_chunk(
-    bytes: &[u8],
-    chunk: &Chunk,
-    size: &mut Option<[u32; 3]>,
-    layout: &mut Layout,
-) -> Result<(), VoxError> {
+fn check_chunk(bytes: &[u8], chunk: &Chunk, size: &mut Option<[u32; 3]>, layout: &mut Layout) -> Result<(), VoxError> {
     if chunk.children_bytes != 0 {
-        return Err(chunk.fail(format!(
-            "has {} bytes of child chunks; only MAIN may have children",
-            chunk.children_bytes
-        )));
+        return Err(
+            chunk.fail(format!("has {} bytes of child chunks; only MAIN may have children", chunk.children_bytes))
+        );
     }
     let mut cursor = Cursor::new(bytes, chunk);
     match &chunk.id {
         b"SIZE" => *size = Some(check_size(&mut cursor)?),
         b"XYZI" => check_voxels(&mut cursor, *size, layout)?,
         b"RGBA" if chunk.content_len() != PALETTE_BYTES => {
-            return Err(chunk.fail(format!(
-                "has {} bytes; a palette has {PALETTE_BYTES} (256 RGBA colours)",
-                chunk.content_len()
-            )));
+            return Err(chunk
+                .fail(format!("has {} bytes; a palette has {PALETTE_BYTES} (256 RGBA colours)", chunk.content_len())));
         }
         b"MATL" => {
             cursor.u32("material id")?;
@@ -123,11 +108,7 @@ fn check_size(cursor: &mut Cursor<'_>) -> Result<[u32; 3], VoxError> {
     if len != 12 {
         return Err(cursor.chunk.fail(format!("has {len} bytes; SIZE holds 12")));
     }
-    let size = [
-        cursor.u32("x size")?,
-        cursor.u32("y size")?,
-        cursor.u32("z size")?,
-    ];
+    let size = [cursor.u32("x size")?, cursor.u32("y size")?, cursor.u32("z size")?];
     if size.iter().any(|&s| s == 0 || s > MAX_MODEL_EDGE) {
         return Err(cursor.chunk.fail(format!(
             "gives model size {}x{}x{}; each edge must be 1..={MAX_MODEL_EDGE}",
@@ -137,11 +118,7 @@ fn check_size(cursor: &mut Cursor<'_>) -> Result<[u32; 3], VoxError> {
     Ok(size)
 }
 
-fn check_voxels(
-    cursor: &mut Cursor<'_>,
-    size: Option<[u32; 3]>,
-    layout: &mut Layout,
-) -> Result<(), VoxError> {
+fn check_voxels(cursor: &mut Cursor<'_>, size: Option<[u32; 3]>, layout: &mut Layout) -> Result<(), VoxError> {
     let chunk = cursor.chunk;
     let size = size.ok_or_else(|| chunk.fail("comes before any SIZE chunk"))?;
     let count = widen(cursor.u32("voxel count")?);
@@ -152,10 +129,7 @@ fn check_voxels(
     let model = layout.model_voxels.len();
     let data = cursor.take(count * 4, "voxels")?;
     for (ordinal, voxel) in data.chunks_exact(4).enumerate() {
-        let inside = voxel[..3]
-            .iter()
-            .zip(size)
-            .all(|(&c, edge)| u32::from(c) < edge);
+        let inside = voxel[..3].iter().zip(size).all(|(&c, edge)| u32::from(c) < edge);
         if !inside {
             return Err(chunk.fail(format!(
                 "has voxel {ordinal} at ({}, {}, {}) outside the model size {}x{}x{}",
@@ -189,9 +163,7 @@ fn check_group_node(cursor: &mut Cursor<'_>) -> Result<u32, VoxError> {
     let children = widen(cursor.u32("child count")?);
     let held = cursor.remaining();
     if children > held / 4 {
-        return Err(cursor
-            .chunk
-            .fail(format!("claims {children} children but holds {held} bytes")));
+        return Err(cursor.chunk.fail(format!("claims {children} children but holds {held} bytes")));
     }
     cursor.take(children * 4, "child ids")?;
     Ok(id)
@@ -210,9 +182,7 @@ fn check_shape_node(cursor: &mut Cursor<'_>) -> Result<u32, VoxError> {
 
 /// Property names of a MATT chunk's property bits 0..=6, in bit order.
 /// Bit 7 ("total power") carries no value and is not kept.
-const MATT_PROPERTIES: [&str; 7] = [
-    "_plastic", "_rough", "_spec", "_ior", "_att", "_flux", "_glow",
-];
+const MATT_PROPERTIES: [&str; 7] = ["_plastic", "_rough", "_spec", "_ior", "_att", "_flux", "_glow"];
 
 /// Reads an old (MagicaVoxel 0.98) MATT chunk into a [`Material`], the way
 /// opengametools' ogt_vox does: the type gives the kind, the weight becomes
@@ -226,17 +196,13 @@ fn read_matt(cursor: &mut Cursor<'_>) -> Result<(u8, Material), VoxError> {
         2 => MaterialKind::Glass,
         3 => MaterialKind::Emit,
         other => {
-            return Err(cursor
-                .chunk
-                .fail(format!("has unknown material type {other}")));
+            return Err(cursor.chunk.fail(format!("has unknown material type {other}")));
         }
     };
     let weight = cursor.f32("material weight")?;
     let bits = cursor.u32("property bits")?;
     let mut material = Material::new(kind);
-    material
-        .params
-        .insert("_weight".to_owned(), weight.to_string());
+    material.params.insert("_weight".to_owned(), weight.to_string());
     let weight_key = match kind {
         MaterialKind::Metal => Some("_metal"),
         MaterialKind::Glass => Some("_trans"),
