@@ -3,6 +3,7 @@
 //! the window. `docs/replay.md` describes it.
 
 mod parse;
+mod record;
 mod run;
 
 use std::fmt;
@@ -13,6 +14,7 @@ use glam::{DVec3, IVec3};
 use crate::tool::{Brush, Tool};
 
 pub use parse::{ScriptError, load_script, parse_script};
+pub use record::Recorder;
 pub use run::{Failure, Runner, RunnerMode, ScriptReport, StepResult};
 
 /// One line of a script.
@@ -20,14 +22,24 @@ pub use run::{Failure, Runner, RunnerMode, ScriptReport, StepResult};
 pub enum Command {
     Load(PathBuf),
     New,
-    Camera { eye: DVec3, target: DVec3, fov: Option<f32> },
+    /// The built-in demo scene (what the window opens without a file).
+    Demo,
+    Camera {
+        eye: DVec3,
+        target: DVec3,
+        fov: Option<f32>,
+    },
     Viewport(u32, u32),
     Brush(Brush),
     Color(u8),
     Place(IVec3),
     Remove(IVec3),
     Paint(IVec3),
-    Click { x: u32, y: u32, tool: Tool },
+    Click {
+        x: u32,
+        y: u32,
+        tool: Tool,
+    },
     Undo(u32),
     Redo(u32),
     Save(PathBuf),
@@ -59,6 +71,7 @@ impl fmt::Display for Command {
         match self {
             Command::Load(path) => write!(f, "load {}", path.display()),
             Command::New => write!(f, "new"),
+            Command::Demo => write!(f, "demo"),
             Command::Camera { eye, target, fov } => {
                 write!(f, "camera {} {} {} {} {} {}", eye.x, eye.y, eye.z, target.x, target.y, target.z)?;
                 match fov {

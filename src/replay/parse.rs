@@ -145,6 +145,7 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
     Ok(match name.text {
         "load" => Command::Load(c.path()?),
         "new" => Command::New,
+        "demo" => Command::Demo,
         "camera" => {
             let mut v = [0.0; 6];
             for (slot, what) in v.iter_mut().zip(["EX", "EY", "EZ", "TX", "TY", "TZ"]) {
@@ -273,7 +274,7 @@ mod tests {
 
     #[test]
     fn every_command_round_trips_through_display() {
-        let text = "load a.vox\nnew\ncamera 1 2 3 4 5 6.5 40\nviewport 64 48\nbrush voxel\nbrush sphere 3\nbrush box 1 2 3\n\
+        let text = "load a.vox\nnew\ndemo\ncamera 1 2 3 4 5 6.5 40\nviewport 64 48\nbrush voxel\nbrush sphere 3\nbrush box 1 2 3\n\
                     color 7\nplace -1 2 3\nremove 1 2 3\npaint 1 2 -3\nclick 3 4 erase\nundo 2\nredo 1\nsave b.vox\n\
                     render c.png\nexpect voxel 1 2 3 0\nexpect count 5\nexpect written <= 512\nexpect image c.png 0.01\n";
         let script = parse_script(Path::new("t.ovr"), text).unwrap();
@@ -283,6 +284,6 @@ mod tests {
             script.lines.iter().map(|l| &l.command).collect::<Vec<_>>(),
             again.lines.iter().map(|l| &l.command).collect::<Vec<_>>()
         );
-        assert_eq!(script.lines.len(), 20);
+        assert_eq!(script.lines.len(), 21);
     }
 }

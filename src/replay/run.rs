@@ -122,6 +122,7 @@ impl Runner {
                 self.set_scene(crate::io::load_scene(&path, 0).map_err(|e| e.to_string())?);
             }
             Command::New => self.set_scene(Scene::default()),
+            Command::Demo => self.set_scene(crate::scene::demo::demo_scene()),
             Command::Camera { eye, target, fov } => {
                 self.camera = Camera { eye: *eye, target: *target, fov_y_deg: fov.unwrap_or(self.camera.fov_y_deg) };
             }

@@ -1,0 +1,117 @@
+//! Recording a window session as a script (`octovox --record PATH`): the
+//! camera, brush and colour in force, and every click as the
+//! `place`/`remove`/`paint` it became, so `octovox replay` reproduces it.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use glam::IVec3;
+
+use super::{Command, edit_command};
+use crate::camera::Camera;
+use crate::tool::{Brush, Tool};
+
+/// Writes script lines as the user works. Lines are flushed as they are
+/// written, so a crash loses nothing that was recorded.
+pub struct Recorder {
+    out: std::io::BufWriter<std::fs::File>,
+    path: PathBuf,
+    camera: Option<Camera>,
+    brush: Option<Brush>,
+    color: Option<u8>,
+    /// Edits of each undo step still undoable / redoable (a stroke is one
+    /// step in the window but one line per edit in the script).
+    done: Vec<u32>,
+    undone: Vec<u32>,
+    open_stroke: u32,
+}
+
+impl Recorder {
+    pub fn create(path: &Path) -> std::io::Result<Recorder> {
+        let file = std::fs::File::create(path)?;
+        let mut recorder = Recorder {
+            out: std::io::BufWriter::new(file),
+            path: path.to_path_buf(),
+            camera: None,
+            brush: None,
+            color: None,
+            done: Vec::new(),
+            undone: Vec::new(),
+            open_stroke: 0,
+        };
+        recorder.line("# recorded by octovox --record")?;
+        Ok(recorder)
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    fn line(&mut self, text: &str) -> std::io::Result<()> {
+        writeln!(self.out, "{text}")?;
+        self.out.flush()
+    }
+
+    fn command(&mut self, command: &Command) -> std::io::Result<()> {
+        self.line(&command.to_string())
+    }
+
+    /// The scene was replaced: `load PATH` (absolute), or `demo`/`new`.
+    pub fn scene(&mut self, command: Command) -> std::io::Result<()> {
+        self.done.clear();
+        self.undone.clear();
+        self.open_stroke = 0;
+        self.command(&command)
+    }
+
+    /// One edit made by a click: writes the state it depends on if it
+    /// changed, then the edit line.
+    pub fn edit(&mut self, camera: &Camera, brush: Brush, color: u8, tool: Tool, center: IVec3) -> std::io::Result<()> {
+        if self.camera != Some(*camera) {
+            self.camera = Some(*camera);
+            let (eye, target) = (camera.eye, camera.target);
+            self.command(&Command::Camera { eye, target, fov: Some(camera.fov_y_deg) })?;
+        }
+        if self.brush != Some(brush) {
+            self.brush = Some(brush);
+            self.command(&Command::Brush(brush))?;
+        }
+        if tool != Tool::Erase && self.color != Some(color) {
+            self.color = Some(color);
+            self.command(&Command::Color(color))?;
+        }
+        self.undone.clear();
+        self.open_stroke += 1;
+        self.command(&edit_command(tool, center))
+    }
+
+    /// Ends an undo step (a click or a whole drag).
+    pub fn end_step(&mut self) {
+        if self.open_stroke > 0 {
+            self.done.push(self.open_stroke);
+            self.open_stroke = 0;
+        }
+    }
+
+    pub fn undo(&mut self) -> std::io::Result<()> {
+        self.end_step();
+        match self.done.pop() {
+            Some(n) => {
+                self.undone.push(n);
+                self.command(&Command::Undo(n))
+            }
+            None => Ok(()),
+        }
+    }
+
+    pub fn redo(&mut self) -> std::io::Result<()> {
+        self.end_step();
+        match self.undone.pop() {
+            Some(n) => {
+                self.done.push(n);
+                self.command(&Command::Redo(n))
+            }
+            None => Ok(()),
+        }
+    }
+}
