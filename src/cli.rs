@@ -28,6 +28,10 @@ pub struct WindowArgs {
     /// Initial camera as EX,EY,EZ:TX,TY,TZ (eye and target, world voxels).
     #[arg(long, value_parser = parse_camera)]
     pub camera: Option<(DVec3, DVec3)>,
+    /// Draw N frames as fast as possible after the first, print the average
+    /// frame rate and exit (a benchmark of the whole frame: trace, blit, egui).
+    #[arg(long, value_name = "N")]
+    pub bench_frames: Option<u32>,
 }
 
 #[derive(Subcommand, Debug)]

@@ -10,7 +10,7 @@ use crate::cli::{Cli, Command};
 
 pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
-        None => anyhow::bail!("the sandbox window is not built yet; try `octovox info FILE`"),
+        None => crate::app::run(cli.window),
         Some(Command::Info { file, json, frame }) => info::run(&file, json, frame),
         Some(Command::Convert {
             input,
