@@ -141,12 +141,19 @@ impl App {
             fatal: None,
             args,
         };
+        app.state.settings.render_scale = app.args.render_scale.clamp(0.25, 1.0);
+        app.state.settings.shadows = !app.args.no_shadows;
         if let Some((eye, target)) = app.args.camera {
             app.state.camera = Camera { eye, target, fov_y_deg: app.state.camera.fov_y_deg };
         }
         match app.args.file.clone() {
             Some(path) => app.start_loading(path),
-            None => app.replace_scene(octovox::scene::demo::demo_scene(), None),
+            None => {
+                app.replace_scene(octovox::scene::demo::demo_scene(), None);
+                if app.args.camera.is_none() {
+                    camera_control::frame_model(&mut app.state.camera, app.scene.tree.solid_bounds());
+                }
+            }
         }
         app
     }

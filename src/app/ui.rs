@@ -84,7 +84,7 @@ fn rgba(palette: &Palette, index: u8) -> Color32 {
 /// Draws every panel; returns what the user asked for.
 pub fn show(ui: &mut egui::Ui, state: &mut EditorState, ui_state: &mut UiState, info: &Info) -> Vec<Command> {
     let mut out = Vec::new();
-    egui::Panel::top("menu").show(ui, |ui| menu_bar(ui, info, &mut out));
+    egui::Panel::top("menu").show(ui, |ui| menu_bar(ui, info, ui_state, &mut out));
     egui::Panel::left("tools").resizable(false).exact_size(PANEL_WIDTH).show(ui, |ui| {
         egui::ScrollArea::vertical().show(ui, |ui| {
             tools(ui, state);
@@ -94,8 +94,6 @@ pub fn show(ui: &mut egui::Ui, state: &mut EditorState, ui_state: &mut UiState, 
             render(ui, state);
             ui.separator();
             stats(ui, info);
-            ui.separator();
-            message(ui, ui_state, info);
         });
     });
     dialog(ui.ctx(), ui_state, &mut out);
@@ -103,7 +101,7 @@ pub fn show(ui: &mut egui::Ui, state: &mut EditorState, ui_state: &mut UiState, 
     out
 }
 
-fn menu_bar(ui: &mut egui::Ui, info: &Info, out: &mut Vec<Command>) {
+fn menu_bar(ui: &mut egui::Ui, info: &Info, ui_state: &mut UiState, out: &mut Vec<Command>) {
     egui::MenuBar::new().ui(ui, |ui| {
         ui.menu_button("File", |ui| {
             if ui.button("New          Ctrl+N").clicked() {
@@ -143,6 +141,7 @@ fn menu_bar(ui: &mut egui::Ui, info: &Info, out: &mut Vec<Command>) {
             ui.spinner();
             ui.label(format!("loading {} … {seconds:.1} s", path.display()));
         }
+        message(ui, ui_state);
     });
 }
 
@@ -173,37 +172,45 @@ fn tools(ui: &mut egui::Ui, state: &mut EditorState) {
 
 fn palette(ui: &mut egui::Ui, state: &mut EditorState, palette: &Palette) {
     ui.heading("Palette");
-    let cell = 13.0;
-    egui::Grid::new("palette").spacing(Vec2::splat(1.0)).show(ui, |ui| {
-        for row in 0..16u16 {
-            for column in 0..16u16 {
-                let index = (row * 16 + column) as u8;
-                let (rect, response) = ui.allocate_exact_size(Vec2::splat(cell), Sense::click());
-                if index == 0 {
-                    // Index 0 is "empty", not a colour.
-                    ui.painter().line_segment([rect.left_bottom(), rect.right_top()], Stroke::new(1.0, Color32::GRAY));
-                    continue;
-                }
-                ui.painter().rect_filled(rect, 0.0, rgba(palette, index));
-                if index == state.color {
-                    ui.painter().rect_stroke(
-                        rect.expand(1.0),
-                        0.0,
-                        Stroke::new(2.0, Color32::WHITE),
-                        egui::StrokeKind::Outside,
-                    );
-                }
-                if response.clicked() {
-                    state.color = index;
-                }
-                response.on_hover_text(format!("{index}"));
-            }
-            ui.end_row();
+    // One 16×16 block painted by hand: 256 widgets would be slow and loose.
+    let cell = ((ui.available_width() - 4.0) / 16.0).floor().clamp(8.0, 16.0);
+    let (rect, response) = ui.allocate_exact_size(Vec2::splat(cell * 16.0), Sense::click());
+    let cell_rect = |index: u8| {
+        let (row, column) = (f32::from(index / 16), f32::from(index % 16));
+        egui::Rect::from_min_size(rect.min + Vec2::new(column, row) * cell, Vec2::splat(cell)).shrink(0.5)
+    };
+    let painter = ui.painter_at(rect);
+    for index in 0..=255u8 {
+        let r = cell_rect(index);
+        if index == 0 {
+            // Index 0 is "empty", not a colour.
+            painter.line_segment([r.left_bottom(), r.right_top()], Stroke::new(1.0, Color32::GRAY));
+        } else {
+            painter.rect_filled(r, 0.0, rgba(palette, index));
         }
-    });
+    }
+    let selected = cell_rect(state.color);
+    painter.rect_stroke(selected, 0.0, Stroke::new(2.0, Color32::WHITE), egui::StrokeKind::Inside);
+    let index_at = |pos: egui::Pos2| {
+        let offset = (pos - rect.min) / cell;
+        let (column, row) = (offset.x.floor() as i32, offset.y.floor() as i32);
+        ((0..16).contains(&column) && (0..16).contains(&row)).then(|| (row * 16 + column) as u8)
+    };
+    if response.clicked()
+        && let Some(index) = response.interact_pointer_pos().and_then(index_at).filter(|i| *i != 0)
+    {
+        state.color = index;
+    }
+    if let Some(index) = response.hover_pos().and_then(index_at) {
+        response.on_hover_text(format!("{index}"));
+    }
     let material = palette.material(state.color);
     let [r, g, b, _] = palette.color(state.color);
-    ui.label(format!("colour {} · #{r:02x}{g:02x}{b:02x} · {}", state.color, material.kind.vox_name()));
+    ui.label(format!(
+        "colour {} · #{r:02x}{g:02x}{b:02x} · {}",
+        state.color,
+        material.kind.vox_name().trim_start_matches('_')
+    ));
     let params: Vec<String> =
         material.params.iter().filter(|(k, _)| k.as_str() != "_type").map(|(k, v)| format!("{k}={v}")).collect();
     if !params.is_empty() {
@@ -224,7 +231,7 @@ fn render(ui: &mut egui::Ui, state: &mut EditorState) {
         ui.radio_value(&mut settings.mode, TraceMode::Grid, "Grid (DDA)");
     });
     ui.checkbox(&mut settings.shadows, "Sun shadows");
-    ui.add(egui::Slider::new(&mut settings.render_scale, 0.25..=1.0).text("render scale"));
+    ui.add(egui::Slider::new(&mut settings.render_scale, 0.25..=1.0).text("scale"));
 }
 
 fn stats(ui: &mut egui::Ui, info: &Info) {
@@ -251,18 +258,14 @@ fn stats(ui: &mut egui::Ui, info: &Info) {
     });
 }
 
-fn message(ui: &mut egui::Ui, ui_state: &mut UiState, info: &Info) {
-    if let Some((path, _)) = info.loading {
-        ui.horizontal(|ui| {
-            ui.spinner();
-            ui.label(format!("loading {}", path.display()));
-        });
-    }
+/// The last message (errors in red), on the menu bar where it is always seen.
+fn message(ui: &mut egui::Ui, ui_state: &mut UiState) {
     let mut clear = false;
     if let Some((text, is_error)) = &ui_state.message {
+        ui.separator();
         let color = if *is_error { Color32::from_rgb(255, 110, 100) } else { Color32::LIGHT_GREEN };
         ui.colored_label(color, text);
-        clear = ui.small_button("dismiss").clicked();
+        clear = ui.small_button("×").on_hover_text("dismiss").clicked();
     }
     if clear {
         ui_state.message = None;
@@ -294,6 +297,10 @@ fn dialog(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
         ui.label("Path:");
         let field = ui.text_edit_singleline(path);
         let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+        // Typing goes to the path at once (nothing else has focus while the dialog is up).
+        if !entered && ui.memory(|m| m.focused().is_none()) {
+            field.request_focus();
+        }
         for file in nearby_vox_files().into_iter().take(12) {
             if ui.link(file.display().to_string()).clicked() {
                 *path = file.display().to_string();
