@@ -28,6 +28,16 @@ pub struct WindowArgs {
     /// Initial camera as EX,EY,EZ:TX,TY,TZ (eye and target, world voxels).
     #[arg(long, value_parser = parse_camera)]
     pub camera: Option<(DVec3, DVec3)>,
+    /// Draw N frames as fast as possible after the first, print the average
+    /// frame rate and exit (a benchmark of the whole frame: trace, blit, egui).
+    #[arg(long, value_name = "N")]
+    pub bench_frames: Option<u32>,
+    /// Fraction of the window's pixels traced per axis (0.25..=1; the UI can change it).
+    #[arg(long, default_value_t = 1.0)]
+    pub render_scale: f32,
+    /// Start with sun shadows off (the UI can turn them on).
+    #[arg(long)]
+    pub no_shadows: bool,
 }
 
 #[derive(Subcommand, Debug)]

@@ -17,7 +17,7 @@ fn update_images() -> bool {
 
 pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
-        None => anyhow::bail!("the sandbox window is not built yet; try `octovox info FILE`"),
+        None => crate::app::run(cli.window),
         Some(Command::Info { file, json, frame }) => info::run(&file, json, frame),
         Some(Command::Convert { input, output, frame }) => convert::run(&input, &output, frame),
         Some(Command::Render(args)) => render::run(&args),

@@ -1,6 +1,7 @@
 //! Everything that talks to wgpu: device setup, the scene's GPU buffers, the
 //! trace pass, timing and readback. The engine modules never import this.
 
+pub mod blit_pass;
 pub mod context;
 pub mod readback;
 pub mod renderer;
@@ -8,6 +9,7 @@ pub mod scene_buffers;
 pub mod timer;
 pub mod trace_pass;
 
+pub use blit_pass::BlitPass;
 pub use context::{GpuContext, GpuError};
 pub use renderer::Renderer;
 pub use scene_buffers::SceneBuffers;

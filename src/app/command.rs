@@ -1,0 +1,84 @@
+//! What the user (or, later, a replay script) asks the app to do. The panels
+//! and the input handler produce these; `App::execute` is the one place that
+//! carries them out, so a scripted edit and a mouse edit share every step.
+
+use std::path::PathBuf;
+
+use octovox::camera::Camera;
+use octovox::edit::Edit;
+
+use super::state::Tool;
+
+/// Where a pointer edit is in its stroke.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StrokePhase {
+    /// Button pressed: open an undo step and edit under the pointer.
+    Begin,
+    /// Pointer moved with the button held: edit the new cell, same undo step.
+    Move,
+    /// Button released: close the undo step.
+    End,
+    /// A press and release in one (a right click, or a scripted click).
+    Click,
+}
+
+/// What the unsaved-changes prompt was opened for.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Pending {
+    New,
+    Open(PathBuf),
+    Quit,
+}
+
+/// The answer to the unsaved-changes prompt.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Choice {
+    Save,
+    Discard,
+    Cancel,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Command {
+    /// Apply an edit (scripts; mouse edits arrive as `PointerEdit` and end here too).
+    #[expect(dead_code, reason = "produced by --replay, which is not wired yet")]
+    Edit(Edit),
+    /// Edit with `tool` at the window pixel `(x, y)` (physical pixels).
+    PointerEdit {
+        phase: StrokePhase,
+        tool: Tool,
+        x: f64,
+        y: f64,
+    },
+    Undo,
+    Redo,
+    SetTool(Tool),
+    #[expect(dead_code, reason = "produced by --replay, which is not wired yet")]
+    SetCamera(Camera),
+    Orbit {
+        dx: f64,
+        dy: f64,
+    },
+    Pan {
+        dx: f64,
+        dy: f64,
+    },
+    Zoom {
+        steps: f64,
+    },
+    FrameModel,
+    /// Start over with an empty scene (asks first if there are unsaved changes).
+    New,
+    /// Load a .vox on a background thread (asks first if there are unsaved changes).
+    Open(PathBuf),
+    /// Save to the current file, or ask for one.
+    Save,
+    SaveAs(PathBuf),
+    /// Show the Open or Save As path dialog.
+    AskOpen,
+    AskSaveAs,
+    Screenshot,
+    Quit,
+    /// Answer to the unsaved-changes prompt.
+    Resolve(Choice),
+}

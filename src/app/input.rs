@@ -1,0 +1,185 @@
+//! Mouse and keyboard: turns winit events that egui did not consume into
+//! [`Command`]s, and remembers what is held (buttons, fly keys, modifiers).
+
+use std::collections::HashSet;
+
+use glam::DVec3;
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
+use winit::keyboard::{KeyCode, ModifiersState, PhysicalKey};
+
+use super::command::{Command, StrokePhase};
+use super::state::Tool;
+
+/// A right press becomes an orbit once the pointer moved this far (pixels);
+/// released before that, it is a click.
+const CLICK_SLOP_PIXELS: f64 = 4.0;
+/// Pixels per wheel "line" for touchpads that report pixels.
+const PIXELS_PER_LINE: f64 = 40.0;
+
+#[derive(Debug, Default)]
+pub struct Input {
+    cursor: Option<(f64, f64)>,
+    left: bool,
+    middle: bool,
+    /// Where the right button went down, and whether it has moved since.
+    right: Option<((f64, f64), bool)>,
+    keys: HashSet<KeyCode>,
+    modifiers: ModifiersState,
+}
+
+impl Input {
+    /// The pointer in physical window pixels, if it is in the window.
+    pub fn cursor(&self) -> Option<(f64, f64)> {
+        self.cursor
+    }
+
+    /// Fly direction (right, up, forward) while the right button is held.
+    pub fn fly_direction(&self) -> Option<DVec3> {
+        self.right?;
+        let axis = |plus: KeyCode, minus: KeyCode| {
+            f64::from(u8::from(self.keys.contains(&plus))) - f64::from(u8::from(self.keys.contains(&minus)))
+        };
+        let dir = DVec3::new(
+            axis(KeyCode::KeyD, KeyCode::KeyA),
+            axis(KeyCode::KeyE, KeyCode::KeyQ),
+            axis(KeyCode::KeyW, KeyCode::KeyS),
+        );
+        (dir != DVec3::ZERO).then_some(dir)
+    }
+
+    /// Handles one event. `consumed` is egui's verdict: a consumed press
+    /// starts nothing, but releases and motion are always tracked so that no
+    /// button stays stuck.
+    pub fn on_event(&mut self, event: &WindowEvent, consumed: bool, tool: Tool) -> Vec<Command> {
+        let mut out = Vec::new();
+        match event {
+            WindowEvent::ModifiersChanged(m) => self.modifiers = m.state(),
+            WindowEvent::Focused(false) => {
+                self.keys.clear();
+                if self.left {
+                    self.left = false;
+                    if let Some((x, y)) = self.cursor {
+                        out.push(Command::PointerEdit { phase: StrokePhase::End, tool, x, y });
+                    }
+                }
+                self.middle = false;
+                self.right = None;
+            }
+            WindowEvent::CursorLeft { .. } => self.cursor = None,
+            WindowEvent::CursorMoved { position, .. } => {
+                let (x, y) = (position.x, position.y);
+                if let Some((px, py)) = self.cursor {
+                    let (dx, dy) = (x - px, y - py);
+                    if let Some((start, moved)) = &mut self.right {
+                        if !*moved && ((x - start.0).powi(2) + (y - start.1).powi(2)).sqrt() > CLICK_SLOP_PIXELS {
+                            *moved = true;
+                            // Catch up with the motion made inside the slop.
+                            out.push(Command::Orbit { dx: x - start.0, dy: y - start.1 });
+                        } else if *moved {
+                            out.push(Command::Orbit { dx, dy });
+                        }
+                    } else if self.middle {
+                        out.push(Command::Pan { dx, dy });
+                    }
+                }
+                self.cursor = Some((x, y));
+                if self.left {
+                    out.push(Command::PointerEdit { phase: StrokePhase::Move, tool, x, y });
+                }
+            }
+            WindowEvent::MouseInput { state, button, .. } => {
+                let pressed = *state == ElementState::Pressed;
+                let at = self.cursor;
+                match (button, pressed) {
+                    (MouseButton::Left, true) if !consumed && !self.left => {
+                        if let Some((x, y)) = at {
+                            self.left = true;
+                            out.push(Command::PointerEdit { phase: StrokePhase::Begin, tool, x, y });
+                        }
+                    }
+                    (MouseButton::Left, false) if self.left => {
+                        self.left = false;
+                        let (x, y) = at.unwrap_or_default();
+                        out.push(Command::PointerEdit { phase: StrokePhase::End, tool, x, y });
+                    }
+                    (MouseButton::Right, true) if !consumed => {
+                        if let Some(p) = at {
+                            self.right = Some((p, false));
+                        }
+                    }
+                    (MouseButton::Right, false) => {
+                        // A right click without drag erases while Attach is active.
+                        if let (Some((_, false)), Some((x, y)), Tool::Attach) = (self.right, at, tool) {
+                            out.push(Command::PointerEdit { phase: StrokePhase::Click, tool: Tool::Erase, x, y });
+                        }
+                        self.right = None;
+                    }
+                    (MouseButton::Middle, true) if !consumed => self.middle = true,
+                    (MouseButton::Middle, false) => self.middle = false,
+                    _ => {}
+                }
+            }
+            WindowEvent::MouseWheel { delta, .. } if !consumed => {
+                let steps = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => f64::from(*y),
+                    MouseScrollDelta::PixelDelta(p) => p.y / PIXELS_PER_LINE,
+                };
+                out.push(Command::Zoom { steps });
+            }
+            WindowEvent::KeyboardInput { event, .. } => {
+                log::debug!(
+                    "key {:?} {:?} consumed={consumed} modifiers={:?}",
+                    event.physical_key,
+                    event.state,
+                    self.modifiers
+                );
+                let PhysicalKey::Code(code) = event.physical_key else { return out };
+                if event.state == ElementState::Released {
+                    self.keys.remove(&code);
+                    return out;
+                }
+                if consumed {
+                    return out;
+                }
+                self.keys.insert(code);
+                if let Some(command) = self.shortcut(code, event.repeat) {
+                    out.push(command);
+                }
+            }
+            _ => {}
+        }
+        out
+    }
+
+    /// Keyboard shortcuts (physical keys, so they work on any layout).
+    fn shortcut(&self, code: KeyCode, repeat: bool) -> Option<Command> {
+        let ctrl = self.modifiers.control_key();
+        let shift = self.modifiers.shift_key();
+        if ctrl {
+            return match code {
+                KeyCode::KeyZ if shift => Some(Command::Redo),
+                KeyCode::KeyZ => Some(Command::Undo),
+                KeyCode::KeyY => Some(Command::Redo),
+                KeyCode::KeyS if repeat => None,
+                KeyCode::KeyS if shift => Some(Command::AskSaveAs),
+                KeyCode::KeyS => Some(Command::Save),
+                KeyCode::KeyO => Some(Command::AskOpen),
+                KeyCode::KeyN => Some(Command::New),
+                KeyCode::KeyQ => Some(Command::Quit),
+                _ => None,
+            };
+        }
+        if repeat {
+            return None;
+        }
+        // While the right button is held, WASDQE fly; the tool keys still work.
+        match code {
+            KeyCode::KeyT => Some(Command::SetTool(Tool::Attach)),
+            KeyCode::KeyR => Some(Command::SetTool(Tool::Erase)),
+            KeyCode::KeyG => Some(Command::SetTool(Tool::Paint)),
+            KeyCode::KeyF if self.right.is_none() => Some(Command::FrameModel),
+            KeyCode::F12 => Some(Command::Screenshot),
+            _ => None,
+        }
+    }
+}

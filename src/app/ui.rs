@@ -1,0 +1,354 @@
+//! The egui panels. They read the plain editor state, bind its knobs (tool,
+//! brush, colour, render settings) directly, and return [`Command`]s for
+//! everything that acts (edits, files, camera moves).
+//!
+//! Layout: a menu bar on top and a tool panel on the left, both drawn *over*
+//! the traced image, which always fills the whole window. So window pixel
+//! (x, y) is trace pixel (x, y) at render scale 1, whatever the panels do.
+
+use std::path::{Path, PathBuf};
+
+use egui::{Color32, Sense, Stroke, Vec2};
+
+use octovox::scene::{Octree, Palette};
+use octovox::settings::{TraceMode, View};
+
+use super::command::{Choice, Command, Pending};
+use super::state::{BrushKind, EditorState, Tool};
+
+/// Width of the left panel in points.
+pub const PANEL_WIDTH: f32 = 236.0;
+
+/// Numbers the stats panel shows.
+#[derive(Clone, Debug, Default)]
+pub struct Stats {
+    /// Frames per second over recent continuously drawn frames.
+    pub fps: f64,
+    /// Wall time of the last frame function, milliseconds.
+    pub frame_ms: f64,
+    /// Trace pass time: GPU timestamps when available, else wall time.
+    pub trace_ms: f64,
+    /// Bytes the last edit (or undo/redo) wrote to the GPU.
+    pub last_edit_bytes: u64,
+    /// Byte ranges of the last edit.
+    pub last_edit_ranges: usize,
+}
+
+/// Read-only facts the panels show.
+pub struct Info<'a> {
+    pub palette: &'a Palette,
+    pub tree: &'a Octree,
+    pub stats: &'a Stats,
+    pub adapter: &'a str,
+    pub timestamps: bool,
+    /// File being loaded and seconds since it started.
+    pub loading: Option<(&'a Path, f64)>,
+    pub can_undo: bool,
+    pub can_redo: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DialogKind {
+    Open,
+    SaveAs,
+}
+
+/// UI-only state: open dialogs, the prompt, the message line.
+#[derive(Debug, Default)]
+pub struct UiState {
+    pub dialog: Option<(DialogKind, String)>,
+    /// An action waiting for the unsaved-changes prompt.
+    pub pending: Option<Pending>,
+    pub prompt_open: bool,
+    /// Last message for the user, and whether it is an error.
+    pub message: Option<(String, bool)>,
+}
+
+impl UiState {
+    pub fn error(&mut self, text: impl Into<String>) {
+        let text = text.into();
+        eprintln!("octovox: {text}");
+        self.message = Some((text, true));
+    }
+
+    pub fn info(&mut self, text: impl Into<String>) {
+        self.message = Some((text.into(), false));
+    }
+}
+
+fn rgba(palette: &Palette, index: u8) -> Color32 {
+    let [r, g, b, _] = palette.color(index);
+    Color32::from_rgb(r, g, b)
+}
+
+/// Draws every panel; returns what the user asked for.
+pub fn show(ui: &mut egui::Ui, state: &mut EditorState, ui_state: &mut UiState, info: &Info) -> Vec<Command> {
+    let mut out = Vec::new();
+    egui::Panel::top("menu").show(ui, |ui| menu_bar(ui, info, ui_state, &mut out));
+    egui::Panel::left("tools").resizable(false).exact_size(PANEL_WIDTH).show(ui, |ui| {
+        egui::ScrollArea::vertical().show(ui, |ui| {
+            tools(ui, state);
+            ui.separator();
+            palette(ui, state, info.palette);
+            ui.separator();
+            render(ui, state);
+            ui.separator();
+            stats(ui, info);
+        });
+    });
+    dialog(ui.ctx(), ui_state, &mut out);
+    prompt(ui.ctx(), ui_state, &mut out);
+    out
+}
+
+fn menu_bar(ui: &mut egui::Ui, info: &Info, ui_state: &mut UiState, out: &mut Vec<Command>) {
+    egui::MenuBar::new().ui(ui, |ui| {
+        ui.menu_button("File", |ui| {
+            if ui.button("New          Ctrl+N").clicked() {
+                out.push(Command::New);
+            }
+            if ui.button("Open…        Ctrl+O").clicked() {
+                out.push(Command::AskOpen);
+            }
+            if ui.button("Save         Ctrl+S").clicked() {
+                out.push(Command::Save);
+            }
+            if ui.button("Save As…     Ctrl+Shift+S").clicked() {
+                out.push(Command::AskSaveAs);
+            }
+            if ui.button("Screenshot   F12").clicked() {
+                out.push(Command::Screenshot);
+            }
+            ui.separator();
+            if ui.button("Quit         Ctrl+Q").clicked() {
+                out.push(Command::Quit);
+            }
+        });
+        ui.menu_button("Edit", |ui| {
+            if ui.add_enabled(info.can_undo, egui::Button::new("Undo   Ctrl+Z")).clicked() {
+                out.push(Command::Undo);
+            }
+            if ui.add_enabled(info.can_redo, egui::Button::new("Redo   Ctrl+Shift+Z / Ctrl+Y")).clicked() {
+                out.push(Command::Redo);
+            }
+        });
+        ui.menu_button("View", |ui| {
+            if ui.button("Frame model   F").clicked() {
+                out.push(Command::FrameModel);
+            }
+        });
+        if let Some((path, seconds)) = info.loading {
+            ui.spinner();
+            ui.label(format!("loading {} … {seconds:.1} s", path.display()));
+        }
+        message(ui, ui_state);
+    });
+}
+
+fn tools(ui: &mut egui::Ui, state: &mut EditorState) {
+    ui.heading("Tool");
+    ui.horizontal(|ui| {
+        for tool in Tool::ALL {
+            ui.selectable_value(&mut state.tool, tool, tool.label());
+        }
+    });
+    ui.label("Brush");
+    ui.horizontal(|ui| {
+        ui.selectable_value(&mut state.brush_kind, BrushKind::Voxel, "Voxel");
+        ui.selectable_value(&mut state.brush_kind, BrushKind::Sphere, "Sphere");
+        ui.selectable_value(&mut state.brush_kind, BrushKind::Box, "Box");
+    });
+    match state.brush_kind {
+        BrushKind::Voxel => {}
+        BrushKind::Sphere => {
+            ui.add(egui::Slider::new(&mut state.sphere_radius, 0..=32).text("radius"));
+        }
+        BrushKind::Box => {
+            ui.add(egui::Slider::new(&mut state.box_size, 1..=64).text("size"));
+        }
+    }
+    ui.small("left: apply · right-drag: orbit · right-click: erase (Attach) · middle: pan · wheel: zoom · WASDQE + right: fly · F: frame");
+}
+
+fn palette(ui: &mut egui::Ui, state: &mut EditorState, palette: &Palette) {
+    ui.heading("Palette");
+    // One 16×16 block painted by hand: 256 widgets would be slow and loose.
+    let cell = ((ui.available_width() - 4.0) / 16.0).floor().clamp(8.0, 16.0);
+    let (rect, response) = ui.allocate_exact_size(Vec2::splat(cell * 16.0), Sense::click());
+    let cell_rect = |index: u8| {
+        let (row, column) = (f32::from(index / 16), f32::from(index % 16));
+        egui::Rect::from_min_size(rect.min + Vec2::new(column, row) * cell, Vec2::splat(cell)).shrink(0.5)
+    };
+    let painter = ui.painter_at(rect);
+    for index in 0..=255u8 {
+        let r = cell_rect(index);
+        if index == 0 {
+            // Index 0 is "empty", not a colour.
+            painter.line_segment([r.left_bottom(), r.right_top()], Stroke::new(1.0, Color32::GRAY));
+        } else {
+            painter.rect_filled(r, 0.0, rgba(palette, index));
+        }
+    }
+    let selected = cell_rect(state.color);
+    painter.rect_stroke(selected, 0.0, Stroke::new(2.0, Color32::WHITE), egui::StrokeKind::Inside);
+    let index_at = |pos: egui::Pos2| {
+        let offset = (pos - rect.min) / cell;
+        let (column, row) = (offset.x.floor() as i32, offset.y.floor() as i32);
+        ((0..16).contains(&column) && (0..16).contains(&row)).then(|| (row * 16 + column) as u8)
+    };
+    if response.clicked()
+        && let Some(index) = response.interact_pointer_pos().and_then(index_at).filter(|i| *i != 0)
+    {
+        state.color = index;
+    }
+    if let Some(index) = response.hover_pos().and_then(index_at) {
+        response.on_hover_text(format!("{index}"));
+    }
+    let material = palette.material(state.color);
+    let [r, g, b, _] = palette.color(state.color);
+    ui.label(format!(
+        "colour {} · #{r:02x}{g:02x}{b:02x} · {}",
+        state.color,
+        material.kind.vox_name().trim_start_matches('_')
+    ));
+    let params: Vec<String> =
+        material.params.iter().filter(|(k, _)| k.as_str() != "_type").map(|(k, v)| format!("{k}={v}")).collect();
+    if !params.is_empty() {
+        ui.small(params.join(" "));
+    }
+}
+
+fn render(ui: &mut egui::Ui, state: &mut EditorState) {
+    ui.heading("Render");
+    let settings = &mut state.settings;
+    egui::ComboBox::from_id_salt("view").selected_text(format!("{:?}", settings.view)).show_ui(ui, |ui| {
+        for view in View::ALL {
+            ui.selectable_value(&mut settings.view, view, format!("{view:?}"));
+        }
+    });
+    ui.horizontal(|ui| {
+        ui.radio_value(&mut settings.mode, TraceMode::Svo, "SVO");
+        ui.radio_value(&mut settings.mode, TraceMode::Grid, "Grid (DDA)");
+    });
+    ui.checkbox(&mut settings.shadows, "Sun shadows");
+    ui.add(egui::Slider::new(&mut settings.render_scale, 0.25..=1.0).text("scale"));
+}
+
+fn stats(ui: &mut egui::Ui, info: &Info) {
+    ui.heading("Stats");
+    let s = info.stats;
+    let tree = info.tree;
+    let pool = tree.pool();
+    let trace = if info.timestamps { "GPU" } else { "wall" };
+    egui::Grid::new("stats").num_columns(2).show(ui, |ui| {
+        let mut row = |name: &str, value: String| {
+            ui.label(name);
+            ui.label(value);
+            ui.end_row();
+        };
+        row("fps", format!("{:.1}", s.fps));
+        row("frame", format!("{:.2} ms", s.frame_ms));
+        row("trace", format!("{:.2} ms ({trace})", s.trace_ms));
+        row("voxels", format!("{}", tree.solid_voxels()));
+        row("nodes", format!("{} + {} bricks", tree.node_count(), tree.brick_count()));
+        row("pool", format!("{} bytes", pool.live_bytes()));
+        row("last edit", format!("{} bytes, {} ranges", s.last_edit_bytes, s.last_edit_ranges));
+        row("uploaded", format!("{} bytes total", pool.stats.total_bytes));
+        row("adapter", info.adapter.to_string());
+    });
+}
+
+/// The last message (errors in red), on the menu bar where it is always seen.
+fn message(ui: &mut egui::Ui, ui_state: &mut UiState) {
+    let mut clear = false;
+    if let Some((text, is_error)) = &ui_state.message {
+        ui.separator();
+        let color = if *is_error { Color32::from_rgb(255, 110, 100) } else { Color32::LIGHT_GREEN };
+        ui.colored_label(color, text);
+        clear = ui.small_button("×").on_hover_text("dismiss").clicked();
+    }
+    if clear {
+        ui_state.message = None;
+    }
+}
+
+/// .vox files in the current folder and in `saves/`, for the path dialogs.
+fn nearby_vox_files() -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = [Path::new("."), Path::new("saves")]
+        .iter()
+        .filter_map(|dir| std::fs::read_dir(dir).ok())
+        .flatten()
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("vox")))
+        .collect();
+    files.sort();
+    files
+}
+
+fn dialog(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
+    let Some((kind, path)) = &mut ui_state.dialog else { return };
+    let title = match kind {
+        DialogKind::Open => "Open .vox",
+        DialogKind::SaveAs => "Save as .vox",
+    };
+    let mut close = false;
+    egui::Window::new(title).collapsible(false).resizable(false).show(ctx, |ui| {
+        ui.label("Path:");
+        let field = ui.text_edit_singleline(path);
+        let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+        // Typing goes to the path at once (nothing else has focus while the dialog is up).
+        if !entered && ui.memory(|m| m.focused().is_none()) {
+            field.request_focus();
+        }
+        for file in nearby_vox_files().into_iter().take(12) {
+            if ui.link(file.display().to_string()).clicked() {
+                *path = file.display().to_string();
+            }
+        }
+        ui.horizontal(|ui| {
+            let ok = ui.button(if *kind == DialogKind::Open { "Open" } else { "Save" }).clicked();
+            if (ok || entered) && !path.trim().is_empty() {
+                let chosen = PathBuf::from(path.trim());
+                out.push(match kind {
+                    DialogKind::Open => Command::Open(chosen),
+                    DialogKind::SaveAs => Command::SaveAs(chosen),
+                });
+                close = true;
+            }
+            if ui.button("Cancel").clicked() {
+                close = true;
+            }
+        });
+    });
+    if close {
+        ui_state.dialog = None;
+    }
+}
+
+fn prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
+    if !ui_state.prompt_open {
+        return;
+    }
+    let what = match &ui_state.pending {
+        Some(Pending::New) => "starting a new scene",
+        Some(Pending::Open(_)) => "opening another file",
+        Some(Pending::Quit) => "quitting",
+        None => "continuing",
+    };
+    egui::Modal::new(egui::Id::unique("unsaved")).show(ctx, |ui| {
+        ui.heading("Unsaved changes");
+        ui.label(format!("Save the changes before {what}?"));
+        ui.horizontal(|ui| {
+            if ui.button("Save").clicked() {
+                out.push(Command::Resolve(Choice::Save));
+            }
+            if ui.button("Discard").clicked() {
+                out.push(Command::Resolve(Choice::Discard));
+            }
+            if ui.button("Cancel").clicked() {
+                out.push(Command::Resolve(Choice::Cancel));
+            }
+        });
+    });
+}

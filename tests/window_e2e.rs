@@ -1,0 +1,328 @@
+//! End to end: the real `octovox` binary in a real window on its own Xvfb
+//! display, driven with the real mouse and keyboard through `xdotool`.
+//!
+//! The test opens a copy of `torus64.vox` with a fixed camera and window size,
+//! computes on the CPU (`Camera::basis` + `svo::trace`, the app's own picking
+//! path) a window pixel that hits a voxel face, clicks it (Attach), saves with
+//! Ctrl+S and checks the file gained exactly the voxel in front of that face;
+//! then erases it the same way and checks the file is back to the original.
+//! Along the way it screenshots the X screen (model and panel visible), takes
+//! the app's own F12 screenshot, and checks from the app's stdout that each
+//! click wrote at most 1 KiB to the GPU.
+//!
+//! The pixel mapping holds because the app traces the whole window at render
+//! scale 1 and draws its egui panels *over* the image (docs/window.md).
+//!
+//! Needs `Xvfb`, `xdotool`, `xwd` and ImageMagick's `convert`
+//! (`apt-get install -y mesa-vulkan-drivers xvfb xdotool x11-apps imagemagick`).
+
+// A test: a failed unwrap is a failed test, with its message.
+#![allow(clippy::unwrap_used)]
+
+use std::collections::HashSet;
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc::{self, Receiver};
+use std::time::{Duration, Instant};
+
+use glam::IVec3;
+use octovox::camera::Camera;
+use octovox::scene::Octree;
+use octovox::trace::{Ray, svo};
+
+const WIDTH: u32 = 800;
+const HEIGHT: u32 = 600;
+/// The left panel is 236 points wide and the menu bar about 25 high; clicks
+/// stay clear of both.
+const FREE_X: u32 = 300;
+const FREE_Y: u32 = 60;
+
+/// Kills a child process when dropped (also when the test panics).
+struct KillOnDrop(Child, &'static str);
+
+impl Drop for KillOnDrop {
+    fn drop(&mut self) {
+        if let Ok(None) = self.0.try_wait() {
+            let _ = self.0.kill();
+            let _ = self.0.wait();
+            eprintln!("(stopped {})", self.1);
+        }
+    }
+}
+
+fn require_tool(name: &str) {
+    let found =
+        std::env::var_os("PATH").is_some_and(|paths| std::env::split_paths(&paths).any(|dir| dir.join(name).is_file()));
+    assert!(
+        found,
+        "`{name}` is not installed; the window test needs Xvfb, xdotool, xwd and ImageMagick: \
+         apt-get install -y mesa-vulkan-drivers xvfb xdotool x11-apps imagemagick"
+    );
+}
+
+/// Starts Xvfb on a free display number derived from the process id and
+/// waits until it accepts connections.
+fn start_xvfb() -> (KillOnDrop, String) {
+    let base = 100 + std::process::id() % 400;
+    let number = (base..base + 200)
+        .find(|n| {
+            !Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() && !Path::new(&format!("/tmp/.X{n}-lock")).exists()
+        })
+        .expect("no free X display number");
+    let display = format!(":{number}");
+    let child = Command::new("Xvfb")
+        .args([&display, "-screen", "0", "1600x1000x24", "-nolisten", "tcp"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("cannot start Xvfb");
+    let guard = KillOnDrop(child, "Xvfb");
+    let deadline = Instant::now() + Duration::from_secs(30);
+    loop {
+        let ok = Command::new("xdotool")
+            .arg("getdisplaygeometry")
+            .env("DISPLAY", &display)
+            .stderr(Stdio::null())
+            .output()
+            .is_ok_and(|o| o.status.success());
+        if ok {
+            break;
+        }
+        assert!(Instant::now() < deadline, "Xvfb on {display} did not accept connections within 30 s");
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    (guard, display)
+}
+
+fn xdotool(display: &str, args: &[&str]) -> String {
+    let out = Command::new("xdotool").args(args).env("DISPLAY", display).output().expect("cannot run xdotool");
+    assert!(out.status.success(), "xdotool {args:?} failed: {}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8_lossy(&out.stdout).trim().to_string()
+}
+
+/// The app's stdout, line by line, with a record of everything seen.
+struct Lines {
+    rx: Receiver<String>,
+    seen: Vec<String>,
+}
+
+impl Lines {
+    fn new(child: &mut Child) -> Lines {
+        let stdout = child.stdout.take().expect("stdout is piped");
+        let (tx, rx) = mpsc::channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+                eprintln!("app: {line}");
+                if tx.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        Lines { rx, seen: Vec::new() }
+    }
+
+    /// Waits for a line starting with `prefix`; returns it.
+    fn wait_for(&mut self, prefix: &str, timeout: Duration) -> String {
+        let deadline = Instant::now() + timeout;
+        loop {
+            let left = deadline.saturating_duration_since(Instant::now());
+            match self.rx.recv_timeout(left) {
+                Ok(line) => {
+                    self.seen.push(line.clone());
+                    if line.starts_with(prefix) {
+                        return line;
+                    }
+                }
+                Err(_) => panic!("no `{prefix}` line from the app within {timeout:?}; saw {:?}", self.seen),
+            }
+        }
+    }
+}
+
+/// A pixel clear of the panels whose 5×5 neighbourhood hits the same voxel
+/// through the same face, so a click there cannot land on a neighbour.
+fn stable_pixel(tree: &Octree, camera: &Camera) -> (u32, u32, IVec3, IVec3) {
+    let basis = camera.basis(WIDTH, HEIGHT, tree.origin());
+    let hit_at = |x: u32, y: u32| {
+        let (o, d) = basis.ray(x, y);
+        svo::trace(tree, &Ray::new(o, d))
+    };
+    let (cx, cy) = ((FREE_X + WIDTH) / 2, (FREE_Y + HEIGHT) / 2);
+    let mut candidates: Vec<(u32, u32)> = (FREE_Y + 4..HEIGHT - 4)
+        .step_by(3)
+        .flat_map(|y| (FREE_X + 4..WIDTH - 4).step_by(3).map(move |x| (x, y)))
+        .collect();
+    candidates.sort_by_key(|&(x, y)| (x as i64 - cx as i64).pow(2) + (y as i64 - cy as i64).pow(2));
+    for (x, y) in candidates {
+        let hit = hit_at(x, y);
+        if !hit.is_hit() || hit.normal == IVec3::ZERO {
+            continue;
+        }
+        let stable = (-2..=2).all(|dy: i32| {
+            (-2..=2).all(|dx: i32| {
+                let h = hit_at(x.wrapping_add_signed(dx), y.wrapping_add_signed(dy));
+                h.voxel == hit.voxel && h.normal == hit.normal
+            })
+        });
+        if stable {
+            return (x, y, hit.voxel + tree.origin(), hit.normal);
+        }
+    }
+    panic!("no pixel of the view hits a voxel face steadily");
+}
+
+fn voxel_set(path: &Path) -> HashSet<IVec3> {
+    let scene = octovox::io::load_scene(path, 0).expect("the saved file loads");
+    scene.tree.voxels().into_iter().map(|(p, _)| p).collect()
+}
+
+/// Mean and variance of the grey level of a rectangle of an image.
+fn grey_stats(image: &image::RgbImage, x0: u32, y0: u32, x1: u32, y1: u32) -> (f64, f64) {
+    let values: Vec<f64> = (y0..y1)
+        .flat_map(|y| (x0..x1).map(move |x| (x, y)))
+        .map(|(x, y)| {
+            let p = image.get_pixel(x, y);
+            (f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2])) / 3.0
+        })
+        .collect();
+    let mean = values.iter().sum::<f64>() / values.len() as f64;
+    let variance = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / values.len() as f64;
+    (mean, variance)
+}
+
+fn screenshot_x(display: &str, out: &Path) -> image::RgbImage {
+    let status = Command::new("sh")
+        .arg("-c")
+        .arg(format!("xwd -root -silent | convert xwd:- png:'{}'", out.display()))
+        .env("DISPLAY", display)
+        .status()
+        .expect("cannot run xwd | convert");
+    assert!(status.success(), "xwd | convert failed");
+    image::open(out).expect("the X screenshot is a PNG").to_rgb8()
+}
+
+/// Clicks window pixel (x, y) with the left button and waits for the edit.
+fn click(display: &str, window: &str, lines: &mut Lines, x: u32, y: u32) -> u64 {
+    xdotool(display, &["mousemove", "--window", window, &x.to_string(), &y.to_string()]);
+    // Let a frame show the hover highlight first (not needed for the edit).
+    std::thread::sleep(Duration::from_millis(300));
+    xdotool(display, &["click", "1"]);
+    let line = lines.wait_for("edit:", Duration::from_secs(30));
+    line.split_whitespace().nth(1).and_then(|n| n.parse().ok()).expect("edit line: `edit: N bytes written …`")
+}
+
+fn save(display: &str, lines: &mut Lines, file: &Path) {
+    xdotool(display, &["key", "ctrl+s"]);
+    let line = lines.wait_for("saved:", Duration::from_secs(30));
+    assert!(line.ends_with(&*file.file_name().unwrap().to_string_lossy()), "{line}");
+}
+
+#[test]
+fn click_attach_save_erase_save_in_a_real_window() {
+    for tool in ["Xvfb", "xdotool", "xwd", "convert"] {
+        require_tool(tool);
+    }
+    let started = Instant::now();
+    let source = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/vox/seed/torus64.vox");
+    assert!(source.is_file(), "missing test model {}", source.display());
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("torus.vox");
+    std::fs::copy(&source, &file).unwrap();
+
+    // The CPU reference decides where to click and what must happen.
+    let original = octovox::io::load_scene(&file, 0).unwrap();
+    let original_voxels: HashSet<IVec3> = original.tree.voxels().into_iter().map(|(p, _)| p).collect();
+    let (lo, hi) = original.tree.solid_bounds().unwrap();
+    let camera = Camera::framing(lo, hi, 50.0);
+    let (x, y, hit_voxel, normal) = stable_pixel(&original.tree, &camera);
+    let placed = hit_voxel + normal;
+    assert!(!original_voxels.contains(&placed));
+    eprintln!("click at ({x}, {y}): hits {hit_voxel} through face {normal}; attach goes to {placed}");
+
+    let (_xvfb, display) = start_xvfb();
+    let runtime_dir = dir.path().join("xdg");
+    std::fs::create_dir_all(&runtime_dir).unwrap();
+    let camera_arg = format!(
+        "{},{},{}:{},{},{}",
+        camera.eye.x, camera.eye.y, camera.eye.z, camera.target.x, camera.target.y, camera.target.z
+    );
+    let mut child = Command::new(env!("CARGO_BIN_EXE_octovox"))
+        .arg(&file)
+        .args(["--size", &format!("{WIDTH}x{HEIGHT}"), &format!("--camera={camera_arg}")])
+        .current_dir(dir.path())
+        .env("DISPLAY", &display)
+        .env("XDG_RUNTIME_DIR", &runtime_dir)
+        .env_remove("WAYLAND_DISPLAY")
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("cannot start octovox");
+    let mut lines = Lines::new(&mut child);
+    let mut app = KillOnDrop(child, "octovox");
+
+    let window = xdotool(&display, &["search", "--sync", "--name", "octovox"]);
+    let window = window.lines().next().unwrap().to_string();
+    let ready = lines.wait_for("octovox: ready", Duration::from_secs(90));
+    assert_eq!(ready, format!("octovox: ready {WIDTH}x{HEIGHT}"), "the window must have the requested size");
+    // Without a window manager nothing focuses the window; keys go to the focus.
+    xdotool(&display, &["windowfocus", "--sync", &window]);
+
+    // The screen shows the model (not one flat colour) and the egui panel.
+    let shot = screenshot_x(&display, &dir.path().join("screen.png"));
+    let (_, view_variance) = grey_stats(&shot, FREE_X, FREE_Y, WIDTH, HEIGHT);
+    assert!(view_variance > 100.0, "the traced view looks flat (variance {view_variance:.1})");
+    let (panel_mean, _) = grey_stats(&shot, 4, 300, 200, 340);
+    let (sky_mean, _) = grey_stats(&shot, WIDTH - 40, FREE_Y, WIDTH - 4, FREE_Y + 40);
+    assert!(
+        panel_mean < 80.0 && sky_mean > 120.0,
+        "no dark egui panel over the bright sky: panel {panel_mean:.0}, sky {sky_mean:.0}"
+    );
+
+    // Attach one voxel in front of the clicked face, save, check the file.
+    let bytes = click(&display, &window, &mut lines, x, y);
+    assert!(bytes <= 1024, "a one-voxel click wrote {bytes} bytes to the GPU");
+    save(&display, &mut lines, &file);
+    let after_attach = voxel_set(&file);
+    let added: Vec<&IVec3> = after_attach.difference(&original_voxels).collect();
+    let removed: Vec<&IVec3> = original_voxels.difference(&after_attach).collect();
+    assert_eq!((added, removed), (vec![&placed], vec![]), "Attach must add exactly the voxel at hit + normal");
+
+    // The same pixel now hits the new voxel (the ray passed through its cell).
+    let edited = octovox::io::load_scene(&file, 0).unwrap();
+    let basis = camera.basis(WIDTH, HEIGHT, edited.tree.origin());
+    let (o, d) = basis.ray(x, y);
+    let again = svo::trace(&edited.tree, &Ray::new(o, d));
+    assert_eq!(again.voxel + edited.tree.origin(), placed);
+
+    // Erase it with the R tool, save, and the file is the original again.
+    xdotool(&display, &["key", "r"]);
+    let bytes = click(&display, &window, &mut lines, x, y);
+    assert!(bytes <= 1024, "a one-voxel erase wrote {bytes} bytes to the GPU");
+    save(&display, &mut lines, &file);
+    assert_eq!(voxel_set(&file), original_voxels, "Erase must remove exactly the placed voxel");
+
+    // The app's own screenshot (F12) lands in saves/ and is not flat.
+    xdotool(&display, &["key", "F12"]);
+    let line = lines.wait_for("screenshot:", Duration::from_secs(30));
+    let png = dir.path().join(line.trim_start_matches("screenshot:").trim());
+    let own = image::open(&png).expect("the app's screenshot is a PNG").to_rgb8();
+    assert_eq!(own.dimensions(), (WIDTH, HEIGHT));
+    assert!(grey_stats(&own, FREE_X, FREE_Y, WIDTH, HEIGHT).1 > 100.0, "the app's screenshot is flat");
+
+    // Ctrl+Q quits without a prompt: everything was saved.
+    xdotool(&display, &["key", "ctrl+q"]);
+    let deadline = Instant::now() + Duration::from_secs(30);
+    let status = loop {
+        if let Some(status) = app.0.try_wait().unwrap() {
+            break status;
+        }
+        assert!(Instant::now() < deadline, "octovox did not quit on Ctrl+Q");
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    assert!(status.success(), "octovox exited with {status}");
+    for line in lines.seen.iter().filter(|l| l.starts_with("edit:")) {
+        let n: u64 = line.split_whitespace().nth(1).and_then(|n| n.parse().ok()).unwrap();
+        assert!(n <= 1024, "{line}");
+    }
+    eprintln!("window test took {:.1} s", started.elapsed().as_secs_f64());
+}
