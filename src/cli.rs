@@ -38,6 +38,12 @@ pub struct WindowArgs {
     /// Start with sun shadows off (the UI can turn them on).
     #[arg(long)]
     pub no_shadows: bool,
+    /// Play a replay script visibly, one line per frame (docs/replay.md).
+    #[arg(long, value_name = "SCRIPT")]
+    pub replay: Option<PathBuf>,
+    /// Record the session (camera, brush, colour, every edit) as a script.
+    #[arg(long, value_name = "PATH")]
+    pub record: Option<PathBuf>,
 }
 
 #[derive(Subcommand, Debug)]

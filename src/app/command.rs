@@ -41,7 +41,6 @@ pub enum Choice {
 #[derive(Clone, Debug, PartialEq)]
 pub enum Command {
     /// Apply an edit (scripts; mouse edits arrive as `PointerEdit` and end here too).
-    #[expect(dead_code, reason = "produced by --replay, which is not wired yet")]
     Edit(Edit),
     /// Edit with `tool` at the window pixel `(x, y)` (physical pixels).
     PointerEdit {
@@ -53,7 +52,6 @@ pub enum Command {
     Undo,
     Redo,
     SetTool(Tool),
-    #[expect(dead_code, reason = "produced by --replay, which is not wired yet")]
     SetCamera(Camera),
     Orbit {
         dx: f64,

@@ -5,6 +5,7 @@
 mod camera_control;
 mod command;
 mod input;
+mod script;
 mod state;
 mod ui;
 
@@ -115,6 +116,14 @@ struct App {
     next_repaint: Option<Instant>,
     bench: Option<Bench>,
     fatal: Option<anyhow::Error>,
+    /// `--replay`: the script being played.
+    player: Option<script::Player>,
+    /// `--record`: where the session is written as a script.
+    recorder: Option<octovox::replay::Recorder>,
+    /// A failed expectation or line of the playing script, to report.
+    check_message: Option<String>,
+    /// Where the next screenshot goes (a script's `render PATH`), else `saves/`.
+    screenshot_path: Option<PathBuf>,
 }
 
 impl App {
@@ -139,8 +148,13 @@ impl App {
             next_repaint: None,
             bench: args.bench_frames.map(|n| Bench { left: n.max(1), total: n.max(1), started: None, trace_ms: 0.0 }),
             fatal: None,
+            player: None,
+            recorder: None,
+            check_message: None,
+            screenshot_path: None,
             args,
         };
+        app.open_script_files();
         app.state.settings.render_scale = app.args.render_scale.clamp(0.25, 1.0);
         app.state.settings.shadows = !app.args.no_shadows;
         if let Some((eye, target)) = app.args.camera {
@@ -267,6 +281,12 @@ impl App {
 
     /// Puts a new scene in place (load, New, start-up) and uploads it whole.
     fn replace_scene(&mut self, scene: Scene, path: Option<PathBuf>) {
+        let line = match &path {
+            Some(path) => octovox::replay::Command::Load(std::fs::canonicalize(path).unwrap_or_else(|_| path.clone())),
+            None if scene.tree.solid_voxels() == 0 => octovox::replay::Command::New,
+            None => octovox::replay::Command::Demo,
+        };
+        self.record(|r| r.scene(line));
         self.scene = scene;
         self.history.clear();
         self.stroke = None;
@@ -301,12 +321,18 @@ impl App {
             }
             Command::PointerEdit { phase, tool, x, y } if !busy_loading => self.pointer_edit(phase, tool, x, y),
             Command::Undo if !busy_loading => match self.history.undo(&mut self.scene.tree) {
-                Ok(true) => self.after_change("undo"),
+                Ok(true) => {
+                    self.record(|r| r.undo());
+                    self.after_change("undo");
+                }
                 Ok(false) => self.ui.info("nothing to undo"),
                 Err(err) => self.ui.error(format!("undo failed: {err}")),
             },
             Command::Redo if !busy_loading => match self.history.redo(&mut self.scene.tree) {
-                Ok(true) => self.after_change("redo"),
+                Ok(true) => {
+                    self.record(|r| r.redo());
+                    self.after_change("redo");
+                }
                 Ok(false) => self.ui.info("nothing to redo"),
                 Err(err) => self.ui.error(format!("redo failed: {err}")),
             },
@@ -400,6 +426,7 @@ impl App {
                 {
                     self.ui.error(format!("cannot seed the new scene: {err}"));
                 }
+                self.record(|r| r.seed(color, IVec3::ZERO));
                 self.upload();
                 self.state.dirty = false;
                 camera_control::frame_model(&mut self.state.camera, Some((IVec3::splat(-4), IVec3::splat(4))));
@@ -504,6 +531,10 @@ impl App {
             StrokePhase::End => {
                 self.history.end_stroke();
                 self.stroke = None;
+                self.record(|r| {
+                    r.end_step();
+                    Ok(())
+                });
             }
             StrokePhase::Click => {
                 self.pointer_edit(StrokePhase::Begin, tool, x, y);
@@ -528,11 +559,14 @@ impl App {
         if stroke.last_center == Some(center) {
             return;
         }
+        let tool = stroke.tool;
         if self.apply_edit(edit)
             && let Some(stroke) = &mut self.stroke
         {
             stroke.plane.get_or_insert(layer);
             stroke.last_center = Some(center);
+            let (camera, brush, color) = (self.state.camera, self.state.brush(), self.state.color.max(1));
+            self.record(|r| r.edit(&camera, brush, color, tool, center));
         }
     }
 
@@ -553,6 +587,9 @@ impl App {
         self.last_frame = Some(started);
 
         self.poll_loading();
+        if self.ready {
+            self.play_step(event_loop);
+        }
         if let Some(dir) = self.input.fly_direction() {
             camera_control::fly(&mut self.state.camera, dir, seconds);
         }
@@ -696,7 +733,10 @@ impl App {
         self.bench_step(event_loop);
 
         // Keep drawing while something moves; otherwise wait for input.
-        let animating = self.loading.is_some() || self.input.fly_direction().is_some() || self.bench.is_some();
+        let animating = self.loading.is_some()
+            || self.input.fly_direction().is_some()
+            || self.bench.is_some()
+            || self.player.is_some();
         self.next_repaint = match repaint_delay {
             _ if animating => Some(Instant::now()),
             Some(delay) if delay < Duration::from_secs(5) => Some(Instant::now() + delay),
@@ -727,15 +767,18 @@ impl App {
     fn save_screenshot(&mut self, window_copy: Option<(wgpu::Buffer, u32, u32, bool)>) {
         let Some(gfx) = &self.gfx else { return };
         let stamp = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_millis());
-        let base = Path::new(SCREENSHOT_DIR).join(format!("octovox-{stamp}"));
-        let view_path = base.with_extension("png");
+        let view_path = self
+            .screenshot_path
+            .take()
+            .unwrap_or_else(|| Path::new(SCREENSHOT_DIR).join(format!("octovox-{stamp}.png")));
+        let base = view_path.with_extension("");
         let (w, h) = gfx.trace.size();
         let result = gfx
             .trace
             .read_color(&gfx.gpu)
             .map_err(anyhow::Error::from)
             .and_then(|bytes| image::RgbaImage::from_raw(w, h, bytes).context("trace readback has the wrong size"))
-            .and_then(|image| crate::commands::render::save_png(&image, &view_path));
+            .and_then(|image| octovox::io::png::save_png(&image, &view_path).map_err(anyhow::Error::from));
         match result {
             Ok(()) => println!("screenshot: {}", view_path.display()),
             Err(err) => {
@@ -755,7 +798,7 @@ impl App {
                 pixels.chunks_exact_mut(4).for_each(|p| p[3] = 255);
                 let image =
                     image::RgbaImage::from_raw(width, height, pixels).context("frame readback has the wrong size")?;
-                crate::commands::render::save_png(&image, &window_path)
+                octovox::io::png::save_png(&image, &window_path).map_err(anyhow::Error::from)
             });
             match result {
                 Ok(()) => println!("screenshot: {}", window_path.display()),

@@ -1,9 +1,7 @@
 //! Plain editor state: tool, brush, colour, camera and render settings. No
 //! wgpu, winit or egui types live here, so the UI, the input handler and a
-//! replay script all read and change the same data.
-//!
-//! `Tool`, `Brush` and `click_edit` mirror `src/tool.rs` on the main branch
-//! (names and semantics kept identical) so the two can be merged into one.
+//! replay script all read and change the same data. Tools, brushes and
+//! what a click does come from `octovox::tool`, shared with replay's `click`.
 
 use std::path::PathBuf;
 
@@ -11,77 +9,8 @@ use glam::IVec3;
 
 use octovox::camera::Camera;
 use octovox::edit::Edit;
-use octovox::scene::{Op, Shape};
 use octovox::settings::RenderSettings;
-
-/// What a click does (MagicaVoxel's names and keys: T, R, G).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Tool {
-    /// Place voxels on the face that was clicked.
-    #[default]
-    Attach,
-    /// Remove the clicked voxels.
-    Erase,
-    /// Recolour the clicked voxels.
-    Paint,
-}
-
-impl Tool {
-    pub const ALL: [Tool; 3] = [Tool::Attach, Tool::Erase, Tool::Paint];
-
-    pub fn label(self) -> &'static str {
-        match self {
-            Tool::Attach => "Attach (T)",
-            Tool::Erase => "Erase (R)",
-            Tool::Paint => "Paint (G)",
-        }
-    }
-
-    /// The operation this tool performs with a colour.
-    pub fn op(self, color: u8) -> Op {
-        match self {
-            Tool::Attach => Op::Place(color),
-            Tool::Erase => Op::Remove,
-            Tool::Paint => Op::Paint(color),
-        }
-    }
-
-    /// The cell a click acts on: Attach works in front of the face that was hit.
-    pub fn target(self, voxel: IVec3, normal: IVec3) -> IVec3 {
-        match self {
-            Tool::Attach => voxel + normal,
-            Tool::Erase | Tool::Paint => voxel,
-        }
-    }
-}
-
-/// The brush shape, centred on the cell a click picks.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Brush {
-    #[default]
-    Voxel,
-    /// Cells with dx² + dy² + dz² ≤ r².
-    Sphere(i32),
-    /// `size` cells per axis, from `center - size / 2`.
-    Box(IVec3),
-}
-
-impl Brush {
-    pub fn shape_at(&self, center: IVec3) -> Shape {
-        match *self {
-            Brush::Voxel => Shape::Voxel(center),
-            Brush::Sphere(radius) => Shape::Sphere { center, radius },
-            Brush::Box(size) => Shape::centered_box(center, size),
-        }
-    }
-}
-
-/// The edit of a click with `tool` on (world) `voxel` through the face with
-/// `normal`; also returns the brush centre.
-pub fn click_edit(tool: Tool, brush: &Brush, color: u8, voxel: IVec3, normal: IVec3) -> (IVec3, Edit) {
-    let center = tool.target(voxel, normal);
-    (center, Edit::Brush { shape: brush.shape_at(center), op: tool.op(color) })
-}
+pub use octovox::tool::{Brush, Tool, click_edit};
 
 /// The voxel and face under the cursor, in world coordinates.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -169,6 +98,7 @@ impl EditorState {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use octovox::scene::{Op, Shape};
 
     #[test]
     fn attach_places_in_front_of_the_face() {

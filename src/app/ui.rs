@@ -149,7 +149,7 @@ fn tools(ui: &mut egui::Ui, state: &mut EditorState) {
     ui.heading("Tool");
     ui.horizontal(|ui| {
         for tool in Tool::ALL {
-            ui.selectable_value(&mut state.tool, tool, tool.label());
+            ui.selectable_value(&mut state.tool, tool, tool_label(tool));
         }
     });
     ui.label("Brush");
@@ -351,4 +351,13 @@ fn prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
             }
         });
     });
+}
+
+/// Button text of a tool, with its MagicaVoxel key.
+fn tool_label(tool: Tool) -> &'static str {
+    match tool {
+        Tool::Attach => "Attach (T)",
+        Tool::Erase => "Erase (R)",
+        Tool::Paint => "Paint (G)",
+    }
 }

@@ -64,6 +64,16 @@ impl Recorder {
         self.command(&command)
     }
 
+    /// A voxel the window places by itself (the seed of a new scene), not an
+    /// undo step there: recorded so the replay starts from the same voxels.
+    pub fn seed(&mut self, color: u8, at: IVec3) -> std::io::Result<()> {
+        self.brush = Some(Brush::Voxel);
+        self.color = Some(color);
+        self.command(&Command::Brush(Brush::Voxel))?;
+        self.command(&Command::Color(color))?;
+        self.command(&edit_command(Tool::Attach, at))
+    }
+
     /// One edit made by a click: writes the state it depends on if it
     /// changed, then the edit line.
     pub fn edit(&mut self, camera: &Camera, brush: Brush, color: u8, tool: Tool, center: IVec3) -> std::io::Result<()> {

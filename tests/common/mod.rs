@@ -2,6 +2,8 @@
 //! comparison.
 #![allow(dead_code)] // each test binary uses a different subset
 
+pub mod window;
+
 use std::path::PathBuf;
 
 use glam::{DVec3, IVec3};

@@ -1,0 +1,179 @@
+//! `--replay SCRIPT` plays a script visibly, one line per frame, through the
+//! window's own commands; `--record PATH` writes the session as a script.
+//! Both use the same edit path as the mouse (`App::apply_edit`).
+
+use std::path::{Path, PathBuf};
+
+use octovox::camera::Camera;
+use octovox::edit::Edit;
+use octovox::replay::{Command as Line, Script};
+use octovox::scene::{Op, Scene};
+use octovox::tool::{Brush, click_edit};
+
+use super::{App, Command};
+
+/// A script being played in the window.
+pub struct Player {
+    script: Script,
+    base: PathBuf,
+    next: usize,
+    brush: Brush,
+    color: u8,
+    passed: usize,
+    failed: usize,
+}
+
+impl Player {
+    pub fn new(script: Script) -> Player {
+        let base = script.path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        Player { script, base, next: 0, brush: Brush::Voxel, color: 1, passed: 0, failed: 0 }
+    }
+}
+
+impl App {
+    /// Plays the next script line, if a script is playing and the app is
+    /// idle (not loading). Prints the summary after the last line.
+    pub(super) fn play_step(&mut self, event_loop: &winit::event_loop::ActiveEventLoop) {
+        if self.loading.is_some() {
+            return;
+        }
+        let Some(player) = &mut self.player else { return };
+        let Some(line) = player.script.lines.get(player.next).cloned() else {
+            println!("replay: {} passed, {} failed", player.passed, player.failed);
+            self.ui.info(format!("replay done: {} passed, {} failed", player.passed, player.failed));
+            self.player = None;
+            return;
+        };
+        player.next += 1;
+        let base = player.base.clone();
+        let where_ = format!("{}:{}", player.script.path.display(), line.number);
+        match self.play_line(&base, &line.command, event_loop) {
+            Ok(None) => {}
+            Ok(Some(true)) => self.with_player(|p| p.passed += 1),
+            Ok(Some(false)) | Err(_) => self.with_player(|p| p.failed += 1),
+        }
+        if let Some(message) = self.check_message.take() {
+            println!("{where_}: {message}");
+            self.ui.error(format!("{where_}: {message}"));
+        }
+        self.request_redraw();
+    }
+
+    fn with_player(&mut self, f: impl FnOnce(&mut Player)) {
+        if let Some(player) = &mut self.player {
+            f(player);
+        }
+    }
+
+    /// Carries out one line. `Some(passed)` for expectations.
+    fn play_line(
+        &mut self,
+        base: &Path,
+        line: &Line,
+        event_loop: &winit::event_loop::ActiveEventLoop,
+    ) -> Result<Option<bool>, ()> {
+        let (brush, color) = self.player.as_ref().map_or((Brush::Voxel, 1), |p| (p.brush, p.color));
+        let brush_edit = |at, op| Edit::Brush { shape: brush.shape_at(at), op };
+        match line {
+            Line::Load(path) => self.start_loading(base.join(path)),
+            Line::New => self.replace_scene(Scene::default(), None),
+            Line::Demo => self.replace_scene(octovox::scene::demo::demo_scene(), None),
+            Line::Camera { eye, target, fov } => {
+                let fov_y_deg = fov.unwrap_or(self.state.camera.fov_y_deg);
+                self.execute(Command::SetCamera(Camera { eye: *eye, target: *target, fov_y_deg }), event_loop);
+            }
+            // The window's size is the viewport.
+            Line::Viewport(..) => {}
+            Line::Brush(b) => self.with_player(|p| p.brush = *b),
+            Line::Color(c) => {
+                self.with_player(|p| p.color = *c);
+                self.state.color = *c;
+            }
+            Line::Place(at) => self.execute(Command::Edit(brush_edit(*at, Op::Place(color))), event_loop),
+            Line::Remove(at) => self.execute(Command::Edit(brush_edit(*at, Op::Remove)), event_loop),
+            Line::Paint(at) => self.execute(Command::Edit(brush_edit(*at, Op::Paint(color))), event_loop),
+            Line::Click { x, y, tool } => match self.pick_at(f64::from(*x) + 0.5, f64::from(*y) + 0.5) {
+                Some(pick) => {
+                    let (_, edit) = click_edit(*tool, &brush, color, pick.voxel, pick.normal);
+                    self.execute(Command::Edit(edit), event_loop);
+                }
+                None => return self.fail(format!("expected pixel ({x}, {y}) to hit a voxel, got nothing")),
+            },
+            Line::Undo(n) | Line::Redo(n) => {
+                let command = if matches!(line, Line::Undo(_)) { Command::Undo } else { Command::Redo };
+                for _ in 0..*n {
+                    self.execute(command.clone(), event_loop);
+                }
+            }
+            Line::Save(path) => {
+                if !self.save(&base.join(path)) {
+                    return self.fail(format!("could not save {}", path.display()));
+                }
+            }
+            Line::Render(path) => {
+                self.screenshot_path = Some(base.join(path));
+                self.execute(Command::Screenshot, event_loop);
+            }
+            Line::ExpectVoxel(p, want) => {
+                let got = self.scene.tree.get(*p);
+                return self.check(got == *want, format!("expected voxel {p} = {want}, got {got}"));
+            }
+            Line::ExpectCount(want) => {
+                let got = self.scene.tree.solid_voxels();
+                return self.check(got == *want, format!("expected {want} voxels, got {got}"));
+            }
+            Line::ExpectWritten(limit) => {
+                let got = self.stats.last_edit_bytes;
+                return self.check(got <= *limit, format!("expected at most {limit} bytes written, got {got}"));
+            }
+            // The window's size and panels differ from a headless render.
+            Line::ExpectImage(..) => println!("replay: 'expect image' is checked by `octovox replay`, not in the window"),
+        }
+        Ok(None)
+    }
+
+    fn check(&mut self, ok: bool, message: String) -> Result<Option<bool>, ()> {
+        if !ok {
+            self.check_message = Some(message);
+        }
+        Ok(Some(ok))
+    }
+
+    fn fail(&mut self, message: String) -> Result<Option<bool>, ()> {
+        self.check_message = Some(message);
+        Err(())
+    }
+
+    /// Runs `f` on the recorder; an I/O error stops recording with a message.
+    pub(super) fn record(&mut self, f: impl FnOnce(&mut octovox::replay::Recorder) -> std::io::Result<()>) {
+        if let Some(recorder) = &mut self.recorder
+            && let Err(err) = f(recorder)
+        {
+            self.ui.error(format!("recording to {} stopped: {err}", recorder.path().display()));
+            self.recorder = None;
+        }
+    }
+}
+
+impl App {
+    /// Opens `--replay` and `--record` files given on the command line.
+    pub(super) fn open_script_files(&mut self) {
+        if let Some(path) = self.args.replay.clone() {
+            match octovox::replay::load_script(&path) {
+                Ok(script) => self.player = Some(Player::new(script)),
+                Err(errors) => {
+                    for error in &errors {
+                        println!("{error}");
+                    }
+                    self.ui.error(format!("cannot play {}: {} error(s)", path.display(), errors.len()));
+                }
+            }
+        }
+        if let Some(path) = self.args.record.clone() {
+            match octovox::replay::Recorder::create(&path) {
+                Ok(recorder) => self.recorder = Some(recorder),
+                Err(err) => self.ui.error(format!("cannot record to {}: {err}", path.display())),
+            }
+        }
+    }
+}

@@ -1,0 +1,202 @@
+//! Helpers of the window tests: an Xvfb display of their own, xdotool, the
+//! app's stdout, CPU-chosen click targets, screenshots.
+
+use std::collections::HashSet;
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc::{self, Receiver};
+use std::time::{Duration, Instant};
+
+use glam::IVec3;
+use octovox::camera::Camera;
+use octovox::scene::Octree;
+use octovox::trace::{Ray, svo};
+
+pub const WIDTH: u32 = 800;
+pub const HEIGHT: u32 = 600;
+/// The left panel is 236 points wide and the menu bar about 25 high; clicks
+/// stay clear of both.
+pub const FREE_X: u32 = 300;
+pub const FREE_Y: u32 = 60;
+
+/// Kills a child process when dropped (also when the test panics).
+pub struct KillOnDrop(pub Child, pub &'static str);
+
+impl Drop for KillOnDrop {
+    fn drop(&mut self) {
+        if let Ok(None) = self.0.try_wait() {
+            let _ = self.0.kill();
+            let _ = self.0.wait();
+            eprintln!("(stopped {})", self.1);
+        }
+    }
+}
+
+pub fn require_tool(name: &str) {
+    let found =
+        std::env::var_os("PATH").is_some_and(|paths| std::env::split_paths(&paths).any(|dir| dir.join(name).is_file()));
+    assert!(
+        found,
+        "`{name}` is not installed; the window test needs Xvfb, xdotool, xwd and ImageMagick: \
+         apt-get install -y mesa-vulkan-drivers xvfb xdotool x11-apps imagemagick"
+    );
+}
+
+/// Starts Xvfb on a free display number derived from the process id and
+/// waits until it accepts connections.
+pub fn start_xvfb() -> (KillOnDrop, String) {
+    let base = 100 + std::process::id() % 400;
+    let number = (base..base + 200)
+        .find(|n| {
+            !Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() && !Path::new(&format!("/tmp/.X{n}-lock")).exists()
+        })
+        .expect("no free X display number");
+    let display = format!(":{number}");
+    let child = Command::new("Xvfb")
+        .args([&display, "-screen", "0", "1600x1000x24", "-nolisten", "tcp"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("cannot start Xvfb");
+    let guard = KillOnDrop(child, "Xvfb");
+    let deadline = Instant::now() + Duration::from_secs(30);
+    loop {
+        let ok = Command::new("xdotool")
+            .arg("getdisplaygeometry")
+            .env("DISPLAY", &display)
+            .stderr(Stdio::null())
+            .output()
+            .is_ok_and(|o| o.status.success());
+        if ok {
+            break;
+        }
+        assert!(Instant::now() < deadline, "Xvfb on {display} did not accept connections within 30 s");
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    (guard, display)
+}
+
+pub fn xdotool(display: &str, args: &[&str]) -> String {
+    let out = Command::new("xdotool").args(args).env("DISPLAY", display).output().expect("cannot run xdotool");
+    assert!(out.status.success(), "xdotool {args:?} failed: {}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8_lossy(&out.stdout).trim().to_string()
+}
+
+/// The app's stdout, line by line, with a record of everything seen.
+pub struct Lines {
+    rx: Receiver<String>,
+    pub seen: Vec<String>,
+}
+
+impl Lines {
+    pub fn new(child: &mut Child) -> Lines {
+        let stdout = child.stdout.take().expect("stdout is piped");
+        let (tx, rx) = mpsc::channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+                eprintln!("app: {line}");
+                if tx.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        Lines { rx, seen: Vec::new() }
+    }
+
+    /// Waits for a line starting with `prefix`; returns it.
+    pub fn wait_for(&mut self, prefix: &str, timeout: Duration) -> String {
+        let deadline = Instant::now() + timeout;
+        loop {
+            let left = deadline.saturating_duration_since(Instant::now());
+            match self.rx.recv_timeout(left) {
+                Ok(line) => {
+                    self.seen.push(line.clone());
+                    if line.starts_with(prefix) {
+                        return line;
+                    }
+                }
+                Err(_) => panic!("no `{prefix}` line from the app within {timeout:?}; saw {:?}", self.seen),
+            }
+        }
+    }
+}
+
+/// A pixel clear of the panels whose 5×5 neighbourhood hits the same voxel
+/// through the same face, so a click there cannot land on a neighbour.
+pub fn stable_pixel(tree: &Octree, camera: &Camera) -> (u32, u32, IVec3, IVec3) {
+    let basis = camera.basis(WIDTH, HEIGHT, tree.origin());
+    let hit_at = |x: u32, y: u32| {
+        let (o, d) = basis.ray(x, y);
+        svo::trace(tree, &Ray::new(o, d))
+    };
+    let (cx, cy) = ((FREE_X + WIDTH) / 2, (FREE_Y + HEIGHT) / 2);
+    let mut candidates: Vec<(u32, u32)> = (FREE_Y + 4..HEIGHT - 4)
+        .step_by(3)
+        .flat_map(|y| (FREE_X + 4..WIDTH - 4).step_by(3).map(move |x| (x, y)))
+        .collect();
+    candidates.sort_by_key(|&(x, y)| (x as i64 - cx as i64).pow(2) + (y as i64 - cy as i64).pow(2));
+    for (x, y) in candidates {
+        let hit = hit_at(x, y);
+        if !hit.is_hit() || hit.normal == IVec3::ZERO {
+            continue;
+        }
+        let stable = (-2..=2).all(|dy: i32| {
+            (-2..=2).all(|dx: i32| {
+                let h = hit_at(x.wrapping_add_signed(dx), y.wrapping_add_signed(dy));
+                h.voxel == hit.voxel && h.normal == hit.normal
+            })
+        });
+        if stable {
+            return (x, y, hit.voxel + tree.origin(), hit.normal);
+        }
+    }
+    panic!("no pixel of the view hits a voxel face steadily");
+}
+
+pub fn voxel_set(path: &Path) -> HashSet<IVec3> {
+    let scene = octovox::io::load_scene(path, 0).expect("the saved file loads");
+    scene.tree.voxels().into_iter().map(|(p, _)| p).collect()
+}
+
+/// Mean and variance of the grey level of a rectangle of an image.
+pub fn grey_stats(image: &image::RgbImage, x0: u32, y0: u32, x1: u32, y1: u32) -> (f64, f64) {
+    let values: Vec<f64> = (y0..y1)
+        .flat_map(|y| (x0..x1).map(move |x| (x, y)))
+        .map(|(x, y)| {
+            let p = image.get_pixel(x, y);
+            (f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2])) / 3.0
+        })
+        .collect();
+    let mean = values.iter().sum::<f64>() / values.len() as f64;
+    let variance = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / values.len() as f64;
+    (mean, variance)
+}
+
+pub fn screenshot_x(display: &str, out: &Path) -> image::RgbImage {
+    let status = Command::new("sh")
+        .arg("-c")
+        .arg(format!("xwd -root -silent | convert xwd:- png:'{}'", out.display()))
+        .env("DISPLAY", display)
+        .status()
+        .expect("cannot run xwd | convert");
+    assert!(status.success(), "xwd | convert failed");
+    image::open(out).expect("the X screenshot is a PNG").to_rgb8()
+}
+
+/// Clicks window pixel (x, y) with the left button and waits for the edit.
+pub fn click(display: &str, window: &str, lines: &mut Lines, x: u32, y: u32) -> u64 {
+    xdotool(display, &["mousemove", "--window", window, &x.to_string(), &y.to_string()]);
+    // Let a frame show the hover highlight first (not needed for the edit).
+    std::thread::sleep(Duration::from_millis(300));
+    xdotool(display, &["click", "1"]);
+    let line = lines.wait_for("edit:", Duration::from_secs(30));
+    line.split_whitespace().nth(1).and_then(|n| n.parse().ok()).expect("edit line: `edit: N bytes written …`")
+}
+
+pub fn save(display: &str, lines: &mut Lines, file: &Path) {
+    xdotool(display, &["key", "ctrl+s"]);
+    let line = lines.wait_for("saved:", Duration::from_secs(30));
+    assert!(line.ends_with(&*file.file_name().unwrap().to_string_lossy()), "{line}");
+}
+

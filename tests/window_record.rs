@@ -1,0 +1,124 @@
+//! A session recorded in the real window (`--record`) replays headless
+//! (`octovox replay`) to the same voxels; and `--replay` plays a script in
+//! the window through the same edit path.
+#![allow(clippy::unwrap_used)] // in tests a panic is the failure report
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use common::window::*;
+use octovox::camera::Camera;
+
+fn spawn_app(display: &str, dir: &Path, args: &[String]) -> (KillOnDrop, Lines) {
+    let runtime_dir = dir.join("xdg");
+    std::fs::create_dir_all(&runtime_dir).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_octovox"))
+        .args(args)
+        .current_dir(dir)
+        .env("DISPLAY", display)
+        .env("XDG_RUNTIME_DIR", &runtime_dir)
+        .env_remove("WAYLAND_DISPLAY")
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("cannot start octovox");
+    let lines = Lines::new(&mut child);
+    (KillOnDrop(child, "octovox"), lines)
+}
+
+fn wait_exit(app: &mut Child) {
+    let deadline = Instant::now() + Duration::from_secs(30);
+    loop {
+        if let Some(status) = app.try_wait().unwrap() {
+            assert!(status.success(), "octovox exited with {status}");
+            return;
+        }
+        assert!(Instant::now() < deadline, "octovox did not quit");
+        std::thread::sleep(Duration::from_millis(100));
+    }
+}
+
+fn camera_arg(camera: &Camera) -> String {
+    let (e, t) = (camera.eye, camera.target);
+    format!("--camera={},{},{}:{},{},{}", e.x, e.y, e.z, t.x, t.y, t.z)
+}
+
+#[test]
+fn recorded_window_session_replays_to_the_same_voxels() {
+    for tool in ["Xvfb", "xdotool"] {
+        require_tool(tool);
+    }
+    let source = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/vox/seed/torus64.vox");
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("torus.vox");
+    std::fs::copy(&source, &file).unwrap();
+    let original = octovox::io::load_scene(&file, 0).unwrap();
+    let (lo, hi) = original.tree.solid_bounds().unwrap();
+    let camera = Camera::framing(lo, hi, 50.0);
+    let (x, y, _, _) = stable_pixel(&original.tree, &camera);
+
+    let (_xvfb, display) = start_xvfb();
+    let script = dir.path().join("session.ovr");
+    let args = [
+        file.display().to_string(),
+        "--size".into(),
+        format!("{WIDTH}x{HEIGHT}"),
+        camera_arg(&camera),
+        "--record".into(),
+        script.display().to_string(),
+    ];
+    let (mut app, mut lines) = spawn_app(&display, dir.path(), &args);
+    let window = xdotool(&display, &["search", "--sync", "--name", "octovox"]).lines().next().unwrap().to_string();
+    lines.wait_for("octovox: ready", Duration::from_secs(90));
+    xdotool(&display, &["windowfocus", "--sync", &window]);
+
+    // Attach twice on the same spot (the second lands on the first), paint,
+    // undo the paint, then save and quit.
+    click(&display, &window, &mut lines, x, y);
+    click(&display, &window, &mut lines, x, y);
+    xdotool(&display, &["key", "g"]);
+    click(&display, &window, &mut lines, x + 1, y);
+    xdotool(&display, &["key", "ctrl+z"]);
+    lines.wait_for("undo:", Duration::from_secs(30));
+    save(&display, &mut lines, &file);
+    xdotool(&display, &["key", "ctrl+q"]);
+    wait_exit(&mut app.0);
+
+    // Replay the recording headless and save what it built.
+    let recorded = std::fs::read_to_string(&script).unwrap();
+    eprintln!("recorded:\n{recorded}");
+    assert!(recorded.lines().filter(|l| l.starts_with("place ")).count() == 2, "{recorded}");
+    assert!(recorded.contains("\npaint ") && recorded.contains("\nundo 1"), "{recorded}");
+    let replayed = dir.path().join("replayed.vox");
+    std::fs::write(&script, format!("{recorded}save {}\n", replayed.display())).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_octovox")).args(["replay", "--cpu"]).arg(&script).output().unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stdout));
+
+    let window_scene = octovox::io::load_scene(&file, 0).unwrap();
+    let replay_scene = octovox::io::load_scene(&replayed, 0).unwrap();
+    assert_eq!(window_scene.tree.solid_voxels(), original.tree.solid_voxels() + 2);
+    assert_eq!(window_scene.tree.voxels(), replay_scene.tree.voxels(), "replay differs from the window session");
+}
+
+#[test]
+fn window_plays_a_script_through_the_edit_path() {
+    require_tool("Xvfb");
+    let dir = tempfile::tempdir().unwrap();
+    let script = dir.path().join("play.ovr");
+    std::fs::write(
+        &script,
+        "new\ncamera 20 15 25 0 0 0 50\ncolor 9\nbrush box 3 3 3\nplace 0 0 0\nexpect count 27\n\
+         brush sphere 1\nremove 1 1 1\nexpect voxel 1 1 1 0\nexpect written <= 1024\nundo\nexpect count 27\n\
+         expect voxel 0 0 0 9\nsave out.vox\n",
+    )
+    .unwrap();
+    let (_xvfb, display) = start_xvfb();
+    let args = ["--size".to_string(), "640x480".into(), "--replay".into(), script.display().to_string()];
+    let (_app, mut lines) = spawn_app(&display, dir.path(), &args);
+    let summary = lines.wait_for("replay:", Duration::from_secs(120));
+    assert_eq!(summary, "replay: 6 passed, 0 failed", "{:?}", lines.seen);
+    let saved = octovox::io::load_scene(&dir.path().join("out.vox"), 0).unwrap();
+    assert_eq!(saved.tree.solid_voxels(), 27);
+}
