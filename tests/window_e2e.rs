@@ -101,6 +101,26 @@ fn xdotool(display: &str, args: &[&str]) -> String {
     String::from_utf8_lossy(&out.stdout).trim().to_string()
 }
 
+/// Polls for the app's window (not `xdotool search --sync`, which waits
+/// forever if the app died), failing with the app's stderr if it exited.
+fn find_window(display: &str, app: &mut KillOnDrop, stderr_path: &Path) -> String {
+    let deadline = Instant::now() + Duration::from_secs(90);
+    loop {
+        if let Ok(Some(status)) = app.0.try_wait() {
+            let stderr = std::fs::read_to_string(stderr_path).unwrap_or_default();
+            panic!("octovox exited ({status}) before opening its window; stderr:\n{stderr}");
+        }
+        let out = Command::new("xdotool").args(["search", "--name", "octovox"]).env("DISPLAY", display).output();
+        if let Some(id) =
+            out.ok().and_then(|o| String::from_utf8(o.stdout).ok()).and_then(|s| s.lines().next().map(str::to_string))
+        {
+            return id;
+        }
+        assert!(Instant::now() < deadline, "no octovox window within 90 s");
+        std::thread::sleep(Duration::from_millis(200));
+    }
+}
+
 /// The app's stdout, line by line, with a record of everything seen.
 struct Lines {
     rx: Receiver<String>,
@@ -142,7 +162,7 @@ impl Lines {
 
 /// A pixel clear of the panels whose 5×5 neighbourhood hits the same voxel
 /// through the same face, so a click there cannot land on a neighbour.
-fn stable_pixel(tree: &Octree, camera: &Camera) -> (u32, u32, IVec3, IVec3) {
+fn stable_pixel(tree: &Octree, camera: &Camera, accept: impl Fn(IVec3, IVec3) -> bool) -> (u32, u32, IVec3, IVec3) {
     let basis = camera.basis(WIDTH, HEIGHT, tree.origin());
     let hit_at = |x: u32, y: u32| {
         let (o, d) = basis.ray(x, y);
@@ -156,7 +176,7 @@ fn stable_pixel(tree: &Octree, camera: &Camera) -> (u32, u32, IVec3, IVec3) {
     candidates.sort_by_key(|&(x, y)| (x as i64 - cx as i64).pow(2) + (y as i64 - cy as i64).pow(2));
     for (x, y) in candidates {
         let hit = hit_at(x, y);
-        if !hit.is_hit() || hit.normal == IVec3::ZERO {
+        if !hit.is_hit() || hit.normal == IVec3::ZERO || !accept(hit.voxel + tree.origin(), hit.normal) {
             continue;
         }
         let stable = (-2..=2).all(|dy: i32| {
@@ -170,6 +190,39 @@ fn stable_pixel(tree: &Octree, camera: &Camera) -> (u32, u32, IVec3, IVec3) {
         }
     }
     panic!("no pixel of the view hits a voxel face steadily");
+}
+
+/// A pixel near `from` whose ray (steadily) hits a voxel other than `voxel`
+/// through the same face layer (same normal, same depth along it).
+fn same_layer_pixel(tree: &Octree, camera: &Camera, from: (u32, u32), voxel: IVec3, normal: IVec3) -> (u32, u32) {
+    let basis = camera.basis(WIDTH, HEIGHT, tree.origin());
+    let hit_at = |x: u32, y: u32| {
+        let (o, d) = basis.ray(x, y);
+        let hit = svo::trace(tree, &Ray::new(o, d));
+        (hit.voxel + tree.origin(), hit.normal, hit.is_hit())
+    };
+    let good = |x: u32, y: u32| {
+        let (v, n, solid) = hit_at(x, y);
+        solid && n == normal && v.dot(normal) == voxel.dot(normal) && v != voxel
+    };
+    for distance in 4..80u32 {
+        for (dx, dy) in [(1i64, 0i64), (-1, 0), (0, 1), (0, -1)] {
+            let x = from.0 as i64 + dx * i64::from(distance);
+            let y = from.1 as i64 + dy * i64::from(distance);
+            if x < i64::from(FREE_X) + 3
+                || y < i64::from(FREE_Y) + 3
+                || x > i64::from(WIDTH) - 4
+                || y > i64::from(HEIGHT) - 4
+            {
+                continue;
+            }
+            let (x, y) = (x as u32, y as u32);
+            if (x - 2..=x + 2).all(|px| (y - 2..=y + 2).all(|py| good(px, py))) {
+                return (x, y);
+            }
+        }
+    }
+    panic!("no pixel near {from:?} hits the same face layer as {voxel}");
 }
 
 fn voxel_set(path: &Path) -> HashSet<IVec3> {
@@ -235,7 +288,7 @@ fn click_attach_save_erase_save_in_a_real_window() {
     let original_voxels: HashSet<IVec3> = original.tree.voxels().into_iter().map(|(p, _)| p).collect();
     let (lo, hi) = original.tree.solid_bounds().unwrap();
     let camera = Camera::framing(lo, hi, 50.0);
-    let (x, y, hit_voxel, normal) = stable_pixel(&original.tree, &camera);
+    let (x, y, hit_voxel, normal) = stable_pixel(&original.tree, &camera, |_, _| true);
     let placed = hit_voxel + normal;
     assert!(!original_voxels.contains(&placed));
     eprintln!("click at ({x}, {y}): hits {hit_voxel} through face {normal}; attach goes to {placed}");
@@ -247,6 +300,7 @@ fn click_attach_save_erase_save_in_a_real_window() {
         "{},{},{}:{},{},{}",
         camera.eye.x, camera.eye.y, camera.eye.z, camera.target.x, camera.target.y, camera.target.z
     );
+    let stderr_path = dir.path().join("octovox.stderr");
     let mut child = Command::new(env!("CARGO_BIN_EXE_octovox"))
         .arg(&file)
         .args(["--size", &format!("{WIDTH}x{HEIGHT}"), &format!("--camera={camera_arg}")])
@@ -255,13 +309,13 @@ fn click_attach_save_erase_save_in_a_real_window() {
         .env("XDG_RUNTIME_DIR", &runtime_dir)
         .env_remove("WAYLAND_DISPLAY")
         .stdout(Stdio::piped())
+        .stderr(std::fs::File::create(&stderr_path).unwrap())
         .spawn()
         .expect("cannot start octovox");
     let mut lines = Lines::new(&mut child);
     let mut app = KillOnDrop(child, "octovox");
 
-    let window = xdotool(&display, &["search", "--sync", "--name", "octovox"]);
-    let window = window.lines().next().unwrap().to_string();
+    let window = find_window(&display, &mut app, &stderr_path);
     let ready = lines.wait_for("octovox: ready", Duration::from_secs(90));
     assert_eq!(ready, format!("octovox: ready {WIDTH}x{HEIGHT}"), "the window must have the requested size");
     // Without a window manager nothing focuses the window; keys go to the focus.
@@ -300,6 +354,34 @@ fn click_attach_save_erase_save_in_a_real_window() {
     assert!(bytes <= 1024, "a one-voxel erase wrote {bytes} bytes to the GPU");
     save(&display, &mut lines, &file);
     assert_eq!(voxel_set(&file), original_voxels, "Erase must remove exactly the placed voxel");
+
+    // A drag is a stroke: several edits, one undo step. It ends on a pixel
+    // that (after the first attach) still hits another voxel of the same face
+    // layer, so the stroke must place there too.
+    let (x, y, top_voxel, _) = stable_pixel(&original.tree, &camera, |v, n| n == IVec3::Y && v.y == hi.y);
+    let mut stroked = original.tree.clone();
+    let first = octovox::scene::Shape::Voxel(top_voxel + IVec3::Y);
+    octovox::edit::Edit::Brush { shape: first, op: octovox::scene::Op::Place(1) }.apply(&mut stroked).unwrap();
+    let (ex, ey) = same_layer_pixel(&stroked, &camera, (x, y), top_voxel, IVec3::Y);
+    eprintln!("stroke from ({x}, {y}) to ({ex}, {ey})");
+    xdotool(&display, &["key", "t"]);
+    xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y.to_string()]);
+    xdotool(&display, &["mousedown", "1"]);
+    for step in 1..=8 {
+        let sx = x as i64 + (ex as i64 - x as i64) * step / 8;
+        let sy = y as i64 + (ey as i64 - y as i64) * step / 8;
+        xdotool(&display, &["mousemove", "--window", &window, &sx.to_string(), &sy.to_string()]);
+        std::thread::sleep(Duration::from_millis(60));
+    }
+    xdotool(&display, &["mouseup", "1"]);
+    let before = lines.seen.len();
+    xdotool(&display, &["key", "ctrl+z"]);
+    let undo = lines.wait_for("undo:", Duration::from_secs(30));
+    let stroke_edits = lines.seen[before..].iter().filter(|l| l.starts_with("edit:")).count();
+    eprintln!("stroke: {stroke_edits} edits, undone by one `{undo}`");
+    assert!(stroke_edits >= 2, "dragging along the face made {stroke_edits} edits");
+    save(&display, &mut lines, &file);
+    assert_eq!(voxel_set(&file), original_voxels, "one Ctrl+Z must undo the whole stroke");
 
     // The app's own screenshot (F12) lands in saves/ and is not flat.
     xdotool(&display, &["key", "F12"]);
