@@ -47,6 +47,15 @@ pub enum Brush {
 }
 
 impl Brush {
+    /// How far the brush reaches from its centre along an axis.
+    pub fn reach(&self) -> i32 {
+        match *self {
+            Brush::Voxel => 0,
+            Brush::Sphere(radius) => radius.max(0),
+            Brush::Box(size) => size.max_element().max(1) / 2,
+        }
+    }
+
     pub fn shape_at(&self, center: IVec3) -> Shape {
         match *self {
             Brush::Voxel => Shape::Voxel(center),

@@ -48,7 +48,7 @@ fn click_attach_save_erase_save_in_a_real_window() {
     let original_voxels: HashSet<IVec3> = original.tree.voxels().into_iter().map(|(p, _)| p).collect();
     let (lo, hi) = original.tree.solid_bounds().unwrap();
     let camera = Camera::framing(lo, hi, 50.0);
-    let (x, y, hit_voxel, normal) = stable_pixel(&original.tree, &camera);
+    let (x, y, hit_voxel, normal) = stable_pixel(&original.tree, &camera, |_, _| true);
     let placed = hit_voxel + normal;
     assert!(!original_voxels.contains(&placed));
     eprintln!("click at ({x}, {y}): hits {hit_voxel} through face {normal}; attach goes to {placed}");
@@ -60,6 +60,7 @@ fn click_attach_save_erase_save_in_a_real_window() {
         "{},{},{}:{},{},{}",
         camera.eye.x, camera.eye.y, camera.eye.z, camera.target.x, camera.target.y, camera.target.z
     );
+    let stderr_path = dir.path().join("octovox.stderr");
     let mut child = Command::new(env!("CARGO_BIN_EXE_octovox"))
         .arg(&file)
         .args(["--size", &format!("{WIDTH}x{HEIGHT}"), &format!("--camera={camera_arg}")])
@@ -68,13 +69,13 @@ fn click_attach_save_erase_save_in_a_real_window() {
         .env("XDG_RUNTIME_DIR", &runtime_dir)
         .env_remove("WAYLAND_DISPLAY")
         .stdout(Stdio::piped())
+        .stderr(std::fs::File::create(&stderr_path).unwrap())
         .spawn()
         .expect("cannot start octovox");
     let mut lines = Lines::new(&mut child);
     let mut app = KillOnDrop(child, "octovox");
 
-    let window = xdotool(&display, &["search", "--sync", "--name", "octovox"]);
-    let window = window.lines().next().unwrap().to_string();
+    let window = find_window(&display, &mut app, &stderr_path);
     let ready = lines.wait_for("octovox: ready", Duration::from_secs(90));
     assert_eq!(ready, format!("octovox: ready {WIDTH}x{HEIGHT}"), "the window must have the requested size");
     // Without a window manager nothing focuses the window; keys go to the focus.
@@ -113,6 +114,34 @@ fn click_attach_save_erase_save_in_a_real_window() {
     assert!(bytes <= 1024, "a one-voxel erase wrote {bytes} bytes to the GPU");
     save(&display, &mut lines, &file);
     assert_eq!(voxel_set(&file), original_voxels, "Erase must remove exactly the placed voxel");
+
+    // A drag is a stroke: several edits, one undo step. It ends on a pixel
+    // that (after the first attach) still hits another voxel of the same face
+    // layer, so the stroke must place there too.
+    let (x, y, top_voxel, _) = stable_pixel(&original.tree, &camera, |v, n| n == IVec3::Y && v.y == hi.y);
+    let mut stroked = original.tree.clone();
+    let first = octovox::scene::Shape::Voxel(top_voxel + IVec3::Y);
+    octovox::edit::Edit::Brush { shape: first, op: octovox::scene::Op::Place(1) }.apply(&mut stroked).unwrap();
+    let (ex, ey) = same_layer_pixel(&stroked, &camera, (x, y), top_voxel, IVec3::Y);
+    eprintln!("stroke from ({x}, {y}) to ({ex}, {ey})");
+    xdotool(&display, &["key", "t"]);
+    xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y.to_string()]);
+    xdotool(&display, &["mousedown", "1"]);
+    for step in 1..=8 {
+        let sx = x as i64 + (ex as i64 - x as i64) * step / 8;
+        let sy = y as i64 + (ey as i64 - y as i64) * step / 8;
+        xdotool(&display, &["mousemove", "--window", &window, &sx.to_string(), &sy.to_string()]);
+        std::thread::sleep(Duration::from_millis(60));
+    }
+    xdotool(&display, &["mouseup", "1"]);
+    let before = lines.seen.len();
+    xdotool(&display, &["key", "ctrl+z"]);
+    let undo = lines.wait_for("undo:", Duration::from_secs(30));
+    let stroke_edits = lines.seen[before..].iter().filter(|l| l.starts_with("edit:")).count();
+    eprintln!("stroke: {stroke_edits} edits, undone by one `{undo}`");
+    assert!(stroke_edits >= 2, "dragging along the face made {stroke_edits} edits");
+    save(&display, &mut lines, &file);
+    assert_eq!(voxel_set(&file), original_voxels, "one Ctrl+Z must undo the whole stroke");
 
     // The app's own screenshot (F12) lands in saves/ and is not flat.
     xdotool(&display, &["key", "F12"]);

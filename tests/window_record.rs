@@ -12,7 +12,8 @@ use std::time::{Duration, Instant};
 use common::window::*;
 use octovox::camera::Camera;
 
-fn spawn_app(display: &str, dir: &Path, args: &[String]) -> (KillOnDrop, Lines) {
+fn spawn_app(display: &str, dir: &Path, args: &[String]) -> (KillOnDrop, Lines, PathBuf) {
+    let stderr_path = dir.join("octovox.stderr");
     let runtime_dir = dir.join("xdg");
     std::fs::create_dir_all(&runtime_dir).unwrap();
     let mut child = Command::new(env!("CARGO_BIN_EXE_octovox"))
@@ -22,10 +23,11 @@ fn spawn_app(display: &str, dir: &Path, args: &[String]) -> (KillOnDrop, Lines) 
         .env("XDG_RUNTIME_DIR", &runtime_dir)
         .env_remove("WAYLAND_DISPLAY")
         .stdout(Stdio::piped())
+        .stderr(std::fs::File::create(&stderr_path).unwrap())
         .spawn()
         .expect("cannot start octovox");
     let lines = Lines::new(&mut child);
-    (KillOnDrop(child, "octovox"), lines)
+    (KillOnDrop(child, "octovox"), lines, stderr_path)
 }
 
 fn wait_exit(app: &mut Child) {
@@ -57,7 +59,7 @@ fn recorded_window_session_replays_to_the_same_voxels() {
     let original = octovox::io::load_scene(&file, 0).unwrap();
     let (lo, hi) = original.tree.solid_bounds().unwrap();
     let camera = Camera::framing(lo, hi, 50.0);
-    let (x, y, _, _) = stable_pixel(&original.tree, &camera);
+    let (x, y, _, _) = stable_pixel(&original.tree, &camera, |_, _| true);
 
     let (_xvfb, display) = start_xvfb();
     let script = dir.path().join("session.ovr");
@@ -69,8 +71,8 @@ fn recorded_window_session_replays_to_the_same_voxels() {
         "--record".into(),
         script.display().to_string(),
     ];
-    let (mut app, mut lines) = spawn_app(&display, dir.path(), &args);
-    let window = xdotool(&display, &["search", "--sync", "--name", "octovox"]).lines().next().unwrap().to_string();
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
+    let window = find_window(&display, &mut app, &stderr_path);
     lines.wait_for("octovox: ready", Duration::from_secs(90));
     xdotool(&display, &["windowfocus", "--sync", &window]);
 
@@ -116,7 +118,8 @@ fn window_plays_a_script_through_the_edit_path() {
     .unwrap();
     let (_xvfb, display) = start_xvfb();
     let args = ["--size".to_string(), "640x480".into(), "--replay".into(), script.display().to_string()];
-    let (_app, mut lines) = spawn_app(&display, dir.path(), &args);
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
+    find_window(&display, &mut app, &stderr_path);
     let summary = lines.wait_for("replay:", Duration::from_secs(120));
     assert_eq!(summary, "replay: 6 passed, 0 failed", "{:?}", lines.seen);
     let saved = octovox::io::load_scene(&dir.path().join("out.vox"), 0).unwrap();

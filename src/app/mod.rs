@@ -9,6 +9,7 @@ mod script;
 mod state;
 mod ui;
 
+use std::cell::Cell;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -78,9 +79,8 @@ struct Loading {
     result: Receiver<Result<Scene, String>>,
 }
 
-/// An open mouse stroke: its tool, the face plane it started on (strokes
-/// stay on that layer, so dragging does not dig or pile up toward the
-/// camera), and the last brush centre applied.
+/// An open mouse stroke: its tool, the face (normal and layer) it started
+/// on, and the last brush centre applied.
 struct Stroke {
     tool: Tool,
     plane: Option<(IVec3, i32)>,
@@ -114,6 +114,8 @@ struct App {
     ready: bool,
     last_frame: Option<Instant>,
     next_repaint: Option<Instant>,
+    /// A frame was asked for since the last one (see `request_redraw`).
+    redraw_wanted: Cell<bool>,
     bench: Option<Bench>,
     fatal: Option<anyhow::Error>,
     /// `--replay`: the script being played.
@@ -146,6 +148,7 @@ impl App {
             ready: false,
             last_frame: None,
             next_repaint: None,
+            redraw_wanted: Cell::new(true),
             bench: args.bench_frames.map(|n| Bench { left: n.max(1), total: n.max(1), started: None, trace_ms: 0.0 }),
             fatal: None,
             player: None,
@@ -165,7 +168,7 @@ impl App {
             None => {
                 app.replace_scene(octovox::scene::demo::demo_scene(), None);
                 if app.args.camera.is_none() {
-                    camera_control::frame_model(&mut app.state.camera, app.scene.tree.solid_bounds());
+                    app.frame_model();
                 }
             }
         }
@@ -229,8 +232,12 @@ impl App {
         })
     }
 
+    /// Asks for a frame. Only frames asked for here are drawn: on X11 with
+    /// lavapipe every present comes back as another `RedrawRequested`, and
+    /// drawing those would keep two cores busy with an unchanged picture.
     fn request_redraw(&self) {
         if let Some(gfx) = &self.gfx {
+            self.redraw_wanted.set(true);
             gfx.window.request_redraw();
         }
     }
@@ -347,7 +354,7 @@ impl App {
                 camera_control::pan(&mut self.state.camera, dx, dy, height);
             }
             Command::Zoom { steps } => camera_control::zoom(&mut self.state.camera, steps),
-            Command::FrameModel => camera_control::frame_model(&mut self.state.camera, self.scene.tree.solid_bounds()),
+            Command::FrameModel => self.frame_model(),
             Command::New => self.guard_unsaved(Pending::New, event_loop),
             Command::Open(path) => self.guard_unsaved(Pending::Open(path), event_loop),
             Command::Quit => self.guard_unsaved(Pending::Quit, event_loop),
@@ -485,12 +492,21 @@ impl App {
                 // A camera from the command line wins for the file it came with.
                 let keep_camera = self.args.camera.is_some() && self.args.file.as_ref() == Some(&loading.path);
                 if !keep_camera {
-                    camera_control::frame_model(&mut self.state.camera, self.scene.tree.solid_bounds());
+                    self.frame_model();
                 }
                 self.ui.info(format!("opened {}", loading.path.display()));
             }
             Err(err) => self.ui.error(format!("cannot open {}: {err}", loading.path.display())),
         }
+    }
+
+    /// Frames the whole model, centred in the part of the window that the
+    /// side panel leaves free.
+    fn frame_model(&mut self) {
+        camera_control::frame_model(&mut self.state.camera, self.scene.tree.solid_bounds());
+        let (scale, height) =
+            self.gfx.as_ref().map_or((1.0, self.args.size.1), |g| (g.window.scale_factor(), g.config.height));
+        camera_control::pan(&mut self.state.camera, f64::from(ui::PANEL_WIDTH) * scale * 0.5, 0.0, height);
     }
 
     // ----- picking and mouse edits ---------------------------------------------------
@@ -552,7 +568,13 @@ impl App {
             return; // the camera is inside a voxel: no face to attach to
         }
         let layer = (pick.normal, pick.voxel.dot(pick.normal));
-        if stroke.tool != Tool::Paint && stroke.plane.is_some_and(|plane| plane != layer) {
+        // Attach and Erase strokes stay on the face they started on, within
+        // the brush's reach of its layer: the cells they reveal or create
+        // would otherwise be picked next and the stroke would dig or pile up
+        // toward the camera.
+        let reach = self.state.brush().reach();
+        let off_layer = |(normal, depth): (IVec3, i32)| normal != layer.0 || (layer.1 - depth).abs() > reach;
+        if stroke.tool != Tool::Paint && stroke.plane.is_some_and(off_layer) {
             return;
         }
         let (center, edit) = self.state.edit_at(stroke.tool, &pick);
@@ -623,6 +645,10 @@ impl App {
         self.pointer_over_ui = ctx.is_pointer_over_egui();
         gfx.egui_state.handle_platform_output(&gfx.window, full.platform_output);
         let repaint_delay = full.viewport_output.get(&egui::ViewportId::ROOT).map(|v| v.repaint_delay);
+        log::trace!("egui repaint in {repaint_delay:?}: {:?}", ctx.repaint_causes());
+        if !commands.is_empty() {
+            log::debug!("panel commands {commands:?}");
+        }
         for command in commands {
             self.execute(command, event_loop);
         }
@@ -675,11 +701,15 @@ impl App {
         let frame = match gfx.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(frame) | wgpu::CurrentSurfaceTexture::Suboptimal(frame) => frame,
             wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                log::debug!("surface outdated or lost; reconfiguring");
                 gfx.surface.configure(&gfx.gpu.device, &gfx.config);
+                self.redraw_wanted.set(true);
                 gfx.window.request_redraw();
                 return;
             }
             wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
+                log::debug!("surface timeout or occluded; skipping the frame");
+                self.redraw_wanted.set(true);
                 gfx.window.request_redraw();
                 return;
             }
@@ -940,8 +970,12 @@ impl ApplicationHandler for App {
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
         let Some(gfx) = &mut self.gfx else { return };
+        if !matches!(event, WindowEvent::RedrawRequested) {
+            log::trace!("window event {event:?}");
+        }
         let response = gfx.egui_state.on_window_event(&gfx.window, &event);
-        if response.repaint {
+        if response.repaint && !matches!(event, WindowEvent::RedrawRequested) {
+            self.redraw_wanted.set(true);
             gfx.window.request_redraw();
         }
         match &event {
@@ -956,6 +990,7 @@ impl ApplicationHandler for App {
                     gfx.config.width = size.width;
                     gfx.config.height = size.height;
                     gfx.surface.configure(&gfx.gpu.device, &gfx.config);
+                    self.redraw_wanted.set(true);
                     gfx.window.request_redraw();
                 }
                 return;
@@ -966,7 +1001,7 @@ impl ApplicationHandler for App {
             }
             WindowEvent::RedrawRequested => {
                 let size = gfx.window.inner_size();
-                if size.width > 0 && size.height > 0 {
+                if size.width > 0 && size.height > 0 && self.redraw_wanted.take() {
                     self.frame(event_loop);
                 }
                 return;
@@ -981,6 +1016,7 @@ impl ApplicationHandler for App {
     }
 
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        log::trace!("about to wait; next repaint {:?}", self.next_repaint);
         match self.next_repaint {
             Some(at) if at <= Instant::now() => {
                 self.next_repaint = None;

@@ -83,6 +83,26 @@ pub fn xdotool(display: &str, args: &[&str]) -> String {
     String::from_utf8_lossy(&out.stdout).trim().to_string()
 }
 
+/// Polls for the app's window (not `xdotool search --sync`, which waits
+/// forever if the app died), failing with the app's stderr if it exited.
+pub fn find_window(display: &str, app: &mut KillOnDrop, stderr_path: &Path) -> String {
+    let deadline = Instant::now() + Duration::from_secs(90);
+    loop {
+        if let Ok(Some(status)) = app.0.try_wait() {
+            let stderr = std::fs::read_to_string(stderr_path).unwrap_or_default();
+            panic!("octovox exited ({status}) before opening its window; stderr:\n{stderr}");
+        }
+        let out = Command::new("xdotool").args(["search", "--name", "octovox"]).env("DISPLAY", display).output();
+        if let Some(id) =
+            out.ok().and_then(|o| String::from_utf8(o.stdout).ok()).and_then(|s| s.lines().next().map(str::to_string))
+        {
+            return id;
+        }
+        assert!(Instant::now() < deadline, "no octovox window within 90 s");
+        std::thread::sleep(Duration::from_millis(200));
+    }
+}
+
 /// The app's stdout, line by line, with a record of everything seen.
 pub struct Lines {
     rx: Receiver<String>,
@@ -124,7 +144,7 @@ impl Lines {
 
 /// A pixel clear of the panels whose 5×5 neighbourhood hits the same voxel
 /// through the same face, so a click there cannot land on a neighbour.
-pub fn stable_pixel(tree: &Octree, camera: &Camera) -> (u32, u32, IVec3, IVec3) {
+pub fn stable_pixel(tree: &Octree, camera: &Camera, accept: impl Fn(IVec3, IVec3) -> bool) -> (u32, u32, IVec3, IVec3) {
     let basis = camera.basis(WIDTH, HEIGHT, tree.origin());
     let hit_at = |x: u32, y: u32| {
         let (o, d) = basis.ray(x, y);
@@ -138,7 +158,7 @@ pub fn stable_pixel(tree: &Octree, camera: &Camera) -> (u32, u32, IVec3, IVec3) 
     candidates.sort_by_key(|&(x, y)| (x as i64 - cx as i64).pow(2) + (y as i64 - cy as i64).pow(2));
     for (x, y) in candidates {
         let hit = hit_at(x, y);
-        if !hit.is_hit() || hit.normal == IVec3::ZERO {
+        if !hit.is_hit() || hit.normal == IVec3::ZERO || !accept(hit.voxel + tree.origin(), hit.normal) {
             continue;
         }
         let stable = (-2..=2).all(|dy: i32| {
@@ -152,6 +172,39 @@ pub fn stable_pixel(tree: &Octree, camera: &Camera) -> (u32, u32, IVec3, IVec3) 
         }
     }
     panic!("no pixel of the view hits a voxel face steadily");
+}
+
+/// A pixel near `from` whose ray (steadily) hits a voxel other than `voxel`
+/// through the same face layer (same normal, same depth along it).
+pub fn same_layer_pixel(tree: &Octree, camera: &Camera, from: (u32, u32), voxel: IVec3, normal: IVec3) -> (u32, u32) {
+    let basis = camera.basis(WIDTH, HEIGHT, tree.origin());
+    let hit_at = |x: u32, y: u32| {
+        let (o, d) = basis.ray(x, y);
+        let hit = svo::trace(tree, &Ray::new(o, d));
+        (hit.voxel + tree.origin(), hit.normal, hit.is_hit())
+    };
+    let good = |x: u32, y: u32| {
+        let (v, n, solid) = hit_at(x, y);
+        solid && n == normal && v.dot(normal) == voxel.dot(normal) && v != voxel
+    };
+    for distance in 4..80u32 {
+        for (dx, dy) in [(1i64, 0i64), (-1, 0), (0, 1), (0, -1)] {
+            let x = from.0 as i64 + dx * i64::from(distance);
+            let y = from.1 as i64 + dy * i64::from(distance);
+            if x < i64::from(FREE_X) + 3
+                || y < i64::from(FREE_Y) + 3
+                || x > i64::from(WIDTH) - 4
+                || y > i64::from(HEIGHT) - 4
+            {
+                continue;
+            }
+            let (x, y) = (x as u32, y as u32);
+            if (x - 2..=x + 2).all(|px| (y - 2..=y + 2).all(|py| good(px, py))) {
+                return (x, y);
+            }
+        }
+    }
+    panic!("no pixel near {from:?} hits the same face layer as {voxel}");
 }
 
 pub fn voxel_set(path: &Path) -> HashSet<IVec3> {
