@@ -663,8 +663,21 @@ impl App {
         // Blit + egui onto the swapchain image.
         let frame = match gfx.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(frame) | wgpu::CurrentSurfaceTexture::Suboptimal(frame) => frame,
-            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
-                log::debug!("surface outdated or lost; reconfiguring");
+            wgpu::CurrentSurfaceTexture::Outdated => {
+                log::debug!("surface outdated; reconfiguring");
+                gfx.surface.configure(&gfx.gpu.device, &gfx.config);
+                self.redraw_wanted.set(true);
+                gfx.window.request_redraw();
+                return;
+            }
+            wgpu::CurrentSurfaceTexture::Lost => {
+                // A lost surface must be made again; if that fails too, keep
+                // the old one and retry on the next frame.
+                log::warn!("surface lost; creating it again");
+                match gfx.gpu.instance.create_surface(gfx.window.clone()) {
+                    Ok(surface) => gfx.surface = surface,
+                    Err(err) => log::error!("cannot re-create the surface: {err}"),
+                }
                 gfx.surface.configure(&gfx.gpu.device, &gfx.config);
                 self.redraw_wanted.set(true);
                 gfx.window.request_redraw();
