@@ -39,6 +39,15 @@ use input::Input;
 use state::{EditorState, Pick, Tool};
 use ui::{DialogKind, Stats, UiState};
 
+/// Prints one status line on stdout (`edit: …`, `saved: …`, `octovox: ready`;
+/// tests and scripts read them). A closed stdout is not an error worth dying for.
+macro_rules! report {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
 /// Where Screenshot writes, relative to the working directory.
 const SCREENSHOT_DIR: &str = "saves";
 
@@ -251,7 +260,7 @@ impl App {
         let upload = self.upload();
         self.stats.last_edit_bytes = upload.bytes;
         self.stats.last_edit_ranges = upload.ranges;
-        println!(
+        report!(
             "{what}: {} bytes written in {} ranges{}",
             upload.bytes,
             upload.ranges,
@@ -420,7 +429,7 @@ impl App {
     fn save(&mut self, path: &Path) -> bool {
         match octovox::io::save_scene(path, &self.scene) {
             Ok(()) => {
-                println!("saved: {}", path.display());
+                report!("saved: {}", path.display());
                 self.state.dirty = false;
                 self.ui.info(format!("saved {}", path.display()));
                 self.update_title();
@@ -460,7 +469,7 @@ impl App {
         match result {
             Ok(scene) => {
                 let seconds = loading.started.elapsed().as_secs_f64();
-                println!("loaded: {} ({} voxels, {seconds:.2} s)", loading.path.display(), scene.tree.solid_voxels());
+                report!("loaded: {} ({} voxels, {seconds:.2} s)", loading.path.display(), scene.tree.solid_voxels());
                 self.replace_scene(scene, Some(loading.path.clone()));
                 // A camera from the command line wins for the file it came with.
                 let keep_camera = self.args.camera.is_some() && self.args.file.as_ref() == Some(&loading.path);
@@ -734,7 +743,7 @@ impl App {
         if !self.ready && self.loading.is_none() {
             self.ready = true;
             let (w, h) = self.gfx.as_ref().map_or((0, 0), |g| (g.config.width, g.config.height));
-            println!("octovox: ready {w}x{h}");
+            report!("octovox: ready {w}x{h}");
         }
         self.bench_step(event_loop);
 
@@ -780,7 +789,7 @@ impl App {
             .and_then(|bytes| image::RgbaImage::from_raw(w, h, bytes).context("trace readback has the wrong size"))
             .and_then(|image| crate::commands::render::save_png(&image, &view_path));
         match result {
-            Ok(()) => println!("screenshot: {}", view_path.display()),
+            Ok(()) => report!("screenshot: {}", view_path.display()),
             Err(err) => {
                 self.ui.error(format!("screenshot failed: {err:#}"));
                 return;
@@ -801,7 +810,7 @@ impl App {
                 crate::commands::render::save_png(&image, &window_path)
             });
             match result {
-                Ok(()) => println!("screenshot: {}", window_path.display()),
+                Ok(()) => report!("screenshot: {}", window_path.display()),
                 Err(err) => self.ui.error(format!("window screenshot failed: {err:#}")),
             }
         }
@@ -824,7 +833,7 @@ impl App {
                 if bench.left == 0 {
                     let seconds = started.elapsed().as_secs_f64();
                     let n = f64::from(bench.total);
-                    println!(
+                    report!(
                         "bench: {} frames at {w}x{h}: {:.2} fps, {:.1} ms/frame, trace {:.1} ms ({clock})",
                         bench.total,
                         n / seconds,

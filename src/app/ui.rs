@@ -67,7 +67,7 @@ pub struct UiState {
 impl UiState {
     pub fn error(&mut self, text: impl Into<String>) {
         let text = text.into();
-        eprintln!("octovox: {text}");
+        log::warn!("{text}");
         self.message = Some((text, true));
     }
 
