@@ -53,7 +53,7 @@ fn click_attach_save_erase_save_in_a_real_window() {
     assert!(!original_voxels.contains(&placed));
     eprintln!("click at ({x}, {y}): hits {hit_voxel} through face {normal}; attach goes to {placed}");
 
-    let (_xvfb, display) = start_xvfb();
+    let (_xvfb, display) = start_xvfb(0);
     let runtime_dir = dir.path().join("xdg");
     std::fs::create_dir_all(&runtime_dir).unwrap();
     let camera_arg = format!(
@@ -167,4 +167,76 @@ fn click_attach_save_erase_save_in_a_real_window() {
         assert!(n <= 1024, "{line}");
     }
     eprintln!("window test took {:.1} s", started.elapsed().as_secs_f64());
+}
+
+/// A file that takes seconds to arrive (a FIFO fed later) loads on the
+/// background thread: the window keeps drawing and answering the mouse, and
+/// the scene appears when the bytes do.
+#[test]
+fn slow_load_keeps_the_window_live() {
+    for tool in ["Xvfb", "xdotool", "xwd", "convert", "mkfifo"] {
+        require_tool(tool);
+    }
+    let teapot = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/vox/seed/teapot256.vox");
+    assert!(teapot.is_file(), "missing test model {}", teapot.display());
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("slow.vox");
+    assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+
+    let (_xvfb, display) = start_xvfb(1);
+    let runtime_dir = dir.path().join("xdg");
+    std::fs::create_dir_all(&runtime_dir).unwrap();
+    let stderr_path = dir.path().join("octovox.stderr");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_octovox"))
+        .args(["--size", "640x480", "--render-scale", "0.5", "--no-shadows"])
+        .current_dir(dir.path())
+        .env("DISPLAY", &display)
+        .env("XDG_RUNTIME_DIR", &runtime_dir)
+        .env_remove("WAYLAND_DISPLAY")
+        .stdout(Stdio::piped())
+        .stderr(std::fs::File::create(&stderr_path).unwrap())
+        .spawn()
+        .expect("cannot start octovox");
+    let mut lines = Lines::new(&mut child);
+    let mut app = KillOnDrop(child, "octovox");
+    let window = find_window(&display, &mut app, &stderr_path);
+    lines.wait_for("octovox: ready", Duration::from_secs(90));
+    xdotool(&display, &["windowfocus", "--sync", &window]);
+
+    // Open the FIFO through the Open dialog: the reader blocks until we write.
+    xdotool(&display, &["key", "ctrl+o"]);
+    std::thread::sleep(Duration::from_millis(700));
+    xdotool(&display, &["key", "ctrl+a"]);
+    xdotool(&display, &["type", "slow.vox"]);
+    xdotool(&display, &["key", "Return"]);
+    std::thread::sleep(Duration::from_millis(1500));
+
+    // While the load hangs, an orbit still changes the picture.
+    let before = screenshot_x(&display, &dir.path().join("before.png"));
+    xdotool(&display, &["mousemove", "--window", &window, "420", "240"]);
+    xdotool(&display, &["mousedown", "3"]);
+    for _ in 0..6 {
+        xdotool(&display, &["mousemove_relative", "--", "20", "5"]);
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    xdotool(&display, &["mouseup", "3"]);
+    std::thread::sleep(Duration::from_millis(1500));
+    let after = screenshot_x(&display, &dir.path().join("after.png"));
+    let changed = (260..640)
+        .flat_map(|x| (40..480).map(move |y| (x, y)))
+        .filter(|&(x, y)| before.get_pixel(x, y) != after.get_pixel(x, y))
+        .count();
+    assert!(changed > 5000, "the view did not follow the mouse during the load ({changed} pixels changed)");
+    assert!(lines.rx.try_recv().map_or(true, |l| !l.starts_with("loaded:")), "the load finished too early");
+
+    // Now the bytes arrive and the teapot replaces the demo.
+    std::fs::write(&fifo, std::fs::read(&teapot).unwrap()).unwrap();
+    let loaded = lines.wait_for("loaded:", Duration::from_secs(60));
+    assert!(loaded.contains("(101683 voxels"), "{loaded}");
+    xdotool(&display, &["key", "ctrl+q"]);
+    let deadline = Instant::now() + Duration::from_secs(30);
+    while app.0.try_wait().unwrap().is_none() {
+        assert!(Instant::now() < deadline, "octovox did not quit on Ctrl+Q");
+        std::thread::sleep(Duration::from_millis(100));
+    }
 }

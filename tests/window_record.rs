@@ -61,7 +61,7 @@ fn recorded_window_session_replays_to_the_same_voxels() {
     let camera = Camera::framing(lo, hi, 50.0);
     let (x, y, _, _) = stable_pixel(&original.tree, &camera, |_, _| true);
 
-    let (_xvfb, display) = start_xvfb();
+    let (_xvfb, display) = start_xvfb(0);
     let script = dir.path().join("session.ovr");
     let args = [
         file.display().to_string(),
@@ -116,7 +116,7 @@ fn window_plays_a_script_through_the_edit_path() {
          expect voxel 0 0 0 9\nsave out.vox\n",
     )
     .unwrap();
-    let (_xvfb, display) = start_xvfb();
+    let (_xvfb, display) = start_xvfb(1);
     let args = ["--size".to_string(), "640x480".into(), "--replay".into(), script.display().to_string()];
     let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
     find_window(&display, &mut app, &stderr_path);

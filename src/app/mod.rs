@@ -2,7 +2,17 @@
 //! (pool upload → trace → blit → egui → present), and `execute`, the one
 //! place every command — mouse, keyboard, panel, later replay — is carried out.
 
+/// Prints one status line on stdout (`edit: …`, `saved: …`, `octovox: ready`;
+/// tests and scripts read them). A closed stdout is not an error worth dying for.
+macro_rules! report {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
 mod camera_control;
+mod capture;
 mod command;
 mod input;
 mod script;
@@ -17,7 +27,7 @@ use std::sync::mpsc::{self, Receiver, TryRecvError};
 use std::time::{Duration, Instant};
 
 use anyhow::Context as _;
-use glam::{IVec3, Vec3};
+use glam::IVec3;
 use winit::application::ApplicationHandler;
 use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
@@ -25,7 +35,6 @@ use winit::window::{Window, WindowId};
 
 use octovox::camera::Camera;
 use octovox::edit::{Edit, History};
-use octovox::gpu::readback::{padded_row_bytes, read_buffer, staging_buffer};
 use octovox::gpu::scene_buffers::UploadStats;
 use octovox::gpu::timer::PassTimer;
 use octovox::gpu::{BlitPass, FrameUniforms, GpuContext, SceneBuffers, TracePass};
@@ -265,7 +274,7 @@ impl App {
         let upload = self.upload();
         self.stats.last_edit_bytes = upload.bytes;
         self.stats.last_edit_ranges = upload.ranges;
-        println!(
+        report!(
             "{what}: {} bytes written in {} ranges{}",
             upload.bytes,
             upload.ranges,
@@ -447,7 +456,7 @@ impl App {
     fn save(&mut self, path: &Path) -> bool {
         match octovox::io::save_scene(path, &self.scene) {
             Ok(()) => {
-                println!("saved: {}", path.display());
+                report!("saved: {}", path.display());
                 self.state.dirty = false;
                 self.ui.info(format!("saved {}", path.display()));
                 self.update_title();
@@ -487,7 +496,7 @@ impl App {
         match result {
             Ok(scene) => {
                 let seconds = loading.started.elapsed().as_secs_f64();
-                println!("loaded: {} ({} voxels, {seconds:.2} s)", loading.path.display(), scene.tree.solid_voxels());
+                report!("loaded: {} ({} voxels, {seconds:.2} s)", loading.path.display(), scene.tree.solid_voxels());
                 self.replace_scene(scene, Some(loading.path.clone()));
                 // A camera from the command line wins for the file it came with.
                 let keep_camera = self.args.camera.is_some() && self.args.file.as_ref() == Some(&loading.path);
@@ -638,14 +647,13 @@ impl App {
             ctx.run_ui(raw_input, |ui| {
                 commands = ui::show(ui, state, ui_state, &info);
                 if let Some(pick) = pick {
-                    draw_brush_outline(ui, state, &pick, &info);
+                    ui::draw_brush_outline(ui, state, &pick, &info);
                 }
             })
         };
         self.pointer_over_ui = ctx.is_pointer_over_egui();
         gfx.egui_state.handle_platform_output(&gfx.window, full.platform_output);
         let repaint_delay = full.viewport_output.get(&egui::ViewportId::ROOT).map(|v| v.repaint_delay);
-        log::trace!("egui repaint in {repaint_delay:?}: {:?}", ctx.repaint_causes());
         if !commands.is_empty() {
             log::debug!("panel commands {commands:?}");
         }
@@ -700,8 +708,21 @@ impl App {
         // Blit + egui onto the swapchain image.
         let frame = match gfx.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(frame) | wgpu::CurrentSurfaceTexture::Suboptimal(frame) => frame,
-            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
-                log::debug!("surface outdated or lost; reconfiguring");
+            wgpu::CurrentSurfaceTexture::Outdated => {
+                log::debug!("surface outdated; reconfiguring");
+                gfx.surface.configure(&gfx.gpu.device, &gfx.config);
+                self.redraw_wanted.set(true);
+                gfx.window.request_redraw();
+                return;
+            }
+            wgpu::CurrentSurfaceTexture::Lost => {
+                // A lost surface must be made again; if that fails too, keep
+                // the old one and retry on the next frame.
+                log::warn!("surface lost; creating it again");
+                match gfx.gpu.instance.create_surface(gfx.window.clone()) {
+                    Ok(surface) => gfx.surface = surface,
+                    Err(err) => log::error!("cannot re-create the surface: {err}"),
+                }
                 gfx.surface.configure(&gfx.gpu.device, &gfx.config);
                 self.redraw_wanted.set(true);
                 gfx.window.request_redraw();
@@ -742,8 +763,8 @@ impl App {
             });
             gfx.egui_renderer.render(&mut pass.forget_lifetime(), &prims, &screen);
         }
-        let window_copy =
-            (self.screenshot_requested && gfx.can_copy_frame).then(|| copy_frame(gfx, &mut encoder, &frame.texture));
+        let window_copy = (self.screenshot_requested && gfx.can_copy_frame)
+            .then(|| capture::copy_frame(gfx, &mut encoder, &frame.texture));
         gfx.gpu.queue.submit(user_buffers.into_iter().chain([encoder.finish()]));
         gfx.window.pre_present_notify();
         gfx.gpu.queue.present(frame);
@@ -758,7 +779,7 @@ impl App {
         if !self.ready && self.loading.is_none() {
             self.ready = true;
             let (w, h) = self.gfx.as_ref().map_or((0, 0), |g| (g.config.width, g.config.height));
-            println!("octovox: ready {w}x{h}");
+            report!("octovox: ready {w}x{h}");
         }
         self.bench_step(event_loop);
 
@@ -791,107 +812,6 @@ impl App {
             }
         }
     }
-
-    /// Writes the traced view (and, where the swapchain allows copies, the
-    /// whole window with its panels) as PNGs under `saves/`.
-    fn save_screenshot(&mut self, window_copy: Option<(wgpu::Buffer, u32, u32, bool)>) {
-        let Some(gfx) = &self.gfx else { return };
-        let stamp = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_millis());
-        let view_path = self
-            .screenshot_path
-            .take()
-            .unwrap_or_else(|| Path::new(SCREENSHOT_DIR).join(format!("octovox-{stamp}.png")));
-        let base = view_path.with_extension("");
-        let (w, h) = gfx.trace.size();
-        let result = gfx
-            .trace
-            .read_color(&gfx.gpu)
-            .map_err(anyhow::Error::from)
-            .and_then(|bytes| image::RgbaImage::from_raw(w, h, bytes).context("trace readback has the wrong size"))
-            .and_then(|image| octovox::io::png::save_png(&image, &view_path).map_err(anyhow::Error::from));
-        match result {
-            Ok(()) => println!("screenshot: {}", view_path.display()),
-            Err(err) => {
-                self.ui.error(format!("screenshot failed: {err:#}"));
-                return;
-            }
-        }
-        if let Some((buffer, width, height, bgra)) = window_copy {
-            let window_path = PathBuf::from(format!("{}-window.png", base.display()));
-            let result = read_buffer(&gfx.gpu, &buffer).map_err(anyhow::Error::from).and_then(|bytes| {
-                let row = (width * 4) as usize;
-                let mut pixels: Vec<u8> =
-                    bytes.chunks(padded_row_bytes(width) as usize).flat_map(|r| &r[..row]).copied().collect();
-                if bgra {
-                    pixels.chunks_exact_mut(4).for_each(|p| p.swap(0, 2));
-                }
-                pixels.chunks_exact_mut(4).for_each(|p| p[3] = 255);
-                let image =
-                    image::RgbaImage::from_raw(width, height, pixels).context("frame readback has the wrong size")?;
-                octovox::io::png::save_png(&image, &window_path).map_err(anyhow::Error::from)
-            });
-            match result {
-                Ok(()) => println!("screenshot: {}", window_path.display()),
-                Err(err) => self.ui.error(format!("window screenshot failed: {err:#}")),
-            }
-        }
-        self.ui.info(format!("screenshot saved to {}", view_path.display()));
-    }
-
-    fn bench_step(&mut self, event_loop: &ActiveEventLoop) {
-        if !self.ready {
-            return;
-        }
-        let (w, h) = self.trace_size();
-        let clock = self.gfx.as_ref().map_or("", |g| if g.gpu.timestamps { "GPU timestamps" } else { "wall" });
-        let Some(bench) = &mut self.bench else { return };
-        match bench.started {
-            // The first ready frame warms up; timing starts after it.
-            None => bench.started = Some(Instant::now()),
-            Some(started) => {
-                bench.trace_ms += self.stats.trace_ms;
-                bench.left -= 1;
-                if bench.left == 0 {
-                    let seconds = started.elapsed().as_secs_f64();
-                    let n = f64::from(bench.total);
-                    println!(
-                        "bench: {} frames at {w}x{h}: {:.2} fps, {:.1} ms/frame, trace {:.1} ms ({clock})",
-                        bench.total,
-                        n / seconds,
-                        seconds * 1e3 / n,
-                        bench.trace_ms / n,
-                    );
-                    self.bench = None;
-                    event_loop.exit();
-                }
-            }
-        }
-    }
-}
-
-/// Copies the swapchain image into a mappable buffer (read after submit).
-fn copy_frame(
-    gfx: &Gfx,
-    encoder: &mut wgpu::CommandEncoder,
-    texture: &wgpu::Texture,
-) -> (wgpu::Buffer, u32, u32, bool) {
-    let (width, height) = (texture.width(), texture.height());
-    let padded = padded_row_bytes(width);
-    let buffer = staging_buffer(&gfx.gpu.device, "window screenshot", u64::from(padded) * u64::from(height));
-    encoder.copy_texture_to_buffer(
-        texture.as_image_copy(),
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(padded),
-                rows_per_image: Some(height),
-            },
-        },
-        wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-    );
-    let bgra = matches!(gfx.config.format, wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb);
-    (buffer, width, height, bgra)
 }
 
 /// The palette index used most often is a better first colour than 1.
@@ -899,53 +819,6 @@ fn first_used_color(scene: &Scene) -> Option<u8> {
     let mut counts = [0u64; 256];
     scene.tree.for_each_solid_cell(|_, size, value| counts[usize::from(value)] += 1u64 << (3 * size.trailing_zeros()));
     (1..=255u8).max_by_key(|v| counts[usize::from(*v)]).filter(|v| counts[usize::from(*v)] > 0)
-}
-
-/// Outlines the cells the brush would touch (projected with the trace
-/// camera), so the preview also shows Attach's target cells, which are empty
-/// and so cannot be tinted by the shader.
-fn draw_brush_outline(ui: &egui::Ui, state: &EditorState, pick: &Pick, info: &ui::Info) {
-    let (lo, hi) = state.preview_box(pick);
-    let screen = ui.ctx().content_rect();
-    let (w, h) = (screen.width().max(1.0), screen.height().max(1.0));
-    let basis = state.camera.basis(w as u32, h as u32, info.tree.origin());
-    let origin = info.tree.origin().as_vec3();
-    let project = |p: Vec3| -> Option<egui::Pos2> {
-        let d = p - origin - basis.eye;
-        let depth = d.dot(basis.forward);
-        if depth <= 0.05 {
-            return None;
-        }
-        let nx = d.dot(basis.right) / basis.right.length_squared() / depth;
-        let ny = d.dot(basis.up) / basis.up.length_squared() / depth;
-        Some(egui::pos2((nx + 1.0) * 0.5 * w, (1.0 - ny) * 0.5 * h))
-    };
-    let (a, b) = (lo.as_vec3(), (hi + IVec3::ONE).as_vec3());
-    let corner = |i: usize| {
-        Vec3::new(
-            if i & 1 == 0 { a.x } else { b.x },
-            if i & 2 == 0 { a.y } else { b.y },
-            if i & 4 == 0 { a.z } else { b.z },
-        )
-    };
-    let painter =
-        ui.ctx().layer_painter(egui::LayerId::new(egui::Order::Background, egui::Id::unique("brush outline")));
-    let color = match state.tool {
-        Tool::Attach => egui::Color32::from_rgb(120, 255, 140),
-        Tool::Erase => egui::Color32::from_rgb(255, 100, 90),
-        Tool::Paint => egui::Color32::from_rgb(255, 220, 90),
-    };
-    for i in 0..8usize {
-        for bit in [1usize, 2, 4] {
-            let j = i | bit;
-            if j == i {
-                continue;
-            }
-            if let (Some(p), Some(q)) = (project(corner(i)), project(corner(j))) {
-                painter.line_segment([p, q], egui::Stroke::new(1.5, color));
-            }
-        }
-    }
 }
 
 impl ApplicationHandler for App {
@@ -1016,7 +889,6 @@ impl ApplicationHandler for App {
     }
 
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
-        log::trace!("about to wait; next repaint {:?}", self.next_repaint);
         match self.next_repaint {
             Some(at) if at <= Instant::now() => {
                 self.next_repaint = None;

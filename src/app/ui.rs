@@ -14,7 +14,8 @@ use octovox::scene::{Octree, Palette};
 use octovox::settings::{TraceMode, View};
 
 use super::command::{Choice, Command, Pending};
-use super::state::{BrushKind, EditorState, Tool};
+use super::state::{BrushKind, EditorState, Pick, Tool};
+use glam::{IVec3, Vec3};
 
 /// Width of the left panel in points.
 pub const PANEL_WIDTH: f32 = 236.0;
@@ -67,7 +68,7 @@ pub struct UiState {
 impl UiState {
     pub fn error(&mut self, text: impl Into<String>) {
         let text = text.into();
-        eprintln!("octovox: {text}");
+        log::warn!("{text}");
         self.message = Some((text, true));
     }
 
@@ -359,5 +360,52 @@ fn tool_label(tool: Tool) -> &'static str {
         Tool::Attach => "Attach (T)",
         Tool::Erase => "Erase (R)",
         Tool::Paint => "Paint (G)",
+    }
+}
+
+/// Outlines the cells the brush would touch (projected with the trace
+/// camera), so the preview also shows Attach's target cells, which are empty
+/// and so cannot be tinted by the shader.
+pub fn draw_brush_outline(ui: &egui::Ui, state: &EditorState, pick: &Pick, info: &Info) {
+    let (lo, hi) = state.preview_box(pick);
+    let screen = ui.ctx().content_rect();
+    let (w, h) = (screen.width().max(1.0), screen.height().max(1.0));
+    let basis = state.camera.basis(w as u32, h as u32, info.tree.origin());
+    let origin = info.tree.origin().as_vec3();
+    let project = |p: Vec3| -> Option<egui::Pos2> {
+        let d = p - origin - basis.eye;
+        let depth = d.dot(basis.forward);
+        if depth <= 0.05 {
+            return None;
+        }
+        let nx = d.dot(basis.right) / basis.right.length_squared() / depth;
+        let ny = d.dot(basis.up) / basis.up.length_squared() / depth;
+        Some(egui::pos2((nx + 1.0) * 0.5 * w, (1.0 - ny) * 0.5 * h))
+    };
+    let (a, b) = (lo.as_vec3(), (hi + IVec3::ONE).as_vec3());
+    let corner = |i: usize| {
+        Vec3::new(
+            if i & 1 == 0 { a.x } else { b.x },
+            if i & 2 == 0 { a.y } else { b.y },
+            if i & 4 == 0 { a.z } else { b.z },
+        )
+    };
+    let painter =
+        ui.ctx().layer_painter(egui::LayerId::new(egui::Order::Background, egui::Id::unique("brush outline")));
+    let color = match state.tool {
+        Tool::Attach => egui::Color32::from_rgb(120, 255, 140),
+        Tool::Erase => egui::Color32::from_rgb(255, 100, 90),
+        Tool::Paint => egui::Color32::from_rgb(255, 220, 90),
+    };
+    for i in 0..8usize {
+        for bit in [1usize, 2, 4] {
+            let j = i | bit;
+            if j == i {
+                continue;
+            }
+            if let (Some(p), Some(q)) = (project(corner(i)), project(corner(j))) {
+                painter.line_segment([p, q], egui::Stroke::new(1.5, color));
+            }
+        }
     }
 }

@@ -45,8 +45,9 @@ pub fn require_tool(name: &str) {
 
 /// Starts Xvfb on a free display number derived from the process id and
 /// waits until it accepts connections.
-pub fn start_xvfb() -> (KillOnDrop, String) {
-    let base = 100 + std::process::id() % 400;
+/// `slot` separates the tests of this binary, which run in parallel.
+pub fn start_xvfb(slot: u32) -> (KillOnDrop, String) {
+    let base = 100 + std::process::id() % 400 + slot * 500;
     let number = (base..base + 200)
         .find(|n| {
             !Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() && !Path::new(&format!("/tmp/.X{n}-lock")).exists()
@@ -105,7 +106,7 @@ pub fn find_window(display: &str, app: &mut KillOnDrop, stderr_path: &Path) -> S
 
 /// The app's stdout, line by line, with a record of everything seen.
 pub struct Lines {
-    rx: Receiver<String>,
+    pub rx: Receiver<String>,
     pub seen: Vec<String>,
 }
 

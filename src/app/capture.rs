@@ -1,0 +1,116 @@
+//! Screenshots (F12) and `--bench-frames`: the two things that read frames
+//! back or time them. Kept out of the frame function so it stays readable.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::Context as _;
+use winit::event_loop::ActiveEventLoop;
+
+use octovox::gpu::readback::{padded_row_bytes, read_buffer, staging_buffer};
+
+use super::{App, Gfx, SCREENSHOT_DIR};
+
+impl App {
+    /// Writes the traced view (and, where the swapchain allows copies, the
+    /// whole window with its panels) as PNGs under `saves/`.
+    pub(super) fn save_screenshot(&mut self, window_copy: Option<(wgpu::Buffer, u32, u32, bool)>) {
+        let Some(gfx) = &self.gfx else { return };
+        let stamp = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_millis());
+        // A script's `render PATH` names the file; otherwise a stamped name in saves/.
+        let view_path = self
+            .screenshot_path
+            .take()
+            .unwrap_or_else(|| Path::new(SCREENSHOT_DIR).join(format!("octovox-{stamp}.png")));
+        let base = view_path.with_extension("");
+        let (w, h) = gfx.trace.size();
+        let result = gfx
+            .trace
+            .read_color(&gfx.gpu)
+            .map_err(anyhow::Error::from)
+            .and_then(|bytes| image::RgbaImage::from_raw(w, h, bytes).context("trace readback has the wrong size"))
+            .and_then(|image| octovox::io::png::save_png(&image, &view_path).map_err(anyhow::Error::from));
+        match result {
+            Ok(()) => report!("screenshot: {}", view_path.display()),
+            Err(err) => {
+                self.ui.error(format!("screenshot failed: {err:#}"));
+                return;
+            }
+        }
+        if let Some((buffer, width, height, bgra)) = window_copy {
+            let window_path = PathBuf::from(format!("{}-window.png", base.display()));
+            let result = read_buffer(&gfx.gpu, &buffer).map_err(anyhow::Error::from).and_then(|bytes| {
+                let row = (width * 4) as usize;
+                let mut pixels: Vec<u8> =
+                    bytes.chunks(padded_row_bytes(width) as usize).flat_map(|r| &r[..row]).copied().collect();
+                if bgra {
+                    pixels.chunks_exact_mut(4).for_each(|p| p.swap(0, 2));
+                }
+                pixels.chunks_exact_mut(4).for_each(|p| p[3] = 255);
+                let image =
+                    image::RgbaImage::from_raw(width, height, pixels).context("frame readback has the wrong size")?;
+                octovox::io::png::save_png(&image, &window_path).map_err(anyhow::Error::from)
+            });
+            match result {
+                Ok(()) => report!("screenshot: {}", window_path.display()),
+                Err(err) => self.ui.error(format!("window screenshot failed: {err:#}")),
+            }
+        }
+        self.ui.info(format!("screenshot saved to {}", view_path.display()));
+    }
+
+    pub(super) fn bench_step(&mut self, event_loop: &ActiveEventLoop) {
+        if !self.ready {
+            return;
+        }
+        let (w, h) = self.trace_size();
+        let clock = self.gfx.as_ref().map_or("", |g| if g.gpu.timestamps { "GPU timestamps" } else { "wall" });
+        let Some(bench) = &mut self.bench else { return };
+        match bench.started {
+            // The first ready frame warms up; timing starts after it.
+            None => bench.started = Some(Instant::now()),
+            Some(started) => {
+                bench.trace_ms += self.stats.trace_ms;
+                bench.left -= 1;
+                if bench.left == 0 {
+                    let seconds = started.elapsed().as_secs_f64();
+                    let n = f64::from(bench.total);
+                    report!(
+                        "bench: {} frames at {w}x{h}: {:.2} fps, {:.1} ms/frame, trace {:.1} ms ({clock})",
+                        bench.total,
+                        n / seconds,
+                        seconds * 1e3 / n,
+                        bench.trace_ms / n,
+                    );
+                    self.bench = None;
+                    event_loop.exit();
+                }
+            }
+        }
+    }
+}
+
+/// Copies the swapchain image into a mappable buffer (read after submit).
+pub(super) fn copy_frame(
+    gfx: &Gfx,
+    encoder: &mut wgpu::CommandEncoder,
+    texture: &wgpu::Texture,
+) -> (wgpu::Buffer, u32, u32, bool) {
+    let (width, height) = (texture.width(), texture.height());
+    let padded = padded_row_bytes(width);
+    let buffer = staging_buffer(&gfx.gpu.device, "window screenshot", u64::from(padded) * u64::from(height));
+    encoder.copy_texture_to_buffer(
+        texture.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded),
+                rows_per_image: Some(height),
+            },
+        },
+        wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+    );
+    let bgra = matches!(gfx.config.format, wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb);
+    (buffer, width, height, bgra)
+}
