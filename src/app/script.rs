@@ -127,7 +127,9 @@ impl App {
                 return self.check(got <= *limit, format!("expected at most {limit} bytes written, got {got}"));
             }
             // The window's size and panels differ from a headless render.
-            Line::ExpectImage(..) => println!("replay: 'expect image' is checked by `octovox replay`, not in the window"),
+            Line::ExpectImage(..) => {
+                println!("replay: 'expect image' is checked by `octovox replay`, not in the window")
+            }
         }
         Ok(None)
     }

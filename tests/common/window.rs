@@ -253,4 +253,3 @@ pub fn save(display: &str, lines: &mut Lines, file: &Path) {
     let line = lines.wait_for("saved:", Duration::from_secs(30));
     assert!(line.ends_with(&*file.file_name().unwrap().to_string_lossy()), "{line}");
 }
-
