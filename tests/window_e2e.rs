@@ -23,7 +23,7 @@ mod common;
 
 use std::collections::HashSet;
 use std::path::PathBuf;
-use std::process::{Command, Stdio};
+use std::process::Command;
 use std::time::{Duration, Instant};
 
 use common::window::*;
@@ -54,26 +54,8 @@ fn click_attach_save_erase_save_in_a_real_window() {
     eprintln!("click at ({x}, {y}): hits {hit_voxel} through face {normal}; attach goes to {placed}");
 
     let (_xvfb, display) = start_xvfb(0);
-    let runtime_dir = dir.path().join("xdg");
-    std::fs::create_dir_all(&runtime_dir).unwrap();
-    let camera_arg = format!(
-        "{},{},{}:{},{},{}",
-        camera.eye.x, camera.eye.y, camera.eye.z, camera.target.x, camera.target.y, camera.target.z
-    );
-    let stderr_path = dir.path().join("octovox.stderr");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_octovox"))
-        .arg(&file)
-        .args(["--size", &format!("{WIDTH}x{HEIGHT}"), &format!("--camera={camera_arg}")])
-        .current_dir(dir.path())
-        .env("DISPLAY", &display)
-        .env("XDG_RUNTIME_DIR", &runtime_dir)
-        .env_remove("WAYLAND_DISPLAY")
-        .stdout(Stdio::piped())
-        .stderr(std::fs::File::create(&stderr_path).unwrap())
-        .spawn()
-        .expect("cannot start octovox");
-    let mut lines = Lines::new(&mut child);
-    let mut app = KillOnDrop(child, "octovox");
+    let args = [file.display().to_string(), "--size".into(), format!("{WIDTH}x{HEIGHT}"), camera_arg(&camera)];
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
 
     let window = find_window(&display, &mut app, &stderr_path);
     let ready = lines.wait_for("octovox: ready", Duration::from_secs(90));
@@ -184,21 +166,8 @@ fn slow_load_keeps_the_window_live() {
     assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
 
     let (_xvfb, display) = start_xvfb(1);
-    let runtime_dir = dir.path().join("xdg");
-    std::fs::create_dir_all(&runtime_dir).unwrap();
-    let stderr_path = dir.path().join("octovox.stderr");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_octovox"))
-        .args(["--size", "640x480", "--render-scale", "0.5", "--no-shadows"])
-        .current_dir(dir.path())
-        .env("DISPLAY", &display)
-        .env("XDG_RUNTIME_DIR", &runtime_dir)
-        .env_remove("WAYLAND_DISPLAY")
-        .stdout(Stdio::piped())
-        .stderr(std::fs::File::create(&stderr_path).unwrap())
-        .spawn()
-        .expect("cannot start octovox");
-    let mut lines = Lines::new(&mut child);
-    let mut app = KillOnDrop(child, "octovox");
+    let args = ["--size", "640x480", "--render-scale", "0.5", "--no-shadows"].map(String::from);
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
     let window = find_window(&display, &mut app, &stderr_path);
     lines.wait_for("octovox: ready", Duration::from_secs(90));
     xdotool(&display, &["windowfocus", "--sync", &window]);

@@ -5,30 +5,12 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::path::PathBuf;
+use std::process::{Child, Command};
 use std::time::{Duration, Instant};
 
 use common::window::*;
 use octovox::camera::Camera;
-
-fn spawn_app(display: &str, dir: &Path, args: &[String]) -> (KillOnDrop, Lines, PathBuf) {
-    let stderr_path = dir.join("octovox.stderr");
-    let runtime_dir = dir.join("xdg");
-    std::fs::create_dir_all(&runtime_dir).unwrap();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_octovox"))
-        .args(args)
-        .current_dir(dir)
-        .env("DISPLAY", display)
-        .env("XDG_RUNTIME_DIR", &runtime_dir)
-        .env_remove("WAYLAND_DISPLAY")
-        .stdout(Stdio::piped())
-        .stderr(std::fs::File::create(&stderr_path).unwrap())
-        .spawn()
-        .expect("cannot start octovox");
-    let lines = Lines::new(&mut child);
-    (KillOnDrop(child, "octovox"), lines, stderr_path)
-}
 
 fn wait_exit(app: &mut Child) {
     let deadline = Instant::now() + Duration::from_secs(30);
@@ -40,11 +22,6 @@ fn wait_exit(app: &mut Child) {
         assert!(Instant::now() < deadline, "octovox did not quit");
         std::thread::sleep(Duration::from_millis(100));
     }
-}
-
-fn camera_arg(camera: &Camera) -> String {
-    let (e, t) = (camera.eye, camera.target);
-    format!("--camera={},{},{}:{},{},{}", e.x, e.y, e.z, t.x, t.y, t.z)
 }
 
 #[test]

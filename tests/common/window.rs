@@ -3,7 +3,7 @@
 
 use std::collections::HashSet;
 use std::io::{BufRead, BufReader};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::mpsc::{self, Receiver};
 use std::time::{Duration, Instant};
@@ -252,4 +252,30 @@ pub fn save(display: &str, lines: &mut Lines, file: &Path) {
     xdotool(display, &["key", "ctrl+s"]);
     let line = lines.wait_for("saved:", Duration::from_secs(30));
     assert!(line.ends_with(&*file.file_name().unwrap().to_string_lossy()), "{line}");
+}
+
+/// Starts the real binary on `display` in `dir`, stdout piped to a
+/// [`Lines`] and stderr to a file (shown if the app dies early).
+pub fn spawn_app(display: &str, dir: &Path, args: &[String]) -> (KillOnDrop, Lines, PathBuf) {
+    let stderr_path = dir.join("octovox.stderr");
+    let runtime_dir = dir.join("xdg");
+    std::fs::create_dir_all(&runtime_dir).unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_octovox"))
+        .args(args)
+        .current_dir(dir)
+        .env("DISPLAY", display)
+        .env("XDG_RUNTIME_DIR", &runtime_dir)
+        .env_remove("WAYLAND_DISPLAY")
+        .stdout(Stdio::piped())
+        .stderr(std::fs::File::create(&stderr_path).unwrap())
+        .spawn()
+        .expect("cannot start octovox");
+    let lines = Lines::new(&mut child);
+    (KillOnDrop(child, "octovox"), lines, stderr_path)
+}
+
+/// `--camera=EX,EY,EZ:TX,TY,TZ` for a camera.
+pub fn camera_arg(camera: &Camera) -> String {
+    let (e, t) = (camera.eye, camera.target);
+    format!("--camera={},{},{}:{},{},{}", e.x, e.y, e.z, t.x, t.y, t.z)
 }
