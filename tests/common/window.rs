@@ -54,8 +54,10 @@ pub fn start_xvfb(slot: u32) -> (KillOnDrop, String) {
         })
         .expect("no free X display number");
     let display = format!(":{number}");
+    // -noreset: by default the server resets when its last client leaves,
+    // and the app's connection right after the readiness probe can fail.
     let child = Command::new("Xvfb")
-        .args([&display, "-screen", "0", "1600x1000x24", "-nolisten", "tcp"])
+        .args([&display, "-screen", "0", "1600x1000x24", "-nolisten", "tcp", "-noreset"])
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
