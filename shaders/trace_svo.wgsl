@@ -47,6 +47,11 @@ fn trace_svo(r: Ray) -> Hit {
     var path_high = 0u;
     var level = depth;
     var node = u.root;
+    // Node words one, two and three levels up; `cached` of them are valid.
+    var up1 = 0u;
+    var up2 = 0u;
+    var up3 = 0u;
+    var cached = 0u;
     var node_min = vec3<i32>(0);
     var octant = first_octant(r, node_min, level, t, axis);
     var iterations = 0u;
@@ -66,6 +71,11 @@ fn trace_svo(r: Ray) -> Hit {
                 path_high = (path_high & ~(7u << (3u * (i - 10u)))) | (octant << (3u * (i - 10u)));
             }
             level -= 1u;
+            // Keep the last three ancestors in registers (a short stack).
+            up3 = up2;
+            up2 = up1;
+            up1 = node;
+            cached = min(cached + 1u, 3u);
             node = word;
             node_min = child_min;
             octant = first_octant(r, node_min, level, t, axis);
@@ -102,12 +112,30 @@ fn trace_svo(r: Ray) -> Hit {
         if (left_root) {
             break;
         }
-        if (level != start_level) {
-            // Fetch the node word at the new level along the path.
+        let climbed = level - start_level;
+        if (climbed == 0u) {
+            continue;
+        }
+        if (climbed <= cached) {
+            // The new node is an ancestor still held in registers.
+            if (climbed == 1u) {
+                node = up1;
+                up1 = up2;
+                up2 = up3;
+            } else if (climbed == 2u) {
+                node = up2;
+                up1 = up3;
+            } else {
+                node = up3;
+            }
+            cached -= climbed;
+        } else {
+            // Deeper pop: fetch the node word again from the root along the path.
             node = u.root;
             for (var l = depth; l > level; l--) {
                 node = child_word(node, l, path_octant(path_low, path_high, l));
             }
+            cached = 0u;
         }
     }
     miss.iterations = iterations;
