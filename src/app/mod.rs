@@ -41,7 +41,7 @@ use octovox::gpu::{BlitPass, FrameUniforms, GpuContext, SceneBuffers, TracePass}
 use octovox::scene::Scene;
 use octovox::settings::TraceMode;
 use octovox::trace::grid::DenseGrid;
-use octovox::trace::{Ray, svo};
+use octovox::trace::svo;
 
 use crate::cli::WindowArgs;
 pub use command::{Choice, Command, Pending, StrokePhase};
@@ -131,8 +131,6 @@ struct App {
     player: Option<script::Player>,
     /// `--record`: where the session is written as a script.
     recorder: Option<octovox::replay::Recorder>,
-    /// A failed expectation or line of the playing script, to report.
-    check_message: Option<String>,
     /// Where the next screenshot goes (a script's `render PATH`), else `saves/`.
     screenshot_path: Option<PathBuf>,
 }
@@ -162,7 +160,6 @@ impl App {
             fatal: None,
             player: None,
             recorder: None,
-            check_message: None,
             screenshot_path: None,
             args,
         };
@@ -538,11 +535,8 @@ impl App {
         }
         let px = ((x * f64::from(w) / f64::from(window_w)) as u32).min(w - 1);
         let py = ((y * f64::from(h) / f64::from(window_h)) as u32).min(h - 1);
-        let tree = &self.scene.tree;
-        let basis = self.state.camera.basis(w, h, tree.origin());
-        let (origin, dir) = basis.ray(px, py);
-        let hit = svo::trace(tree, &Ray::new(origin, dir));
-        hit.is_hit().then(|| Pick { voxel: hit.voxel + tree.origin(), normal: hit.normal, value: hit.value })
+        let hit = svo::pick(&self.scene.tree, &self.state.camera, (w, h), px, py)?;
+        Some(Pick { voxel: hit.voxel, normal: hit.normal, value: hit.value })
     }
 
     fn pointer_edit(&mut self, phase: StrokePhase, tool: Tool, x: f64, y: f64) {

@@ -30,6 +30,20 @@ impl Player {
     }
 }
 
+/// What one played line did.
+enum Played {
+    Done,
+    Passed,
+    /// A failed expectation or a line that could not run, with the message.
+    Failed(String),
+}
+
+impl Played {
+    fn check(ok: bool, message: String) -> Played {
+        if ok { Played::Passed } else { Played::Failed(message) }
+    }
+}
+
 impl App {
     /// Plays the next script line, if a script is playing and the app is
     /// idle (not loading). Prints the summary after the last line.
@@ -48,13 +62,13 @@ impl App {
         let base = player.base.clone();
         let where_ = format!("{}:{}", player.script.path.display(), line.number);
         match self.play_line(&base, &line.command, event_loop) {
-            Ok(None) => {}
-            Ok(Some(true)) => self.with_player(|p| p.passed += 1),
-            Ok(Some(false)) | Err(_) => self.with_player(|p| p.failed += 1),
-        }
-        if let Some(message) = self.check_message.take() {
-            println!("{where_}: {message}");
-            self.ui.error(format!("{where_}: {message}"));
+            Played::Done => {}
+            Played::Passed => self.with_player(|p| p.passed += 1),
+            Played::Failed(message) => {
+                self.with_player(|p| p.failed += 1);
+                println!("{where_}: {message}");
+                self.ui.error(format!("{where_}: {message}"));
+            }
         }
         self.request_redraw();
     }
@@ -65,13 +79,8 @@ impl App {
         }
     }
 
-    /// Carries out one line. `Some(passed)` for expectations.
-    fn play_line(
-        &mut self,
-        base: &Path,
-        line: &Line,
-        event_loop: &winit::event_loop::ActiveEventLoop,
-    ) -> Result<Option<bool>, ()> {
+    /// Carries out one line.
+    fn play_line(&mut self, base: &Path, line: &Line, event_loop: &winit::event_loop::ActiveEventLoop) -> Played {
         let (brush, color) = self.player.as_ref().map_or((Brush::Voxel, 1), |p| (p.brush, p.color));
         let brush_edit = |at, op| Edit::Brush { shape: brush.shape_at(at), op };
         match line {
@@ -97,7 +106,7 @@ impl App {
                     let (_, edit) = click_edit(*tool, &brush, color, pick.voxel, pick.normal);
                     self.execute(Command::Edit(edit), event_loop);
                 }
-                None => return self.fail(format!("expected pixel ({x}, {y}) to hit a voxel, got nothing")),
+                None => return Played::Failed(format!("expected pixel ({x}, {y}) to hit a voxel, got nothing")),
             },
             Line::Undo(n) | Line::Redo(n) => {
                 let command = if matches!(line, Line::Undo(_)) { Command::Undo } else { Command::Redo };
@@ -107,7 +116,7 @@ impl App {
             }
             Line::Save(path) => {
                 if !self.save(&base.join(path)) {
-                    return self.fail(format!("could not save {}", path.display()));
+                    return Played::Failed(format!("could not save {}", path.display()));
                 }
             }
             Line::Render(path) => {
@@ -116,34 +125,22 @@ impl App {
             }
             Line::ExpectVoxel(p, want) => {
                 let got = self.scene.tree.get(*p);
-                return self.check(got == *want, format!("expected voxel {p} = {want}, got {got}"));
+                return Played::check(got == *want, format!("expected voxel {p} = {want}, got {got}"));
             }
             Line::ExpectCount(want) => {
                 let got = self.scene.tree.solid_voxels();
-                return self.check(got == *want, format!("expected {want} voxels, got {got}"));
+                return Played::check(got == *want, format!("expected {want} voxels, got {got}"));
             }
             Line::ExpectWritten(limit) => {
                 let got = self.stats.last_edit_bytes;
-                return self.check(got <= *limit, format!("expected at most {limit} bytes written, got {got}"));
+                return Played::check(got <= *limit, format!("expected at most {limit} bytes written, got {got}"));
             }
             // The window's size and panels differ from a headless render.
             Line::ExpectImage(..) => {
                 println!("replay: 'expect image' is checked by `octovox replay`, not in the window")
             }
         }
-        Ok(None)
-    }
-
-    fn check(&mut self, ok: bool, message: String) -> Result<Option<bool>, ()> {
-        if !ok {
-            self.check_message = Some(message);
-        }
-        Ok(Some(ok))
-    }
-
-    fn fail(&mut self, message: String) -> Result<Option<bool>, ()> {
-        self.check_message = Some(message);
-        Err(())
+        Played::Done
     }
 
     /// Runs `f` on the recorder; an I/O error stops recording with a message.

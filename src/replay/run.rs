@@ -14,7 +14,7 @@ use crate::scene::{Op, Scene};
 use crate::settings::RenderSettings;
 use crate::tool::{Brush, click_edit};
 use crate::trace::render::render_scene_cpu;
-use crate::trace::{Ray, svo};
+use crate::trace::svo;
 
 /// Where renders and pool flushes go.
 pub enum RunnerMode {
@@ -177,10 +177,7 @@ impl Runner {
 
     /// The world voxel and face normal under a pixel (what the mouse picks).
     pub fn pick(&self, x: u32, y: u32) -> Option<(IVec3, IVec3)> {
-        let basis = self.camera.basis(self.viewport.0, self.viewport.1, self.scene.tree.origin());
-        let (origin, dir) = basis.ray(x, y);
-        let hit = svo::trace(&self.scene.tree, &Ray::new(origin, dir));
-        hit.is_hit().then(|| (hit.voxel + self.scene.tree.origin(), hit.normal))
+        svo::pick(&self.scene.tree, &self.camera, self.viewport, x, y).map(|hit| (hit.voxel, hit.normal))
     }
 
     fn brush_edit(&mut self, at: IVec3, op: Op) -> Result<(), String> {

@@ -9,11 +9,22 @@
 use glam::{IVec3, Vec3};
 
 use super::{Hit, MAX_ITERATIONS, NO_AXIS, Ray, argmin};
+use crate::camera::Camera;
 use crate::gpu_pool::{is_pointer, slot_of};
 use crate::scene::octree::{MAX_DEPTH, Octree, octant_offset};
 
 // The octant path holds 20 levels of 3 bits in two words.
 const _: () = assert!(MAX_DEPTH <= 20);
+
+/// The voxel and face under pixel (x, y) of a `size` view, with the voxel in
+/// world coordinates: the one CPU pick that the window's mouse and replay's
+/// `click` share.
+pub fn pick(tree: &Octree, camera: &Camera, size: (u32, u32), x: u32, y: u32) -> Option<Hit> {
+    let basis = camera.basis(size.0, size.1, tree.origin());
+    let (origin, dir) = basis.ray(x, y);
+    let hit = trace(tree, &Ray::new(origin, dir));
+    hit.is_hit().then(|| Hit { voxel: hit.voxel + tree.origin(), ..hit })
+}
 
 /// The first solid voxel along `ray` (tree-local coordinates).
 pub fn trace(tree: &Octree, ray: &Ray) -> Hit {
