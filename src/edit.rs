@@ -4,6 +4,8 @@
 //! the single path from "the user wants this" to changed octree slots (which
 //! the node pool then flushes to the GPU).
 
+use std::collections::VecDeque;
+
 use crate::scene::{EditError, Octree, Op, Patch, Shape};
 
 /// One change to the scene.
@@ -33,11 +35,20 @@ struct Step {
     inverses: Vec<Edit>,
 }
 
+impl Step {
+    /// Memory its undo data holds.
+    fn bytes(&self) -> usize {
+        self.inverses.iter().map(edit_bytes).sum()
+    }
+}
+
 /// Undo and redo stacks. Unlimited, except that the oldest steps are dropped
 /// once the undo data passes `memory_limit_bytes`.
 #[derive(Clone, Debug)]
 pub struct History {
-    done: Vec<Step>,
+    done: VecDeque<Step>,
+    /// Undo data held by `done` (kept as a running total, not re-summed).
+    done_bytes: usize,
     undone: Vec<Step>,
     stroke: Option<Step>,
     pub memory_limit_bytes: usize,
@@ -45,7 +56,7 @@ pub struct History {
 
 impl Default for History {
     fn default() -> History {
-        History { done: Vec::new(), undone: Vec::new(), stroke: None, memory_limit_bytes: 2 << 30 }
+        History { done: VecDeque::new(), done_bytes: 0, undone: Vec::new(), stroke: None, memory_limit_bytes: 2 << 30 }
     }
 }
 
@@ -78,18 +89,20 @@ impl History {
     }
 
     fn push(&mut self, step: Step) {
-        self.done.push(step);
-        let size = |s: &Step| s.inverses.iter().map(edit_bytes).sum::<usize>();
-        let mut total: usize = self.done.iter().map(size).sum();
-        while total > self.memory_limit_bytes && self.done.len() > 1 {
-            total -= size(&self.done.remove(0));
+        self.done_bytes += step.bytes();
+        self.done.push_back(step);
+        while self.done_bytes > self.memory_limit_bytes && self.done.len() > 1 {
+            if let Some(oldest) = self.done.pop_front() {
+                self.done_bytes -= oldest.bytes();
+            }
         }
     }
 
     /// Undoes the last step; false when there is none.
     pub fn undo(&mut self, tree: &mut Octree) -> Result<bool, EditError> {
         self.end_stroke();
-        let Some(mut step) = self.done.pop() else { return Ok(false) };
+        let Some(mut step) = self.done.pop_back() else { return Ok(false) };
+        self.done_bytes -= step.bytes();
         for inverse in step.inverses.iter().rev() {
             inverse.apply(tree)?;
         }
@@ -105,7 +118,7 @@ impl History {
         for edit in &step.edits {
             step.inverses.push(edit.apply(tree)?);
         }
-        self.done.push(step);
+        self.push(step);
         Ok(true)
     }
 
@@ -120,6 +133,7 @@ impl History {
     /// Forgets everything (a new scene was loaded).
     pub fn clear(&mut self) {
         self.done.clear();
+        self.done_bytes = 0;
         self.undone.clear();
         self.stroke = None;
     }
