@@ -17,9 +17,11 @@ struct FrameUniforms {
     grid_dims: vec3<u32>,
     highlight_on: u32,
     highlight_min: vec3<i32>,
-    _pad0: u32,
+    // 1: write a hit record per pixel (tests and benchmarks read them; the
+    // window does not, and they cost a scattered 16-byte store per pixel).
+    hit_records: u32,
     highlight_max: vec3<i32>,
-    _pad1: u32,
+    _pad: u32,
 }
 
 @group(0) @binding(0) var<uniform> u: FrameUniforms;
@@ -152,12 +154,9 @@ fn hit_cell(r: Ray, value: u32, mn: vec3<i32>, level: u32, t: f32, axis: u32, it
 }
 
 fn normal_vector(code: u32) -> vec3<f32> {
-    if (code == 0u || code > 6u) {
-        return vec3<f32>(0.0);
-    }
-    var n = vec3<f32>(0.0);
-    n[(code - 1u) / 2u] = select(-1.0, 1.0, code % 2u == 1u);
-    return n;
+    let on_axis = vec3<u32>(0u, 1u, 2u) == vec3<u32>((code - 1u) / 2u);
+    let valid = code != 0u && code <= 6u;
+    return select(vec3<f32>(0.0), vec3<f32>(select(-1.0, 1.0, code % 2u == 1u)), on_axis & vec3<bool>(valid));
 }
 
 // The shadow ray starts in the empty voxel in front of the entered face.
@@ -171,21 +170,24 @@ fn sky_color(d: vec3<f32>) -> vec3<f32> {
     return mix(vec3<f32>(0.86, 0.89, 0.95), vec3<f32>(0.32, 0.5, 0.82), up);
 }
 
+// Blue → cyan → green → yellow → red over [0, 1]. Written without a local
+// array: those live in per-thread memory on CPU-emulated GPUs.
 fn heat(x_in: f32) -> vec3<f32> {
     let x = clamp(x_in, 0.0, 1.0) * 4.0;
-    var stops = array<vec3<f32>, 5>(
-        vec3<f32>(0.05, 0.05, 0.45),
-        vec3<f32>(0.0, 0.6, 0.9),
-        vec3<f32>(0.1, 0.8, 0.2),
-        vec3<f32>(0.95, 0.9, 0.1),
-        vec3<f32>(0.9, 0.1, 0.05),
-    );
-    let i = min(u32(floor(x)), 3u);
-    return mix(stops[i], stops[i + 1u], x - f32(i));
+    let i = min(floor(x), 3.0);
+    let f = x - i;
+    let s0 = vec3<f32>(0.05, 0.05, 0.45);
+    let s1 = vec3<f32>(0.0, 0.6, 0.9);
+    let s2 = vec3<f32>(0.1, 0.8, 0.2);
+    let s3 = vec3<f32>(0.95, 0.9, 0.1);
+    let s4 = vec3<f32>(0.9, 0.1, 0.05);
+    let lo = select(select(select(s3, s2, i < 2.5), s1, i < 1.5), s0, i < 0.5);
+    let hi = select(select(select(s4, s3, i < 2.5), s2, i < 1.5), s1, i < 0.5);
+    return mix(lo, hi, f);
 }
 
 fn in_highlight(hit: Hit) -> bool {
-    return u.highlight_on != 0u && hit.value != 0u && all(hit.voxel >= u.highlight_min) && all(hit.voxel <= u.highlight_max);
+    return hit.value != 0u && all(hit.voxel >= u.highlight_min) && all(hit.voxel <= u.highlight_max);
 }
 
 // Twin of `shade` in src/trace/render.rs.
@@ -216,10 +218,16 @@ fn shade(hit: Hit, d: vec3<f32>, in_shadow: bool) -> vec3<f32> {
 
 fn write_pixel(px: vec2<u32>, hit: Hit, d: vec3<f32>, in_shadow: bool) {
     var rgb = shade(hit, d, in_shadow);
-    if (in_highlight(hit)) {
-        rgb = mix(rgb, vec3<f32>(1.0, 0.85, 0.2), 0.45);
+    // Uniform branches: skipped as a whole when off.
+    if (u.highlight_on != 0u) {
+        if (in_highlight(hit)) {
+            rgb = mix(rgb, vec3<f32>(1.0, 0.85, 0.2), 0.45);
+        }
     }
     textureStore(out_color, vec2<i32>(px), vec4<f32>(rgb, 1.0));
+    if (u.hit_records == 0u) {
+        return;
+    }
     let info = hit.value | (hit.normal_code << 8u) | (min(hit.level, 31u) << 11u) | (min(hit.iterations, 0xffffu) << 16u);
     hit_records[px.y * u.width + px.x] = vec4<u32>(bitcast<u32>(hit.voxel.x), bitcast<u32>(hit.voxel.y), bitcast<u32>(hit.voxel.z), info);
 }

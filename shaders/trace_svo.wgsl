@@ -1,5 +1,25 @@
-// Stack-based SVO traversal, one thread per pixel. Line-for-line twin of
-// src/trace/svo.rs: change both together. Prefixed with common.wgsl.
+// Stack-based SVO traversal, one thread per pixel, after a beam prepass that
+// gives each tile of pixels a safe distance to start from. The traversal is
+// the twin of src/trace/svo.rs: change both together. Prefixed with
+// common.wgsl.
+//
+// The loop body is straight-line code choosing between "push" and "advance"
+// with select(): on SIMD hardware, and above all on CPU-emulated GPUs, both
+// sides of a divergent branch run anyway, and the bookkeeping of branches
+// costs more than the selects.
+
+@group(0) @binding(7) var<storage, read_write> beam_distance: array<f32>;
+
+// Side of the square tile of pixels that shares one beam.
+const BEAM_TILE: u32 = 8u;
+// The beam stops at nodes this small (4³ voxels): finer levels cost more
+// prepass steps than they save.
+const BEAM_LEVEL: u32 = 2u;
+// No solid cell in the tile's frustum.
+const BEAM_NONE: f32 = 3.0e38;
+const BEAM_MAX_VISITS: u32 = 4096u;
+// Pending siblings: at most 7 per level below the root, plus the root.
+const BEAM_STACK: u32 = 144u;
 
 fn octant_offset(o: u32) -> vec3<i32> {
     return vec3<i32>(i32(o & 1u), i32((o >> 1u) & 1u), i32((o >> 2u) & 1u));
@@ -15,139 +35,227 @@ fn child_word(word: u32, level: u32, octant: u32) -> u32 {
     return nodes[slot * 8u + octant];
 }
 
-// Per axis: has the ray crossed the mid-plane (the rule of `crossed`, in
-// vector form: no dynamic vector indexing, which is slow on some drivers)?
-fn first_octant(r: Ray, mn: vec3<i32>, level: u32, t: f32, entry_axis: u32) -> u32 {
-    let mid = vec3<f32>(mn + vec3<i32>(1 << (level - 1u)));
-    let t_mid = (mid - r.o) * r.inv;
+// The child cell of node (`mn`, level) that holds the ray point at t: per
+// axis, whether the ray has crossed the mid-plane (the rule of `crossed`).
+fn child_cell(r: Ray, mn: vec3<i32>, level: u32, t: f32, entry_axis: u32) -> vec3<i32> {
+    let half = 1 << (level - 1u);
+    let t_mid = (vec3<f32>(mn + vec3<i32>(half)) - r.o) * r.inv;
     let tie_counts = vec3<u32>(0u, 1u, 2u) <= vec3<u32>(entry_axis);
-    let c = select(t_mid < vec3<f32>(t), t_mid <= vec3<f32>(t), tie_counts);
-    let upper = select(!c, c, r.d > vec3<f32>(0.0));
-    return select(0u, 1u, upper.x) | select(0u, 2u, upper.y) | select(0u, 4u, upper.z);
+    let crossed = select(t_mid < vec3<f32>(t), t_mid <= vec3<f32>(t), tie_counts);
+    let upper = crossed == (r.d > vec3<f32>(0.0));
+    return mn + select(vec3<i32>(0), vec3<i32>(half), upper);
 }
 
-fn trace_svo(r: Ray) -> Hit {
+// Octant of a cell of size 2^(level-1) within its node: one coordinate bit
+// per axis. The cell's coordinates hold its octant at every level above, so
+// the traversal keeps no octant stack.
+fn octant_of(cell: vec3<i32>, level: u32) -> u32 {
+    let b = (vec3<u32>(cell) >> vec3<u32>(level - 1u)) & vec3<u32>(1u);
+    return b.x | (b.y << 1u) | (b.z << 2u);
+}
+
+// `argmin3` without branches.
+fn argmin3_select(t: vec3<f32>) -> u32 {
+    return select(select(2u, 1u, t.y <= t.z), 0u, t.x <= t.y && t.x <= t.z);
+}
+
+// The first solid voxel along `r` at or after `t_min`.
+fn trace_svo(r: Ray, t_min: f32) -> Hit {
     var miss: Hit;
     let depth = u.depth;
     let size = f32(1u << depth);
     let s = slab(r, vec3<f32>(0.0), vec3<f32>(size));
-    if (s.t_enter > s.t_exit || s.t_exit < 0.0) {
+    if (s.t_enter > s.t_exit || s.t_exit < max(t_min, 0.0)) {
         return miss;
     }
     var t = max(s.t_enter, 0.0);
+    // NO_AXIS: the ray starts inside the root, so no face was entered yet.
     var axis = select(NO_AXIS, s.axis, s.t_enter >= 0.0);
+    if (t_min > t) {
+        t = t_min;
+        axis = NO_AXIS;
+    }
     if ((u.root & POINTER_BIT) == 0u) {
         return hit_cell(r, u.root, vec3<i32>(0), depth, t, axis, 1u);
     }
-    // The stack: the octant taken at every level, 3 bits a level, in two
-    // registers. Node words above the current one are fetched again from the
-    // root after a pop (no per-thread array: those are slow, very slow on
-    // CPU-emulated GPUs like lavapipe).
-    var path_low = 0u;
-    var path_high = 0u;
+    let positive = r.d > vec3<f32>(0.0);
+    let far_side = select(vec3<i32>(0), vec3<i32>(1), positive);
+    let below = select(vec3<i32>(-1), vec3<i32>(0), positive);
     var level = depth;
     var node = u.root;
-    // Node words one, two and three levels up; `cached` of them are valid.
+    // The stack: node words one, two and three levels up, `cached` of them
+    // valid. A pop past them restarts from the root (see below); a per-thread
+    // array would be slower, very much so on CPU-emulated GPUs.
     var up1 = 0u;
     var up2 = 0u;
     var up3 = 0u;
     var cached = 0u;
-    var node_min = vec3<i32>(0);
-    var octant = first_octant(r, node_min, level, t, axis);
+    // After a restart the cell is already known down to this node level, so
+    // the descent follows its coordinate bits instead of the ray.
+    var known = depth;
+    var cell = child_cell(r, vec3<i32>(0), level, t, axis);
     var iterations = 0u;
+    var value = 0u;
     loop {
         if (iterations >= MAX_ITERATIONS) {
             break;
         }
         iterations += 1u;
-        let half = 1 << (level - 1u);
-        let child_min = node_min + octant_offset(octant) * half;
-        let word = child_word(node, level, octant);
-        if ((word & POINTER_BIT) != 0u) {
-            let i = level - 1u;
-            if (i < 10u) {
-                path_low = (path_low & ~(7u << (3u * i))) | (octant << (3u * i));
-            } else {
-                path_high = (path_high & ~(7u << (3u * (i - 10u)))) | (octant << (3u * (i - 10u)));
-            }
-            level -= 1u;
-            // Keep the last three ancestors in registers (a short stack).
-            up3 = up2;
-            up2 = up1;
-            up1 = node;
-            cached = min(cached + 1u, 3u);
-            node = word;
-            node_min = child_min;
-            octant = first_octant(r, node_min, level, t, axis);
-            continue;
-        }
-        if (word != 0u) {
-            return hit_cell(r, word, child_min, level - 1u, t, axis, iterations);
-        }
-        // Empty child: leave it through its nearest exit plane.
-        let far = vec3<f32>(child_min) + select(vec3<f32>(0.0), vec3<f32>(f32(half)), r.d > vec3<f32>(0.0));
-        let exits = (far - r.o) * r.inv;
-        let a = argmin3(exits);
-        t = min(min(exits.x, exits.y), exits.z);
-        axis = a;
-        let bit = 1u << a;
-        let positive = r.d > vec3<f32>(0.0);
-        let forward = select(select(positive.z, positive.y, a == 1u), positive.x, a == 0u);
-        let start_level = level;
-        var left_root = false;
-        loop {
-            let leaving = select((octant & bit) == 0u, (octant & bit) != 0u, forward);
-            if (!leaving) {
-                octant ^= bit;
-                break;
-            }
-            if (level == depth) {
-                left_root = true;
-                break;
-            }
-            level += 1u;
-            octant = path_octant(path_low, path_high, level);
-            node_min -= octant_offset(octant) * (1 << (level - 1u));
-        }
-        if (left_root) {
+        let word = child_word(node, level, octant_of(cell, level));
+        let push = (word & POINTER_BIT) != 0u;
+        if (!push && word != 0u) {
+            value = word;
             break;
         }
-        let climbed = level - start_level;
-        if (climbed == 0u) {
-            continue;
+        // Push: the child cell of the new node holding the ray point.
+        let child_level = level - 1u;
+        let pushed_cell = select(cell, child_cell(r, cell, max(child_level, 1u), t, axis), child_level < known);
+        // Advance: leave the empty cell through its nearest exit plane. The
+        // highest coordinate bit that changes is the octant bit of the
+        // smallest node holding both cells: that is where the step pops to.
+        let half = 1 << (level - 1u);
+        let exits = (vec3<f32>(cell + far_side * half) - r.o) * r.inv;
+        let a = argmin3_select(exits);
+        let next = cell + select(vec3<i32>(0), far_side * half + below, vec3<u32>(0u, 1u, 2u) == vec3<u32>(a));
+        let changed = vec3<u32>(cell ^ next);
+        let new_level = firstLeadingBit(changed.x | changed.y | changed.z) + 1u;
+        if (!push && new_level > depth) {
+            break;
         }
-        if (climbed <= cached) {
-            // The new node is an ancestor still held in registers.
-            if (climbed == 1u) {
-                node = up1;
-                up1 = up2;
-                up2 = up3;
-            } else if (climbed == 2u) {
-                node = up2;
-                up1 = up3;
-            } else {
-                node = up3;
-            }
-            cached -= climbed;
-        } else {
-            // Deeper pop: fetch the node word again from the root along the path.
-            node = u.root;
-            for (var l = depth; l > level; l--) {
-                node = child_word(node, l, path_octant(path_low, path_high, l));
-            }
-            cached = 0u;
-        }
+        let climbed = new_level - level;
+        // Popping past the cached ancestors restarts at the root and descends
+        // again along the cell's coordinate bits.
+        let restart = climbed > cached;
+        let popped = select(select(select(node, up3, climbed == 3u), up2, climbed == 2u), up1, climbed == 1u);
+        let popped_up1 = select(select(up1, up3, climbed == 2u), up2, climbed == 1u);
+        let popped_up2 = select(up2, up3, climbed == 1u);
+        let parent = node;
+        t = select(min(min(exits.x, exits.y), exits.z), t, push);
+        axis = select(a, axis, push);
+        cell = select(next & vec3<i32>(~((1 << (new_level - 1u)) - 1)), pushed_cell, vec3<bool>(push));
+        known = select(new_level, min(known, child_level), push);
+        node = select(select(popped, u.root, restart), word, push);
+        up3 = select(up3, up2, push);
+        up2 = select(popped_up2, up1, push);
+        up1 = select(popped_up1, parent, push);
+        level = select(select(new_level, depth, restart), child_level, push);
+        cached = select(select(cached - climbed, 0u, restart), min(cached + 1u, 3u), push);
     }
-    miss.iterations = iterations;
-    return miss;
+    if (value == 0u) {
+        miss.iterations = iterations;
+        return miss;
+    }
+    return hit_cell(r, value, cell, level - 1u, t, axis, iterations);
 }
 
-fn path_octant(low: u32, high: u32, level: u32) -> u32 {
-    let i = level - 1u;
-    if (i < 10u) {
-        return (low >> (3u * i)) & 7u;
+fn beam_tiles() -> vec2<u32> {
+    return (vec2<u32>(u.width, u.height) + vec2<u32>(BEAM_TILE - 1u)) / BEAM_TILE;
+}
+
+// Direction through a point of the image plane given in pixels (corners at
+// whole numbers); `pixel_ray` uses pixel centres.
+fn image_direction(p: vec2<f32>) -> vec3<f32> {
+    let ndc = vec2<f32>(2.0 * p.x / f32(u.width) - 1.0, 1.0 - 2.0 * p.y / f32(u.height));
+    return u.forward + u.right * ndc.x + u.up * ndc.y;
+}
+
+struct Frustum {
+    n0: vec3<f32>,
+    n1: vec3<f32>,
+    n2: vec3<f32>,
+    n3: vec3<f32>,
+}
+
+// Is the box (lo, hi) wholly outside the half-space n·(p - eye) >= 0?
+fn beyond(n: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>) -> bool {
+    return dot(n, select(lo, hi, n >= vec3<f32>(0.0)) - u.eye) < 0.0;
+}
+
+fn inward(n: vec3<f32>, center: vec3<f32>) -> vec3<f32> {
+    return select(-n, n, dot(n, center) >= 0.0);
+}
+
+// Beam prepass, one thread per tile: the distance from the eye to the
+// nearest non-empty node of BEAM_LEVEL (or uniform solid node) inside the
+// pyramid of the tile's corner rays. Every pixel ray of the tile lies in
+// that pyramid, so none can meet a solid voxel closer than this distance.
+// Front-to-back depth-first search, pruned by the best distance so far.
+@compute @workgroup_size(8, 8)
+fn beam(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let tiles = beam_tiles();
+    if (gid.x >= tiles.x || gid.y >= tiles.y) {
+        return;
     }
-    return (high >> (3u * (i - 10u))) & 7u;
+    let p0 = vec2<f32>(gid.xy * BEAM_TILE);
+    let p1 = vec2<f32>(min((gid.xy + vec2<u32>(1u)) * BEAM_TILE, vec2<u32>(u.width, u.height)));
+    let c00 = image_direction(p0);
+    let c10 = image_direction(vec2<f32>(p1.x, p0.y));
+    let c11 = image_direction(p1);
+    let c01 = image_direction(vec2<f32>(p0.x, p1.y));
+    let center = image_direction((p0 + p1) * 0.5);
+    let f = Frustum(
+        inward(cross(c00, c10), center),
+        inward(cross(c10, c11), center),
+        inward(cross(c11, c01), center),
+        inward(cross(c01, c00), center),
+    );
+    var stack: array<vec4<u32>, BEAM_STACK>;
+    // (word, min.x, min.y, min.z | level << 24); coordinates are below 2^24.
+    stack[0] = vec4<u32>(u.root, 0u, 0u, u.depth << 24u);
+    var top = 1u;
+    var best = BEAM_NONE;
+    var visits = 0u;
+    while (top > 0u) {
+        if (visits >= BEAM_MAX_VISITS) {
+            // Out of budget: start those rays from the eye.
+            best = 0.0;
+            break;
+        }
+        visits += 1u;
+        top -= 1u;
+        let item = stack[top];
+        let level = item.w >> 24u;
+        let mn = vec3<i32>(vec3<u32>(item.y, item.z, item.w & 0xffffffu));
+        // Half a voxel of slack against rounding in the plane tests.
+        let lo = vec3<f32>(mn) - vec3<f32>(0.5);
+        let hi = vec3<f32>(mn + vec3<i32>(1 << level)) + vec3<f32>(0.5);
+        if (beyond(f.n0, lo, hi) || beyond(f.n1, lo, hi) || beyond(f.n2, lo, hi) || beyond(f.n3, lo, hi)) {
+            continue;
+        }
+        let distance = length(max(max(lo - u.eye, u.eye - hi), vec3<f32>(0.0)));
+        if (distance >= best) {
+            continue;
+        }
+        if ((item.x & POINTER_BIT) == 0u || level <= BEAM_LEVEL) {
+            best = distance;
+            continue;
+        }
+        // Push the non-empty children, the one nearest the eye last so that
+        // it is searched first.
+        let half = 1 << (level - 1u);
+        let near_side = u.eye >= vec3<f32>(mn + vec3<i32>(half));
+        let near = select(0u, 1u, near_side.x) | select(0u, 2u, near_side.y) | select(0u, 4u, near_side.z);
+        for (var k = 7i; k >= 0; k--) {
+            let o = near ^ u32(k);
+            let child = nodes[(item.x & ~POINTER_BIT) * 8u + o];
+            if (child != 0u) {
+                let child_min = vec3<u32>(mn + octant_offset(o) * half);
+                stack[top] = vec4<u32>(child, child_min.x, child_min.y, child_min.z | ((level - 1u) << 24u));
+                top += 1u;
+            }
+        }
+    }
+    beam_distance[gid.y * tiles.x + gid.x] = best;
+}
+
+// Where the pixel's ray may start: one voxel before its tile's beam distance
+// (t measures distance in units of |d|), or BEAM_NONE when the tile is empty.
+fn beam_start(px: vec2<u32>, r: Ray) -> f32 {
+    let distance = beam_distance[(px.y / BEAM_TILE) * beam_tiles().x + px.x / BEAM_TILE];
+    if (distance >= BEAM_NONE) {
+        return BEAM_NONE;
+    }
+    return max(distance - 1.0, 0.0) / length(r.d);
 }
 
 @compute @workgroup_size(8, 8)
@@ -156,10 +264,14 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let r = pixel_ray(gid.xy);
-    let hit = trace_svo(r);
+    var hit: Hit;
+    let t_start = beam_start(gid.xy, r);
+    if (t_start < BEAM_NONE) {
+        hit = trace_svo(r, t_start);
+    }
     var in_shadow = false;
     if (SHADOWS && u.view == 0u && hit.value != 0u && hit.normal_code != 0u) {
-        in_shadow = trace_svo(shadow_ray(hit)).value != 0u;
+        in_shadow = trace_svo(shadow_ray(hit), 0.0).value != 0u;
     }
     write_pixel(gid.xy, hit, r.d, in_shadow);
 }

@@ -18,6 +18,11 @@ pub struct Renderer {
     pub buffers: SceneBuffers,
     pub pass: TracePass,
     timer: PassTimer,
+    /// Whether frames write the per-pixel hit records that
+    /// [`Renderer::read_hits`] returns; off by default, as they cost time.
+    pub hit_records: bool,
+    /// Whether the last frame wrote them.
+    records_written: bool,
 }
 
 impl Renderer {
@@ -25,7 +30,7 @@ impl Renderer {
         let buffers = SceneBuffers::new(&gpu.device);
         let pass = TracePass::new(&gpu, &buffers, 1, 1)?;
         let timer = PassTimer::new(&gpu);
-        Ok(Renderer { gpu, buffers, pass, timer })
+        Ok(Renderer { gpu, buffers, pass, timer, hit_records: false, records_written: false })
     }
 
     /// A renderer on the default headless adapter.
@@ -57,7 +62,11 @@ impl Renderer {
         self.pass.resize(&self.gpu.device, &self.buffers, size.0, size.1);
         let basis = camera.basis(size.0.max(1), size.1.max(1), tree.origin());
         let local = highlight.map(|(lo, hi)| (lo - tree.origin(), hi - tree.origin()));
-        let uniforms = FrameUniforms::new(&basis, tree, &self.buffers, settings.view, local);
+        let uniforms = FrameUniforms {
+            hit_records: u32::from(self.hit_records),
+            ..FrameUniforms::new(&basis, tree, &self.buffers, settings.view, local)
+        };
+        self.records_written = self.hit_records;
         self.pass.prepare(&self.gpu.device, &self.gpu.queue, &self.buffers, &uniforms);
         let mut encoder =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
@@ -66,7 +75,12 @@ impl Renderer {
         self.timer.submit_and_measure(&self.gpu, encoder)
     }
 
+    /// The hit records of the last frame, which must have been rendered with
+    /// `hit_records` on.
     pub fn read_hits(&self) -> Result<Vec<Hit>, GpuError> {
+        if !self.records_written {
+            return Err(GpuError::Readback("the last frame wrote no hit records (set Renderer::hit_records)".into()));
+        }
         self.pass.read_hits(&self.gpu)
     }
 

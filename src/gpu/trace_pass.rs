@@ -32,9 +32,10 @@ pub struct FrameUniforms {
     pub grid_dims: [u32; 3],
     pub highlight_on: u32,
     pub highlight_min: [i32; 3],
-    pub _pad0: u32,
+    /// 1: write the per-pixel hit records (see [`TracePass::read_hits`]).
+    pub hit_records: u32,
     pub highlight_max: [i32; 3],
-    pub _pad1: u32,
+    pub _pad: u32,
 }
 
 impl FrameUniforms {
@@ -62,9 +63,9 @@ impl FrameUniforms {
             grid_dims: buffers.grid_dims.into(),
             highlight_on: u32::from(highlight.is_some()),
             highlight_min: lo.into(),
-            _pad0: 0,
+            hit_records: 0,
             highlight_max: hi.into(),
-            _pad1: 0,
+            _pad: 0,
         }
     }
 }
@@ -74,16 +75,24 @@ struct Target {
     texture: wgpu::Texture,
     view: wgpu::TextureView,
     hits_buf: wgpu::Buffer,
+    /// One f32 per tile of BEAM_TILE² pixels, written by the beam prepass.
+    beam_buf: wgpu::Buffer,
     width: u32,
     height: u32,
 }
 
+/// Side of the pixel tile that shares one beam (`BEAM_TILE` in WGSL).
+const BEAM_TILE: u32 = 8;
+
 /// Pipelines are compiled per tracer and per shadow setting (an override
-/// constant), so a scene rendered without shadows pays nothing for them.
+/// constant), so a scene rendered without shadows pays nothing for them. The
+/// SVO tracer runs in two dispatches: the beam prepass (one thread per tile
+/// of pixels) and the per-pixel trace, which starts where the beam allows.
 pub struct TracePass {
     layout: wgpu::BindGroupLayout,
     /// [svo without shadows, svo with, grid without, grid with].
     pipelines: [wgpu::ComputePipeline; 4],
+    beam: wgpu::ComputePipeline,
     uniform_buf: wgpu::Buffer,
     target: Target,
     bind_group: wgpu::BindGroup,
@@ -134,6 +143,7 @@ impl TracePass {
                     count: None,
                 },
                 buffer_entry(6, false),
+                buffer_entry(7, false),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -143,12 +153,12 @@ impl TracePass {
         });
         let svo = gpu.shader("trace_svo.wgsl", &format!("{COMMON_WGSL}\n{SVO_WGSL}"))?;
         let grid = gpu.shader("trace_grid.wgsl", &format!("{COMMON_WGSL}\n{GRID_WGSL}"))?;
-        let pipeline = |module: &wgpu::ShaderModule, shadows: bool, label: &str| {
+        let pipeline = |module: &wgpu::ShaderModule, entry: &str, shadows: bool, label: &str| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(label),
                 layout: Some(&pipeline_layout),
                 module,
-                entry_point: Some("main"),
+                entry_point: Some(entry),
                 compilation_options: wgpu::PipelineCompilationOptions {
                     constants: &[("SHADOWS", if shadows { 1.0 } else { 0.0 })],
                     zero_initialize_workgroup_memory: false,
@@ -157,11 +167,12 @@ impl TracePass {
             })
         };
         let pipelines = [
-            pipeline(&svo, false, "trace svo"),
-            pipeline(&svo, true, "trace svo + shadows"),
-            pipeline(&grid, false, "trace grid"),
-            pipeline(&grid, true, "trace grid + shadows"),
+            pipeline(&svo, "main", false, "trace svo"),
+            pipeline(&svo, "main", true, "trace svo + shadows"),
+            pipeline(&grid, "main", false, "trace grid"),
+            pipeline(&grid, "main", true, "trace grid + shadows"),
         ];
+        let beam = pipeline(&svo, "beam", false, "beam prepass");
         let uniform_buf = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("frame uniforms"),
             size: std::mem::size_of::<FrameUniforms>() as u64,
@@ -170,7 +181,7 @@ impl TracePass {
         });
         let target = Self::make_target(device, width, height);
         let bind_group = Self::make_bind_group(device, &layout, &uniform_buf, buffers, &target);
-        Ok(TracePass { layout, pipelines, uniform_buf, target, bind_group, bound_generation: buffers.generation })
+        Ok(TracePass { layout, pipelines, beam, uniform_buf, target, bind_group, bound_generation: buffers.generation })
     }
 
     fn make_target(device: &wgpu::Device, width: u32, height: u32) -> Target {
@@ -194,7 +205,14 @@ impl TracePass {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        Target { texture, view, hits_buf, width, height }
+        let tiles = u64::from(width.div_ceil(BEAM_TILE)) * u64::from(height.div_ceil(BEAM_TILE));
+        let beam_buf = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("beam distances"),
+            size: tiles * 4,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        Target { texture, view, hits_buf, beam_buf, width, height }
     }
 
     fn make_bind_group(
@@ -215,6 +233,7 @@ impl TracePass {
                 wgpu::BindGroupEntry { binding: 4, resource: buffers.grid_buf.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&target.view) },
                 wgpu::BindGroupEntry { binding: 6, resource: target.hits_buf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 7, resource: target.beam_buf.as_entire_binding() },
             ],
         })
     }
@@ -253,7 +272,7 @@ impl TracePass {
         queue.write_buffer(&self.uniform_buf, 0, bytemuck::bytes_of(uniforms));
     }
 
-    /// Records the dispatch.
+    /// Records the dispatches: the beam prepass (SVO only), then the trace.
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -266,8 +285,13 @@ impl TracePass {
         } + usize::from(settings.shadows);
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("trace"), timestamp_writes: timestamps });
-        pass.set_pipeline(&self.pipelines[index]);
         pass.set_bind_group(0, &self.bind_group, &[]);
+        if settings.mode == TraceMode::Svo {
+            let (tiles_x, tiles_y) = (self.target.width.div_ceil(BEAM_TILE), self.target.height.div_ceil(BEAM_TILE));
+            pass.set_pipeline(&self.beam);
+            pass.dispatch_workgroups(tiles_x.div_ceil(8), tiles_y.div_ceil(8), 1);
+        }
+        pass.set_pipeline(&self.pipelines[index]);
         pass.dispatch_workgroups(self.target.width.div_ceil(8), self.target.height.div_ceil(8), 1);
     }
 

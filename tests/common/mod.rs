@@ -91,6 +91,12 @@ impl Agreement {
 
     /// ≥ 99.99 % identical, and every difference is between touching voxels.
     pub fn assert_good(&self, what: &str) {
+        eprintln!(
+            "{what}: {:.4} % exact of {} pixels, {} adjacent",
+            100.0 * self.exact_fraction(),
+            self.pixels,
+            self.adjacent
+        );
         assert!(
             self.exact_fraction() >= 0.9999 && self.other == 0,
             "{what}: {self:?} ({:.4} % exact)",
