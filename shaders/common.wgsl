@@ -21,12 +21,13 @@ struct FrameUniforms {
     // window does not, and they cost a scattered 16-byte store per pixel).
     hit_records: u32,
     highlight_max: vec3<i32>,
-    _pad: u32,
+    // Word index of the first brick in `pool` (nodes come first).
+    brick_base: u32,
 }
 
 @group(0) @binding(0) var<uniform> u: FrameUniforms;
-@group(0) @binding(1) var<storage, read> nodes: array<u32>;
-@group(0) @binding(2) var<storage, read> bricks: array<u32>;
+// Nodes (8 words each) and then bricks (2 words each) of the node pool.
+@group(0) @binding(1) var<storage, read> pool: array<u32>;
 @group(0) @binding(3) var<storage, read> palette: array<u32>;
 @group(0) @binding(4) var<storage, read> grid: array<u32>;
 @group(0) @binding(5) var out_color: texture_storage_2d<rgba8unorm, write>;

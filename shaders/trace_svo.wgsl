@@ -17,22 +17,20 @@ const BEAM_TILE: u32 = 8u;
 const BEAM_LEVEL: u32 = 2u;
 // No solid cell in the tile's frustum.
 const BEAM_NONE: f32 = 3.0e38;
-const BEAM_MAX_VISITS: u32 = 4096u;
-// Pending siblings: at most 7 per level below the root, plus the root.
-const BEAM_STACK: u32 = 144u;
+const BEAM_MAX_STEPS: u32 = 16384u;
 
 fn octant_offset(o: u32) -> vec3<i32> {
     return vec3<i32>(i32(o & 1u), i32((o >> 1u) & 1u), i32((o >> 2u) & 1u));
 }
 
-// Child word of a node (level >= 2) or voxel value of a brick (level 1).
+// Child word of a node (level >= 2) or voxel value of a brick (level 1),
+// with a single load: each load site in the loop costs a scalar loop over
+// the SIMD lanes on CPU-emulated GPUs.
 fn child_word(word: u32, level: u32, octant: u32) -> u32 {
     let slot = word & ~POINTER_BIT;
-    if (level == 1u) {
-        let packed = bricks[slot * 2u + (octant >> 2u)];
-        return (packed >> (8u * (octant & 3u))) & 0xffu;
-    }
-    return nodes[slot * 8u + octant];
+    let brick = level == 1u;
+    let loaded = pool[select(slot * 8u + octant, u.brick_base + slot * 2u + (octant >> 2u), brick)];
+    return select(loaded, (loaded >> (8u * (octant & 3u))) & 0xffu, brick);
 }
 
 // The child cell of node (`mn`, level) that holds the ray point at t: per
@@ -159,13 +157,6 @@ fn image_direction(p: vec2<f32>) -> vec3<f32> {
     return u.forward + u.right * ndc.x + u.up * ndc.y;
 }
 
-struct Frustum {
-    n0: vec3<f32>,
-    n1: vec3<f32>,
-    n2: vec3<f32>,
-    n3: vec3<f32>,
-}
-
 // Is the box (lo, hi) wholly outside the half-space n·(p - eye) >= 0?
 fn beyond(n: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>) -> bool {
     return dot(n, select(lo, hi, n >= vec3<f32>(0.0)) - u.eye) < 0.0;
@@ -179,7 +170,8 @@ fn inward(n: vec3<f32>, center: vec3<f32>) -> vec3<f32> {
 // nearest non-empty node of BEAM_LEVEL (or uniform solid node) inside the
 // pyramid of the tile's corner rays. Every pixel ray of the tile lies in
 // that pyramid, so none can meet a solid voxel closer than this distance.
-// Front-to-back depth-first search, pruned by the best distance so far.
+// A depth-first search, near children first, pruned by the best distance so
+// far; its stack is the child taken at every level, 3 bits a level.
 @compute @workgroup_size(8, 8)
 fn beam(@builtin(global_invocation_id) gid: vec3<u32>) {
     let tiles = beam_tiles();
@@ -193,57 +185,80 @@ fn beam(@builtin(global_invocation_id) gid: vec3<u32>) {
     let c11 = image_direction(p1);
     let c01 = image_direction(vec2<f32>(p0.x, p1.y));
     let center = image_direction((p0 + p1) * 0.5);
-    let f = Frustum(
-        inward(cross(c00, c10), center),
-        inward(cross(c10, c11), center),
-        inward(cross(c11, c01), center),
-        inward(cross(c01, c00), center),
-    );
-    var stack: array<vec4<u32>, BEAM_STACK>;
-    // (word, min.x, min.y, min.z | level << 24); coordinates are below 2^24.
-    stack[0] = vec4<u32>(u.root, 0u, 0u, u.depth << 24u);
-    var top = 1u;
+    let n0 = inward(cross(c00, c10), center);
+    let n1 = inward(cross(c10, c11), center);
+    let n2 = inward(cross(c11, c01), center);
+    let n3 = inward(cross(c01, c00), center);
     var best = BEAM_NONE;
-    var visits = 0u;
-    while (top > 0u) {
-        if (visits >= BEAM_MAX_VISITS) {
+    let depth = u.depth;
+    if ((u.root & POINTER_BIT) == 0u || depth <= BEAM_LEVEL) {
+        // Too small to search: start every ray at the eye.
+        beam_distance[gid.y * tiles.x + gid.x] = select(0.0, BEAM_NONE, u.root == 0u);
+        return;
+    }
+    var node = u.root;
+    var level = depth;
+    var mn = vec3<i32>(0);
+    var next = 0u;
+    var path_low = 0u;
+    var path_high = 0u;
+    var steps = 0u;
+    loop {
+        if (steps >= BEAM_MAX_STEPS) {
             // Out of budget: start those rays from the eye.
             best = 0.0;
             break;
         }
-        visits += 1u;
-        top -= 1u;
-        let item = stack[top];
-        let level = item.w >> 24u;
-        let mn = vec3<i32>(vec3<u32>(item.y, item.z, item.w & 0xffffffu));
-        // Half a voxel of slack against rounding in the plane tests.
-        let lo = vec3<f32>(mn) - vec3<f32>(0.5);
-        let hi = vec3<f32>(mn + vec3<i32>(1 << level)) + vec3<f32>(0.5);
-        if (beyond(f.n0, lo, hi) || beyond(f.n1, lo, hi) || beyond(f.n2, lo, hi) || beyond(f.n3, lo, hi)) {
+        steps += 1u;
+        if (next == 8u) {
+            // This node is done: back to its parent's next child.
+            if (level == depth) {
+                break;
+            }
+            level += 1u;
+            let shift = 3u * ((level - 1u) % 10u);
+            let saved = select(path_high, path_low, level <= 10u);
+            next = ((saved >> shift) & 7u) + 1u;
+            mn = mn & vec3<i32>(~((1 << level) - 1));
+            node = u.root;
+            for (var l = depth; l > level; l--) {
+                node = pool[(node & ~POINTER_BIT) * 8u + octant_of(mn, l)];
+            }
             continue;
         }
-        let distance = length(max(max(lo - u.eye, u.eye - hi), vec3<f32>(0.0)));
-        if (distance >= best) {
-            continue;
-        }
-        if ((item.x & POINTER_BIT) == 0u || level <= BEAM_LEVEL) {
-            best = distance;
-            continue;
-        }
-        // Push the non-empty children, the one nearest the eye last so that
-        // it is searched first.
         let half = 1 << (level - 1u);
         let near_side = u.eye >= vec3<f32>(mn + vec3<i32>(half));
         let near = select(0u, 1u, near_side.x) | select(0u, 2u, near_side.y) | select(0u, 4u, near_side.z);
-        for (var k = 7i; k >= 0; k--) {
-            let o = near ^ u32(k);
-            let child = nodes[(item.x & ~POINTER_BIT) * 8u + o];
-            if (child != 0u) {
-                let child_min = vec3<u32>(mn + octant_offset(o) * half);
-                stack[top] = vec4<u32>(child, child_min.x, child_min.y, child_min.z | ((level - 1u) << 24u));
-                top += 1u;
-            }
+        let o = near ^ next;
+        let child = pool[(node & ~POINTER_BIT) * 8u + o];
+        let child_min = mn + octant_offset(o) * half;
+        next += 1u;
+        if (child == 0u) {
+            continue;
         }
+        // Half a voxel of slack against rounding in the plane tests.
+        let lo = vec3<f32>(child_min) - vec3<f32>(0.5);
+        let hi = vec3<f32>(child_min + vec3<i32>(half)) + vec3<f32>(0.5);
+        let distance = length(max(max(lo - u.eye, u.eye - hi), vec3<f32>(0.0)));
+        if (beyond(n0, lo, hi) || beyond(n1, lo, hi) || beyond(n2, lo, hi) || beyond(n3, lo, hi) || distance >= best) {
+            continue;
+        }
+        if ((child & POINTER_BIT) == 0u || level - 1u <= BEAM_LEVEL) {
+            best = distance;
+            continue;
+        }
+        // Descend, remembering which child this was.
+        let shift = 3u * ((level - 1u) % 10u);
+        let entry = (next - 1u) << shift;
+        if (level <= 10u) {
+            path_low = (path_low & ~(7u << shift)) | entry;
+        } else {
+            path_high = (path_high & ~(7u << shift)) | entry;
+        }
+        node = child;
+        level -= 1u;
+        mn = child_min;
+        next = 0u;
     }
     beam_distance[gid.y * tiles.x + gid.x] = best;
 }

@@ -133,6 +133,34 @@ fn gpu_flat_wall_has_no_holes() {
     }
 }
 
+/// Edits between frames that outgrow the GPU pool (nodes and bricks share one
+/// buffer, bricks after nodes): after each regrowth and its GPU-side copy, the
+/// GPU still sees exactly the tree the CPU sees.
+#[test]
+fn gpu_pool_growth_keeps_the_picture() {
+    let mut tree = Octree::default();
+    tree.apply_brush(&Shape::Sphere { center: IVec3::splat(8), radius: 6 }, Op::Place(3)).unwrap();
+    let mut renderer = renderer_for(&mut tree);
+    let camera =
+        Camera { eye: DVec3::new(-150.0, 120.0, -160.0), target: DVec3::new(40.0, 10.0, 40.0), fov_y_deg: 60.0 };
+    let size = (64, 48);
+    let mut growths = 0;
+    for i in 0..6 {
+        // Scattered spheres add nodes and bricks in both regions.
+        let center = IVec3::new(20 * i, (i * 7) % 13, 80 - 16 * i);
+        tree.apply_brush(&Shape::Sphere { center, radius: 4 + 5 * i }, Op::Place(4 + i as u8)).unwrap();
+        let stats = renderer.sync(&mut tree, &Palette::default());
+        eprintln!("edit {i}: {} nodes, {} bricks, {stats:?}", tree.node_count(), tree.brick_count());
+        growths += u32::from(stats.grew);
+        let gpu = gpu_hits(&mut renderer, &tree, &camera, size, TraceMode::Svo);
+        let cpu = trace_image(Tracer::Svo(&tree), &camera.basis(size.0, size.1, tree.origin()));
+        let mut agreement = Agreement::default();
+        agreement.add(&gpu, &cpu);
+        agreement.assert_good(&format!("after edit {i}"));
+    }
+    assert!(growths >= 1, "the edits never grew the pool");
+}
+
 /// Every shared .vox model, at least 8 cameras each (outside, inside the
 /// bounding box, grazing): GPU SVO = CPU SVO = CPU grid = GPU grid.
 #[test]

@@ -1,5 +1,10 @@
-//! The scene on the GPU: node and brick pools (patched by dirty ranges),
-//! the palette, and the dense grid for the baseline tracer.
+//! The scene on the GPU: the node pool (patched by dirty ranges), the
+//! palette, and the dense grid for the baseline tracer.
+//!
+//! Nodes and bricks share one buffer, nodes first and bricks from
+//! `brick_base`: the tracer then reads either with one load instruction,
+//! and on CPU-emulated GPUs every load site in the loop is a scalar loop
+//! over the SIMD lanes.
 
 use crate::gpu_pool::{Region, SlotArena};
 use crate::scene::{Octree, Palette};
@@ -19,8 +24,11 @@ pub struct UploadStats {
 /// GPU buffers of one scene. `generation` changes whenever a buffer is
 /// re-created, so passes know to rebuild their bind groups.
 pub struct SceneBuffers {
-    pub nodes_buf: wgpu::Buffer,
-    pub bricks_buf: wgpu::Buffer,
+    pub pool_buf: wgpu::Buffer,
+    /// Bytes reserved for nodes at the start of `pool_buf`; bricks follow.
+    node_capacity: u64,
+    /// Bytes reserved for bricks after them.
+    brick_capacity: u64,
     pub palette_buf: wgpu::Buffer,
     pub grid_buf: wgpu::Buffer,
     pub grid_min: glam::IVec3,
@@ -40,8 +48,9 @@ fn storage_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer
 impl SceneBuffers {
     pub fn new(device: &wgpu::Device) -> SceneBuffers {
         SceneBuffers {
-            nodes_buf: storage_buffer(device, "octree nodes", 0),
-            bricks_buf: storage_buffer(device, "octree bricks", 0),
+            pool_buf: storage_buffer(device, "node pool", 0),
+            node_capacity: 0,
+            brick_capacity: 0,
             palette_buf: storage_buffer(device, "palette", 256 * 4),
             grid_buf: storage_buffer(device, "dense grid", 0),
             grid_min: glam::IVec3::ZERO,
@@ -55,18 +64,51 @@ impl SceneBuffers {
     /// GPU-side copy of the old contents.
     pub fn upload_pool(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, tree: &mut Octree) -> UploadStats {
         let upload = tree.pool_mut().flush();
-        let pool = tree.pool();
-        let grew_nodes = write_region(device, queue, &mut self.nodes_buf, "octree nodes", &upload.nodes, &pool.nodes);
-        let grew_bricks =
-            write_region(device, queue, &mut self.bricks_buf, "octree bricks", &upload.bricks, &pool.bricks);
-        if grew_nodes || grew_bricks {
-            self.generation += 1;
+        let node_capacity = upload.nodes.grow_to_bytes().map_or(self.node_capacity, |b| b.max(self.node_capacity));
+        let brick_capacity = upload.bricks.grow_to_bytes().map_or(self.brick_capacity, |b| b.max(self.brick_capacity));
+        let grew = (node_capacity, brick_capacity) != (self.node_capacity, self.brick_capacity);
+        if grew {
+            self.grow(device, queue, node_capacity, brick_capacity);
         }
+        let pool = tree.pool();
+        write_region(queue, &self.pool_buf, 0, &upload.nodes, &pool.nodes);
+        write_region(queue, &self.pool_buf, self.node_capacity, &upload.bricks, &pool.bricks);
         UploadStats {
             bytes: upload.byte_count(),
             ranges: upload.nodes.range_count() + upload.bricks.range_count(),
-            grew: grew_nodes || grew_bricks,
+            grew,
         }
+    }
+
+    /// Where the bricks start in the pool buffer, in 32-bit words.
+    pub fn brick_base(&self) -> u32 {
+        u32::try_from(self.node_capacity / 4).unwrap_or(u32::MAX)
+    }
+
+    /// Re-creates the pool buffer with the given region sizes and copies
+    /// both old regions across on the GPU.
+    fn grow(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, node_capacity: u64, brick_capacity: u64) {
+        let bigger = storage_buffer(device, "node pool", node_capacity + brick_capacity);
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pool grow") });
+        if self.node_capacity > 0 {
+            encoder.copy_buffer_to_buffer(&self.pool_buf, 0, &bigger, 0, self.node_capacity);
+        }
+        if self.brick_capacity > 0 {
+            encoder.copy_buffer_to_buffer(
+                &self.pool_buf,
+                self.node_capacity,
+                &bigger,
+                node_capacity,
+                self.brick_capacity,
+            );
+        }
+        // Submitted now: queued writes run at the start of the *next*
+        // submit, so they land after this copy, not under it.
+        queue.submit([encoder.finish()]);
+        self.pool_buf = bigger;
+        self.node_capacity = node_capacity;
+        self.brick_capacity = brick_capacity;
+        self.generation += 1;
     }
 
     /// Writes the 256 palette colours (RGBA8, one word each).
@@ -89,32 +131,15 @@ impl SceneBuffers {
     }
 }
 
-/// Grows `buffer` if the region asks for it (copying the old contents on the
-/// GPU), then writes the region's ranges. Returns whether it grew.
+/// Writes the region's changed ranges into `buffer` from byte `base` on.
 fn write_region<T: bytemuck::Pod>(
-    device: &wgpu::Device,
     queue: &wgpu::Queue,
-    buffer: &mut wgpu::Buffer,
-    label: &str,
+    buffer: &wgpu::Buffer,
+    base: u64,
     region: &Region,
     arena: &SlotArena<T>,
-) -> bool {
-    let grew = match region.grow_to_bytes() {
-        Some(bytes) if bytes > buffer.size() => {
-            let bigger = storage_buffer(device, label, bytes);
-            let mut encoder =
-                device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pool grow") });
-            encoder.copy_buffer_to_buffer(buffer, 0, &bigger, 0, buffer.size());
-            // Submitted now: queued writes run at the start of the *next*
-            // submit, so they land after this copy, not under it.
-            queue.submit([encoder.finish()]);
-            *buffer = bigger;
-            true
-        }
-        _ => false,
-    };
+) {
     for (offset, bytes) in region.ranges(arena) {
-        queue.write_buffer(buffer, offset, bytes);
+        queue.write_buffer(buffer, base + offset, bytes);
     }
-    grew
 }

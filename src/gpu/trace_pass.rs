@@ -35,7 +35,8 @@ pub struct FrameUniforms {
     /// 1: write the per-pixel hit records (see [`TracePass::read_hits`]).
     pub hit_records: u32,
     pub highlight_max: [i32; 3],
-    pub _pad: u32,
+    /// Word index of the first brick in the pool buffer.
+    pub brick_base: u32,
 }
 
 impl FrameUniforms {
@@ -65,7 +66,7 @@ impl FrameUniforms {
             highlight_min: lo.into(),
             hit_records: 0,
             highlight_max: hi.into(),
-            _pad: 0,
+            brick_base: buffers.brick_base(),
         }
     }
 }
@@ -129,7 +130,6 @@ impl TracePass {
                     count: None,
                 },
                 buffer_entry(1, true),
-                buffer_entry(2, true),
                 buffer_entry(3, true),
                 buffer_entry(4, true),
                 wgpu::BindGroupLayoutEntry {
@@ -227,8 +227,7 @@ impl TracePass {
             layout,
             entries: &[
                 wgpu::BindGroupEntry { binding: 0, resource: uniform_buf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: buffers.nodes_buf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: buffers.bricks_buf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: buffers.pool_buf.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 3, resource: buffers.palette_buf.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 4, resource: buffers.grid_buf.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&target.view) },
