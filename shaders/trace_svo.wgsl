@@ -11,7 +11,7 @@
 @group(0) @binding(7) var<storage, read_write> beam_distance: array<f32>;
 
 // Side of the square tile of pixels that shares one beam.
-const BEAM_TILE: u32 = 8u;
+const BEAM_TILE: u32 = 16u;
 // The beam stops at nodes this small (4³ voxels): finer levels cost more
 // prepass steps than they save.
 const BEAM_LEVEL: u32 = 2u;

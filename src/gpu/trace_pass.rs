@@ -83,7 +83,7 @@ struct Target {
 }
 
 /// Side of the pixel tile that shares one beam (`BEAM_TILE` in WGSL).
-const BEAM_TILE: u32 = 8;
+const BEAM_TILE: u32 = 16;
 
 /// Pipelines are compiled per tracer and per shadow setting (an override
 /// constant), so a scene rendered without shadows pays nothing for them. The
