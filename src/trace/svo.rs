@@ -1,19 +1,24 @@
-//! The stack-based SVO traversal on the CPU. `shaders/trace_svo.wgsl` is a
-//! line-for-line twin: change both together.
+//! The stack-based SVO traversal on the CPU, the reference for
+//! `shaders/trace_svo.wgsl`: the same steps and the same plane-crossing rule,
+//! so change both together.
 //!
-//! Per ray: descend into the child containing the current point, step to the
-//! next sibling across the nearest exit plane (by t, never by nudging the
-//! position), pop when the step leaves the node. The stack holds the octant
-//! taken at every level (see `OctantPath`).
+//! Per ray: descend into the child holding the current point, step to the
+//! next cell across the nearest exit plane (by t, never by nudging the
+//! position), and pop to the smallest node holding both cells. The cell's
+//! integer coordinates carry the octant taken at every level, so the pop
+//! target is the highest coordinate bit the step changes. The GPU keeps
+//! three ancestors in registers and restarts from the root past them, and
+//! starts each ray at its tile's beam distance; here a plain array of node
+//! words serves, and rays start at the eye.
 
 use glam::{IVec3, Vec3};
 
 use super::{Hit, MAX_ITERATIONS, NO_AXIS, Ray, argmin};
 use crate::camera::Camera;
 use crate::gpu_pool::{is_pointer, slot_of};
-use crate::scene::octree::{MAX_DEPTH, Octree, octant_offset};
+use crate::scene::octree::{MAX_DEPTH, Octree};
 
-// The octant path holds 20 levels of 3 bits in two words.
+// The GPU beam's octant path holds 20 levels of 3 bits in two words.
 const _: () = assert!(MAX_DEPTH <= 20);
 
 /// The voxel and face under pixel (x, y) of a `size` view, with the voxel in
@@ -41,90 +46,52 @@ pub fn trace(tree: &Octree, ray: &Ray) -> Hit {
     if !is_pointer(root) {
         return hit_cell(ray, root as u8, IVec3::ZERO, depth, t, axis, 1);
     }
-    // The stack: the octant taken at every level, 3 bits a level, in two
-    // words (registers on a GPU, unlike an array). The node words above the
-    // current one are not kept: after a pop they are fetched again from the
-    // root along the octant path, which is cheaper on GPUs (and far cheaper on
-    // CPU-emulated ones) than a per-thread array.
-    let mut path = OctantPath::default();
+    // The stack: the node word at every level of the current path.
+    let mut nodes = [0u32; MAX_DEPTH as usize + 1];
     let mut level = depth;
-    let mut node = root;
-    let mut node_min = IVec3::ZERO;
-    let mut octant = first_octant(ray, node_min, level, t, axis);
+    nodes[level as usize] = root;
+    // The child cell the ray is in: min corner, size 2^(level - 1).
+    let mut cell = child_cell(ray, IVec3::ZERO, level, t, axis);
     let mut iterations = 0;
     while iterations < MAX_ITERATIONS {
         iterations += 1;
-        let half = 1 << (level - 1);
-        let child_min = node_min + octant_offset(octant) * half;
-        let word = child_word(tree, node, level, octant);
+        let word = child_word(tree, nodes[level as usize], level, octant_of(cell, level));
         if is_pointer(word) {
-            path.set(level, octant);
             level -= 1;
-            node = word;
-            node_min = child_min;
-            octant = first_octant(ray, node_min, level, t, axis);
+            nodes[level as usize] = word;
+            cell = child_cell(ray, cell, level, t, axis);
             continue;
         }
         if word != 0 {
-            return hit_cell(ray, word as u8, child_min, level - 1, t, axis, iterations);
+            return hit_cell(ray, word as u8, cell, level - 1, t, axis, iterations);
         }
-        // Empty child: leave it through its nearest exit plane.
-        let far = child_min.as_vec3() + Vec3::select(ray.dir.cmpgt(Vec3::ZERO), Vec3::splat(half as f32), Vec3::ZERO);
-        let exits = (far - ray.origin) * ray.inv;
+        // Empty cell: leave it through its nearest exit plane.
+        let half = 1 << (level - 1);
+        let positive = ray.dir.cmpgt(Vec3::ZERO);
+        let far = cell + IVec3::select(positive, IVec3::splat(half), IVec3::ZERO);
+        let exits = (far.as_vec3() - ray.origin) * ray.inv;
         let a = argmin(exits);
         t = exits[a];
         axis = a;
-        let bit = 1 << a;
-        let start_level = level;
-        loop {
-            let leaving = if ray.dir[a] > 0.0 { octant & bit != 0 } else { octant & bit == 0 };
-            if !leaving {
-                octant ^= bit;
-                break;
-            }
-            if level == depth {
-                return Hit { iterations, ..Hit::default() };
-            }
-            level += 1;
-            octant = path.get(level);
-            node_min -= octant_offset(octant) * (1 << (level - 1));
+        let mut next = cell;
+        next[a] += if positive.test(a) { half } else { -1 };
+        // The highest changed coordinate bit is the octant bit of the
+        // smallest node holding both cells.
+        let new_level = u32::BITS - ((cell[a] ^ next[a]) as u32).leading_zeros();
+        if new_level > depth {
+            break;
         }
-        if level != start_level {
-            node = refetch(tree, root, depth, level, &path);
-        }
+        level = new_level;
+        cell = next & IVec3::splat(!((1 << (level - 1)) - 1));
     }
     Hit { iterations, ..Hit::default() }
 }
 
-/// Octants taken at levels 1..=20, 3 bits each (`octant_path_*` in WGSL).
-#[derive(Default, Clone, Copy)]
-struct OctantPath {
-    low: u32,
-    high: u32,
-}
-
-impl OctantPath {
-    fn get(&self, level: u32) -> usize {
-        let i = level - 1;
-        (if i < 10 { self.low >> (3 * i) } else { self.high >> (3 * (i - 10)) } & 7) as usize
-    }
-
-    fn set(&mut self, level: u32, octant: usize) {
-        let i = level - 1;
-        let (word, shift) = if i < 10 { (&mut self.low, 3 * i) } else { (&mut self.high, 3 * (i - 10)) };
-        *word = (*word & !(7 << shift)) | (octant as u32) << shift;
-    }
-}
-
-/// The node word at `level` on the current path, fetched from the root.
-fn refetch(tree: &Octree, root: u32, depth: u32, level: u32, path: &OctantPath) -> u32 {
-    let mut word = root;
-    let mut l = depth;
-    while l > level {
-        word = child_word(tree, word, l, path.get(l));
-        l -= 1;
-    }
-    word
+/// Octant of a cell of size 2^(level - 1) within its node: one coordinate
+/// bit per axis.
+fn octant_of(cell: IVec3, level: u32) -> usize {
+    let b = (cell >> (level - 1) as i32) & IVec3::ONE;
+    (b.x | (b.y << 1) | (b.z << 2)) as usize
 }
 
 /// Child word of a node (level ≥ 2) or voxel value of a brick (level 1).
@@ -136,17 +103,18 @@ fn child_word(tree: &Octree, word: u32, level: u32, octant: usize) -> u32 {
     }
 }
 
-/// Octant of the node (`min`, level) holding the ray point at `t`: per axis,
-/// whether the ray has crossed the mid-plane (by [`Ray::crossed`]).
-fn first_octant(ray: &Ray, min: IVec3, level: u32, t: f32, entry_axis: usize) -> usize {
-    let mid = (min + IVec3::splat(1 << (level - 1))).as_vec3();
-    let mut octant = 0;
+/// The child cell of node (`min`, level) that holds the ray point at `t`:
+/// per axis, whether the ray has crossed the mid-plane (by [`Ray::crossed`]).
+fn child_cell(ray: &Ray, min: IVec3, level: u32, t: f32, entry_axis: usize) -> IVec3 {
+    let half = 1 << (level - 1);
+    let mut cell = min;
     for a in 0..3 {
-        let crossed = ray.crossed(a, mid[a], t, entry_axis);
-        let upper = if ray.dir[a] > 0.0 { crossed } else { !crossed };
-        octant |= usize::from(upper) << a;
+        let crossed = ray.crossed(a, (min[a] + half) as f32, t, entry_axis);
+        if crossed == (ray.dir[a] > 0.0) {
+            cell[a] += half;
+        }
     }
-    octant
+    cell
 }
 
 /// The hit inside a uniform cell: the voxel of the cell where the ray is at
