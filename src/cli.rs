@@ -65,6 +65,8 @@ pub enum Command {
         #[arg(long, default_value_t = 0)]
         frame: usize,
     },
+    /// Voxelize a closed .obj mesh (solid inside) and save it as .vox.
+    Import(ImportArgs),
     /// Ray-trace a scene to a PNG (GPU, or the CPU reference with --cpu).
     Render(RenderArgs),
     /// Measure build, edit and render speed and memory; writes docs/bench/.
@@ -77,6 +79,23 @@ pub enum Command {
         #[arg(long)]
         cpu: bool,
     },
+}
+
+#[derive(Args, Debug)]
+pub struct ImportArgs {
+    /// A Wavefront .obj mesh.
+    pub mesh: PathBuf,
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Voxels along the mesh's longest side.
+    #[arg(long, default_value_t = octovox::io::mesh::DEFAULT_MESH_SIZE)]
+    pub size: u32,
+    /// Which mesh axis points up.
+    #[arg(long, value_enum, default_value_t = octovox::io::mesh::UpAxis::Y)]
+    pub up: octovox::io::mesh::UpAxis,
+    /// Palette index of the voxels (1..=255, default palette).
+    #[arg(long, default_value_t = octovox::io::mesh::MESH_COLOR, value_parser = clap::value_parser!(u8).range(1..))]
+    pub color: u8,
 }
 
 #[derive(Args, Debug)]

@@ -8,7 +8,8 @@ use common::{Agreement, cameras_for, sculpture};
 use glam::{DVec3, IVec3};
 use octovox::camera::Camera;
 use octovox::gpu::Renderer;
-use octovox::scene::{Octree, Op, Palette, Shape};
+use octovox::io::mesh::{MESH_COLOR, UpAxis, voxelize_obj};
+use octovox::scene::{Octree, Op, Palette, Scene, Shape};
 use octovox::settings::{RenderSettings, TraceMode, View};
 use octovox::trace::MAX_ITERATIONS;
 use octovox::trace::grid::DenseGrid;
@@ -62,6 +63,15 @@ fn gpu_matches_cpu_on_sculpture() {
     let mut tree = sculpture();
     let (lo, hi) = tree.solid_bounds().unwrap();
     check_scene(&mut tree, &cameras_for(lo, hi), (96, 72));
+}
+
+#[test]
+fn gpu_matches_cpu_on_a_voxelized_scan() {
+    let path = common::assets().join("meshes/nefertiti.obj");
+    let dense = voxelize_obj(&path, 96, UpAxis::Z, MESH_COLOR).unwrap();
+    let mut scene = Scene::from_dense(&dense).unwrap();
+    let (lo, hi) = scene.tree.solid_bounds().unwrap();
+    check_scene(&mut scene.tree, &cameras_for(lo, hi), (96, 72));
 }
 
 #[test]

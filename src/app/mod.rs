@@ -303,7 +303,9 @@ impl App {
         self.scene = scene;
         self.history.clear();
         self.stroke = None;
-        self.state.path = path;
+        // An imported mesh has no .vox to save back to: Save asks for one
+        // rather than writing .vox bytes over the .obj.
+        self.state.path = path.filter(|p| !octovox::io::is_mesh_path(p));
         self.state.dirty = false;
         self.state.color = first_used_color(&self.scene).unwrap_or(self.state.color);
         self.grid_stale = true;
@@ -466,7 +468,8 @@ impl App {
         }
     }
 
-    /// Reads a .vox on a background thread; the window keeps drawing.
+    /// Reads a .vox (or voxelizes an .obj) on a background thread; the
+    /// window keeps drawing.
     fn start_loading(&mut self, path: PathBuf) {
         let (tx, rx) = mpsc::channel();
         let thread_path = path.clone();

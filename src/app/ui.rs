@@ -273,15 +273,19 @@ fn message(ui: &mut egui::Ui, ui_state: &mut UiState) {
     }
 }
 
-/// .vox files in the current folder and in `saves/`, for the path dialogs.
-fn nearby_vox_files() -> Vec<PathBuf> {
+/// Files in the current folder and in `saves/` for a path dialog: .vox and
+/// .obj to open, .vox to save over.
+fn nearby_files(kind: DialogKind) -> Vec<PathBuf> {
     let mut files: Vec<PathBuf> = [Path::new("."), Path::new("saves")]
         .iter()
         .filter_map(|dir| std::fs::read_dir(dir).ok())
         .flatten()
         .filter_map(Result::ok)
         .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("vox")))
+        .filter(|p| {
+            p.extension().is_some_and(|e| e.eq_ignore_ascii_case("vox"))
+                || (kind == DialogKind::Open && octovox::io::is_mesh_path(p))
+        })
         .collect();
     files.sort();
     files
@@ -290,7 +294,7 @@ fn nearby_vox_files() -> Vec<PathBuf> {
 fn dialog(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
     let Some((kind, path)) = &mut ui_state.dialog else { return };
     let title = match kind {
-        DialogKind::Open => "Open .vox",
+        DialogKind::Open => "Open .vox or .obj",
         DialogKind::SaveAs => "Save as .vox",
     };
     let mut close = false;
@@ -302,7 +306,7 @@ fn dialog(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
         if !entered && ui.memory(|m| m.focused().is_none()) {
             field.request_focus();
         }
-        for file in nearby_vox_files().into_iter().take(12) {
+        for file in nearby_files(*kind).into_iter().take(12) {
             if ui.link(file.display().to_string()).clicked() {
                 *path = file.display().to_string();
             }

@@ -2,6 +2,7 @@
 
 mod bench;
 mod convert;
+mod import;
 mod info;
 pub mod render;
 mod replay;
@@ -20,6 +21,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         None => crate::app::run(cli.window),
         Some(Command::Info { file, json, frame }) => info::run(&file, json, frame),
         Some(Command::Convert { input, output, frame }) => convert::run(&input, &output, frame),
+        Some(Command::Import(args)) => import::run(&args),
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
         Some(Command::Replay { scripts, cpu }) => replay::run(&scripts, cpu, update_images()),

@@ -1,11 +1,8 @@
 //! Loading: pre-pass, guarded `dot_vox` parse, scene placement, axis change.
 
-use std::cell::Cell;
 use std::collections::{BTreeMap, HashSet};
 use std::io::Read;
-use std::panic::{self, AssertUnwindSafe};
 use std::path::Path;
-use std::sync::Once;
 
 use dot_vox::DotVoxData;
 use glam::IVec3;
@@ -14,6 +11,7 @@ use super::scene;
 use super::transform::{Placement, Transform};
 use super::validate::{self, Layout};
 use super::{MAX_FILE_BYTES, VoxError};
+use crate::io::guard::catch_quietly;
 use crate::scene::{Material, MaterialKind, Palette, Voxel, VoxelModel};
 
 /// Reads and loads the `.vox` file at `path`; see [`load_vox`].
@@ -63,12 +61,6 @@ pub fn load_vox(bytes: &[u8], frame: usize) -> Result<VoxelModel, VoxError> {
     Ok(VoxelModel { palette: palette_of(&data, &layout), voxels, models: placements.len() })
 }
 
-thread_local! {
-    /// Set while this thread is inside [`catch_quietly`], so the panic hook
-    /// stays quiet.
-    static QUIET_PANICS: Cell<bool> = const { Cell::new(false) };
-}
-
 /// Runs `dot_vox::load_bytes`, turning a panic into [`VoxError::ParserPanic`].
 ///
 /// The pre-pass should leave `dot_vox` nothing to panic on; this is the
@@ -78,35 +70,6 @@ fn parse_guarded(bytes: &[u8]) -> Result<DotVoxData, VoxError> {
         Ok(parsed) => parsed.map_err(VoxError::Parser),
         Err(message) => Err(VoxError::ParserPanic(message)),
     }
-}
-
-/// Runs `f`, returning a panic's message as `Err` instead of unwinding.
-///
-/// A panic hook, installed once, skips panics raised on a thread while it is
-/// inside this function and passes every other panic to the hook it
-/// replaced, so the caught panic does not print while other threads' panics
-/// still do.
-fn catch_quietly<T>(f: impl FnOnce() -> T) -> Result<T, String> {
-    static INSTALL_HOOK: Once = Once::new();
-    INSTALL_HOOK.call_once(|| {
-        let previous = panic::take_hook();
-        panic::set_hook(Box::new(move |info| {
-            if !QUIET_PANICS.try_with(Cell::get).unwrap_or(false) {
-                previous(info);
-            }
-        }));
-    });
-    let was_quiet = QUIET_PANICS.replace(true);
-    // Callers only read shared data, so no broken invariant leaks out of a panic.
-    let result = panic::catch_unwind(AssertUnwindSafe(f));
-    QUIET_PANICS.set(was_quiet);
-    result.map_err(|payload| {
-        payload
-            .downcast_ref::<&str>()
-            .map(|s| (*s).to_owned())
-            .or_else(|| payload.downcast_ref::<String>().cloned())
-            .unwrap_or_else(|| "unknown panic".to_owned())
-    })
 }
 
 /// `dot_vox` must have seen the same models and nodes as the pre-pass, or
@@ -215,18 +178,4 @@ fn material_from_properties(properties: &dot_vox::Dict) -> Material {
         .map(|(key, value)| (key.clone(), value.clone()))
         .collect();
     Material { kind, params }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn panics_become_errors() {
-        assert_eq!(catch_quietly(|| 7), Ok(7));
-        let boom: Result<(), String> = catch_quietly(|| panic!("boom {}", 1));
-        assert_eq!(boom, Err("boom 1".to_owned()));
-        // The thread is loud again afterwards.
-        assert!(!QUIET_PANICS.get());
-    }
 }
