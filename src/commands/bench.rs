@@ -172,7 +172,7 @@ struct EditRow {
 }
 
 fn bench_edit(quick: bool) -> anyhow::Result<(String, String)> {
-    let model = octovox::io::vox::load_vox_file(&assets().join("teapot256.vox"), 0)?;
+    let model = octovox::io::vox::load_vox_file(&assets().join("vox/seed/teapot256.vox"), 0)?;
     let mut tree = Octree::from_voxels(&model.voxels)?;
     tree.pool_mut().flush();
     // The first solid voxel along +x through the centre: on the teapot's

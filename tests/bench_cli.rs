@@ -1,0 +1,29 @@
+//! `octovox bench … --quick` as a smoke run: every table is produced, for
+//! every model, and written to the output folder. (Speed is measured by the
+//! full bench, not by tests.)
+#![allow(clippy::unwrap_used)] // in tests a panic is the failure report
+
+use std::process::Command;
+
+#[test]
+fn every_bench_runs_and_writes_its_tables() {
+    let out = tempfile::tempdir().unwrap();
+    for (kind, rows) in [
+        ("build", &["torus64", "teapot256", "nefertiti512", "sculpture10M"][..]),
+        ("edit", &["one voxel", "sphere r = 8", "sphere r = 32"][..]),
+        ("render", &["torus64", "teapot256", "nefertiti512", "sculpture10M"][..]),
+    ] {
+        let run = Command::new(env!("CARGO_BIN_EXE_octovox"))
+            .args(["bench", kind, "--quick", "--out"])
+            .arg(out.path())
+            .output()
+            .unwrap();
+        assert!(run.status.success(), "bench {kind}: {}", String::from_utf8_lossy(&run.stderr));
+        let md = std::fs::read_to_string(out.path().join(format!("{kind}.md"))).unwrap();
+        let json = std::fs::read_to_string(out.path().join(format!("{kind}.json"))).unwrap();
+        for row in rows {
+            assert!(md.contains(&format!("| {row} |")), "bench {kind}: no row {row}\n{md}");
+        }
+        assert!(json.trim_start().starts_with('['), "{json}");
+    }
+}
