@@ -301,7 +301,7 @@ fn bench_render(quick: bool) -> anyhow::Result<(String, String)> {
     }
     let mut md = header(&format!("Grid DDA vs SVO, {width}×{height}"));
     md += &format!(
-        "Adapter: **{}**; GPU time from timestamp queries where available, else wall time of submit + wait; median of the frames after one warm-up. Shadows off (the report's shading had none). Camera frames each whole model. The SVO time covers both of its dispatches: the beam prepass (one thread per 16×16-pixel tile) and the per-pixel traversal; its mean steps count the traversal's loop iterations per pixel.\n\n",
+        "Adapter: **{}**; GPU time from timestamp queries where available, else wall time of submit + wait; median of the frames after one warm-up. Shadows off (the report's shading had none). Camera frames each whole model. The SVO time covers both of its dispatches: the beam prepass (one thread per 16×16-pixel tile) and the per-pixel traversal; its mean steps count the traversal's loop iterations per pixel. The report's 10 M-voxel scene is the Pietà, which is not public: `nefertiti512` is DESIGN.md's stand-in for it (the solid voxelization of meshes/nefertiti.obj, 512 voxels tall, 12.8 M voxels) and `sculpture10M` a smooth procedural shape with the Pietà's extent (11.6 M voxels); both rows compare with the report's Pietà.\n\n",
         renderer.gpu.adapter_name
     );
     md += "| model | grid ms | SVO ms | grid / SVO | report grid / SVO | SVO Mrays/s | mean steps grid | mean steps SVO |\n|---|---|---|---|---|---|---|---|\n";
