@@ -11,10 +11,14 @@ use octovox::gpu::readback::{padded_row_bytes, read_buffer, staging_buffer};
 
 use super::{App, Gfx, SCREENSHOT_DIR};
 
+/// The window's image copied for a screenshot: buffer, width, height, and
+/// whether its bytes are BGRA.
+pub(super) type WindowCopy = (wgpu::Buffer, u32, u32, bool);
+
 impl App {
     /// Writes the traced view (and, where the swapchain allows copies, the
     /// whole window with its panels) as PNGs under `saves/`.
-    pub(super) fn save_screenshot(&mut self, window_copy: Option<(wgpu::Buffer, u32, u32, bool)>) {
+    pub(super) fn save_screenshot(&mut self, window_copy: Option<WindowCopy>) {
         let Some(gfx) = &self.gfx else { return };
         let stamp = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_millis());
         // A script's `render PATH` names the file; otherwise a stamped name in saves/.
@@ -91,11 +95,7 @@ impl App {
 }
 
 /// Copies the swapchain image into a mappable buffer (read after submit).
-pub(super) fn copy_frame(
-    gfx: &Gfx,
-    encoder: &mut wgpu::CommandEncoder,
-    texture: &wgpu::Texture,
-) -> (wgpu::Buffer, u32, u32, bool) {
+pub(super) fn copy_frame(gfx: &Gfx, encoder: &mut wgpu::CommandEncoder, texture: &wgpu::Texture) -> WindowCopy {
     let (width, height) = (texture.width(), texture.height());
     let padded = padded_row_bytes(width);
     let buffer = staging_buffer(&gfx.gpu.device, "window screenshot", u64::from(padded) * u64::from(height));

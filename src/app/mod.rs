@@ -1,6 +1,7 @@
-//! The sandbox window: winit `ApplicationHandler`, wgpu surface, the frame
-//! (pool upload → trace → blit → egui → present), and `execute`, the one
-//! place every command — mouse, keyboard, panel, later replay — is carried out.
+//! The sandbox window: winit `ApplicationHandler`, the wgpu surface, the one
+//! path for edits (edit → history → octree → pool upload), and `execute`, the
+//! one place every command — mouse, keyboard, panel, played script — is
+//! carried out. The frame is in `frame`, opening and saving in `files`.
 
 /// Prints one status line on stdout (`edit: …`, `saved: …`, `octovox: ready`;
 /// tests and scripts read them). A closed stdout is not an error worth dying for.
@@ -14,17 +15,19 @@ macro_rules! report {
 mod camera_control;
 mod capture;
 mod command;
+mod files;
+mod frame;
 mod input;
 mod script;
 mod state;
 mod ui;
 
 use std::cell::Cell;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
-use std::sync::mpsc::{self, Receiver, TryRecvError};
-use std::time::{Duration, Instant};
+use std::sync::mpsc::Receiver;
+use std::time::Instant;
 
 use anyhow::Context as _;
 use glam::IVec3;
@@ -37,10 +40,8 @@ use octovox::camera::Camera;
 use octovox::edit::{Edit, History};
 use octovox::gpu::scene_buffers::UploadStats;
 use octovox::gpu::timer::PassTimer;
-use octovox::gpu::{BlitPass, FrameUniforms, GpuContext, SceneBuffers, TracePass};
+use octovox::gpu::{BlitPass, GpuContext, SceneBuffers, TracePass};
 use octovox::scene::Scene;
-use octovox::settings::TraceMode;
-use octovox::trace::grid::DenseGrid;
 use octovox::trace::svo;
 
 use crate::cli::WindowArgs;
@@ -292,32 +293,6 @@ impl App {
         }
     }
 
-    /// Puts a new scene in place (load, New, start-up) and uploads it whole.
-    fn replace_scene(&mut self, scene: Scene, path: Option<PathBuf>) {
-        let line = match &path {
-            Some(path) => octovox::replay::Command::Load(std::fs::canonicalize(path).unwrap_or_else(|_| path.clone())),
-            None if scene.tree.solid_voxels() == 0 => octovox::replay::Command::New,
-            None => octovox::replay::Command::Demo,
-        };
-        self.record(|r| r.scene(line));
-        self.scene = scene;
-        self.history.clear();
-        self.stroke = None;
-        // An imported mesh has no .vox to save back to: Save asks for one
-        // rather than writing .vox bytes over the .obj.
-        self.state.path = path.filter(|p| !octovox::io::is_mesh_path(p));
-        self.state.dirty = false;
-        self.state.color = first_used_color(&self.scene).unwrap_or(self.state.color);
-        self.grid_stale = true;
-        if let Some(gfx) = &self.gfx {
-            gfx.buffers.upload_palette(&gfx.gpu.queue, &self.scene.palette);
-        }
-        let upload = self.upload();
-        log::info!("scene uploaded: {} bytes", upload.bytes);
-        self.update_title();
-        self.request_redraw();
-    }
-
     fn update_title(&self) {
         if let Some(gfx) = &self.gfx {
             gfx.window.set_title(&self.state.title());
@@ -326,7 +301,7 @@ impl App {
 
     // ----- commands -----------------------------------------------------------
 
-    /// Carries out one command. Panels, keys, the mouse and (later) replay
+    /// Carries out one command. Panels, keys, the mouse and played replay
     /// scripts all end up here.
     fn execute(&mut self, command: Command, event_loop: &ActiveEventLoop) {
         let busy_loading = self.loading.is_some();
@@ -394,119 +369,6 @@ impl App {
             Command::Resolve(choice) => self.resolve(choice, event_loop),
         }
         self.request_redraw();
-    }
-
-    /// Runs `action` now, or first asks about unsaved changes.
-    fn guard_unsaved(&mut self, action: Pending, event_loop: &ActiveEventLoop) {
-        if self.state.dirty {
-            self.ui.pending = Some(action);
-            self.ui.prompt_open = true;
-        } else {
-            self.perform(action, event_loop);
-        }
-    }
-
-    fn resolve(&mut self, choice: Choice, event_loop: &ActiveEventLoop) {
-        self.ui.prompt_open = false;
-        let Some(pending) = self.ui.pending.take() else { return };
-        match choice {
-            Choice::Cancel => {}
-            Choice::Discard => self.perform(pending, event_loop),
-            Choice::Save => match self.state.path.clone() {
-                Some(path) => {
-                    if self.save(&path) {
-                        self.perform(pending, event_loop);
-                    }
-                }
-                None => {
-                    // Ask for a path; SaveAs carries on with the pending action.
-                    self.ui.pending = Some(pending);
-                    self.ui.dialog = Some((DialogKind::SaveAs, "saves/untitled.vox".into()));
-                }
-            },
-        }
-    }
-
-    fn perform(&mut self, action: Pending, event_loop: &ActiveEventLoop) {
-        match action {
-            Pending::New => {
-                self.replace_scene(Scene::default(), None);
-                self.state.camera = Camera { fov_y_deg: self.state.camera.fov_y_deg, ..Camera::default() };
-                // A lone voxel to attach to: an empty scene gives the mouse nothing to hit.
-                let color = self.state.color.max(1);
-                if let Err(err) = self
-                    .scene
-                    .tree
-                    .apply_brush(&octovox::scene::Shape::Voxel(IVec3::ZERO), octovox::scene::Op::Place(color))
-                {
-                    self.ui.error(format!("cannot seed the new scene: {err}"));
-                }
-                self.record(|r| r.seed(color, IVec3::ZERO));
-                self.upload();
-                self.state.dirty = false;
-                camera_control::frame_model(&mut self.state.camera, Some((IVec3::splat(-4), IVec3::splat(4))));
-            }
-            Pending::Open(path) => self.start_loading(path),
-            Pending::Quit => event_loop.exit(),
-        }
-    }
-
-    /// Saves atomically; reports the outcome in the UI and on stdout.
-    fn save(&mut self, path: &Path) -> bool {
-        match octovox::io::save_scene(path, &self.scene) {
-            Ok(()) => {
-                report!("saved: {}", path.display());
-                self.state.dirty = false;
-                self.ui.info(format!("saved {}", path.display()));
-                self.update_title();
-                true
-            }
-            Err(err) => {
-                self.ui.error(format!("save failed: {err}"));
-                false
-            }
-        }
-    }
-
-    /// Reads a .vox (or voxelizes an .obj) on a background thread; the
-    /// window keeps drawing.
-    fn start_loading(&mut self, path: PathBuf) {
-        let (tx, rx) = mpsc::channel();
-        let thread_path = path.clone();
-        let spawned = std::thread::Builder::new().name("vox loader".into()).spawn(move || {
-            let result = octovox::io::load_scene(&thread_path, 0).map_err(|e| e.to_string());
-            // The window may have closed meanwhile; then nobody wants the scene.
-            let _ = tx.send(result);
-        });
-        match spawned {
-            Ok(_) => self.loading = Some(Loading { path, started: Instant::now(), result: rx }),
-            Err(err) => self.ui.error(format!("cannot start loading: {err}")),
-        }
-        self.request_redraw();
-    }
-
-    fn poll_loading(&mut self) {
-        let Some(loading) = &self.loading else { return };
-        let result = match loading.result.try_recv() {
-            Ok(result) => result,
-            Err(TryRecvError::Empty) => return,
-            Err(TryRecvError::Disconnected) => Err("the loader thread stopped".to_string()),
-        };
-        let Some(loading) = self.loading.take() else { return };
-        match result {
-            Ok(scene) => {
-                let seconds = loading.started.elapsed().as_secs_f64();
-                report!("loaded: {} ({} voxels, {seconds:.2} s)", loading.path.display(), scene.tree.solid_voxels());
-                self.replace_scene(scene, Some(loading.path.clone()));
-                // A camera from the command line wins for the file it came with.
-                let keep_camera = self.args.camera.is_some() && self.args.file.as_ref() == Some(&loading.path);
-                if !keep_camera {
-                    self.frame_model();
-                }
-                self.ui.info(format!("opened {}", loading.path.display()));
-            }
-            Err(err) => self.ui.error(format!("cannot open {}: {err}", loading.path.display())),
-        }
     }
 
     /// Frames the whole model, centred in the part of the window that the
@@ -595,218 +457,6 @@ impl App {
             stroke.last_center = Some(center);
             let (camera, brush, color) = (self.state.camera, self.state.brush(), self.state.color.max(1));
             self.record(|r| r.edit(&camera, brush, color, tool, center));
-        }
-    }
-
-    // ----- the frame ------------------------------------------------------------
-
-    /// One frame, top to bottom: background load, camera fly, panels and their
-    /// commands, hover pick, trace, blit, egui, present.
-    fn frame(&mut self, event_loop: &ActiveEventLoop) {
-        let started = Instant::now();
-        let seconds = self.last_frame.map_or(0.0, |t| started.duration_since(t).as_secs_f64().min(0.1));
-        if let Some(last) = self.last_frame {
-            let interval = started.duration_since(last).as_secs_f64();
-            if interval < 1.0 {
-                let fps = 1.0 / interval.max(1e-6);
-                self.stats.fps = if self.stats.fps == 0.0 { fps } else { self.stats.fps * 0.9 + fps * 0.1 };
-            }
-        }
-        self.last_frame = Some(started);
-
-        self.poll_loading();
-        if self.ready {
-            self.play_step(event_loop);
-        }
-        if let Some(dir) = self.input.fly_direction() {
-            camera_control::fly(&mut self.state.camera, dir, seconds);
-        }
-
-        // Panels first: they may change settings and produce commands.
-        let Some(gfx) = &mut self.gfx else { return };
-        let raw_input = gfx.egui_state.take_egui_input(&gfx.window);
-        let ctx = gfx.egui_state.egui_ctx().clone();
-        let loading = self.loading.as_ref().map(|l| (l.path.clone(), l.started.elapsed().as_secs_f64()));
-        let mut commands = Vec::new();
-        let full = {
-            let info = ui::Info {
-                palette: &self.scene.palette,
-                tree: &self.scene.tree,
-                stats: &self.stats,
-                adapter: &gfx.gpu.adapter_name,
-                timestamps: gfx.gpu.timestamps,
-                loading: loading.as_ref().map(|(p, s)| (p.as_path(), *s)),
-                can_undo: self.history.can_undo(),
-                can_redo: self.history.can_redo(),
-            };
-            let (state, ui_state) = (&mut self.state, &mut self.ui);
-            let pick = self.pick;
-            ctx.run_ui(raw_input, |ui| {
-                commands = ui::show(ui, state, ui_state, &info);
-                if let Some(pick) = pick {
-                    ui::draw_brush_outline(ui, state, &pick, &info);
-                }
-            })
-        };
-        self.pointer_over_ui = ctx.is_pointer_over_egui();
-        gfx.egui_state.handle_platform_output(&gfx.window, full.platform_output);
-        let repaint_delay = full.viewport_output.get(&egui::ViewportId::ROOT).map(|v| v.repaint_delay);
-        if !commands.is_empty() {
-            log::debug!("panel commands {commands:?}");
-        }
-        for command in commands {
-            self.execute(command, event_loop);
-        }
-
-        // Hover pick: what a click would edit, highlighted before any click.
-        self.pick = match self.input.cursor() {
-            Some((x, y)) if !self.pointer_over_ui && self.loading.is_none() => self.pick_at(x, y),
-            _ => None,
-        };
-        self.sync_grid();
-
-        let trace_size = self.trace_size();
-        let Some(gfx) = &mut self.gfx else { return };
-        let prims = ctx.tessellate(full.shapes, full.pixels_per_point);
-        // Textures are uploaded before the swapchain image is acquired, so a
-        // skipped frame never loses them.
-        let mut textures = full.textures_delta;
-        for (id, deltas) in textures.set.drain() {
-            for delta in deltas {
-                gfx.egui_renderer.update_texture(&gfx.gpu.device, &gfx.gpu.queue, id, &delta);
-            }
-        }
-        // Freed only after a frame that no longer uses them was submitted.
-        gfx.textures_to_free.extend(textures.free.drain());
-        let screen = egui_wgpu::ScreenDescriptor {
-            size_in_pixels: [gfx.config.width, gfx.config.height],
-            pixels_per_point: full.pixels_per_point,
-        };
-
-        // Trace.
-        let tree = &self.scene.tree;
-        gfx.trace.resize(&gfx.gpu.device, &gfx.buffers, trace_size.0, trace_size.1);
-        let basis = self.state.camera.basis(trace_size.0, trace_size.1, tree.origin());
-        let highlight = self.pick.map(|pick| {
-            let (lo, hi) = self.state.preview_box(&pick);
-            (lo - tree.origin(), hi - tree.origin())
-        });
-        let uniforms = FrameUniforms::new(&basis, tree, &gfx.buffers, self.state.settings.view, highlight);
-        gfx.trace.prepare(&gfx.gpu.device, &gfx.gpu.queue, &gfx.buffers, &uniforms);
-        let mut encoder =
-            gfx.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("trace") });
-        gfx.trace.encode(&mut encoder, &self.state.settings, gfx.timer.pass_writes());
-        gfx.timer.resolve(&mut encoder);
-        match gfx.timer.submit_and_measure(&gfx.gpu, encoder) {
-            Ok(ms) => self.stats.trace_ms = ms,
-            Err(err) => log::warn!("trace timing failed: {err}"),
-        }
-
-        // Blit + egui onto the swapchain image.
-        let frame = match gfx.surface.get_current_texture() {
-            wgpu::CurrentSurfaceTexture::Success(frame) | wgpu::CurrentSurfaceTexture::Suboptimal(frame) => frame,
-            wgpu::CurrentSurfaceTexture::Outdated => {
-                log::debug!("surface outdated; reconfiguring");
-                gfx.surface.configure(&gfx.gpu.device, &gfx.config);
-                self.redraw_wanted.set(true);
-                gfx.window.request_redraw();
-                return;
-            }
-            wgpu::CurrentSurfaceTexture::Lost => {
-                // A lost surface must be made again; if that fails too, keep
-                // the old one and retry on the next frame.
-                log::warn!("surface lost; creating it again");
-                match gfx.gpu.instance.create_surface(gfx.window.clone()) {
-                    Ok(surface) => gfx.surface = surface,
-                    Err(err) => log::error!("cannot re-create the surface: {err}"),
-                }
-                gfx.surface.configure(&gfx.gpu.device, &gfx.config);
-                self.redraw_wanted.set(true);
-                gfx.window.request_redraw();
-                return;
-            }
-            wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
-                log::debug!("surface timeout or occluded; skipping the frame");
-                self.redraw_wanted.set(true);
-                gfx.window.request_redraw();
-                return;
-            }
-            wgpu::CurrentSurfaceTexture::Validation => {
-                log::error!("surface validation error; reconfiguring");
-                gfx.surface.configure(&gfx.gpu.device, &gfx.config);
-                return;
-            }
-        };
-        let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
-        gfx.blit.prepare(&gfx.gpu.device, gfx.trace.output_view());
-        let mut encoder =
-            gfx.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("present") });
-        gfx.blit.encode(&mut encoder, &view);
-        let user_buffers =
-            gfx.egui_renderer.update_buffers(&gfx.gpu.device, &gfx.gpu.queue, &mut encoder, &prims, &screen);
-        {
-            let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("egui"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &view,
-                    resolve_target: None,
-                    depth_slice: None,
-                    ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            gfx.egui_renderer.render(&mut pass.forget_lifetime(), &prims, &screen);
-        }
-        let window_copy = (self.screenshot_requested && gfx.can_copy_frame)
-            .then(|| capture::copy_frame(gfx, &mut encoder, &frame.texture));
-        gfx.gpu.queue.submit(user_buffers.into_iter().chain([encoder.finish()]));
-        gfx.window.pre_present_notify();
-        gfx.gpu.queue.present(frame);
-        for id in std::mem::take(&mut gfx.textures_to_free) {
-            gfx.egui_renderer.free_texture(&id);
-        }
-
-        if std::mem::take(&mut self.screenshot_requested) {
-            self.save_screenshot(window_copy);
-        }
-        self.stats.frame_ms = started.elapsed().as_secs_f64() * 1e3;
-        if !self.ready && self.loading.is_none() {
-            self.ready = true;
-            let (w, h) = self.gfx.as_ref().map_or((0, 0), |g| (g.config.width, g.config.height));
-            report!("octovox: ready {w}x{h}");
-        }
-        self.bench_step(event_loop);
-
-        // Keep drawing while something moves; otherwise wait for input.
-        let animating = self.loading.is_some()
-            || self.input.fly_direction().is_some()
-            || self.bench.is_some()
-            || self.player.is_some();
-        self.next_repaint = match repaint_delay {
-            _ if animating => Some(Instant::now()),
-            Some(delay) if delay < Duration::from_secs(5) => Some(Instant::now() + delay),
-            _ => None,
-        };
-    }
-
-    /// Rebuilds and uploads the dense grid while grid mode is on and the voxels changed.
-    fn sync_grid(&mut self) {
-        if self.state.settings.mode != TraceMode::Grid || !self.grid_stale {
-            return;
-        }
-        let Some(gfx) = &mut self.gfx else { return };
-        match DenseGrid::from_octree(&self.scene.tree) {
-            Some(grid) => {
-                gfx.buffers.upload_grid(&gfx.gpu.device, &gfx.gpu.queue, &grid);
-                self.grid_stale = false;
-            }
-            None => {
-                self.state.settings.mode = TraceMode::Svo;
-                self.ui.error("the scene is too wide for a dense grid; back to SVO");
-            }
         }
     }
 }

@@ -1,0 +1,156 @@
+//! Scenes in and out of the window: replacing the scene, the unsaved-changes
+//! guard, saving, and loading on a background thread.
+
+use std::path::{Path, PathBuf};
+use std::sync::mpsc::{self, TryRecvError};
+use std::time::Instant;
+
+use glam::IVec3;
+use winit::event_loop::ActiveEventLoop;
+
+use octovox::camera::Camera;
+use octovox::scene::Scene;
+
+use super::ui::DialogKind;
+use super::{App, Choice, Loading, Pending, camera_control, first_used_color};
+
+impl App {
+    /// Puts a new scene in place (load, New, start-up) and uploads it whole.
+    pub(super) fn replace_scene(&mut self, scene: Scene, path: Option<PathBuf>) {
+        let line = match &path {
+            Some(path) => octovox::replay::Command::Load(std::fs::canonicalize(path).unwrap_or_else(|_| path.clone())),
+            None if scene.tree.solid_voxels() == 0 => octovox::replay::Command::New,
+            None => octovox::replay::Command::Demo,
+        };
+        self.record(|r| r.scene(line));
+        self.scene = scene;
+        self.history.clear();
+        self.stroke = None;
+        // An imported mesh has no .vox to save back to: Save asks for one
+        // rather than writing .vox bytes over the .obj.
+        self.state.path = path.filter(|p| !octovox::io::is_mesh_path(p));
+        self.state.dirty = false;
+        self.state.color = first_used_color(&self.scene).unwrap_or(self.state.color);
+        self.grid_stale = true;
+        if let Some(gfx) = &self.gfx {
+            gfx.buffers.upload_palette(&gfx.gpu.queue, &self.scene.palette);
+        }
+        let upload = self.upload();
+        log::info!("scene uploaded: {} bytes", upload.bytes);
+        self.update_title();
+        self.request_redraw();
+    }
+
+    /// Runs `action` now, or first asks about unsaved changes.
+    pub(super) fn guard_unsaved(&mut self, action: Pending, event_loop: &ActiveEventLoop) {
+        if self.state.dirty {
+            self.ui.pending = Some(action);
+            self.ui.prompt_open = true;
+        } else {
+            self.perform(action, event_loop);
+        }
+    }
+
+    pub(super) fn resolve(&mut self, choice: Choice, event_loop: &ActiveEventLoop) {
+        self.ui.prompt_open = false;
+        let Some(pending) = self.ui.pending.take() else { return };
+        match choice {
+            Choice::Cancel => {}
+            Choice::Discard => self.perform(pending, event_loop),
+            Choice::Save => match self.state.path.clone() {
+                Some(path) => {
+                    if self.save(&path) {
+                        self.perform(pending, event_loop);
+                    }
+                }
+                None => {
+                    // Ask for a path; SaveAs carries on with the pending action.
+                    self.ui.pending = Some(pending);
+                    self.ui.dialog = Some((DialogKind::SaveAs, "saves/untitled.vox".into()));
+                }
+            },
+        }
+    }
+
+    pub(super) fn perform(&mut self, action: Pending, event_loop: &ActiveEventLoop) {
+        match action {
+            Pending::New => {
+                self.replace_scene(Scene::default(), None);
+                self.state.camera = Camera { fov_y_deg: self.state.camera.fov_y_deg, ..Camera::default() };
+                // A lone voxel to attach to: an empty scene gives the mouse nothing to hit.
+                let color = self.state.color.max(1);
+                if let Err(err) = self
+                    .scene
+                    .tree
+                    .apply_brush(&octovox::scene::Shape::Voxel(IVec3::ZERO), octovox::scene::Op::Place(color))
+                {
+                    self.ui.error(format!("cannot seed the new scene: {err}"));
+                }
+                self.record(|r| r.seed(color, IVec3::ZERO));
+                self.upload();
+                self.state.dirty = false;
+                camera_control::frame_model(&mut self.state.camera, Some((IVec3::splat(-4), IVec3::splat(4))));
+            }
+            Pending::Open(path) => self.start_loading(path),
+            Pending::Quit => event_loop.exit(),
+        }
+    }
+
+    /// Saves atomically; reports the outcome in the UI and on stdout.
+    pub(super) fn save(&mut self, path: &Path) -> bool {
+        match octovox::io::save_scene(path, &self.scene) {
+            Ok(()) => {
+                report!("saved: {}", path.display());
+                self.state.dirty = false;
+                self.ui.info(format!("saved {}", path.display()));
+                self.update_title();
+                true
+            }
+            Err(err) => {
+                self.ui.error(format!("save failed: {err}"));
+                false
+            }
+        }
+    }
+
+    /// Reads a .vox (or voxelizes an .obj) on a background thread; the
+    /// window keeps drawing.
+    pub(super) fn start_loading(&mut self, path: PathBuf) {
+        let (tx, rx) = mpsc::channel();
+        let thread_path = path.clone();
+        let spawned = std::thread::Builder::new().name("vox loader".into()).spawn(move || {
+            let result = octovox::io::load_scene(&thread_path, 0).map_err(|e| e.to_string());
+            // The window may have closed meanwhile; then nobody wants the scene.
+            let _ = tx.send(result);
+        });
+        match spawned {
+            Ok(_) => self.loading = Some(Loading { path, started: Instant::now(), result: rx }),
+            Err(err) => self.ui.error(format!("cannot start loading: {err}")),
+        }
+        self.request_redraw();
+    }
+
+    pub(super) fn poll_loading(&mut self) {
+        let Some(loading) = &self.loading else { return };
+        let result = match loading.result.try_recv() {
+            Ok(result) => result,
+            Err(TryRecvError::Empty) => return,
+            Err(TryRecvError::Disconnected) => Err("the loader thread stopped".to_string()),
+        };
+        let Some(loading) = self.loading.take() else { return };
+        match result {
+            Ok(scene) => {
+                let seconds = loading.started.elapsed().as_secs_f64();
+                report!("loaded: {} ({} voxels, {seconds:.2} s)", loading.path.display(), scene.tree.solid_voxels());
+                self.replace_scene(scene, Some(loading.path.clone()));
+                // A camera from the command line wins for the file it came with.
+                let keep_camera = self.args.camera.is_some() && self.args.file.as_ref() == Some(&loading.path);
+                if !keep_camera {
+                    self.frame_model();
+                }
+                self.ui.info(format!("opened {}", loading.path.display()));
+            }
+            Err(err) => self.ui.error(format!("cannot open {}: {err}", loading.path.display())),
+        }
+    }
+}

@@ -1,0 +1,255 @@
+//! One frame of the window, top to bottom: background load, script step,
+//! camera fly, panels and their commands, hover pick, trace, blit + egui,
+//! present, and when to draw the next one.
+
+use std::cell::Cell;
+use std::time::{Duration, Instant};
+
+use winit::event_loop::ActiveEventLoop;
+
+use octovox::gpu::FrameUniforms;
+use octovox::settings::TraceMode;
+use octovox::trace::grid::DenseGrid;
+
+use super::{App, Gfx, camera_control, capture, ui};
+
+impl App {
+    pub(super) fn frame(&mut self, event_loop: &ActiveEventLoop) {
+        let started = Instant::now();
+        let seconds = self.measure_interval(started);
+        self.poll_loading();
+        if self.ready {
+            self.play_step(event_loop);
+        }
+        if let Some(dir) = self.input.fly_direction() {
+            camera_control::fly(&mut self.state.camera, dir, seconds);
+        }
+        // Panels first: they may change settings and produce commands.
+        let Some((ctx, full)) = self.run_panels(event_loop) else { return };
+        // Hover pick: what a click would edit, highlighted before any click.
+        self.pick = match self.input.cursor() {
+            Some((x, y)) if !self.pointer_over_ui && self.loading.is_none() => self.pick_at(x, y),
+            _ => None,
+        };
+        self.sync_grid();
+        let repaint_delay = full.viewport_output.get(&egui::ViewportId::ROOT).map(|v| v.repaint_delay);
+        let Some(window_copy) = self.trace_and_present(&ctx, full) else { return };
+        if std::mem::take(&mut self.screenshot_requested) {
+            self.save_screenshot(window_copy);
+        }
+        self.stats.frame_ms = started.elapsed().as_secs_f64() * 1e3;
+        if !self.ready && self.loading.is_none() {
+            self.ready = true;
+            let (w, h) = self.gfx.as_ref().map_or((0, 0), |g| (g.config.width, g.config.height));
+            report!("octovox: ready {w}x{h}");
+        }
+        self.bench_step(event_loop);
+        self.schedule_repaint(repaint_delay);
+    }
+
+    /// Updates the smoothed frame rate; returns the seconds since the last
+    /// frame (at most 0.1, so a stall does not fling the flying camera).
+    fn measure_interval(&mut self, started: Instant) -> f64 {
+        let seconds = self.last_frame.map_or(0.0, |t| started.duration_since(t).as_secs_f64().min(0.1));
+        if let Some(last) = self.last_frame {
+            let interval = started.duration_since(last).as_secs_f64();
+            if interval < 1.0 {
+                let fps = 1.0 / interval.max(1e-6);
+                self.stats.fps = if self.stats.fps == 0.0 { fps } else { self.stats.fps * 0.9 + fps * 0.1 };
+            }
+        }
+        self.last_frame = Some(started);
+        seconds
+    }
+
+    /// Lays out the panels and carries out the commands they produced.
+    fn run_panels(&mut self, event_loop: &ActiveEventLoop) -> Option<(egui::Context, egui::FullOutput)> {
+        let gfx = self.gfx.as_mut()?;
+        let raw_input = gfx.egui_state.take_egui_input(&gfx.window);
+        let ctx = gfx.egui_state.egui_ctx().clone();
+        let loading = self.loading.as_ref().map(|l| (l.path.clone(), l.started.elapsed().as_secs_f64()));
+        let mut commands = Vec::new();
+        let mut full = {
+            let info = ui::Info {
+                palette: &self.scene.palette,
+                tree: &self.scene.tree,
+                stats: &self.stats,
+                adapter: &gfx.gpu.adapter_name,
+                timestamps: gfx.gpu.timestamps,
+                loading: loading.as_ref().map(|(p, s)| (p.as_path(), *s)),
+                can_undo: self.history.can_undo(),
+                can_redo: self.history.can_redo(),
+            };
+            let (state, ui_state) = (&mut self.state, &mut self.ui);
+            let pick = self.pick;
+            ctx.run_ui(raw_input, |ui| {
+                commands = ui::show(ui, state, ui_state, &info);
+                if let Some(pick) = pick {
+                    ui::draw_brush_outline(ui, state, &pick, &info);
+                }
+            })
+        };
+        self.pointer_over_ui = ctx.is_pointer_over_egui();
+        gfx.egui_state.handle_platform_output(&gfx.window, std::mem::take(&mut full.platform_output));
+        if !commands.is_empty() {
+            log::debug!("panel commands {commands:?}");
+        }
+        for command in commands {
+            self.execute(command, event_loop);
+        }
+        Some((ctx, full))
+    }
+
+    /// Traces the scene, then draws it and the panels onto the window and
+    /// presents. Returns `None` when the frame was skipped (surface not
+    /// ready), else the window copy for a pending screenshot.
+    fn trace_and_present(
+        &mut self,
+        ctx: &egui::Context,
+        full: egui::FullOutput,
+    ) -> Option<Option<capture::WindowCopy>> {
+        let trace_size = self.trace_size();
+        let gfx = self.gfx.as_mut()?;
+        let prims = ctx.tessellate(full.shapes, full.pixels_per_point);
+        // Textures are uploaded before the swapchain image is acquired, so a
+        // skipped frame never loses them.
+        let mut textures = full.textures_delta;
+        for (id, deltas) in textures.set.drain() {
+            for delta in deltas {
+                gfx.egui_renderer.update_texture(&gfx.gpu.device, &gfx.gpu.queue, id, &delta);
+            }
+        }
+        // Freed only after a frame that no longer uses them was submitted.
+        gfx.textures_to_free.extend(textures.free.drain());
+        let screen = egui_wgpu::ScreenDescriptor {
+            size_in_pixels: [gfx.config.width, gfx.config.height],
+            pixels_per_point: full.pixels_per_point,
+        };
+
+        // Trace.
+        let tree = &self.scene.tree;
+        gfx.trace.resize(&gfx.gpu.device, &gfx.buffers, trace_size.0, trace_size.1);
+        let basis = self.state.camera.basis(trace_size.0, trace_size.1, tree.origin());
+        let highlight = self.pick.map(|pick| {
+            let (lo, hi) = self.state.preview_box(&pick);
+            (lo - tree.origin(), hi - tree.origin())
+        });
+        let uniforms = FrameUniforms::new(&basis, tree, &gfx.buffers, self.state.settings.view, highlight);
+        gfx.trace.prepare(&gfx.gpu.device, &gfx.gpu.queue, &gfx.buffers, &uniforms);
+        let mut encoder =
+            gfx.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("trace") });
+        gfx.trace.encode(&mut encoder, &self.state.settings, gfx.timer.pass_writes());
+        gfx.timer.resolve(&mut encoder);
+        match gfx.timer.submit_and_measure(&gfx.gpu, encoder) {
+            Ok(ms) => self.stats.trace_ms = ms,
+            Err(err) => log::warn!("trace timing failed: {err}"),
+        }
+
+        // Blit + egui onto the swapchain image.
+        let frame = acquire_frame(gfx, &self.redraw_wanted)?;
+        let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
+        gfx.blit.prepare(&gfx.gpu.device, gfx.trace.output_view());
+        let mut encoder =
+            gfx.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("present") });
+        gfx.blit.encode(&mut encoder, &view);
+        let user_buffers =
+            gfx.egui_renderer.update_buffers(&gfx.gpu.device, &gfx.gpu.queue, &mut encoder, &prims, &screen);
+        {
+            let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("egui"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &view,
+                    resolve_target: None,
+                    depth_slice: None,
+                    ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            gfx.egui_renderer.render(&mut pass.forget_lifetime(), &prims, &screen);
+        }
+        let window_copy = (self.screenshot_requested && gfx.can_copy_frame)
+            .then(|| capture::copy_frame(gfx, &mut encoder, &frame.texture));
+        gfx.gpu.queue.submit(user_buffers.into_iter().chain([encoder.finish()]));
+        gfx.window.pre_present_notify();
+        gfx.gpu.queue.present(frame);
+        for id in std::mem::take(&mut gfx.textures_to_free) {
+            gfx.egui_renderer.free_texture(&id);
+        }
+        Some(window_copy)
+    }
+
+    /// Keeps drawing while something moves; otherwise waits for input (or
+    /// for when egui asks to be drawn again).
+    fn schedule_repaint(&mut self, repaint_delay: Option<Duration>) {
+        let animating = self.loading.is_some()
+            || self.input.fly_direction().is_some()
+            || self.bench.is_some()
+            || self.player.is_some();
+        self.next_repaint = match repaint_delay {
+            _ if animating => Some(Instant::now()),
+            Some(delay) if delay < Duration::from_secs(5) => Some(Instant::now() + delay),
+            _ => None,
+        };
+    }
+
+    /// Rebuilds and uploads the dense grid while grid mode is on and the voxels changed.
+    fn sync_grid(&mut self) {
+        if self.state.settings.mode != TraceMode::Grid || !self.grid_stale {
+            return;
+        }
+        let Some(gfx) = &mut self.gfx else { return };
+        match DenseGrid::from_octree(&self.scene.tree) {
+            Some(grid) => {
+                gfx.buffers.upload_grid(&gfx.gpu.device, &gfx.gpu.queue, &grid);
+                self.grid_stale = false;
+            }
+            None => {
+                self.state.settings.mode = TraceMode::Svo;
+                self.ui.error("the scene is too wide for a dense grid; back to SVO");
+            }
+        }
+    }
+}
+
+/// The swapchain image to draw on, or `None` when this frame must be skipped
+/// (the surface is reconfigured or re-created, and another frame asked for).
+fn acquire_frame(gfx: &mut Gfx, redraw_wanted: &Cell<bool>) -> Option<wgpu::SurfaceTexture> {
+    let retry = |gfx: &Gfx| {
+        redraw_wanted.set(true);
+        gfx.window.request_redraw();
+    };
+    match gfx.surface.get_current_texture() {
+        wgpu::CurrentSurfaceTexture::Success(frame) | wgpu::CurrentSurfaceTexture::Suboptimal(frame) => Some(frame),
+        wgpu::CurrentSurfaceTexture::Outdated => {
+            log::debug!("surface outdated; reconfiguring");
+            gfx.surface.configure(&gfx.gpu.device, &gfx.config);
+            retry(gfx);
+            None
+        }
+        wgpu::CurrentSurfaceTexture::Lost => {
+            // A lost surface must be made again; if that fails too, keep
+            // the old one and retry on the next frame.
+            log::warn!("surface lost; creating it again");
+            match gfx.gpu.instance.create_surface(gfx.window.clone()) {
+                Ok(surface) => gfx.surface = surface,
+                Err(err) => log::error!("cannot re-create the surface: {err}"),
+            }
+            gfx.surface.configure(&gfx.gpu.device, &gfx.config);
+            retry(gfx);
+            None
+        }
+        wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
+            log::debug!("surface timeout or occluded; skipping the frame");
+            retry(gfx);
+            None
+        }
+        wgpu::CurrentSurfaceTexture::Validation => {
+            log::error!("surface validation error; reconfiguring");
+            gfx.surface.configure(&gfx.gpu.device, &gfx.config);
+            None
+        }
+    }
+}
