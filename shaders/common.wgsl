@@ -129,6 +129,14 @@ fn voxel_at(r: Ray, t: f32, entry_axis: u32) -> vec3<i32> {
     return k + select(down, up, positive);
 }
 
+// Twin of `Ray::voxel_in_box`: the voxel of the box lo..=hi where the ray is
+// at t, having entered it on `entry_axis` (that axis: the entered face).
+fn voxel_in_box(r: Ray, lo: vec3<i32>, hi: vec3<i32>, t: f32, entry_axis: u32) -> vec3<i32> {
+    let on_face = select(hi, lo, r.d > vec3<f32>(0.0));
+    let is_entry = vec3<u32>(0u, 1u, 2u) == vec3<u32>(entry_axis);
+    return select(clamp(voxel_at(r, t, entry_axis), lo, hi), on_face, is_entry);
+}
+
 fn entry_normal_code(r: Ray, axis: u32) -> u32 {
     if (axis == NO_AXIS) {
         return 0u;
@@ -144,10 +152,7 @@ fn hit_cell(r: Ray, value: u32, mn: vec3<i32>, level: u32, t: f32, axis: u32, it
     if (value == 0u) {
         return hit;
     }
-    let mx = mn + vec3<i32>((1 << level) - 1);
-    let on_face = select(mx, mn, r.d > vec3<f32>(0.0));
-    let is_entry = vec3<u32>(0u, 1u, 2u) == vec3<u32>(axis);
-    hit.voxel = select(clamp(voxel_at(r, t, axis), mn, mx), on_face, is_entry);
+    hit.voxel = voxel_in_box(r, mn, mn + vec3<i32>((1 << level) - 1), t, axis);
     hit.value = value;
     hit.normal_code = entry_normal_code(r, axis);
     hit.level = level;

@@ -23,9 +23,7 @@ fn trace_grid(r: Ray) -> Hit {
     }
     let t = max(s.t_enter, 0.0);
     var axis = select(NO_AXIS, s.axis, s.t_enter >= 0.0);
-    let on_face = select(hi, lo, r.d > vec3<f32>(0.0));
-    let is_entry = vec3<u32>(0u, 1u, 2u) == vec3<u32>(axis);
-    var voxel = select(clamp(voxel_at(r, t, axis), lo, hi), on_face, is_entry);
+    var voxel = voxel_in_box(r, lo, hi, t, axis);
     let step = select(vec3<i32>(-1), vec3<i32>(1), r.d > vec3<f32>(0.0));
     let far_offset = select(vec3<f32>(0.0), vec3<f32>(1.0), r.d > vec3<f32>(0.0));
     var iterations = 0u;

@@ -74,14 +74,7 @@ pub fn trace(grid: &DenseGrid, ray: &Ray) -> Hit {
     }
     let t = t_enter.max(0.0);
     let mut axis = if t_enter >= 0.0 { entry_axis } else { NO_AXIS };
-    let mut voxel = IVec3::ZERO;
-    for b in 0..3 {
-        voxel[b] = if b == axis {
-            if ray.dir[b] > 0.0 { lo[b] } else { hi[b] }
-        } else {
-            ray.voxel_on_axis(b, t, axis).clamp(lo[b], hi[b])
-        };
-    }
+    let mut voxel = ray.voxel_in_box(lo, hi, t, axis);
     let step = IVec3::select(ray.dir.cmpgt(Vec3::ZERO), IVec3::ONE, IVec3::NEG_ONE);
     let far_offset = Vec3::select(ray.dir.cmpgt(Vec3::ZERO), Vec3::ONE, Vec3::ZERO);
     let mut iterations = 0;

@@ -164,6 +164,21 @@ impl Ray {
         }
     }
 
+    /// The voxel of the box `lo..=hi` (inclusive) where the ray is at `t`,
+    /// having entered the box through a plane on `entry_axis`: on that axis
+    /// the entered face, on the others [`Ray::voxel_on_axis`] kept in the box.
+    pub fn voxel_in_box(&self, lo: IVec3, hi: IVec3, t: f32, entry_axis: usize) -> IVec3 {
+        let mut voxel = IVec3::ZERO;
+        for b in 0..3 {
+            voxel[b] = if b == entry_axis {
+                if self.dir[b] > 0.0 { lo[b] } else { hi[b] }
+            } else {
+                self.voxel_on_axis(b, t, entry_axis).clamp(lo[b], hi[b])
+            };
+        }
+        voxel
+    }
+
     /// Face normal of the plane entered along `axis`.
     pub fn entry_normal(&self, axis: usize) -> IVec3 {
         let mut n = IVec3::ZERO;

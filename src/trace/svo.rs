@@ -123,15 +123,7 @@ fn hit_cell(ray: &Ray, value: u8, min: IVec3, level: u32, t: f32, axis: usize, i
     if value == 0 {
         return Hit { iterations, ..Hit::default() };
     }
-    let max = min + IVec3::splat((1 << level) - 1);
-    let mut voxel = IVec3::ZERO;
-    for b in 0..3 {
-        voxel[b] = if b == axis {
-            if ray.dir[b] > 0.0 { min[b] } else { max[b] }
-        } else {
-            ray.voxel_on_axis(b, t, axis).clamp(min[b], max[b])
-        };
-    }
+    let voxel = ray.voxel_in_box(min, min + IVec3::splat((1 << level) - 1), t, axis);
     let normal = if axis == NO_AXIS { IVec3::ZERO } else { ray.entry_normal(axis) };
     Hit { value, voxel, normal, cell_level: level, iterations }
 }
