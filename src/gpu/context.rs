@@ -9,7 +9,7 @@ pub enum GpuError {
     NoAdapter(#[from] wgpu::RequestAdapterError),
     #[error("the GPU refused to create a device: {0}")]
     NoDevice(#[from] wgpu::RequestDeviceError),
-    #[error("shader {name} failed to compile: {message}")]
+    #[error("shader or pipeline {name} is invalid: {message}")]
     Shader { name: String, message: String },
     #[error("could not create a surface for the window: {0}")]
     Surface(#[from] wgpu::CreateSurfaceError),
@@ -82,17 +82,25 @@ impl GpuContext {
         Ok(GpuContext { instance, adapter, device, queue, adapter_name, timestamps: !features.is_empty() })
     }
 
-    /// Compiles WGSL inside a validation error scope, so a bad shader is an
-    /// error value instead of a crash.
+    /// Compiles WGSL; a bad shader is an error value instead of a crash.
     pub fn shader(&self, name: &str, source: &str) -> Result<wgpu::ShaderModule, GpuError> {
+        self.validated(name, |device| {
+            device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(name),
+                source: wgpu::ShaderSource::Wgsl(source.into()),
+            })
+        })
+    }
+
+    /// Runs `create` inside a validation error scope, so that an invalid
+    /// shader or pipeline is an error here rather than a pass that silently
+    /// draws nothing later.
+    pub fn validated<T>(&self, name: &str, create: impl FnOnce(&wgpu::Device) -> T) -> Result<T, GpuError> {
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let module = self.device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some(name),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        });
+        let created = create(&self.device);
         match pollster::block_on(scope.pop()) {
             Some(err) => Err(GpuError::Shader { name: name.to_string(), message: err.to_string() }),
-            None => Ok(module),
+            None => Ok(created),
         }
     }
 

@@ -154,25 +154,27 @@ impl TracePass {
         let svo = gpu.shader("trace_svo.wgsl", &format!("{COMMON_WGSL}\n{SVO_WGSL}"))?;
         let grid = gpu.shader("trace_grid.wgsl", &format!("{COMMON_WGSL}\n{GRID_WGSL}"))?;
         let pipeline = |module: &wgpu::ShaderModule, entry: &str, shadows: bool, label: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(label),
-                layout: Some(&pipeline_layout),
-                module,
-                entry_point: Some(entry),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants: &[("SHADOWS", if shadows { 1.0 } else { 0.0 })],
-                    zero_initialize_workgroup_memory: false,
-                },
-                cache: None,
+            gpu.validated(label, |device| {
+                device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(label),
+                    layout: Some(&pipeline_layout),
+                    module,
+                    entry_point: Some(entry),
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants: &[("SHADOWS", if shadows { 1.0 } else { 0.0 })],
+                        zero_initialize_workgroup_memory: false,
+                    },
+                    cache: None,
+                })
             })
         };
         let pipelines = [
-            pipeline(&svo, "main", false, "trace svo"),
-            pipeline(&svo, "main", true, "trace svo + shadows"),
-            pipeline(&grid, "main", false, "trace grid"),
-            pipeline(&grid, "main", true, "trace grid + shadows"),
+            pipeline(&svo, "main", false, "trace svo")?,
+            pipeline(&svo, "main", true, "trace svo + shadows")?,
+            pipeline(&grid, "main", false, "trace grid")?,
+            pipeline(&grid, "main", true, "trace grid + shadows")?,
         ];
-        let beam = pipeline(&svo, "beam", false, "beam prepass");
+        let beam = pipeline(&svo, "beam", false, "beam prepass")?;
         let uniform_buf = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("frame uniforms"),
             size: std::mem::size_of::<FrameUniforms>() as u64,
