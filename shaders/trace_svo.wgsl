@@ -10,8 +10,9 @@
 
 @group(0) @binding(7) var<storage, read_write> beam_distance: array<f32>;
 
-// Side of the square tile of pixels that shares one beam.
-const BEAM_TILE: u32 = 16u;
+// Side of the square tile of pixels that shares one beam: set from
+// `BEAM_TILE` in src/gpu/trace_pass.rs, which also sizes the beam buffer.
+override BEAM_TILE: u32;
 // The beam stops at nodes this small (4³ voxels): finer levels cost more
 // prepass steps than they save.
 const BEAM_LEVEL: u32 = 2u;

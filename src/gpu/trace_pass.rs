@@ -82,7 +82,8 @@ struct Target {
     height: u32,
 }
 
-/// Side of the pixel tile that shares one beam (`BEAM_TILE` in WGSL).
+/// Side of the pixel tile that shares one beam; it sizes the beam buffer and
+/// sets the shader's `BEAM_TILE` override.
 const BEAM_TILE: u32 = 16;
 
 /// Pipelines are compiled per tracer and per shadow setting (an override
@@ -153,7 +154,7 @@ impl TracePass {
         });
         let svo = gpu.shader("trace_svo.wgsl", &format!("{COMMON_WGSL}\n{SVO_WGSL}"))?;
         let grid = gpu.shader("trace_grid.wgsl", &format!("{COMMON_WGSL}\n{GRID_WGSL}"))?;
-        let pipeline = |module: &wgpu::ShaderModule, entry: &str, shadows: bool, label: &str| {
+        let pipeline = |module: &wgpu::ShaderModule, entry: &str, constants: &[(&str, f64)], label: &str| {
             gpu.validated(label, |device| {
                 device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                     label: Some(label),
@@ -161,20 +162,21 @@ impl TracePass {
                     module,
                     entry_point: Some(entry),
                     compilation_options: wgpu::PipelineCompilationOptions {
-                        constants: &[("SHADOWS", if shadows { 1.0 } else { 0.0 })],
+                        constants,
                         zero_initialize_workgroup_memory: false,
                     },
                     cache: None,
                 })
             })
         };
+        let tile = ("BEAM_TILE", f64::from(BEAM_TILE));
         let pipelines = [
-            pipeline(&svo, "main", false, "trace svo")?,
-            pipeline(&svo, "main", true, "trace svo + shadows")?,
-            pipeline(&grid, "main", false, "trace grid")?,
-            pipeline(&grid, "main", true, "trace grid + shadows")?,
+            pipeline(&svo, "main", &[("SHADOWS", 0.0), tile], "trace svo")?,
+            pipeline(&svo, "main", &[("SHADOWS", 1.0), tile], "trace svo + shadows")?,
+            pipeline(&grid, "main", &[("SHADOWS", 0.0)], "trace grid")?,
+            pipeline(&grid, "main", &[("SHADOWS", 1.0)], "trace grid + shadows")?,
         ];
-        let beam = pipeline(&svo, "beam", false, "beam prepass")?;
+        let beam = pipeline(&svo, "beam", &[tile], "beam prepass")?;
         let uniform_buf = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("frame uniforms"),
             size: std::mem::size_of::<FrameUniforms>() as u64,
