@@ -130,15 +130,14 @@ pub fn voxelize(triangles: &[[Vec3; 3]], size: u32, color: u8) -> DenseVoxels {
     let hi = triangles.iter().flatten().copied().fold(Vec3::NEG_INFINITY, Vec3::max);
     let scale = size as f32 / (hi - lo).max_element().max(f32::MIN_POSITIVE);
     let dims = ((hi - lo) * scale).ceil().as_uvec3().clamp(UVec3::ONE, UVec3::splat(size));
-    let columns = crossings(triangles, lo, scale, dims);
+    let mut columns = crossings(triangles, lo, scale, dims);
+    columns.par_iter_mut().for_each(|ys| ys.sort_by(f32::total_cmp));
     let mut data = vec![0u8; dims.x as usize * dims.y as usize * dims.z as usize];
     let plane = dims.x as usize * dims.y as usize;
     // One z slice per task: each owns its part of `data`.
     data.par_chunks_mut(plane).enumerate().for_each(|(z, slice)| {
         for x in 0..dims.x as usize {
-            let mut ys = columns[z * dims.x as usize + x].clone();
-            ys.sort_by(f32::total_cmp);
-            for pair in ys.chunks_exact(2) {
+            for pair in columns[z * dims.x as usize + x].chunks_exact(2) {
                 // Voxels whose centre y + 0.5 lies in [pair[0], pair[1]).
                 let first = (pair[0] - 0.5).ceil().max(0.0) as usize;
                 let end = ((pair[1] - 0.5).ceil().max(0.0) as usize).min(dims.y as usize);
