@@ -41,6 +41,9 @@ const NO_AXIS: u32 = 3u;
 const MIN_DIRECTION: f32 = 1.1920929e-7; // 2^-23
 const POINTER_BIT: u32 = 0x80000000u;
 const SUN_DIR: vec3<f32> = vec3<f32>(0.4548588, 0.7960029, 0.3980015);
+// Twin of GAVE_UP_COLOR in src/trace/render.rs: a ray that ran out of
+// iterations is drawn in it, never as sky.
+const GAVE_UP_COLOR: vec3<f32> = vec3<f32>(1.0, 0.0, 1.0);
 
 struct Ray {
     o: vec3<f32>,
@@ -211,7 +214,7 @@ fn shade(hit: Hit, d: vec3<f32>, in_shadow: bool) -> vec3<f32> {
         }
         default: {
             if (hit.value == 0u) {
-                return sky_color(d);
+                return select(sky_color(d), GAVE_UP_COLOR, hit.iterations >= MAX_ITERATIONS);
             }
             let albedo = unpack4x8unorm(palette[hit.value]).rgb;
             let lambert = max(dot(n, SUN_DIR), 0.0);

@@ -3,6 +3,25 @@
 
 use glam::{DVec3, IVec3, Vec3};
 
+/// The vertical fields of view octovox draws, in degrees: the CLI, scripts
+/// and the window refuse others, and every projection uses this range.
+pub const FOV_RANGE_DEG: std::ops::RangeInclusive<f32> = 1.0..=179.0;
+
+/// `fov` clamped into [`FOV_RANGE_DEG`] (NaN becomes the narrowest), for
+/// values that were not checked on the way in.
+pub fn clamp_fov(fov: f32) -> f32 {
+    if fov.is_nan() { *FOV_RANGE_DEG.start() } else { fov.clamp(*FOV_RANGE_DEG.start(), *FOV_RANGE_DEG.end()) }
+}
+
+/// Checks a field of view given by the user.
+pub fn check_fov(fov: f32) -> Result<f32, String> {
+    if FOV_RANGE_DEG.contains(&fov) {
+        Ok(fov)
+    } else {
+        Err(format!("field of view {fov} must be {}..={} degrees", FOV_RANGE_DEG.start(), FOV_RANGE_DEG.end()))
+    }
+}
+
 /// Eye, target and vertical field of view, in world coordinates (y up).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
@@ -25,8 +44,10 @@ impl Camera {
         let hi = max.as_dvec3() + DVec3::ONE;
         let center = (lo + hi) * 0.5;
         let radius = ((hi - lo).length() * 0.5).max(1.0);
-        let half_fov = f64::from(fov_y_deg.clamp(5.0, 170.0)).to_radians() * 0.5;
-        let distance = radius / half_fov.sin() * 0.85;
+        let half_fov = f64::from(clamp_fov(fov_y_deg)).to_radians() * 0.5;
+        // The bounding sphere just fills the view at radius / sin(fov / 2);
+        // a little closer crops its empty rim. Never inside the sphere.
+        let distance = (radius / half_fov.sin() * 0.85).max(radius * 1.1);
         let dir = DVec3::new(0.55, 0.45, 0.7).normalize();
         Camera { eye: center + dir * distance, target: center, fov_y_deg }
     }
@@ -38,7 +59,7 @@ impl Camera {
         let world_up = if forward.y.abs() > 0.999 { DVec3::Z } else { DVec3::Y };
         let right = forward.cross(world_up).normalize();
         let up = right.cross(forward);
-        let tan_half = (f64::from(self.fov_y_deg.clamp(1.0, 179.0)).to_radians() * 0.5).tan();
+        let tan_half = (f64::from(clamp_fov(self.fov_y_deg)).to_radians() * 0.5).tan();
         let aspect = f64::from(width.max(1)) / f64::from(height.max(1));
         RayBasis {
             eye: (self.eye - origin.as_dvec3()).as_vec3(),

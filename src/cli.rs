@@ -10,11 +10,17 @@ use octovox::settings::{TraceMode, View};
 
 #[derive(Parser, Debug)]
 #[command(name = "octovox", version, about = "Voxel sandbox with a GPU sparse-voxel-octree ray tracer")]
+#[command(allow_negative_numbers = true)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Option<Command>,
     #[command(flatten)]
     pub window: WindowArgs,
+    /// Most memory one step may take (4G, 512M, …); larger loads, imports,
+    /// brushes and renders are refused with a message (docs/limits.md).
+    #[arg(long, global = true, value_name = "SIZE", value_parser = octovox::budget::parse_bytes,
+          default_value = "4G")]
+    pub memory_budget: u64,
 }
 
 /// Options of the sandbox window (`octovox [FILE]`).
@@ -26,7 +32,7 @@ pub struct WindowArgs {
     #[arg(long, value_parser = parse_size, default_value = "1280x720")]
     pub size: (u32, u32),
     /// Initial camera as EX,EY,EZ:TX,TY,TZ (eye and target, world voxels).
-    #[arg(long, value_parser = parse_camera)]
+    #[arg(long, value_parser = parse_camera, allow_hyphen_values = true)]
     pub camera: Option<(DVec3, DVec3)>,
     /// Draw N frames as fast as possible after the first, print the average
     /// frame rate and exit (a benchmark of the whole frame: trace, blit, egui).
@@ -44,6 +50,9 @@ pub struct WindowArgs {
     /// Record the session (camera, brush, colour, every edit) as a script.
     #[arg(long, value_name = "PATH")]
     pub record: Option<PathBuf>,
+    /// Let --record replace an existing .vox/.obj/.ovr file or an input.
+    #[arg(long)]
+    pub force: bool,
 }
 
 #[derive(Subcommand, Debug)]
@@ -59,15 +68,21 @@ pub enum Command {
         frame: usize,
     },
     /// Load a .vox and save it again through octovox's scene model.
+    #[command(allow_negative_numbers = true)]
     Convert {
         input: PathBuf,
         output: PathBuf,
         #[arg(long, default_value_t = 0)]
         frame: usize,
+        /// Replace OUTPUT even if it exists or is the input.
+        #[arg(long)]
+        force: bool,
     },
     /// Voxelize a closed .obj mesh (solid inside) and save it as .vox.
+    #[command(allow_negative_numbers = true)]
     Import(ImportArgs),
     /// Ray-trace a scene to a PNG (GPU, or the CPU reference with --cpu).
+    #[command(allow_negative_numbers = true)]
     Render(RenderArgs),
     /// Measure build, edit and render speed and memory; writes docs/bench/.
     Bench(BenchArgs),
@@ -78,6 +93,10 @@ pub enum Command {
         /// Run without a GPU: flushes are counted, renders use the CPU tracer.
         #[arg(long)]
         cpu: bool,
+        /// Let `save` and `render` lines replace existing .vox/.obj/.ovr
+        /// files and the run's inputs.
+        #[arg(long)]
+        force: bool,
     },
 }
 
@@ -96,6 +115,9 @@ pub struct ImportArgs {
     /// Palette index of the voxels (1..=255, default palette).
     #[arg(long, default_value_t = octovox::io::mesh::MESH_COLOR, value_parser = clap::value_parser!(u8).range(1..))]
     pub color: u8,
+    /// Replace OUTPUT even if it exists or is the mesh.
+    #[arg(long)]
+    pub force: bool,
 }
 
 #[derive(Args, Debug)]
@@ -107,10 +129,10 @@ pub struct RenderArgs {
     #[arg(long, value_parser = parse_size, default_value = "1280x720")]
     pub size: (u32, u32),
     /// EX,EY,EZ:TX,TY,TZ; without it, a camera that frames the whole model.
-    #[arg(long, value_parser = parse_camera)]
+    #[arg(long, value_parser = parse_camera, allow_hyphen_values = true)]
     pub camera: Option<(DVec3, DVec3)>,
-    /// Vertical field of view in degrees.
-    #[arg(long, default_value_t = 50.0)]
+    /// Vertical field of view in degrees (1..=179).
+    #[arg(long, default_value_t = 50.0, value_parser = parse_fov)]
     pub fov: f32,
     #[arg(long, value_enum, default_value_t = TraceMode::Svo)]
     pub mode: TraceMode,
@@ -124,6 +146,9 @@ pub struct RenderArgs {
     pub no_shadows: bool,
     #[arg(long, default_value_t = 0)]
     pub frame: usize,
+    /// Replace OUTPUT even if it is the input or an existing .vox/.obj/.ovr.
+    #[arg(long)]
+    pub force: bool,
 }
 
 #[derive(Args, Debug)]
@@ -158,6 +183,12 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
         return Err(format!("size '{s}' must be between 1x1 and 16384x16384"));
     }
     Ok((w, h))
+}
+
+/// Parses a field of view in degrees, within [`octovox::camera::FOV_RANGE_DEG`].
+pub fn parse_fov(s: &str) -> Result<f32, String> {
+    let fov: f32 = s.trim().parse().map_err(|_| format!("field of view '{s}' is not a number"))?;
+    octovox::camera::check_fov(fov)
 }
 
 /// Parses "EX,EY,EZ:TX,TY,TZ".

@@ -3,6 +3,7 @@
 //! The engine (scene, octree, edits, .vox I/O, replay) knows nothing of
 //! windows; `gpu` holds the wgpu passes and `app` the winit/egui front end.
 
+pub mod budget;
 pub mod camera;
 pub mod edit;
 pub mod gpu;

@@ -136,10 +136,10 @@ fn the_shared_meshes_import_upright_and_solid() {
 fn bad_meshes_get_clear_errors() {
     let dir = tempfile::tempdir().unwrap();
     let cases: [(&str, &str, &str); 6] = [
-        ("garbage.obj", "\u{0}\u{1}\u{2} this is not a mesh\nf x y z\n", "not a readable .obj"),
+        ("garbage.obj", "\u{0}\u{1}\u{2} this is not a mesh\nf x y z\n", ":2: face vertex index 'x'"),
         ("empty.obj", "", "no triangles"),
         ("points.obj", "v 0 0 0\nv 1 0 0\n", "no triangles"),
-        ("nan.obj", "v 0 0 0\nv 1 0 nan\nv 0 1 0\nf 1 2 3\n", "not a finite number"),
+        ("nan.obj", "v 0 0 0\nv 1 0 nan\nv 0 1 0\nf 1 2 3\n", ":2: vertex coordinate nan is not a finite"),
         ("index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99\n", "out of bounds"),
         ("flat.obj", "v 0 0 0\nv 1e38 0 0\nv 0 -1e38 0\nf 1 2 3\n", "encloses no voxel"),
     ];
@@ -174,8 +174,8 @@ fn import_writes_a_vox_that_reads_back() {
     assert_eq!(scene.tree.solid_voxels(), 256 * 17 * 26);
 
     // Saving never writes .vox bytes over a mesh.
-    let e = octovox::io::save_scene(&obj, &scene).unwrap_err();
-    assert!(e.to_string().contains("not .obj"), "{e}");
+    let e = octovox::io::save_scene(&obj, &scene, Default::default()).unwrap_err();
+    assert!(e.to_string().contains("saved as .vox"), "{e}");
     assert!(std::fs::read_to_string(&obj).unwrap().starts_with("v "));
 
     let bad = write_obj(dir.path(), "bad.obj", "v 0 0 0\nf 1 2 3\n");

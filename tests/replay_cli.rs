@@ -33,7 +33,8 @@ fn scripts() -> Vec<String> {
 fn every_script_passes_on_the_gpu() {
     std::fs::create_dir_all(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/out")).unwrap();
     let scripts = scripts();
-    let mut args = vec!["replay"];
+    // tests/out is scratch space: what an earlier run left there may be replaced.
+    let mut args = vec!["replay", "--force"];
     args.extend(scripts.iter().map(String::as_str));
     let out = octovox(&args);
     let text = stdout(&out);
@@ -45,7 +46,7 @@ fn every_script_passes_on_the_gpu() {
 fn every_script_passes_on_the_cpu() {
     std::fs::create_dir_all(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/out")).unwrap();
     let scripts = scripts();
-    let mut args = vec!["replay", "--cpu"];
+    let mut args = vec!["replay", "--cpu", "--force"];
     args.extend(scripts.iter().map(String::as_str));
     let out = octovox(&args);
     assert!(out.status.success(), "{}", stdout(&out));

@@ -19,8 +19,8 @@ fn renderer_for(tree: &mut Octree) -> Renderer {
     let mut renderer = Renderer::headless().expect("a GPU adapter (lavapipe on CI)");
     renderer.hit_records = true;
     renderer.sync(tree, &Palette::default());
-    if let Some(grid) = DenseGrid::from_octree(tree) {
-        renderer.set_grid(&grid);
+    if let Ok(grid) = DenseGrid::from_octree(tree) {
+        renderer.set_grid(&grid).unwrap();
     }
     renderer
 }

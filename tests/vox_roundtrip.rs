@@ -107,7 +107,7 @@ fn index_255_and_wide_scenes_round_trip() {
         (IVec3::new(255, 255, 255), 2),
         (IVec3::new(256, 256, 256), 3),
     ];
-    let model = VoxelModel { palette: synthetic_palette(), voxels, models: 1 };
+    let model = VoxelModel { palette: synthetic_palette(), voxels, models: 1, ..VoxelModel::default() };
     let again = assert_round_trip("synthetic", &model);
     assert!(again.models >= 4, "expected a split into several models, got {}", again.models);
     assert_eq!(again.palette.colors[255], [1, 2, 3, 4]);

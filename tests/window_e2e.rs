@@ -41,7 +41,7 @@ fn click_attach_save_erase_save_in_a_real_window() {
     assert!(source.is_file(), "missing test model {}", source.display());
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("torus.vox");
-    std::fs::copy(&source, &file).unwrap();
+    common::copy_writable(&source, &file);
 
     // The CPU reference decides where to click and what must happen.
     let original = octovox::io::load_scene(&file, 0).unwrap();
@@ -75,8 +75,17 @@ fn click_attach_save_erase_save_in_a_real_window() {
     );
 
     // Attach one voxel in front of the clicked face, save, check the file.
+    // A read-only file is not replaced: Ctrl+S asks, Escape cancels.
+    let before = std::fs::read(&file).unwrap();
+    set_read_only(&file, true);
     let bytes = click(&display, &window, &mut lines, x, y);
     assert!(bytes <= 1024, "a one-voxel click wrote {bytes} bytes to the GPU");
+    xdotool(&display, &["key", "ctrl+s"]);
+    let asked = lines.wait_for("asking:", Duration::from_secs(30));
+    assert!(asked.ends_with("torus.vox is read-only"), "{asked}");
+    assert_eq!(std::fs::read(&file).unwrap(), before, "a read-only file was overwritten without asking");
+    xdotool(&display, &["key", "Escape"]);
+    set_read_only(&file, false);
     save(&display, &mut lines, &file);
     let after_attach = voxel_set(&file);
     let added: Vec<&IVec3> = after_attach.difference(&original_voxels).collect();
@@ -208,4 +217,10 @@ fn slow_load_keeps_the_window_live() {
         assert!(Instant::now() < deadline, "octovox did not quit on Ctrl+Q");
         std::thread::sleep(Duration::from_millis(100));
     }
+}
+
+fn set_read_only(file: &std::path::Path, read_only: bool) {
+    use std::os::unix::fs::PermissionsExt;
+    let mode = if read_only { 0o444 } else { 0o644 };
+    std::fs::set_permissions(file, std::fs::Permissions::from_mode(mode)).unwrap();
 }

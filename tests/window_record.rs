@@ -32,7 +32,7 @@ fn recorded_window_session_replays_to_the_same_voxels() {
     let source = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/vox/seed/torus64.vox");
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("torus.vox");
-    std::fs::copy(&source, &file).unwrap();
+    common::copy_writable(&source, &file);
     let original = octovox::io::load_scene(&file, 0).unwrap();
     let (lo, hi) = original.tree.solid_bounds().unwrap();
     let camera = Camera::framing(lo, hi, 50.0);

@@ -37,7 +37,7 @@ pub fn orbit(camera: &mut Camera, dx: f64, dy: f64) {
 pub fn pan(camera: &mut Camera, dx: f64, dy: f64, height: u32) {
     let (_, right, up) = frame(camera);
     let distance = (camera.target - camera.eye).length();
-    let half_fov = f64::from(camera.fov_y_deg.clamp(1.0, 179.0)).to_radians() * 0.5;
+    let half_fov = f64::from(octovox::camera::clamp_fov(camera.fov_y_deg)).to_radians() * 0.5;
     let units_per_pixel = 2.0 * distance * half_fov.tan() / f64::from(height.max(1));
     let shift = (-right * dx + up * dy) * units_per_pixel;
     camera.eye += shift;

@@ -22,10 +22,13 @@ impl App {
         let Some(gfx) = &self.gfx else { return };
         let stamp = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_millis());
         // A script's `render PATH` names the file; otherwise a stamped name in saves/.
-        let view_path = self
-            .screenshot_path
-            .take()
-            .unwrap_or_else(|| Path::new(SCREENSHOT_DIR).join(format!("octovox-{stamp}.png")));
+        let view_path = self.screenshot_path.take().unwrap_or_else(|| {
+            // The screenshot folder is ours to make; a path a script names is not.
+            if let Err(err) = std::fs::create_dir_all(SCREENSHOT_DIR) {
+                log::warn!("cannot create {SCREENSHOT_DIR}: {err}");
+            }
+            Path::new(SCREENSHOT_DIR).join(format!("octovox-{stamp}.png"))
+        });
         let base = view_path.with_extension("");
         let (w, h) = gfx.trace.size();
         let result = gfx
@@ -33,7 +36,9 @@ impl App {
             .read_color(&gfx.gpu)
             .map_err(anyhow::Error::from)
             .and_then(|bytes| image::RgbaImage::from_raw(w, h, bytes).context("trace readback has the wrong size"))
-            .and_then(|image| octovox::io::png::save_png(&image, &view_path).map_err(anyhow::Error::from));
+            .and_then(|image| {
+                octovox::io::png::save_png(&image, &view_path, Default::default()).map_err(anyhow::Error::from)
+            });
         match result {
             Ok(()) => report!("screenshot: {}", view_path.display()),
             Err(err) => {
@@ -53,7 +58,7 @@ impl App {
                 pixels.chunks_exact_mut(4).for_each(|p| p[3] = 255);
                 let image =
                     image::RgbaImage::from_raw(width, height, pixels).context("frame readback has the wrong size")?;
-                octovox::io::png::save_png(&image, &window_path).map_err(anyhow::Error::from)
+                octovox::io::png::save_png(&image, &window_path, Default::default()).map_err(anyhow::Error::from)
             });
             match result {
                 Ok(()) => report!("screenshot: {}", window_path.display()),

@@ -72,6 +72,9 @@ pub enum Command {
     /// Save to the current file, or ask for one.
     Save,
     SaveAs(PathBuf),
+    /// Save As, replacing the file even though it is read-only (the user
+    /// said so in the prompt).
+    SaveOver(PathBuf),
     /// Show the Open or Save As path dialog.
     AskOpen,
     AskSaveAs,

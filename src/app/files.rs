@@ -9,6 +9,7 @@ use glam::IVec3;
 use winit::event_loop::ActiveEventLoop;
 
 use octovox::camera::Camera;
+use octovox::io::atomic::WriteOptions;
 use octovox::scene::Scene;
 
 use super::ui::DialogKind;
@@ -59,8 +60,11 @@ impl App {
             Choice::Discard => self.perform(pending, event_loop),
             Choice::Save => match self.state.path.clone() {
                 Some(path) => {
-                    if self.save(&path) {
+                    if self.save(&path, WriteOptions::default()) {
                         self.perform(pending, event_loop);
+                    } else if self.ui.read_only.is_some() {
+                        // Overwriting from the read-only prompt carries on with it.
+                        self.ui.pending = Some(pending);
                     }
                 }
                 None => {
@@ -96,9 +100,27 @@ impl App {
         }
     }
 
-    /// Saves atomically; reports the outcome in the UI and on stdout.
-    pub(super) fn save(&mut self, path: &Path) -> bool {
-        match octovox::io::save_scene(path, &self.scene) {
+    /// Saves, then makes `path` the document and carries on with an action
+    /// that waited for a path to save to.
+    pub(super) fn save_as(&mut self, path: PathBuf, options: WriteOptions, event_loop: &ActiveEventLoop) {
+        if self.save(&path, options) {
+            self.state.path = Some(path);
+            self.update_title();
+            if let Some(pending) = self.ui.pending.take() {
+                self.perform(pending, event_loop);
+            }
+        }
+    }
+
+    /// Saves atomically; reports the outcome in the UI and on stdout. A
+    /// read-only file is not replaced: the user is asked first.
+    pub(super) fn save(&mut self, path: &Path, options: WriteOptions) -> bool {
+        if !options.overwrite_read_only && octovox::io::atomic::is_read_only(path) {
+            report!("asking: {} is read-only", path.display());
+            self.ui.read_only = Some(path.to_path_buf());
+            return false;
+        }
+        match octovox::io::save_scene(path, &self.scene, options) {
             Ok(()) => {
                 report!("saved: {}", path.display());
                 self.state.dirty = false;

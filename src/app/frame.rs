@@ -28,7 +28,8 @@ impl App {
         let Some((ctx, full)) = self.run_panels(event_loop) else { return };
         // Hover pick: what a click would edit, highlighted before any click.
         self.pick = match self.input.cursor() {
-            Some((x, y)) if !self.pointer_over_ui && self.loading.is_none() => self.pick_at(x, y),
+            // A hover over a ray that gave up highlights nothing; a click says why.
+            Some((x, y)) if !self.pointer_over_ui && self.loading.is_none() => self.pick_at(x, y).ok().flatten(),
             _ => None,
         };
         self.sync_grid();
@@ -128,7 +129,11 @@ impl App {
 
         // Trace.
         let tree = &self.scene.tree;
-        gfx.trace.resize(&gfx.gpu.device, &gfx.buffers, trace_size.0, trace_size.1);
+        // The surface is never larger than the GPU's textures, so neither is
+        // the trace; the check stays for a GPU that refuses anyway.
+        if let Err(err) = gfx.trace.resize(&gfx.gpu, &gfx.buffers, trace_size, false) {
+            log::error!("{err}");
+        }
         let basis = self.state.camera.basis(trace_size.0, trace_size.1, tree.origin());
         let highlight = self.pick.map(|pick| {
             let (lo, hi) = self.state.preview_box(&pick);
@@ -202,13 +207,18 @@ impl App {
         }
         let Some(gfx) = &mut self.gfx else { return };
         match DenseGrid::from_octree(&self.scene.tree) {
-            Some(grid) => {
+            Ok(grid) => {
+                if let Err(err) = gfx.gpu.check_binding("the dense grid", grid.data.len() as u64) {
+                    self.state.settings.mode = TraceMode::Svo;
+                    self.ui.error(format!("{err}; back to SVO"));
+                    return;
+                }
                 gfx.buffers.upload_grid(&gfx.gpu.device, &gfx.gpu.queue, &grid);
                 self.grid_stale = false;
             }
-            None => {
+            Err(err) => {
                 self.state.settings.mode = TraceMode::Svo;
-                self.ui.error("the scene is too wide for a dense grid; back to SVO");
+                self.ui.error(format!("{err}; back to SVO"));
             }
         }
     }

@@ -41,6 +41,7 @@ use octovox::edit::{Edit, History};
 use octovox::gpu::scene_buffers::UploadStats;
 use octovox::gpu::timer::PassTimer;
 use octovox::gpu::{BlitPass, GpuContext, SceneBuffers, TracePass};
+use octovox::io::atomic::WriteOptions;
 use octovox::scene::Scene;
 use octovox::trace::svo;
 
@@ -55,6 +56,11 @@ const SCREENSHOT_DIR: &str = "saves";
 
 /// Opens the window and runs until it is closed.
 pub fn run(args: WindowArgs) -> anyhow::Result<ExitCode> {
+    if let Some(record) = &args.record {
+        // Checked before anything opens: recording truncates its file.
+        let inputs: Vec<&std::path::Path> = args.file.iter().chain(&args.replay).map(PathBuf::as_path).collect();
+        octovox::io::output::check_output(record, octovox::io::output::OutputKind::Script, &inputs, args.force)?;
+    }
     let event_loop = EventLoop::new().context("cannot open a window (is DISPLAY or WAYLAND_DISPLAY set?)")?;
     let instance = GpuContext::window_instance(Box::new(event_loop.owned_display_handle()));
     let mut app = App::new(args, instance);
@@ -194,9 +200,9 @@ impl App {
         let surface = instance.create_surface(window.clone()).context("cannot create a surface for the window")?;
         let gpu = pollster::block_on(GpuContext::with_instance(instance, Some(&surface)))?;
         let size = window.inner_size();
-        let mut config = surface
-            .get_default_config(&gpu.adapter, size.width.max(1), size.height.max(1))
-            .context("the GPU cannot present to this window")?;
+        let (width, height) = surface_size(size, &gpu);
+        let mut config =
+            surface.get_default_config(&gpu.adapter, width, height).context("the GPU cannot present to this window")?;
         let caps = surface.get_capabilities(&gpu.adapter);
         // egui-wgpu wants a non-sRGB target; the trace output is already sRGB-encoded.
         if let Some(format) = caps.formats.iter().copied().find(|f| !f.is_srgb()) {
@@ -343,20 +349,12 @@ impl App {
             Command::Quit => self.guard_unsaved(Pending::Quit, event_loop),
             Command::Save => match self.state.path.clone() {
                 Some(path) => {
-                    self.save(&path);
+                    self.save(&path, WriteOptions::default());
                 }
                 None => self.ui.dialog = Some((DialogKind::SaveAs, "saves/untitled.vox".into())),
             },
-            Command::SaveAs(path) => {
-                if self.save(&path) {
-                    self.state.path = Some(path);
-                    self.update_title();
-                    // A prompt that asked for a path to save to can now go on.
-                    if let Some(pending) = self.ui.pending.take() {
-                        self.perform(pending, event_loop);
-                    }
-                }
-            }
+            Command::SaveAs(path) => self.save_as(path, WriteOptions::default(), event_loop),
+            Command::SaveOver(path) => self.save_as(path, WriteOptions { overwrite_read_only: true }, event_loop),
             Command::AskOpen => {
                 let start = self.state.path.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
                 self.ui.dialog = Some((DialogKind::Open, start));
@@ -392,16 +390,17 @@ impl App {
     /// CPU pick of the voxel and face under window pixel (x, y), in world
     /// coordinates. Same ray as the GPU's pixel (window pixels map to trace
     /// pixels by the render scale; the panels sit over the image).
-    fn pick_at(&self, x: f64, y: f64) -> Option<Pick> {
+    /// A ray that gave up is an error, never "nothing under the cursor".
+    fn pick_at(&self, x: f64, y: f64) -> Result<Option<Pick>, svo::GaveUp> {
         let (window_w, window_h) = self.gfx.as_ref().map_or(self.args.size, |g| (g.config.width, g.config.height));
         let (w, h) = self.trace_size();
         if x < 0.0 || y < 0.0 || x >= f64::from(window_w) || y >= f64::from(window_h) {
-            return None;
+            return Ok(None);
         }
         let px = ((x * f64::from(w) / f64::from(window_w)) as u32).min(w - 1);
         let py = ((y * f64::from(h) / f64::from(window_h)) as u32).min(h - 1);
         let hit = svo::pick(&self.scene.tree, &self.state.camera, (w, h), px, py)?;
-        Some(Pick { voxel: hit.voxel, normal: hit.normal, value: hit.value })
+        Ok(hit.map(|hit| Pick { voxel: hit.voxel, normal: hit.normal, value: hit.value }))
     }
 
     fn pointer_edit(&mut self, phase: StrokePhase, tool: Tool, x: f64, y: f64) {
@@ -431,7 +430,14 @@ impl App {
     /// new cell of the stroke's layer.
     fn stroke_step(&mut self, x: f64, y: f64) {
         let Some(stroke) = &self.stroke else { return };
-        let Some(pick) = self.pick_at(x, y) else { return };
+        let pick = match self.pick_at(x, y) {
+            Ok(Some(pick)) => pick,
+            Ok(None) => return,
+            Err(gave_up) => {
+                self.ui.error(gave_up.to_string());
+                return;
+            }
+        };
         if stroke.tool == Tool::Attach && pick.normal == IVec3::ZERO {
             return; // the camera is inside a voxel: no face to attach to
         }
@@ -507,8 +513,7 @@ impl ApplicationHandler for App {
                 // Minimised windows report 0×0: keep the old configuration
                 // and draw nothing until there is a size again.
                 if size.width > 0 && size.height > 0 {
-                    gfx.config.width = size.width;
-                    gfx.config.height = size.height;
+                    (gfx.config.width, gfx.config.height) = surface_size(*size, &gfx.gpu);
                     gfx.surface.configure(&gfx.gpu.device, &gfx.config);
                     self.redraw_wanted.set(true);
                     gfx.window.request_redraw();
@@ -546,4 +551,15 @@ impl ApplicationHandler for App {
             None => event_loop.set_control_flow(ControlFlow::Wait),
         }
     }
+}
+
+/// The surface size for a window size: never zero, and never larger than
+/// the GPU's textures allow (wgpu panics past that); a window larger than
+/// the limit shows the image stretched, with a warning.
+fn surface_size(size: winit::dpi::PhysicalSize<u32>, gpu: &GpuContext) -> (u32, u32) {
+    let limit = gpu.device.limits().max_texture_dimension_2d;
+    if size.width > limit || size.height > limit {
+        log::warn!("the window is {}x{}; this GPU draws at most {limit}x{limit}", size.width, size.height);
+    }
+    (size.width.clamp(1, limit), size.height.clamp(1, limit))
 }

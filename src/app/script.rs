@@ -53,7 +53,7 @@ impl App {
         }
         let Some(player) = &mut self.player else { return };
         let Some(line) = player.script.lines.get(player.next).cloned() else {
-            println!("replay: {} passed, {} failed", player.passed, player.failed);
+            report!("replay: {} passed, {} failed", player.passed, player.failed);
             self.ui.info(format!("replay done: {} passed, {} failed", player.passed, player.failed));
             self.player = None;
             return;
@@ -66,7 +66,7 @@ impl App {
             Played::Passed => self.with_player(|p| p.passed += 1),
             Played::Failed(message) => {
                 self.with_player(|p| p.failed += 1);
-                println!("{where_}: {message}");
+                report!("{where_}: {message}");
                 self.ui.error(format!("{where_}: {message}"));
             }
         }
@@ -102,11 +102,12 @@ impl App {
             Line::Remove(at) => self.execute(Command::Edit(brush_edit(*at, Op::Remove)), event_loop),
             Line::Paint(at) => self.execute(Command::Edit(brush_edit(*at, Op::Paint(color))), event_loop),
             Line::Click { x, y, tool } => match self.pick_at(f64::from(*x) + 0.5, f64::from(*y) + 0.5) {
-                Some(pick) => {
+                Ok(Some(pick)) => {
                     let (_, edit) = click_edit(*tool, &brush, color, pick.voxel, pick.normal);
                     self.execute(Command::Edit(edit), event_loop);
                 }
-                None => return Played::Failed(format!("expected pixel ({x}, {y}) to hit a voxel, got nothing")),
+                Ok(None) => return Played::Failed(format!("expected pixel ({x}, {y}) to hit a voxel, got nothing")),
+                Err(gave_up) => return Played::Failed(format!("expected pixel ({x}, {y}) to hit a voxel: {gave_up}")),
             },
             Line::Undo(n) | Line::Redo(n) => {
                 let command = if matches!(line, Line::Undo(_)) { Command::Undo } else { Command::Redo };
@@ -115,7 +116,7 @@ impl App {
                 }
             }
             Line::Save(path) => {
-                if !self.save(&base.join(path)) {
+                if !self.save(&base.join(path), octovox::io::atomic::WriteOptions::default()) {
                     return Played::Failed(format!("could not save {}", path.display()));
                 }
             }
@@ -137,7 +138,7 @@ impl App {
             }
             // The window's size and panels differ from a headless render.
             Line::ExpectImage(..) => {
-                println!("replay: 'expect image' is checked by `octovox replay`, not in the window")
+                report!("replay: 'expect image' is checked by `octovox replay`, not in the window")
             }
         }
         Played::Done
@@ -162,7 +163,7 @@ impl App {
                 Ok(script) => self.player = Some(Player::new(script)),
                 Err(errors) => {
                     for error in &errors {
-                        println!("{error}");
+                        report!("{error}");
                     }
                     self.ui.error(format!("cannot play {}: {} error(s)", path.display(), errors.len()));
                 }

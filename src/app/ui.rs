@@ -61,6 +61,8 @@ pub struct UiState {
     /// An action waiting for the unsaved-changes prompt.
     pub pending: Option<Pending>,
     pub prompt_open: bool,
+    /// A read-only file the user is asked about overwriting.
+    pub read_only: Option<PathBuf>,
     /// Last message for the user, and whether it is an error.
     pub message: Option<(String, bool)>,
 }
@@ -99,6 +101,7 @@ pub fn show(ui: &mut egui::Ui, state: &mut EditorState, ui_state: &mut UiState, 
     });
     dialog(ui.ctx(), ui_state, &mut out);
     prompt(ui.ctx(), ui_state, &mut out);
+    read_only_prompt(ui.ctx(), ui_state, &mut out);
     out
 }
 
@@ -356,6 +359,28 @@ fn prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
             }
         });
     });
+}
+
+/// Asks before a save replaces a read-only file.
+fn read_only_prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
+    let Some(path) = ui_state.read_only.clone() else { return };
+    let modal = egui::Modal::new(egui::Id::unique("read-only")).show(ctx, |ui| {
+        ui.heading("Read-only file");
+        ui.label(format!("{} is read-only. Overwrite it?", path.display()));
+        ui.horizontal(|ui| {
+            if ui.button("Overwrite").clicked() {
+                ui_state.read_only = None;
+                out.push(Command::SaveOver(path.clone()));
+            }
+            if ui.button("Cancel").clicked() {
+                ui_state.read_only = None;
+            }
+        });
+    });
+    // Escape or a click outside cancels, as Cancel does.
+    if modal.should_close() {
+        ui_state.read_only = None;
+    }
 }
 
 /// Button text of a tool, with its MagicaVoxel key.

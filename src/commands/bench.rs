@@ -79,7 +79,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<ExitCode> {
         BenchKind::Edit => bench_edit(args.quick)?,
         BenchKind::Render => bench_render(args.quick)?,
     };
-    println!("{markdown}");
+    say!("{markdown}")?;
     let name = format!("{:?}", args.what).to_lowercase();
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
     for (ext, text) in [("md", markdown), ("json", json)] {
@@ -124,7 +124,7 @@ fn bench_build(quick: bool) -> anyhow::Result<(String, String)> {
             tree = build(&source)?;
             times.push(start.elapsed().as_secs_f64() * 1e3);
         }
-        let grid = DenseGrid::from_octree(&tree).context("dense grid too large")?;
+        let grid = DenseGrid::from_octree(&tree).map_err(anyhow::Error::msg)?;
         let solid = tree.solid_voxels();
         rows.push(BuildRow {
             model: model.name,
@@ -254,9 +254,9 @@ fn bench_render(quick: bool) -> anyhow::Result<(String, String)> {
     let mut rows = Vec::new();
     for model in &MODELS {
         let mut scene = Scene { palette: Palette::default(), tree: build(&source(model)?)? };
-        let grid = DenseGrid::from_octree(&scene.tree).context("dense grid too large")?;
+        let grid = DenseGrid::from_octree(&scene.tree).map_err(anyhow::Error::msg)?;
         renderer.sync(&mut scene.tree, &scene.palette);
-        renderer.set_grid(&grid);
+        renderer.set_grid(&grid)?;
         let (lo, hi) = scene.tree.solid_bounds().context("empty model")?;
         let camera = Camera::framing(lo, hi, 50.0);
         // Shared machines are noisy: enough frames for a steady median.

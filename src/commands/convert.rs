@@ -1,16 +1,20 @@
-//! `octovox convert IN.vox OUT.vox [--frame N]`: load, then save through
-//! octovox's scene model.
+//! `octovox convert IN.vox OUT.vox [--frame N] [--force]`: load, then save
+//! through octovox's scene model (the octree), one model at a time.
 
 use std::path::Path;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use octovox::io::vox::{load_vox_file, save_vox};
+use octovox::io::atomic::WriteOptions;
+use octovox::io::output::{OutputKind, check_output};
 
-/// Loads `input` (frame `frame`) and saves it to `output`, replacing it atomically.
-pub fn run(input: &Path, output: &Path, frame: usize) -> anyhow::Result<ExitCode> {
-    let model = load_vox_file(input, frame).with_context(|| format!("loading {}", input.display()))?;
-    save_vox(output, &model.palette, &model.voxels).with_context(|| format!("saving {}", output.display()))?;
-    println!("wrote {} voxels to {}", model.voxels.len(), output.display());
+/// Loads `input` (frame `frame`) and saves it to `output`, replacing it
+/// atomically; an existing .vox or the input itself only with `force`.
+pub fn run(input: &Path, output: &Path, frame: usize, force: bool) -> anyhow::Result<ExitCode> {
+    check_output(output, OutputKind::Scene, &[input], force)?;
+    let scene = octovox::io::load_scene(input, frame).with_context(|| format!("loading {}", input.display()))?;
+    let options = WriteOptions { overwrite_read_only: force };
+    octovox::io::save_scene(output, &scene, options).with_context(|| format!("saving {}", output.display()))?;
+    say!("wrote {} voxels to {}", scene.tree.solid_voxels(), output.display())?;
     Ok(ExitCode::SUCCESS)
 }

@@ -5,19 +5,24 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::Context;
+use octovox::io::atomic::WriteOptions;
 use octovox::io::mesh::voxelize_obj;
+use octovox::io::output::{OutputKind, check_output};
 use octovox::scene::Scene;
 
 use crate::cli::ImportArgs;
 
 pub fn run(args: &ImportArgs) -> anyhow::Result<ExitCode> {
+    check_output(&args.output, OutputKind::Scene, &[&args.mesh], args.force)?;
     let start = Instant::now();
     let dense = voxelize_obj(&args.mesh, args.size, args.up, args.color)?;
     let voxelized = start.elapsed();
     let scene = Scene::from_dense(&dense).with_context(|| format!("building {}", args.mesh.display()))?;
-    octovox::io::save_scene(&args.output, &scene).with_context(|| format!("saving {}", args.output.display()))?;
+    let options = WriteOptions { overwrite_read_only: args.force };
+    octovox::io::save_scene(&args.output, &scene, options)
+        .with_context(|| format!("saving {}", args.output.display()))?;
     let d = dense.dims;
-    println!(
+    say!(
         "{}: {} solid voxels in {}×{}×{} (voxelized in {:.2} s), wrote {}",
         args.mesh.display(),
         scene.tree.solid_voxels(),
@@ -26,6 +31,6 @@ pub fn run(args: &ImportArgs) -> anyhow::Result<ExitCode> {
         d.z,
         voxelized.as_secs_f64(),
         args.output.display()
-    );
+    )?;
     Ok(ExitCode::SUCCESS)
 }

@@ -13,9 +13,9 @@ pub fn run(file: &Path, json: bool, frame: usize) -> anyhow::Result<ExitCode> {
     let model = load_vox_file(file, frame).with_context(|| format!("loading {}", file.display()))?;
     let summary = Summary::of(&model);
     if json {
-        println!("{}", serde_json::to_string_pretty(&summary.to_json(file))?);
+        say!("{}", serde_json::to_string_pretty(&summary.to_json(file))?)?;
     } else {
-        print!("{}", summary.to_text(file));
+        std::io::Write::write_all(&mut std::io::stdout().lock(), summary.to_text(file).as_bytes())?;
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -23,6 +23,8 @@ pub fn run(file: &Path, json: bool, frame: usize) -> anyhow::Result<ExitCode> {
 /// The numbers `info` reports.
 struct Summary {
     models: usize,
+    stored_models: usize,
+    warnings: Vec<String>,
     voxels: usize,
     /// Inclusive corners in world axes (y up); `None` for an empty scene.
     bounds: Option<([i32; 3], [i32; 3])>,
@@ -40,6 +42,8 @@ impl Summary {
         }
         Summary {
             models: model.models,
+            stored_models: model.stored_models,
+            warnings: model.warnings.clone(),
             voxels: model.voxels.len(),
             bounds: model.bounds().map(|(lo, hi)| (lo.to_array(), hi.to_array())),
             palette_entries: used.len(),
@@ -62,6 +66,8 @@ impl Summary {
         serde_json::json!({
             "file": file.display().to_string(),
             "models": self.models,
+            "stored_models": self.stored_models,
+            "warnings": self.warnings,
             "voxels": self.voxels,
             "extent": self.extent(),
             "min": self.bounds.map(|(lo, _)| lo),
@@ -78,6 +84,7 @@ impl Summary {
         let rows = [
             ("file", file.display().to_string()),
             ("models", self.models.to_string()),
+            ("stored models", self.stored_models.to_string()),
             ("voxels", self.voxels.to_string()),
             ("extent", format!("{ex} x {ey} x {ez}  (x, y up, z)")),
             ("min", corner(self.bounds.map(|(lo, _)| lo))),
@@ -85,6 +92,7 @@ impl Summary {
             ("palette entries", self.palette_entries.to_string()),
             ("materials", if materials.is_empty() { "-".to_owned() } else { materials.join(", ") }),
         ];
-        rows.iter().map(|(key, value)| format!("{key:<16} {value}\n")).collect()
+        let warnings = self.warnings.iter().map(|w| ("warning", w.clone()));
+        rows.into_iter().chain(warnings).map(|(key, value)| format!("{key:<16} {value}\n")).collect()
     }
 }

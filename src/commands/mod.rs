@@ -1,5 +1,14 @@
 //! One module per subcommand; `run` dispatches.
 
+/// `println!` that returns a write error (such as a closed pipe, which
+/// `main` treats as a normal end) instead of panicking.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout().lock(), $($arg)*)
+    }};
+}
+
 mod bench;
 mod convert;
 mod import;
@@ -17,13 +26,14 @@ fn update_images() -> bool {
 }
 
 pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
+    octovox::budget::set_budget_bytes(cli.memory_budget);
     match cli.command {
         None => crate::app::run(cli.window),
         Some(Command::Info { file, json, frame }) => info::run(&file, json, frame),
-        Some(Command::Convert { input, output, frame }) => convert::run(&input, &output, frame),
+        Some(Command::Convert { input, output, frame, force }) => convert::run(&input, &output, frame, force),
         Some(Command::Import(args)) => import::run(&args),
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
-        Some(Command::Replay { scripts, cpu }) => replay::run(&scripts, cpu, update_images()),
+        Some(Command::Replay { scripts, cpu, force }) => replay::run(&scripts, cpu, force, update_images()),
     }
 }

@@ -8,7 +8,7 @@ use anyhow::Context;
 use octovox::gpu::Renderer;
 use octovox::replay::{Runner, RunnerMode, load_script};
 
-pub fn run(scripts: &[PathBuf], cpu: bool, update_images: bool) -> anyhow::Result<ExitCode> {
+pub fn run(scripts: &[PathBuf], cpu: bool, force: bool, update_images: bool) -> anyhow::Result<ExitCode> {
     let mut mode = if cpu {
         RunnerMode::Cpu
     } else {
@@ -20,7 +20,7 @@ pub fn run(scripts: &[PathBuf], cpu: bool, update_images: bool) -> anyhow::Resul
             Ok(script) => script,
             Err(errors) => {
                 for error in &errors {
-                    println!("{error}");
+                    say!("{error}")?;
                 }
                 failed += errors.len();
                 continue;
@@ -28,14 +28,15 @@ pub fn run(scripts: &[PathBuf], cpu: bool, update_images: bool) -> anyhow::Resul
         };
         let mut runner = Runner::new(mode);
         runner.update_images = update_images;
+        runner.force = force;
         let report = runner.run(&script);
         for failure in &report.failures {
-            println!("{failure}");
+            say!("{failure}")?;
         }
         passed += report.passed;
         failed += report.failures.len();
         mode = runner.into_mode();
     }
-    println!("replay: {passed} passed, {failed} failed");
+    say!("replay: {passed} passed, {failed} failed")?;
     Ok(if failed == 0 { ExitCode::SUCCESS } else { ExitCode::FAILURE })
 }

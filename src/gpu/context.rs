@@ -15,6 +15,12 @@ pub enum GpuError {
     Surface(#[from] wgpu::CreateSurfaceError),
     #[error("GPU readback failed: {0}")]
     Readback(String),
+    /// A size past what the adapter allows (a texture edge, a buffer binding).
+    #[error("{0}")]
+    TooLarge(String),
+    /// wgpu reported a validation error while a frame was recorded.
+    #[error("the GPU rejected the frame: {0}")]
+    Validation(String),
 }
 
 /// Instance, adapter, device and queue, plus what the rest of the program
@@ -68,6 +74,7 @@ impl GpuContext {
         let limits = wgpu::Limits {
             max_storage_buffer_binding_size: supported.max_storage_buffer_binding_size,
             max_buffer_size: supported.max_buffer_size,
+            max_texture_dimension_2d: supported.max_texture_dimension_2d,
             ..wgpu::Limits::default()
         };
         let (device, queue) = adapter
@@ -102,6 +109,42 @@ impl GpuContext {
             Some(err) => Err(GpuError::Shader { name: name.to_string(), message: err.to_string() }),
             None => Ok(created),
         }
+    }
+
+    /// Runs `work` inside a validation error scope: any validation error
+    /// while it records or submits (an oversized binding, a bad dispatch) is
+    /// an error of the command instead of a line in the log and a blank image.
+    pub fn checked<T>(&self, work: impl FnOnce() -> Result<T, GpuError>) -> Result<T, GpuError> {
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let result = work();
+        match pollster::block_on(scope.pop()) {
+            Some(err) => Err(GpuError::Validation(err.to_string())),
+            None => result,
+        }
+    }
+
+    /// Fails unless a `width`×`height` image fits the adapter's textures.
+    pub fn check_image_size(&self, width: u32, height: u32) -> Result<(), GpuError> {
+        let limit = self.device.limits().max_texture_dimension_2d;
+        if width > limit || height > limit {
+            return Err(GpuError::TooLarge(format!(
+                "{width}x{height} pixels is larger than this GPU's {limit}x{limit} limit for an image ({})",
+                self.adapter_name
+            )));
+        }
+        Ok(())
+    }
+
+    /// Fails unless a storage buffer of `bytes` can be bound.
+    pub fn check_binding(&self, what: &str, bytes: u64) -> Result<(), GpuError> {
+        let limit = self.device.limits().max_storage_buffer_binding_size;
+        if bytes > limit {
+            return Err(GpuError::TooLarge(format!(
+                "{what} needs a {bytes}-byte buffer; this GPU binds at most {limit} bytes ({})",
+                self.adapter_name
+            )));
+        }
+        Ok(())
     }
 
     /// Blocks until the GPU has finished all submitted work.

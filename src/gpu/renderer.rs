@@ -45,12 +45,21 @@ impl Renderer {
     }
 
     /// Uploads the dense grid the grid tracer walks.
-    pub fn set_grid(&mut self, grid: &DenseGrid) {
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] when the grid is larger than a binding may be.
+    pub fn set_grid(&mut self, grid: &DenseGrid) -> Result<(), GpuError> {
+        self.gpu.check_binding("the dense grid", grid.data.len() as u64)?;
         self.buffers.upload_grid(&self.gpu.device, &self.gpu.queue, grid);
+        Ok(())
     }
 
     /// Traces one frame and waits for it; returns the pass's milliseconds.
     /// `highlight` is an inclusive world-space voxel box to tint.
+    ///
+    /// # Errors
+    /// An image larger than the adapter allows, or any validation error
+    /// while the frame is recorded: never a silently blank image.
     pub fn render(
         &mut self,
         tree: &Octree,
@@ -59,20 +68,23 @@ impl Renderer {
         settings: &RenderSettings,
         highlight: Option<(IVec3, IVec3)>,
     ) -> Result<f64, GpuError> {
-        self.pass.resize(&self.gpu.device, &self.buffers, size.0, size.1);
-        let basis = camera.basis(size.0.max(1), size.1.max(1), tree.origin());
-        let local = highlight.map(|(lo, hi)| (lo - tree.origin(), hi - tree.origin()));
-        let uniforms = FrameUniforms {
-            hit_records: u32::from(self.hit_records),
-            ..FrameUniforms::new(&basis, tree, &self.buffers, settings.view, local)
-        };
-        self.records_written = self.hit_records;
-        self.pass.prepare(&self.gpu.device, &self.gpu.queue, &self.buffers, &uniforms);
-        let mut encoder =
-            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
-        self.pass.encode(&mut encoder, settings, self.timer.pass_writes());
-        self.timer.resolve(&mut encoder);
-        self.timer.submit_and_measure(&self.gpu, encoder)
+        let gpu = &self.gpu;
+        gpu.checked(|| {
+            self.pass.resize(gpu, &self.buffers, size, self.hit_records)?;
+            let basis = camera.basis(size.0.max(1), size.1.max(1), tree.origin());
+            let local = highlight.map(|(lo, hi)| (lo - tree.origin(), hi - tree.origin()));
+            let uniforms = FrameUniforms {
+                hit_records: u32::from(self.hit_records),
+                ..FrameUniforms::new(&basis, tree, &self.buffers, settings.view, local)
+            };
+            self.records_written = self.hit_records;
+            self.pass.prepare(&gpu.device, &gpu.queue, &self.buffers, &uniforms);
+            let mut encoder =
+                gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+            self.pass.encode(&mut encoder, settings, self.timer.pass_writes());
+            self.timer.resolve(&mut encoder);
+            self.timer.submit_and_measure(gpu, encoder)
+        })
     }
 
     /// The hit records of the last frame, which must have been rendered with

@@ -80,6 +80,8 @@ struct Target {
     beam_buf: wgpu::Buffer,
     width: u32,
     height: u32,
+    /// Whether `hits_buf` holds a record per pixel.
+    hit_records: bool,
 }
 
 /// Side of the pixel tile that shares one beam; it sizes the beam buffer and
@@ -183,12 +185,14 @@ impl TracePass {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let target = Self::make_target(device, width, height);
+        let target = Self::make_target(device, width, height, false);
         let bind_group = Self::make_bind_group(device, &layout, &uniform_buf, buffers, &target);
         Ok(TracePass { layout, pipelines, beam, uniform_buf, target, bind_group, bound_generation: buffers.generation })
     }
 
-    fn make_target(device: &wgpu::Device, width: u32, height: u32) -> Target {
+    /// The outputs; the hit records (16 bytes a pixel) only when asked for,
+    /// so that a large image does not need a buffer past the binding limit.
+    fn make_target(device: &wgpu::Device, width: u32, height: u32, hit_records: bool) -> Target {
         let (width, height) = (width.max(1), height.max(1));
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("trace output"),
@@ -205,7 +209,7 @@ impl TracePass {
         let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
         let hits_buf = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("hit records"),
-            size: u64::from(width) * u64::from(height) * 16,
+            size: Self::hits_bytes(width, height, hit_records),
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
@@ -216,7 +220,7 @@ impl TracePass {
             usage: wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
-        Target { texture, view, hits_buf, beam_buf, width, height }
+        Target { texture, view, hits_buf, beam_buf, width, height, hit_records }
     }
 
     fn make_bind_group(
@@ -241,14 +245,35 @@ impl TracePass {
         })
     }
 
-    /// Re-creates the outputs for a new size (never zero).
-    pub fn resize(&mut self, device: &wgpu::Device, buffers: &SceneBuffers, width: u32, height: u32) {
-        if (width.max(1), height.max(1)) == (self.target.width, self.target.height) {
-            return;
+    fn hits_bytes(width: u32, height: u32, hit_records: bool) -> u64 {
+        if hit_records { u64::from(width) * u64::from(height) * 16 } else { 16 }
+    }
+
+    /// Re-creates the outputs for a new size (never zero) or when hit
+    /// records are turned on or off.
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] when the image or its hit records exceed the
+    /// adapter's limits; the old outputs are kept.
+    pub fn resize(
+        &mut self,
+        gpu: &GpuContext,
+        buffers: &SceneBuffers,
+        (width, height): (u32, u32),
+        hit_records: bool,
+    ) -> Result<(), GpuError> {
+        let (width, height) = (width.max(1), height.max(1));
+        let target = &self.target;
+        if (width, height, hit_records) == (target.width, target.height, target.hit_records) {
+            return Ok(());
         }
-        self.target = Self::make_target(device, width, height);
+        gpu.check_image_size(width, height)?;
+        gpu.check_binding("the hit records", Self::hits_bytes(width, height, hit_records))?;
+        let device = &gpu.device;
+        self.target = Self::make_target(device, width, height, hit_records);
         self.bind_group = Self::make_bind_group(device, &self.layout, &self.uniform_buf, buffers, &self.target);
         self.bound_generation = buffers.generation;
+        Ok(())
     }
 
     pub fn size(&self) -> (u32, u32) {

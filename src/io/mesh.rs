@@ -36,15 +36,15 @@ pub enum UpAxis {
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
     #[error("{}: {source}", path.display())]
-    Io { path: PathBuf, source: std::io::Error },
-    #[error("{}: {size} bytes is more than the {MAX_OBJ_BYTES}-byte limit", path.display())]
-    TooLarge { path: PathBuf, size: u64 },
+    Io { path: PathBuf, source: crate::io::input::InputError },
     #[error("{}: not a readable .obj mesh ({reason})", path.display())]
     Parse { path: PathBuf, reason: String },
     #[error("{}: the mesh has no triangles", path.display())]
     Empty { path: PathBuf },
-    #[error("{}: a vertex coordinate is not a finite number", path.display())]
-    NotFinite { path: PathBuf },
+    #[error("{}:{line}: {reason}", path.display())]
+    BadVertex { path: PathBuf, line: usize, reason: String },
+    #[error("{}: {source}", path.display())]
+    OverBudget { path: PathBuf, source: crate::budget::OverBudget },
     #[error("{}: face index {index} refers past the {vertices} vertices", path.display())]
     BadIndex { path: PathBuf, index: u32, vertices: usize },
     #[error("{}: at {size} voxels the mesh encloses no voxel centre (is it closed?)", path.display())]
@@ -69,26 +69,27 @@ impl DenseVoxels {
 
 /// Reads an .obj file's triangles, in octovox axes.
 pub fn load_obj_triangles(path: &Path, up: UpAxis) -> Result<Vec<[Vec3; 3]>, MeshError> {
-    let io = |source| MeshError::Io { path: path.to_path_buf(), source };
-    let size = std::fs::metadata(path).map_err(io)?.len();
-    if size > MAX_OBJ_BYTES {
-        return Err(MeshError::TooLarge { path: path.to_path_buf(), size });
-    }
-    let bytes = std::fs::read(path).map_err(io)?;
+    let bytes = crate::io::input::read_limited(path, MAX_OBJ_BYTES)
+        .map_err(|source| MeshError::Io { path: path.to_path_buf(), source })?;
+    parse_obj(&bytes, path, up)
+}
+
+/// The triangles of .obj text, in octovox axes; `path` names it in errors.
+pub fn parse_obj(bytes: &[u8], path: &Path, up: UpAxis) -> Result<Vec<[Vec3; 3]>, MeshError> {
     let options = tobj::LoadOptions { triangulate: true, single_index: true, ..Default::default() };
     // Materials are not used: never open the .mtl files a mesh names.
     let parsed = super::guard::catch_quietly(|| {
-        tobj::load_obj_buf(&mut BufReader::new(&bytes[..]), &options, |_| Err(tobj::LoadError::OpenFileFailed))
+        tobj::load_obj_buf(&mut BufReader::new(bytes), &options, |_| Err(tobj::LoadError::OpenFileFailed))
     });
     let reason = |r: String| MeshError::Parse { path: path.to_path_buf(), reason: r };
-    let (models, _materials) = parsed.map_err(reason)?.map_err(|e| reason(e.to_string()))?;
+    let (models, _materials) = parsed.map_err(reason)?.map_err(|e| match bad_line(bytes) {
+        Some((line, text)) => MeshError::BadVertex { path: path.to_path_buf(), line, reason: text },
+        None => reason(e.to_string()),
+    })?;
     let mut triangles = Vec::new();
     for model in &models {
         let mesh = &model.mesh;
         let vertices = mesh.positions.len() / 3;
-        if mesh.positions.iter().any(|c| !c.is_finite()) {
-            return Err(MeshError::NotFinite { path: path.to_path_buf() });
-        }
         let vertex = |i: u32| -> Result<Vec3, MeshError> {
             let i = i as usize;
             if i >= vertices {
@@ -107,7 +108,71 @@ pub fn load_obj_triangles(path: &Path, up: UpAxis) -> Result<Vec<[Vec3; 3]>, Mes
     if triangles.is_empty() {
         return Err(MeshError::Empty { path: path.to_path_buf() });
     }
+    let lo = triangles.iter().flatten().copied().fold(Vec3::INFINITY, Vec3::min);
+    let hi = triangles.iter().flatten().copied().fold(Vec3::NEG_INFINITY, Vec3::max);
+    let all_finite = triangles.iter().flatten().all(|p| p.is_finite());
+    if !all_finite || !(hi - lo).is_finite() {
+        let (line, reason) = largest_vertex(bytes);
+        return Err(MeshError::BadVertex { path: path.to_path_buf(), line, reason });
+    }
     Ok(triangles)
+}
+
+/// The first `v` or `f` line that does not parse, with the reason, to name
+/// the place of an error that the parser reports without one.
+fn bad_line(bytes: &[u8]) -> Option<(usize, String)> {
+    let text = String::from_utf8_lossy(bytes);
+    for (index, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let problem = match words.next() {
+            Some("v") => {
+                let coords: Vec<&str> = words.take(3).collect();
+                match coords.iter().find(|c| c.parse::<f32>().is_err()) {
+                    Some(bad) => Some(format!("vertex coordinate '{bad}' is not a number")),
+                    None if coords.len() < 3 => Some("a vertex needs three coordinates".to_owned()),
+                    None => None,
+                }
+            }
+            Some("f") => words
+                .map(|w| w.split('/').next().unwrap_or(""))
+                .find(|index| index.parse::<i64>().map_or(true, |i| i == 0))
+                .map(|bad| format!("face vertex index '{bad}' is not a non-zero whole number")),
+            _ => None,
+        };
+        if let Some(problem) = problem {
+            return Some((index + 1, problem));
+        }
+    }
+    None
+}
+
+/// The line of the vertex with the largest coordinate, and why it is a
+/// problem: the mesh's extent overflows 32-bit floats (or a coordinate is
+/// not finite to begin with).
+fn largest_vertex(bytes: &[u8]) -> (usize, String) {
+    let text = String::from_utf8_lossy(bytes);
+    let mut worst = (0, 0.0f64, String::new());
+    for (index, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        if words.next() != Some("v") {
+            continue;
+        }
+        for word in words.take(3) {
+            // Not a number, or past f32: as bad as a coordinate gets.
+            let value = word.parse::<f64>().map(f64::abs).ok().filter(|v| *v <= f64::from(f32::MAX));
+            let value = value.unwrap_or(f64::INFINITY);
+            if worst.0 == 0 || value > worst.1 {
+                worst = (index + 1, value, word.to_owned());
+            }
+        }
+    }
+    let (line, value, word) = worst;
+    let reason = if value.is_finite() {
+        format!("vertex coordinate {word} is so large that the mesh's size overflows 32-bit floats")
+    } else {
+        format!("vertex coordinate {word} is not a finite 32-bit number")
+    };
+    (line, reason)
 }
 
 /// Loads and voxelizes an .obj file: the longest side becomes `size` voxels,
@@ -116,20 +181,52 @@ pub fn voxelize_obj(path: &Path, size: u32, up: UpAxis, color: u8) -> Result<Den
     if !(1..=MAX_MESH_SIZE).contains(&size) {
         return Err(MeshError::Size(size));
     }
-    let dense = voxelize(&load_obj_triangles(path, up)?, size, color);
+    let triangles = load_obj_triangles(path, up)?;
+    crate::budget::check(
+        || format!("voxelizing {} at {size} voxels", path.display()),
+        voxelize_bytes(&triangles, size),
+    )
+    .map_err(|source| MeshError::OverBudget { path: path.to_path_buf(), source })?;
+    let dense = voxelize(&triangles, size, color);
     if dense.solid_count() == 0 {
         return Err(MeshError::NothingInside { path: path.to_path_buf(), size });
     }
     Ok(dense)
 }
 
-/// Fills the inside of `triangles` (see the module comment). `size` must be
-/// at least 1; `triangles` must not be empty.
-pub fn voxelize(triangles: &[[Vec3; 3]], size: u32, color: u8) -> DenseVoxels {
+/// The scale and the block size in voxels of `triangles` at `size`.
+fn placement(triangles: &[[Vec3; 3]], size: u32) -> (Vec3, f32, UVec3) {
     let lo = triangles.iter().flatten().copied().fold(Vec3::INFINITY, Vec3::min);
     let hi = triangles.iter().flatten().copied().fold(Vec3::NEG_INFINITY, Vec3::max);
     let scale = size as f32 / (hi - lo).max_element().max(f32::MIN_POSITIVE);
     let dims = ((hi - lo) * scale).ceil().as_uvec3().clamp(UVec3::ONE, UVec3::splat(size));
+    (lo, scale, dims)
+}
+
+/// Peak memory of [`voxelize`]: the dense block (twice, for the octree
+/// built from it), the column lists, and at most one crossing per column
+/// under each triangle's footprint.
+pub fn voxelize_bytes(triangles: &[[Vec3; 3]], size: u32) -> u64 {
+    let (lo, scale, dims) = placement(triangles, size);
+    let columns = u64::from(dims.x) * u64::from(dims.z);
+    let crossings: u64 = triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|p| (p - lo) * scale);
+            let span = |u: f32, v: f32, w: f32| (u.max(v).max(w).ceil() - u.min(v).min(w).floor()) as u64 + 1;
+            span(a.x, b.x, c.x) * span(a.z, b.z, c.z)
+        })
+        .sum();
+    2 * u64::from(dims.x) * u64::from(dims.y) * u64::from(dims.z)
+        + columns * std::mem::size_of::<Vec<f32>>() as u64
+        // A list that grows by doubling may hold twice what it uses.
+        + crossings * 8
+}
+
+/// Fills the inside of `triangles` (see the module comment). `size` must be
+/// at least 1; `triangles` must not be empty.
+pub fn voxelize(triangles: &[[Vec3; 3]], size: u32, color: u8) -> DenseVoxels {
+    let (lo, scale, dims) = placement(triangles, size);
     let mut columns = crossings(triangles, lo, scale, dims);
     columns.par_iter_mut().for_each(|ys| ys.sort_by(f32::total_cmp));
     let mut data = vec![0u8; dims.x as usize * dims.y as usize * dims.z as usize];

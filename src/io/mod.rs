@@ -1,7 +1,10 @@
 //! File formats: MagicaVoxel .vox in and out, .obj meshes in (voxelized).
 
+pub mod atomic;
 mod guard;
+pub mod input;
 pub mod mesh;
+pub mod output;
 pub mod png;
 pub mod vox;
 
@@ -29,6 +32,9 @@ pub fn load_scene(path: &Path, frame: usize) -> Result<Scene, LoadError> {
         return Scene::from_dense(&dense).map_err(build_error);
     }
     let model = vox::load_vox_file(path, frame)?;
+    for warning in &model.warnings {
+        log::warn!("{}: {warning}", path.display());
+    }
     Scene::from_model(&model).map_err(build_error)
 }
 
@@ -37,12 +43,13 @@ pub fn is_mesh_path(path: &Path) -> bool {
     path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"))
 }
 
-/// Saves a scene as .vox (atomically: the old file survives a failed write).
-/// A mesh's name is refused, so an imported mesh is never overwritten.
-pub fn save_scene(path: &Path, scene: &Scene) -> Result<(), vox::VoxError> {
-    if is_mesh_path(path) {
-        let reason = std::io::Error::new(std::io::ErrorKind::InvalidInput, "scenes are saved as .vox, not .obj");
+/// Saves a scene as .vox, one model at a time, atomically (the old file
+/// survives a failed write; see [`atomic`]). A name that is not .vox is
+/// refused, so an imported mesh is never overwritten with .vox bytes.
+pub fn save_scene(path: &Path, scene: &Scene, options: atomic::WriteOptions) -> Result<(), vox::VoxError> {
+    if !path.extension().is_some_and(|e| e.eq_ignore_ascii_case("vox")) {
+        let reason = std::io::Error::new(std::io::ErrorKind::InvalidInput, "scenes are saved as .vox files");
         return Err(vox::VoxError::Write { path: path.to_path_buf(), source: reason });
     }
-    vox::save_vox(path, &scene.palette, &scene.tree.voxels())
+    vox::save_tree(path, &scene.palette, &scene.tree, options)
 }

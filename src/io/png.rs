@@ -1,6 +1,9 @@
 //! PNG files for renders, screenshots and reference images.
 
+use std::io::Write;
 use std::path::Path;
+
+use crate::io::atomic::WriteOptions;
 
 /// Why a PNG could not be read or written.
 #[derive(Debug, thiserror::Error)]
@@ -13,17 +16,30 @@ pub enum PngError {
     Read { path: std::path::PathBuf, source: image::ImageError },
 }
 
-/// Writes a PNG atomically: a temporary file in the same folder, then a rename.
-pub fn save_png(image: &image::RgbaImage, path: &Path) -> Result<(), PngError> {
-    let write_err = |source| PngError::Write { path: path.to_path_buf(), source };
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir).map_err(write_err)?;
-    let tmp = tempfile::Builder::new().suffix(".png").tempfile_in(dir).map_err(write_err)?;
-    image
-        .write_to(&mut std::io::BufWriter::new(tmp.as_file()), image::ImageFormat::Png)
-        .map_err(|source| PngError::Encode { path: path.to_path_buf(), source })?;
-    tmp.persist(path).map_err(|e| write_err(e.error))?;
-    Ok(())
+/// Writes a PNG atomically, like every file octovox writes
+/// ([`crate::io::atomic`]): the folder must exist, links are followed,
+/// devices refused, new files get the usual permissions (umask applied).
+pub fn save_png(image: &image::RgbaImage, path: &Path, options: WriteOptions) -> Result<(), PngError> {
+    let result = crate::io::atomic::write_atomically(path, options, |file| {
+        let mut out = std::io::BufWriter::new(file);
+        image.write_to(&mut out, image::ImageFormat::Png).map_err(EncodeOrIo::Encode)?;
+        out.flush().map_err(EncodeOrIo::Io)
+    });
+    result.map_err(|e| match e {
+        EncodeOrIo::Io(source) => PngError::Write { path: path.to_path_buf(), source },
+        EncodeOrIo::Encode(source) => PngError::Encode { path: path.to_path_buf(), source },
+    })
+}
+
+enum EncodeOrIo {
+    Io(std::io::Error),
+    Encode(image::ImageError),
+}
+
+impl From<std::io::Error> for EncodeOrIo {
+    fn from(e: std::io::Error) -> EncodeOrIo {
+        EncodeOrIo::Io(e)
+    }
 }
 
 pub fn load_png(path: &Path) -> Result<image::RgbaImage, PngError> {

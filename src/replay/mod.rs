@@ -69,7 +69,7 @@ impl fmt::Display for Command {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let v = |p: IVec3| format!("{} {} {}", p.x, p.y, p.z);
         match self {
-            Command::Load(path) => write!(f, "load {}", path.display()),
+            Command::Load(path) => write!(f, "load {}", quoted(path)),
             Command::New => write!(f, "new"),
             Command::Demo => write!(f, "demo"),
             Command::Camera { eye, target, fov } => {
@@ -90,14 +90,34 @@ impl fmt::Display for Command {
             Command::Click { x, y, tool } => write!(f, "click {x} {y} {}", tool.name()),
             Command::Undo(n) => write!(f, "undo {n}"),
             Command::Redo(n) => write!(f, "redo {n}"),
-            Command::Save(path) => write!(f, "save {}", path.display()),
-            Command::Render(path) => write!(f, "render {}", path.display()),
+            Command::Save(path) => write!(f, "save {}", quoted(path)),
+            Command::Render(path) => write!(f, "render {}", quoted(path)),
             Command::ExpectVoxel(p, n) => write!(f, "expect voxel {} {n}", v(*p)),
             Command::ExpectCount(n) => write!(f, "expect count {n}"),
             Command::ExpectWritten(n) => write!(f, "expect written <= {n}"),
-            Command::ExpectImage(path, tol) => write!(f, "expect image {} {tol}", path.display()),
+            Command::ExpectImage(path, tol) => write!(f, "expect image {} {tol}", quoted(path)),
         }
     }
+}
+
+/// A path as a script word: as it is, or in quotes (with `\"` and `\\`
+/// escaped) when it holds spaces, `#`, quotes or backslashes.
+pub fn quoted(path: &std::path::Path) -> String {
+    let text = path.to_string_lossy();
+    let plain = !text.is_empty() && !text.chars().any(|c| c.is_whitespace() || matches!(c, '#' | '"' | '\\'));
+    if plain {
+        return text.into_owned();
+    }
+    let mut out = String::with_capacity(text.len() + 2);
+    out.push('"');
+    for c in text.chars() {
+        if matches!(c, '"' | '\\') {
+            out.push('\\');
+        }
+        out.push(c);
+    }
+    out.push('"');
+    out
 }
 
 /// The edit a `place`/`remove`/`paint` line (or a recorded click) becomes.

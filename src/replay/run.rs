@@ -9,6 +9,8 @@ use super::{Command, Line, Script};
 use crate::camera::Camera;
 use crate::edit::{Edit, History};
 use crate::gpu::Renderer;
+use crate::io::atomic::WriteOptions;
+use crate::io::output::{OutputKind, check_output};
 use crate::io::png::{differing_fraction, load_png, save_png};
 use crate::scene::{Op, Scene};
 use crate::settings::RenderSettings;
@@ -61,6 +63,12 @@ pub struct Runner {
     mode: RunnerMode,
     /// Write missing or different reference images instead of failing.
     pub update_images: bool,
+    /// Let `save` and `render` replace inputs and existing documents.
+    pub force: bool,
+    /// Files this run read (scripts, loaded scenes): never written over.
+    inputs: Vec<PathBuf>,
+    /// Files this run wrote: a later line may write them again.
+    written: Vec<PathBuf>,
 }
 
 /// What one line did, for callers that show progress.
@@ -85,6 +93,9 @@ impl Runner {
             last_render: None,
             mode,
             update_images: false,
+            force: false,
+            inputs: Vec::new(),
+            written: Vec::new(),
         }
     }
 
@@ -96,6 +107,7 @@ impl Runner {
     /// Runs every line; an error stops the script and counts as a failure.
     pub fn run(&mut self, script: &Script) -> ScriptReport {
         let base = script.path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        self.inputs.push(script.path.clone());
         let mut report = ScriptReport::default();
         for line in &script.lines {
             let fail =
@@ -120,6 +132,7 @@ impl Runner {
             Command::Load(path) => {
                 let path = resolve(path);
                 self.set_scene(crate::io::load_scene(&path, 0).map_err(|e| e.to_string())?);
+                self.inputs.push(path);
             }
             Command::New => self.set_scene(Scene::default()),
             Command::Demo => self.set_scene(crate::scene::demo::demo_scene()),
@@ -133,21 +146,30 @@ impl Runner {
             Command::Remove(p) => self.brush_edit(*p, Op::Remove)?,
             Command::Paint(p) => self.brush_edit(*p, Op::Paint(self.color))?,
             Command::Click { x, y, tool } => {
-                let Some((voxel, normal)) = self.pick(*x, *y) else {
-                    return Ok(StepResult::Failed {
-                        expected: format!("pixel ({x}, {y}) to hit a voxel"),
-                        got: "no voxel under it".into(),
-                    });
+                let expected = format!("pixel ({x}, {y}) to hit a voxel");
+                let (voxel, normal) = match self.pick(*x, *y) {
+                    Ok(Some(hit)) => hit,
+                    Ok(None) => return Ok(StepResult::Failed { expected, got: "no voxel under it".into() }),
+                    Err(gave_up) => return Ok(StepResult::Failed { expected, got: gave_up.to_string() }),
                 };
                 let (_, edit) = click_edit(*tool, &self.brush, self.color, voxel, normal);
                 self.apply(edit)?;
             }
             Command::Undo(n) => self.repeat(*n, true)?,
             Command::Redo(n) => self.repeat(*n, false)?,
-            Command::Save(path) => crate::io::save_scene(&resolve(path), &self.scene).map_err(|e| e.to_string())?,
+            Command::Save(path) => {
+                let path = resolve(path);
+                self.check_output(&path, OutputKind::Scene)?;
+                let options = WriteOptions { overwrite_read_only: self.force };
+                crate::io::save_scene(&path, &self.scene, options).map_err(|e| e.to_string())?;
+                self.written.push(path);
+            }
             Command::Render(path) => {
+                let path = resolve(path);
+                self.check_output(&path, OutputKind::Image)?;
                 let image = self.render()?;
-                save_png(&image, &resolve(path)).map_err(|e| e.to_string())?;
+                save_png(&image, &path, WriteOptions { overwrite_read_only: self.force }).map_err(|e| e.to_string())?;
+                self.written.push(path);
                 self.last_render = Some(image);
             }
             Command::ExpectVoxel(p, want) => {
@@ -168,6 +190,14 @@ impl Runner {
         Ok(StepResult::Done)
     }
 
+    /// The rule of every command that writes (`crate::io::output`); a file
+    /// this run wrote itself may be written again.
+    fn check_output(&self, path: &Path, kind: OutputKind) -> Result<(), String> {
+        let ours = self.written.iter().any(|w| w == path);
+        let inputs: Vec<&Path> = self.inputs.iter().map(PathBuf::as_path).collect();
+        check_output(path, kind, &inputs, self.force || ours).map_err(|e| e.to_string())
+    }
+
     fn set_scene(&mut self, scene: Scene) {
         self.scene = scene;
         self.history.clear();
@@ -176,8 +206,8 @@ impl Runner {
     }
 
     /// The world voxel and face normal under a pixel (what the mouse picks).
-    pub fn pick(&self, x: u32, y: u32) -> Option<(IVec3, IVec3)> {
-        svo::pick(&self.scene.tree, &self.camera, self.viewport, x, y).map(|hit| (hit.voxel, hit.normal))
+    pub fn pick(&self, x: u32, y: u32) -> Result<Option<(IVec3, IVec3)>, svo::GaveUp> {
+        Ok(svo::pick(&self.scene.tree, &self.camera, self.viewport, x, y)?.map(|hit| (hit.voxel, hit.normal)))
     }
 
     fn brush_edit(&mut self, at: IVec3, op: Op) -> Result<(), String> {
@@ -226,7 +256,7 @@ impl Runner {
     fn expect_image(&mut self, path: &Path, tolerance: f64) -> Result<StepResult, String> {
         let image = self.last_render.as_ref().ok_or("'expect image' needs a render line before it")?;
         if self.update_images {
-            save_png(image, path).map_err(|e| e.to_string())?;
+            save_png(image, path, WriteOptions::default()).map_err(|e| e.to_string())?;
             return Ok(StepResult::Passed);
         }
         let reference = load_png(path).map_err(|e| format!("{e} (OCTOVOX_UPDATE_IMAGES=1 writes it)"))?;

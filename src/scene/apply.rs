@@ -22,7 +22,14 @@ pub enum EditError {
     Brush(String),
     #[error("palette index 0 means empty; use remove, or a colour in 1..=255")]
     ZeroColor,
+    #[error(transparent)]
+    OverBudget(#[from] crate::budget::OverBudget),
 }
+
+/// Peak bytes an edit takes per surface voxel of its shape: bricks and
+/// nodes, the undo patch and the dirty lists (a radius-4096 sphere, 2·10^8
+/// surface voxels, took 3.8 GB).
+const EDIT_BYTES_PER_SURFACE_VOXEL: u64 = 24;
 
 /// Serialized-subtree tag for a node: eight child subtrees follow.
 const NODE_TAG: u32 = 0x8000_0000;
@@ -70,6 +77,8 @@ impl Octree {
         if op.color() == Some(0) {
             return Err(EditError::ZeroColor);
         }
+        let bytes = shape.surface_voxels().saturating_mul(EDIT_BYTES_PER_SURFACE_VOXEL);
+        crate::budget::check(|| format!("an edit of about {} surface voxels", shape.surface_voxels()), bytes)?;
         let (lo, hi) = shape.bounds();
         let mut patch = Patch::new(self);
         self.grow_to_contain(lo, hi)?;
@@ -230,15 +239,50 @@ impl Octree {
         self.make_node(children, Some(node))
     }
 
-    /// Adds root levels until the root cube holds `lo..=hi`.
+    /// Makes the root cube hold `lo..=hi`: adds root levels toward it, or,
+    /// when that alignment would pass 2^[`MAX_DEPTH`] while the solid voxels
+    /// and the edit together still fit in such a cube, moves the root.
+    /// Nothing changes when the edit is refused.
     pub fn grow_to_contain(&mut self, lo: IVec3, hi: IVec3) -> Result<(), EditError> {
         if lo.min_element() <= -WORLD_LIMIT || hi.max_element() >= WORLD_LIMIT {
             return Err(EditError::OutsideWorld { min: lo, max: hi });
         }
+        if self.grown_depth(lo, hi) <= MAX_DEPTH {
+            self.add_root_levels(lo, hi);
+            return Ok(());
+        }
+        let (union_lo, union_hi) = match self.solid_bounds() {
+            Some((s_lo, s_hi)) => (s_lo.min(lo), s_hi.max(hi)),
+            None => (lo, hi),
+        };
+        let extent = (union_hi.as_i64vec3() - union_lo.as_i64vec3()).max_element() + 1;
+        if extent > 1 << MAX_DEPTH {
+            return Err(EditError::TooWide { min: lo, max: hi });
+        }
+        self.move_root(union_lo, extent);
+        Ok(())
+    }
+
+    /// The root depth that adding levels toward `lo..=hi` would reach.
+    fn grown_depth(&self, lo: IVec3, hi: IVec3) -> u32 {
+        let (mut origin, mut depth) = (self.origin.as_i64vec3(), self.depth);
+        let inside = |origin: glam::I64Vec3, depth: u32, p: IVec3| {
+            let rel = p.as_i64vec3() - origin;
+            rel.cmpge(glam::I64Vec3::ZERO).all() && rel.cmplt(glam::I64Vec3::splat(1 << depth)).all()
+        };
+        while !(inside(origin, depth, lo) && inside(origin, depth, hi)) && depth <= MAX_DEPTH {
+            let below = lo.as_i64vec3().cmplt(origin);
+            let octant = usize::from(below.x) | usize::from(below.y) << 1 | usize::from(below.z) << 2;
+            origin -= octant_offset(octant).as_i64vec3() * (1 << depth);
+            depth += 1;
+        }
+        depth
+    }
+
+    /// Adds root levels until the root cube holds `lo..=hi`; the caller has
+    /// checked with [`Octree::grown_depth`] that this stays within MAX_DEPTH.
+    fn add_root_levels(&mut self, lo: IVec3, hi: IVec3) {
         while !(self.contains(lo) && self.contains(hi)) {
-            if self.depth >= MAX_DEPTH {
-                return Err(EditError::TooWide { min: lo, max: hi });
-            }
             let size = 1 << self.depth;
             // The old root becomes the child on the side away from the edit.
             let below = lo.cmplt(self.origin);
@@ -249,7 +293,26 @@ impl Octree {
             self.origin -= octant_offset(octant) * size;
             self.depth += 1;
         }
-        Ok(())
+    }
+
+    /// Rebuilds the tree under a root cube at `origin`, `extent` voxels wide
+    /// (at most 2^MAX_DEPTH), copying every solid cell. Every slot changes,
+    /// so the next flush uploads the whole pool; this happens only when an
+    /// edit would otherwise be refused.
+    fn move_root(&mut self, origin: IVec3, extent: i64) {
+        let depth = (extent.max(1) as u64).next_power_of_two().trailing_zeros();
+        let mut moved = Octree::empty(origin, depth);
+        // The copy's own undo record is not wanted: the edit's patch holds
+        // the cells it changes.
+        let mut scratch = Patch::default();
+        self.for_each_solid_cell(|min, size, value| {
+            let shape = Shape::Box { min, max: min + IVec3::splat(size - 1) };
+            let op = Op::Place(value);
+            moved.root = moved.brush_word(moved.root, moved.origin, moved.depth, &shape, op, &mut scratch);
+            scratch = Patch::default();
+        });
+        // New slots are all dirty, so the next flush uploads the whole tree.
+        *self = moved;
     }
 
     /// Drops root levels down to the cube (`origin`, `depth`) while everything

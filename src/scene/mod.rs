@@ -25,8 +25,14 @@ pub type Voxel = (IVec3, u8);
 pub struct VoxelModel {
     pub palette: Palette,
     pub voxels: Vec<Voxel>,
-    /// Number of models (shapes placed by the scene graph) the file held.
+    /// Number of models placed (by the scene graph, or the one frame of a
+    /// file without one).
     pub models: usize,
+    /// Number of models (SIZE/XYZI pairs) stored in the file.
+    pub stored_models: usize,
+    /// What the loader accepted but the user should know (ignored bytes,
+    /// clamped values), one sentence each.
+    pub warnings: Vec<String>,
 }
 
 impl VoxelModel {

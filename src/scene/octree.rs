@@ -125,7 +125,33 @@ impl Octree {
         self.visit_cells(self.root, self.origin, self.depth, &mut f);
     }
 
-    fn visit_cells(&self, word: u32, min: IVec3, level: u32, f: &mut impl FnMut(IVec3, i32, u8)) {
+    /// The non-empty cells of level `level` (or the root, when the tree is no
+    /// deeper) as (min corner, child word, level), in octant order: what a
+    /// saver walks to write the scene one block at a time.
+    pub(crate) fn blocks(&self, level: u32) -> Vec<(IVec3, u32, u32)> {
+        let mut out = Vec::new();
+        self.collect_blocks(self.root, self.origin, self.depth, level, &mut out);
+        out
+    }
+
+    fn collect_blocks(&self, word: u32, min: IVec3, level: u32, target: u32, out: &mut Vec<(IVec3, u32, u32)>) {
+        if word == 0 {
+            return;
+        }
+        if level <= target {
+            out.push((min, word, level));
+            return;
+        }
+        let half = 1 << (level - 1);
+        for octant in 0..8 {
+            // A uniform cell above the block level is cut into its blocks.
+            let child = if is_pointer(word) { self.node(word)[octant] } else { word };
+            self.collect_blocks(child, min + octant_offset(octant) * half, level - 1, target, out);
+        }
+    }
+
+    /// Visits the maximal uniform solid cells under one child word.
+    pub(crate) fn visit_cells(&self, word: u32, min: IVec3, level: u32, f: &mut impl FnMut(IVec3, i32, u8)) {
         if !is_pointer(word) {
             if word != 0 {
                 f(min, 1 << level, word as u8);

@@ -79,6 +79,23 @@ impl Shape {
     }
 
     /// Checks the size limits; returns a message naming the problem.
+    /// About how many voxels lie on the shape's surface: what an edit's new
+    /// bricks and nodes grow with (its inside becomes a few uniform cells).
+    pub fn surface_voxels(&self) -> u64 {
+        match *self {
+            Shape::Voxel(_) => 1,
+            Shape::Sphere { radius, .. } => {
+                let r = f64::from(radius.max(0)) + 1.0;
+                (4.0 * std::f64::consts::PI * r * r) as u64
+            }
+            Shape::Box { min, max } => {
+                let [a, b, c] =
+                    (max - min + IVec3::ONE).as_i64vec3().max(glam::I64Vec3::ONE).to_array().map(|v| v as u64);
+                2 * (a * b + b * c + c * a)
+            }
+        }
+    }
+
     pub fn validate(&self) -> Result<(), String> {
         match *self {
             Shape::Voxel(_) => Ok(()),

@@ -23,16 +23,22 @@ pub struct DenseGrid {
 
 impl DenseGrid {
     /// Rasterizes the tree's solid voxels (tree-local coordinates), or
-    /// `None` when the bounding box holds more than [`MAX_GRID_CELLS`].
-    pub fn from_octree(tree: &Octree) -> Option<DenseGrid> {
+    /// says why not: a bounding cube of more than [`MAX_GRID_CELLS`], or
+    /// more bytes than the memory budget allows.
+    pub fn from_octree(tree: &Octree) -> Result<DenseGrid, String> {
         let Some((lo, hi)) = tree.solid_bounds() else {
-            return Some(DenseGrid::default());
+            return Ok(DenseGrid::default());
         };
         let min = lo - tree.origin();
         let dims = UVec3::splat((hi - lo + IVec3::ONE).max_element() as u32);
-        if dims.as_u64vec3().element_product() > MAX_GRID_CELLS {
-            return None;
+        let cells = dims.as_u64vec3().element_product();
+        if cells > MAX_GRID_CELLS {
+            return Err(format!(
+                "the scene's bounding cube of {}³ voxels is larger than a dense grid may be ({MAX_GRID_CELLS} cells)",
+                dims.x
+            ));
         }
+        crate::budget::check(|| format!("a dense grid of {}³ voxels", dims.x), cells).map_err(|e| e.to_string())?;
         let mut data = vec![0u8; dims.x as usize * dims.y as usize * dims.z as usize];
         let index = |p: IVec3| (p.x as usize) + dims.x as usize * (p.y as usize + dims.y as usize * p.z as usize);
         tree.for_each_solid_cell(|cell_min, size, value| {
@@ -44,7 +50,7 @@ impl DenseGrid {
                 }
             }
         });
-        Some(DenseGrid { min, dims, data })
+        Ok(DenseGrid { min, dims, data })
     }
 
     /// Value at a tree-local position (0 outside).

@@ -36,6 +36,12 @@ impl Hit {
         self.value != 0
     }
 
+    /// The ray ran out of iterations ([`MAX_ITERATIONS`]) before it hit a
+    /// voxel or left the tree: not a miss, an unknown.
+    pub fn gave_up(&self) -> bool {
+        !self.is_hit() && self.iterations >= MAX_ITERATIONS
+    }
+
     /// Packs normal, value and iterations the way the shader's hit record does.
     pub fn pack_info(&self) -> u32 {
         u32::from(self.value)

@@ -64,6 +64,11 @@ pub fn shadow_ray(hit: &Hit) -> Option<Ray> {
     Some(Ray::new(origin, Vec3::from(SUN_DIR)))
 }
 
+/// Colour of a ray that ran out of iterations before it hit or left the
+/// scene (twin of `GAVE_UP_COLOR` in `shaders/common.wgsl`): magenta, so a
+/// give-up never looks like sky.
+pub const GAVE_UP_COLOR: Vec3 = Vec3::new(1.0, 0.0, 1.0);
+
 /// One pixel's colour; mirrors `shade` in `shaders/common.wgsl`.
 pub fn shade(hit: &Hit, dir: Vec3, palette: &Palette, view: View, in_shadow: bool) -> [u8; 4] {
     let rgb = match view {
@@ -75,6 +80,7 @@ pub fn shade(hit: &Hit, dir: Vec3, palette: &Palette, view: View, in_shadow: boo
             let sky = if hit.normal == IVec3::ZERO { 0.0 } else { 0.5 + 0.5 * hit.normal.y as f32 };
             albedo * (0.25 + 0.15 * sky + 0.6 * sun)
         }
+        View::Shaded if hit.gave_up() => GAVE_UP_COLOR,
         View::Shaded => sky_color(dir),
         View::Iterations => heat(hit.iterations as f32 / 160.0),
         View::Depth if hit.is_hit() => heat((hit.cell_level as f32 + 1.0) / 8.0),
@@ -121,6 +127,14 @@ pub fn render_scene_cpu(
     };
     let basis = camera.basis(size.0, size.1, scene.tree.origin());
     let hits = trace_image(tracer, &basis);
+    let gave_up = hits.iter().filter(|hit| hit.gave_up()).count();
+    if gave_up > 0 {
+        log::warn!(
+            "{gave_up} of {} rays gave up after {} steps; they are drawn magenta, not as sky",
+            hits.len(),
+            super::MAX_ITERATIONS
+        );
+    }
     let shadows: Vec<bool> = if settings.shadows {
         hits.par_iter().map(|hit| shadow_ray(hit).is_some_and(|ray| tracer.trace(&ray).is_hit())).collect()
     } else {

@@ -24,11 +24,22 @@ const _: () = assert!(MAX_DEPTH <= 20);
 /// The voxel and face under pixel (x, y) of a `size` view, with the voxel in
 /// world coordinates: the one CPU pick that the window's mouse and replay's
 /// `click` share.
-pub fn pick(tree: &Octree, camera: &Camera, size: (u32, u32), x: u32, y: u32) -> Option<Hit> {
+pub fn pick(tree: &Octree, camera: &Camera, size: (u32, u32), x: u32, y: u32) -> Result<Option<Hit>, GaveUp> {
     let basis = camera.basis(size.0, size.1, tree.origin());
     let (origin, dir) = basis.ray(x, y);
     let hit = trace(tree, &Ray::new(origin, dir));
-    hit.is_hit().then(|| Hit { voxel: hit.voxel + tree.origin(), ..hit })
+    if hit.gave_up() {
+        return Err(GaveUp { iterations: hit.iterations });
+    }
+    Ok(hit.is_hit().then(|| Hit { voxel: hit.voxel + tree.origin(), ..hit }))
+}
+
+/// A pick whose ray ran out of iterations: what lies under the pixel is
+/// unknown, which is not the same as nothing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("the ray under the cursor gave up after {iterations} steps without reaching a voxel or leaving the scene")]
+pub struct GaveUp {
+    pub iterations: u32,
 }
 
 /// The first solid voxel along `ray` (tree-local coordinates).

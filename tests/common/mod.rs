@@ -17,6 +17,13 @@ pub fn assets() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/assets")
 }
 
+/// Copies an asset into a test folder as a user's own file: writable,
+/// whatever the read-only permissions of the shared assets.
+pub fn copy_writable(source: &std::path::Path, target: &std::path::Path) {
+    let bytes = std::fs::read(source).unwrap_or_else(|e| panic!("{}: {e}", source.display()));
+    std::fs::write(target, bytes).unwrap_or_else(|e| panic!("{}: {e}", target.display()));
+}
+
 /// A scene of overlapping spheres, boxes and holes with several colours.
 pub fn sculpture() -> Octree {
     let mut tree = Octree::default();

@@ -1,7 +1,6 @@
 //! Loading: pre-pass, guarded `dot_vox` parse, scene placement, axis change.
 
 use std::collections::{BTreeMap, HashSet};
-use std::io::Read;
 use std::path::Path;
 
 use dot_vox::DotVoxData;
@@ -12,6 +11,7 @@ use super::transform::{Placement, Transform};
 use super::validate::{self, Layout};
 use super::{MAX_FILE_BYTES, VoxError};
 use crate::io::guard::catch_quietly;
+use crate::io::input::{InputError, read_limited};
 use crate::scene::{Material, MaterialKind, Palette, Voxel, VoxelModel};
 
 /// Reads and loads the `.vox` file at `path`; see [`load_vox`].
@@ -20,16 +20,11 @@ use crate::scene::{Material, MaterialKind, Palette, Voxel, VoxelModel};
 /// [`VoxError::Read`] (naming the path) when the file cannot be read,
 /// [`VoxError::FileTooLarge`] beyond [`MAX_FILE_BYTES`], else as [`load_vox`].
 pub fn load_vox_file(path: &Path, frame: usize) -> Result<VoxelModel, VoxError> {
-    let read_error = |source| VoxError::Read { path: path.to_owned(), source };
-    let file = std::fs::File::open(path).map_err(read_error)?;
-    let mut bytes = Vec::new();
-    // Read one byte past the limit so that a file that grows while we read
-    // it is still refused rather than silently cut.
-    file.take(MAX_FILE_BYTES + 1).read_to_end(&mut bytes).map_err(read_error)?;
-    let len = u64::try_from(bytes.len()).unwrap_or(u64::MAX);
-    if len > MAX_FILE_BYTES {
-        return Err(VoxError::FileTooLarge { path: path.to_owned(), bytes: len });
-    }
+    let bytes = read_limited(path, MAX_FILE_BYTES).map_err(|e| match e {
+        InputError::Io(source) => VoxError::Read { path: path.to_owned(), source },
+        InputError::NotRegular => VoxError::NotRegular { path: path.to_owned() },
+        InputError::TooLarge { .. } => VoxError::FileTooLarge { path: path.to_owned() },
+    })?;
     load_vox(&bytes, frame)
 }
 
@@ -58,7 +53,13 @@ pub fn load_vox(bytes: &[u8], frame: usize) -> Result<VoxelModel, VoxError> {
         scene::placements(&data.scenes, &layout.node_ids, &layout.model_voxels, frame)?
     };
     let voxels = place_voxels(&data, &layout, &placements)?;
-    Ok(VoxelModel { palette: palette_of(&data, &layout), voxels, models: placements.len() })
+    Ok(VoxelModel {
+        palette: palette_of(&data, &layout),
+        voxels,
+        models: placements.len(),
+        stored_models: data.models.len(),
+        warnings: layout.warnings,
+    })
 }
 
 /// Runs `dot_vox::load_bytes`, turning a panic into [`VoxError::ParserPanic`].
@@ -107,10 +108,15 @@ fn frame_placement(models: usize, frame: usize) -> Result<Vec<Placement>, VoxErr
     Ok(vec![Placement { model: frame, transform: Transform::IDENTITY, centred: false }])
 }
 
+/// Peak bytes per voxel of a load and the octree build after it: the list
+/// (16), its sort, and the build's Morton keys (16 each).
+const BYTES_PER_LOADED_VOXEL: u64 = 48;
+
 /// Every placed voxel in world axes, sorted by position, overlaps resolved.
 fn place_voxels(data: &DotVoxData, layout: &Layout, placements: &[Placement]) -> Result<Vec<Voxel>, VoxError> {
     let empty: HashSet<(usize, usize)> = layout.zero_index_voxels.iter().copied().collect();
-    let total = placements.iter().map(|p| layout.model_voxels[p.model]).sum();
+    let total: usize = placements.iter().map(|p| layout.model_voxels[p.model]).sum();
+    crate::budget::check(|| format!("loading {total} voxels"), total as u64 * BYTES_PER_LOADED_VOXEL)?;
     let mut voxels = Vec::with_capacity(total);
     for placement in placements {
         let model = &data.models[placement.model];

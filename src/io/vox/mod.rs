@@ -21,7 +21,7 @@ mod validate;
 use std::path::PathBuf;
 
 pub use load::{load_vox, load_vox_file};
-pub use save::{encode_vox, save_vox};
+pub use save::{encode_vox, save_tree, save_vox};
 
 /// Most voxels one load may produce (after scene-graph instancing).
 pub const MAX_VOXELS: usize = 1 << 26;
@@ -46,8 +46,11 @@ pub enum VoxError {
     #[error("cannot write {}: {source}", path.display())]
     Write { path: PathBuf, source: std::io::Error },
     /// The file is larger than [`MAX_FILE_BYTES`].
-    #[error("{} is {bytes} bytes; octovox reads .vox files of at most {MAX_FILE_BYTES} bytes", path.display())]
-    FileTooLarge { path: PathBuf, bytes: u64 },
+    #[error("{} is larger than {MAX_FILE_BYTES} bytes, the most octovox reads from a .vox file", path.display())]
+    FileTooLarge { path: PathBuf },
+    /// A device, socket or folder.
+    #[error("{} is not a regular file (a device, socket or folder)", path.display())]
+    NotRegular { path: PathBuf },
     /// The first four bytes are not `VOX `.
     #[error("not a .vox file (missing 'VOX ' magic)")]
     NotVox,
@@ -83,6 +86,9 @@ pub enum VoxError {
     /// `dot_vox`'s result disagrees with the pre-pass (a bug in one of them).
     #[error("internal inconsistency while loading: {0}")]
     Inconsistent(String),
+    /// Loading would take more memory than the budget allows.
+    #[error(transparent)]
+    OverBudget(#[from] crate::budget::OverBudget),
     /// The voxels cannot be written as a `.vox` file.
     #[error("cannot save: {0}")]
     Unsavable(String),

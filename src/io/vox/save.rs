@@ -1,121 +1,230 @@
-//! Saving: world voxels → version-200 `.vox` with a scene graph.
+//! Saving: the octree → version-200 `.vox` with a scene graph, written one
+//! model at a time so that memory stays at one 256³ block whatever the scene.
 
-use std::collections::BTreeMap;
-use std::io::Write;
+use std::io::{Seek, SeekFrom, Write};
 use std::path::Path;
 
-use dot_vox::{Color, Dict, DotVoxData, Frame, Layer, Model, SceneNode, ShapeModel, Size};
 use glam::IVec3;
 
-use super::VoxError;
-use super::load::sort_and_dedup;
 use super::validate::MAX_MODEL_EDGE;
-use crate::scene::{Material, Palette, Voxel};
+use super::{MAX_FILE_BYTES, MAX_VOXELS, VoxError};
+use crate::io::atomic::{WriteOptions, write_atomically};
+use crate::scene::{Material, Octree, Palette, Voxel};
+
+/// Level of the octree cells that become one model: 2^8 = 256 voxels, the
+/// largest model edge MagicaVoxel reads.
+const BLOCK_LEVEL: u32 = 8;
+const _: () = assert!(1 << BLOCK_LEVEL == MAX_MODEL_EDGE);
+
+/// Bytes of a chunk header: id, content size, children size.
+const CHUNK_HEADER_BYTES: u64 = 12;
 
 /// Encodes `voxels` (world positions, y up; palette indices 1..=255) and
-/// `palette` as a version-200 `.vox` file that MagicaVoxel opens.
-///
-/// The file holds an RGBA palette, a MATL chunk for every palette entry whose
-/// material is not plain diffuse (parameters kept verbatim), and a scene
-/// graph: root nTRN → nGRP → for each model an nTRN with a `_t` translation →
-/// nSHP. Scenes wider than 256 voxels on an axis are cut into models of at most
-/// 256³ so nothing is lost. Where two voxels share a position, the later wins.
-/// An empty scene is written as one empty 1×1×1 model.
+/// `palette` in memory, as [`write_vox`] does; where two voxels share a
+/// position, the later wins.
 ///
 /// # Errors
-/// [`VoxError::Unsavable`] for a voxel with palette index 0 (empty) or a model
-/// whose translation does not fit MagicaVoxel's 32-bit range.
+/// [`VoxError::Unsavable`] for a voxel with palette index 0 (empty), a scene
+/// wider than the octree holds, or one octovox could not read back.
 pub fn encode_vox(palette: &Palette, voxels: &[Voxel]) -> Result<Vec<u8>, VoxError> {
-    let blocks = split_into_blocks(voxels)?;
-    let mut models = Vec::with_capacity(blocks.len().max(1));
-    let mut translations = Vec::with_capacity(blocks.len().max(1));
-    for block in blocks {
-        translations.push(block.translation()?);
-        models.push(block.model);
-    }
-    if models.is_empty() {
-        models.push(Model { size: Size { x: 1, y: 1, z: 1 }, voxels: Vec::new() });
-        translations.push([0, 0, 0]);
-    }
-    let data = DotVoxData {
-        version: 200,
-        index_map: dot_vox::DEFAULT_INDEX_MAP.to_vec(),
-        models,
-        palette: rgba_chunk(palette),
-        materials: matl_chunks(palette),
-        scenes: scene_graph(&translations),
-        layers: vec![Layer { attributes: dict([("_name", "0".to_owned())]) }],
-    };
-    let mut bytes = Vec::new();
-    data.write_vox(&mut bytes).map_err(|e| VoxError::Unsavable(e.to_string()))?;
-    Ok(bytes)
+    let tree = tree_of(voxels)?;
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    write_vox(&mut bytes, palette, &tree).map_err(|e| match e {
+        WriteError::Vox(e) => e,
+        WriteError::Io(e) => VoxError::Unsavable(e.to_string()),
+    })?;
+    Ok(bytes.into_inner())
 }
 
-/// Encodes the scene like [`encode_vox`] and writes it to `path` atomically:
-/// the bytes go to a temporary file in the same directory, which then replaces
-/// `path`, so a failed save never destroys the previous file.
+/// Saves `voxels` like [`encode_vox`] to `path`, atomically (see [`save_tree`]).
 ///
 /// # Errors
-/// As [`encode_vox`], plus [`VoxError::Write`] naming `path` when the
-/// temporary file cannot be created, written or renamed.
+/// As [`encode_vox`] and [`save_tree`].
 pub fn save_vox(path: &Path, palette: &Palette, voxels: &[Voxel]) -> Result<(), VoxError> {
-    let bytes = encode_vox(palette, voxels)?;
-    write_atomically(path, &bytes)
+    save_tree(path, palette, &tree_of(voxels)?, WriteOptions::default())
 }
 
-fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), VoxError> {
-    let write_error = |source| VoxError::Write { path: path.to_owned(), source };
-    let dir = match path.parent() {
-        Some(parent) if !parent.as_os_str().is_empty() => parent,
-        _ => Path::new("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".octovox-save-").suffix(".tmp");
-    // tempfile creates files readable by the owner only; give the saved file
-    // the permissions of the file it replaces, or the usual rw-r--r--.
-    let permissions = match std::fs::metadata(path) {
-        Ok(meta) => Some(meta.permissions()),
-        Err(_) => default_permissions(),
-    };
-    if let Some(permissions) = permissions {
-        builder.permissions(permissions);
+fn tree_of(voxels: &[Voxel]) -> Result<Octree, VoxError> {
+    if let Some((p, _)) = voxels.iter().find(|(_, index)| *index == 0) {
+        return Err(VoxError::Unsavable(format!(
+            "the voxel at ({}, {}, {}) has palette index 0, which means empty",
+            p.x, p.y, p.z
+        )));
     }
-    let mut file = builder.tempfile_in(dir).map_err(write_error)?;
-    file.write_all(bytes).map_err(write_error)?;
-    file.as_file().sync_all().map_err(write_error)?;
-    file.persist(path).map_err(|e| write_error(e.error))?;
+    Octree::from_voxels(voxels).map_err(|e| VoxError::Unsavable(e.to_string()))
+}
+
+/// Writes the scene to `path` through a temporary file that replaces it only
+/// when complete (`crate::io::atomic`): a failed save never destroys the
+/// previous file, symlinks are followed, devices and FIFOs are refused.
+///
+/// # Errors
+/// [`VoxError::Unsavable`] before anything is written when the scene cannot
+/// be read back by octovox; [`VoxError::Write`] naming `path` otherwise.
+pub fn save_tree(path: &Path, palette: &Palette, tree: &Octree, options: WriteOptions) -> Result<(), VoxError> {
+    check_savable(tree)?;
+    write_atomically(path, options, |file| {
+        let mut out = std::io::BufWriter::new(file);
+        write_vox(&mut out, palette, tree)?;
+        out.flush()?;
+        Ok(())
+    })
+    .map_err(|e| match e {
+        WriteError::Vox(e) => e,
+        WriteError::Io(source) => VoxError::Write { path: path.to_owned(), source },
+    })
+}
+
+/// What can go wrong while writing: the scene, or the output.
+#[derive(Debug)]
+enum WriteError {
+    Vox(VoxError),
+    Io(std::io::Error),
+}
+
+impl From<std::io::Error> for WriteError {
+    fn from(e: std::io::Error) -> WriteError {
+        WriteError::Io(e)
+    }
+}
+
+/// A file octovox would refuse to load is never written.
+fn check_savable(tree: &Octree) -> Result<(), VoxError> {
+    let voxels = tree.solid_voxels();
+    if voxels > MAX_VOXELS as u64 {
+        return Err(VoxError::Unsavable(format!(
+            "the scene holds {voxels} voxels; a .vox file octovox can read back holds at most {MAX_VOXELS}"
+        )));
+    }
     Ok(())
 }
 
-#[cfg(unix)]
-fn default_permissions() -> Option<std::fs::Permissions> {
-    use std::os::unix::fs::PermissionsExt;
-    Some(std::fs::Permissions::from_mode(0o644))
+/// Writes a version-200 `.vox` file that MagicaVoxel opens: one model per
+/// non-empty 256³ cell of the octree (cropped to its voxels), a scene graph
+/// (root nTRN → nGRP → for each model an nTRN with a `_t` translation →
+/// nSHP), a layer, the RGBA palette and a MATL chunk for every palette entry
+/// whose material is not plain diffuse (parameters kept verbatim, in key
+/// order, so the same scene always gives the same bytes). An empty scene is
+/// written as one empty 1×1×1 model.
+fn write_vox<W: Write + Seek>(out: &mut W, palette: &Palette, tree: &Octree) -> Result<(), WriteError> {
+    check_savable(tree).map_err(WriteError::Vox)?;
+    out.write_all(b"VOX ")?;
+    out.write_all(&200u32.to_le_bytes())?;
+    let main_at = out.stream_position()?;
+    write_chunk(out, b"MAIN", &[], 0)?;
+    let mut translations = Vec::new();
+    for (min, word, level) in tree.blocks(BLOCK_LEVEL) {
+        let block = Block::collect(tree, min, word, level);
+        translations.push(block.translation().map_err(WriteError::Vox)?);
+        block.write(out)?;
+    }
+    if translations.is_empty() {
+        write_chunk(out, b"SIZE", &[1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0], 0)?;
+        write_chunk(out, b"XYZI", &0u32.to_le_bytes(), 0)?;
+        translations.push([0, 0, 0]);
+    }
+    write_scene_graph(out, &translations)?;
+    write_chunk(out, b"LAYR", &layer_chunk(), 0)?;
+    write_chunk(out, b"RGBA", &rgba_chunk(palette), 0)?;
+    for (id, material) in materials(palette) {
+        let mut chunk = id.to_le_bytes().to_vec();
+        write_dict(&mut chunk, material.iter().map(|(k, v)| (k.as_str(), v.as_str())));
+        write_chunk(out, b"MATL", &chunk, 0)?;
+    }
+    let end = out.stream_position()?;
+    let children = end - main_at - CHUNK_HEADER_BYTES;
+    if end > MAX_FILE_BYTES {
+        return Err(WriteError::Vox(VoxError::Unsavable(format!(
+            "the file would be {end} bytes; octovox reads .vox files of at most {MAX_FILE_BYTES}"
+        ))));
+    }
+    out.seek(SeekFrom::Start(main_at + 8))?;
+    out.write_all(&u32::try_from(children).unwrap_or(u32::MAX).to_le_bytes())?;
+    out.seek(SeekFrom::Start(end))?;
+    Ok(())
 }
 
-#[cfg(not(unix))]
-fn default_permissions() -> Option<std::fs::Permissions> {
-    None
+fn write_chunk<W: Write>(out: &mut W, id: &[u8; 4], content: &[u8], children: u32) -> std::io::Result<()> {
+    out.write_all(id)?;
+    out.write_all(&u32::try_from(content.len()).unwrap_or(u32::MAX).to_le_bytes())?;
+    out.write_all(&children.to_le_bytes())?;
+    out.write_all(content)
 }
 
-/// Up to 256³ voxels that become one model.
+fn write_string(buffer: &mut Vec<u8>, text: &str) {
+    buffer.extend_from_slice(&u32::try_from(text.len()).unwrap_or(u32::MAX).to_le_bytes());
+    buffer.extend_from_slice(text.as_bytes());
+}
+
+fn write_dict<'a>(buffer: &mut Vec<u8>, entries: impl ExactSizeIterator<Item = (&'a str, &'a str)>) {
+    buffer.extend_from_slice(&u32::try_from(entries.len()).unwrap_or(u32::MAX).to_le_bytes());
+    for (key, value) in entries {
+        write_string(buffer, key);
+        write_string(buffer, value);
+    }
+}
+
+/// One model: the voxels of one octree cell of at most 256³, in
+/// MagicaVoxel's axes, cropped to their bounds.
 struct Block {
     /// Scene position (MagicaVoxel axes) of the model's voxel (0, 0, 0).
     origin: [i64; 3],
-    model: Model,
+    size: [u32; 3],
+    /// x, y, z, palette index, as XYZI stores them.
+    voxels: Vec<[u8; 4]>,
 }
 
 impl Block {
+    fn collect(tree: &Octree, min: IVec3, word: u32, level: u32) -> Block {
+        let mut lo = [i64::MAX; 3];
+        let mut hi = [i64::MIN; 3];
+        tree.visit_cells(word, min, level, &mut |cell, size, _| {
+            // The cell's corners in scene axes; world z flips into scene −y.
+            for corner in [to_scene(cell), to_scene(cell + IVec3::splat(size - 1))] {
+                for i in 0..3 {
+                    lo[i] = lo[i].min(corner[i]);
+                    hi[i] = hi[i].max(corner[i]);
+                }
+            }
+        });
+        let mut voxels = Vec::new();
+        tree.visit_cells(word, min, level, &mut |cell, size, index| {
+            for z in 0..size {
+                for y in 0..size {
+                    for x in 0..size {
+                        let p = to_scene(cell + IVec3::new(x, y, z));
+                        // A block spans at most 256 positions per axis, so
+                        // every offset fits in a byte.
+                        let offset = |i: usize| u8::try_from(p[i] - lo[i]).unwrap_or(u8::MAX);
+                        voxels.push([offset(0), offset(1), offset(2), index]);
+                    }
+                }
+            }
+        });
+        let edge = |i: usize| u32::try_from(hi[i] - lo[i] + 1).unwrap_or(MAX_MODEL_EDGE);
+        Block { origin: lo, size: [edge(0), edge(1), edge(2)], voxels }
+    }
+
     /// The nTRN translation that puts model voxel `v` at `origin + v`: the
     /// loader places it at `v − size / 2 + t`.
     fn translation(&self) -> Result<[i32; 3], VoxError> {
-        let size = [self.model.size.x, self.model.size.y, self.model.size.z];
-        let t = [0, 1, 2].map(|axis| self.origin[axis] + i64::from(size[axis] / 2));
+        let t = [0, 1, 2].map(|axis| self.origin[axis] + i64::from(self.size[axis] / 2));
         let fit = |c: i64| {
             i32::try_from(c)
                 .map_err(|_| VoxError::Unsavable(format!("a model would sit at {c}, outside the 32-bit range")))
         };
         Ok([fit(t[0])?, fit(t[1])?, fit(t[2])?])
+    }
+
+    fn write<W: Write>(&self, out: &mut W) -> std::io::Result<()> {
+        let size: Vec<u8> = self.size.iter().flat_map(|s| s.to_le_bytes()).collect();
+        write_chunk(out, b"SIZE", &size, 0)?;
+        let count = u32::try_from(self.voxels.len()).unwrap_or(u32::MAX);
+        out.write_all(b"XYZI")?;
+        out.write_all(&(4 + count * 4).to_le_bytes())?;
+        out.write_all(&0u32.to_le_bytes())?;
+        out.write_all(&count.to_le_bytes())?;
+        out.write_all(self.voxels.as_flattened())
     }
 }
 
@@ -125,117 +234,75 @@ fn to_scene(p: IVec3) -> [i64; 3] {
     [i64::from(p.x), -i64::from(p.z), i64::from(p.y)]
 }
 
-/// Groups the voxels into 256-aligned cells of the scene's bounding box and
-/// makes each non-empty cell a model cropped to its own voxels.
-fn split_into_blocks(voxels: &[Voxel]) -> Result<Vec<Block>, VoxError> {
-    if let Some((p, _)) = voxels.iter().find(|(_, index)| *index == 0) {
-        return Err(VoxError::Unsavable(format!(
-            "the voxel at ({}, {}, {}) has palette index 0, which means empty",
-            p.x, p.y, p.z
-        )));
+/// Root nTRN (0) → nGRP (1) → per model k: nTRN (2 + 2k) → nSHP (3 + 2k).
+fn write_scene_graph<W: Write>(out: &mut W, translations: &[[i32; 3]]) -> std::io::Result<()> {
+    let node_id = |k: usize, offset: usize| u32::try_from(2 + 2 * k + offset).unwrap_or(u32::MAX);
+    write_chunk(out, b"nTRN", &transform_node(0, 1, u32::MAX, None), 0)?;
+    let mut group = 1u32.to_le_bytes().to_vec();
+    write_dict(&mut group, std::iter::empty());
+    group.extend_from_slice(&u32::try_from(translations.len()).unwrap_or(u32::MAX).to_le_bytes());
+    for k in 0..translations.len() {
+        group.extend_from_slice(&node_id(k, 0).to_le_bytes());
     }
-    let mut unique = voxels.to_vec();
-    sort_and_dedup(&mut unique);
-    let scene: Vec<([i64; 3], u8)> = unique.iter().map(|&(p, index)| (to_scene(p), index)).collect();
-    let Some(low) = scene.iter().map(|(p, _)| *p).reduce(|a, b| [0, 1, 2].map(|i| a[i].min(b[i]))) else {
-        return Ok(Vec::new());
-    };
-    let edge = i64::from(MAX_MODEL_EDGE);
-    let mut cells: BTreeMap<[i64; 3], Vec<([i64; 3], u8)>> = BTreeMap::new();
-    for &(p, index) in &scene {
-        let key = [0, 1, 2].map(|i| (p[i] - low[i]) / edge);
-        cells.entry(key).or_default().push((p, index));
+    write_chunk(out, b"nGRP", &group, 0)?;
+    for (k, t) in translations.iter().enumerate() {
+        write_chunk(out, b"nTRN", &transform_node(node_id(k, 0), node_id(k, 1), 0, Some(*t)), 0)?;
+        let mut shape = node_id(k, 1).to_le_bytes().to_vec();
+        write_dict(&mut shape, std::iter::empty());
+        shape.extend_from_slice(&1u32.to_le_bytes());
+        shape.extend_from_slice(&u32::try_from(k).unwrap_or(u32::MAX).to_le_bytes());
+        write_dict(&mut shape, std::iter::empty());
+        write_chunk(out, b"nSHP", &shape, 0)?;
     }
-    Ok(cells.into_values().map(|cell| crop_block(&cell)).collect())
+    Ok(())
 }
 
-fn crop_block(cell: &[([i64; 3], u8)]) -> Block {
-    let mut lo = [i64::MAX; 3];
-    let mut hi = [i64::MIN; 3];
-    for (p, _) in cell {
-        for i in 0..3 {
-            lo[i] = lo[i].min(p[i]);
-            hi[i] = hi[i].max(p[i]);
-        }
+/// An nTRN chunk: id, no attributes, child, reserved −1, layer, one frame.
+fn transform_node(id: u32, child: u32, layer: u32, translation: Option<[i32; 3]>) -> Vec<u8> {
+    let mut chunk = id.to_le_bytes().to_vec();
+    write_dict(&mut chunk, std::iter::empty());
+    for word in [child, u32::MAX, layer, 1] {
+        chunk.extend_from_slice(&word.to_le_bytes());
     }
-    // A cell spans at most 256 positions per axis, so every offset and edge
-    // fits in u8 and u32 (the conversions below cannot fail).
-    let edge = |i: usize| u32::try_from(hi[i] - lo[i] + 1).unwrap_or(MAX_MODEL_EDGE);
-    let offset = |p: &[i64; 3], i: usize| u8::try_from(p[i] - lo[i]).unwrap_or(u8::MAX);
-    let voxels = cell
-        .iter()
-        .map(|(p, index)| dot_vox::Voxel {
-            x: offset(p, 0),
-            y: offset(p, 1),
-            z: offset(p, 2),
-            // dot_vox writes `i + 1`; indices here are 1..=255, so 255 → 254 → 255.
-            i: index - 1,
-        })
-        .collect();
-    let size = Size { x: edge(0), y: edge(1), z: edge(2) };
-    Block { origin: lo, model: Model { size, voxels } }
+    match translation {
+        Some([x, y, z]) => write_dict(&mut chunk, [("_t", format!("{x} {y} {z}").as_str())].into_iter()),
+        None => write_dict(&mut chunk, std::iter::empty()),
+    }
+    chunk
 }
 
-/// dot_vox's palette entry k is palette index k + 1 (entry 255 is index 0).
-fn rgba_chunk(palette: &Palette) -> Vec<Color> {
-    (0..256)
-        .map(|entry| {
-            let [r, g, b, a] = palette.colors[(entry + 1) % 256];
-            Color { r, g, b, a }
-        })
-        .collect()
+/// Layer 0, named "0".
+fn layer_chunk() -> Vec<u8> {
+    let mut chunk = 0u32.to_le_bytes().to_vec();
+    write_dict(&mut chunk, [("_name", "0")].into_iter());
+    chunk.extend_from_slice(&u32::MAX.to_le_bytes());
+    chunk
 }
 
-fn matl_chunks(palette: &Palette) -> Vec<dot_vox::Material> {
+/// RGBA entry k is palette index k + 1 (entry 255 is index 0).
+fn rgba_chunk(palette: &Palette) -> Vec<u8> {
+    (0..256).flat_map(|entry| palette.colors[(entry + 1) % 256]).collect()
+}
+
+/// (MagicaVoxel material id, properties in key order) of every palette entry
+/// that is not plain diffuse; ids run 1..=256, where 256 is palette index 0.
+fn materials(palette: &Palette) -> Vec<(u32, Vec<(String, String)>)> {
     let plain = Material::default();
-    palette
+    let mut out: Vec<(u32, Vec<(String, String)>)> = palette
         .materials
         .iter()
         .take(256)
         .enumerate()
         .filter(|(_, material)| **material != plain)
         .map(|(index, material)| {
-            let mut properties: Dict = material.params.iter().map(|(k, v)| (k.clone(), v.clone())).collect();
-            properties.insert("_type".to_owned(), material.kind.vox_name().to_owned());
-            // MagicaVoxel numbers materials 1..=256; 256 stands for index 0.
+            let mut properties: Vec<(String, String)> =
+                material.params.iter().map(|(k, v)| (k.clone(), v.clone())).collect();
+            properties.push(("_type".to_owned(), material.kind.vox_name().to_owned()));
+            properties.sort();
             let id = if index == 0 { 256 } else { u32::try_from(index).unwrap_or(0) };
-            dot_vox::Material { id, properties }
+            (id, properties)
         })
-        .collect()
-}
-
-/// Root nTRN (0) → nGRP (1) → per model k: nTRN (2 + 2k) → nSHP (3 + 2k).
-/// dot_vox writes each node with its index in this list as its id.
-fn scene_graph(translations: &[[i32; 3]]) -> Vec<SceneNode> {
-    let node_id = |k: usize, offset: usize| u32::try_from(2 + 2 * k + offset).unwrap_or(u32::MAX);
-    let mut nodes = vec![
-        SceneNode::Transform {
-            attributes: Dict::default(),
-            frames: vec![Frame::new(Dict::default())],
-            child: 1,
-            layer_id: u32::MAX,
-        },
-        SceneNode::Group {
-            attributes: Dict::default(),
-            children: (0..translations.len()).map(|k| node_id(k, 0)).collect(),
-        },
-    ];
-    for (k, t) in translations.iter().enumerate() {
-        let frame = dict([("_t", format!("{} {} {}", t[0], t[1], t[2]))]);
-        nodes.push(SceneNode::Transform {
-            attributes: Dict::default(),
-            frames: vec![Frame::new(frame)],
-            child: node_id(k, 1),
-            layer_id: 0,
-        });
-        nodes.push(SceneNode::Shape {
-            attributes: Dict::default(),
-            models: vec![ShapeModel { model_id: u32::try_from(k).unwrap_or(u32::MAX), attributes: Dict::default() }],
-        });
-    }
-    nodes
-}
-
-fn dict<const N: usize>(entries: [(&str, String); N]) -> Dict {
-    entries.into_iter().map(|(k, v)| (k.to_owned(), v)).collect()
+        .collect();
+    out.sort_by_key(|(id, _)| *id);
+    out
 }

@@ -39,6 +39,8 @@ pub(super) struct Layout {
     pub zero_index_voxels: Vec<(usize, usize)>,
     /// Materials of old MATT chunks, by palette index.
     pub matt: BTreeMap<u8, Material>,
+    /// Oddities that do not stop the load (bytes that are ignored).
+    pub warnings: Vec<String>,
 }
 
 /// Checks the whole chunk structure of `bytes`.
@@ -55,6 +57,13 @@ pub(super) fn check(bytes: &[u8]) -> Result<Layout, VoxError> {
         let chunk = read_chunk_header(bytes, pos, main.end)?;
         check_chunk(bytes, &chunk, &mut size, &mut layout)?;
         pos = chunk.end;
+    }
+    if main.end < bytes.len() {
+        layout.warnings.push(format!(
+            "{} bytes after the MAIN chunk (from byte {}) are not part of the model and were ignored",
+            bytes.len() - main.end,
+            main.end
+        ));
     }
     Ok(layout)
 }
@@ -128,6 +137,13 @@ fn check_voxels(cursor: &mut Cursor<'_>, size: Option<[u32; 3]>, layout: &mut La
     }
     let model = layout.model_voxels.len();
     let data = cursor.take(count * 4, "voxels")?;
+    if cursor.remaining() > 0 {
+        layout.warnings.push(format!(
+            "chunk XYZI at byte {} holds {} bytes past its {count} voxels; they were ignored",
+            chunk.offset,
+            cursor.remaining()
+        ));
+    }
     for (ordinal, voxel) in data.chunks_exact(4).enumerate() {
         let inside = voxel[..3].iter().zip(size).all(|(&c, edge)| u32::from(c) < edge);
         if !inside {

@@ -1,0 +1,104 @@
+//! Which outputs a command may write: never one of its inputs, never over an
+//! existing document (.vox, .obj, .ovr) unless the user said `--force`, and
+//! only in the format the file's extension names.
+
+use std::path::{Path, PathBuf};
+
+/// What a command writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OutputKind {
+    /// A rendered image: `.png`.
+    Image,
+    /// A scene: `.vox`.
+    Scene,
+    /// A replay script (`--record`): any name, `.ovr` by convention.
+    Script,
+}
+
+impl OutputKind {
+    fn extension(self) -> Option<&'static str> {
+        match self {
+            OutputKind::Image => Some("png"),
+            OutputKind::Scene => Some("vox"),
+            OutputKind::Script => None,
+        }
+    }
+}
+
+/// Extensions of the files users make by hand or with other tools; an
+/// existing one is only replaced with `--force`.
+const DOCUMENT_EXTENSIONS: [&str; 3] = ["vox", "obj", "ovr"];
+
+/// Why an output was refused.
+#[derive(Debug, thiserror::Error, PartialEq, Eq)]
+pub enum OutputError {
+    #[error("{} is an input of this command; refusing to overwrite it (--force overwrites)", path.display())]
+    IsInput { path: PathBuf },
+    #[error("{} already exists; refusing to replace it (--force replaces it)", path.display())]
+    Exists { path: PathBuf },
+    #[error("{} names a .{found} file, but this command writes .{expected} files", path.display())]
+    WrongExtension { path: PathBuf, found: String, expected: &'static str },
+}
+
+/// Checks that `output` may be written by a command that read `inputs`.
+///
+/// # Errors
+/// [`OutputError::WrongExtension`] always; the others unless `force`.
+pub fn check_output(output: &Path, kind: OutputKind, inputs: &[&Path], force: bool) -> Result<(), OutputError> {
+    let extension = extension_of(output);
+    if let Some(expected) = kind.extension()
+        && extension != expected
+    {
+        return Err(OutputError::WrongExtension { path: output.to_path_buf(), found: extension, expected });
+    }
+    if force {
+        return Ok(());
+    }
+    if inputs.iter().any(|input| same_file(input, output)) {
+        return Err(OutputError::IsInput { path: output.to_path_buf() });
+    }
+    if output.exists() && DOCUMENT_EXTENSIONS.contains(&extension.as_str()) {
+        return Err(OutputError::Exists { path: output.to_path_buf() });
+    }
+    Ok(())
+}
+
+/// Lower-case extension, or "" when there is none.
+fn extension_of(path: &Path) -> String {
+    path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default()
+}
+
+/// True when both paths name one existing file (through links and `..`).
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inputs_and_documents_are_protected() {
+        let dir = tempfile::tempdir().unwrap();
+        let model = dir.path().join("model.vox");
+        std::fs::write(&model, b"VOX ").unwrap();
+        let png = dir.path().join("a.png");
+        std::fs::write(&png, b"png").unwrap();
+        let err = check_output(&model, OutputKind::Scene, &[&model], false).unwrap_err();
+        assert!(matches!(err, OutputError::IsInput { .. }), "{err}");
+        let err = check_output(&model, OutputKind::Image, &[], false).unwrap_err();
+        assert!(matches!(err, OutputError::WrongExtension { .. }), "{err}");
+        assert!(matches!(check_output(&model, OutputKind::Scene, &[], false), Err(OutputError::Exists { .. })));
+        assert_eq!(check_output(&model, OutputKind::Scene, &[&model], true), Ok(()));
+        // An existing image is an ordinary output; a new .vox too.
+        assert_eq!(check_output(&png, OutputKind::Image, &[&model], false), Ok(()));
+        assert_eq!(check_output(&dir.path().join("new.vox"), OutputKind::Scene, &[&model], false), Ok(()));
+        // The format comes from the extension, in any case.
+        assert_eq!(check_output(&dir.path().join("X.PNG"), OutputKind::Image, &[], false), Ok(()));
+        assert!(check_output(&dir.path().join("x.jpg"), OutputKind::Image, &[], true).is_err());
+    }
+}

@@ -1,0 +1,505 @@
+//! The failures found by trying to break octovox (issue "Nothing lost,
+//! nothing silent"), one test each, run as a user runs the binary. Each
+//! failed before its fix.
+#![allow(clippy::unwrap_used)] // in tests a panic is the failure report
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use glam::IVec3;
+use octovox::io::atomic::{WriteOptions, write_atomically};
+use octovox::scene::{Octree, Op, Shape};
+
+fn octovox(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_octovox")).args(args).output().expect("run octovox")
+}
+
+fn text(out: &Output) -> String {
+    format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr))
+}
+
+/// Fails unless the command exited non-zero with `needle` in its output
+/// and without a panic.
+fn assert_refused(out: &Output, needle: &str) {
+    let text = text(out);
+    assert!(!out.status.success(), "exited 0: {text}");
+    assert!(text.contains(needle), "expected '{needle}' in: {text}");
+    assert!(!text.contains("panicked"), "{text}");
+}
+
+fn torus() -> PathBuf {
+    common::assets().join("vox/seed/torus64.vox")
+}
+
+fn s(path: &Path) -> &str {
+    path.to_str().expect("UTF-8 temp path")
+}
+
+/// A copy of torus64.vox in a fresh folder.
+fn model_in(dir: &Path) -> PathBuf {
+    let model = dir.join("model.vox");
+    common::copy_writable(&torus(), &model);
+    model
+}
+
+// ----- 1, 2: an output that is an input or an existing document --------------
+
+#[test]
+fn render_never_writes_over_its_input_or_a_document() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = model_in(dir.path());
+    let before = std::fs::read(&model).unwrap();
+    let m = s(&model);
+    assert_refused(&octovox(&["render", m, "-o", m, "--cpu", "--size", "8x8"]), "writes .png files");
+    let png_named_vox = dir.path().join("render.png");
+    common::copy_writable(&model, &png_named_vox);
+    // Same file through another name: refused as an input even with the right extension.
+    assert_refused(
+        &octovox(&["render", s(&png_named_vox), "-o", s(&png_named_vox), "--cpu", "--size", "8x8"]),
+        "is an input",
+    );
+    assert_eq!(std::fs::read(&model).unwrap(), before, "the model changed");
+    let obj = dir.path().join("mesh.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n").unwrap();
+    assert_refused(&octovox(&["render", s(&obj), "-o", s(&obj), "--cpu"]), "writes .png files");
+    assert!(std::fs::read_to_string(&obj).unwrap().starts_with("v 0 0 0"));
+}
+
+#[test]
+fn convert_and_import_replace_an_existing_vox_only_with_force() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = model_in(dir.path());
+    let out = dir.path().join("out.vox");
+    std::fs::write(&out, b"keep me").unwrap();
+    assert_refused(&octovox(&["convert", s(&model), s(&out)]), "already exists");
+    assert_eq!(std::fs::read(&out).unwrap(), b"keep me");
+    assert_refused(&octovox(&["convert", s(&model), s(&model)]), "is an input");
+    let done = octovox(&["convert", s(&model), s(&out), "--force"]);
+    assert!(done.status.success(), "{}", text(&done));
+    assert!(std::fs::read(&out).unwrap().starts_with(b"VOX "));
+    let mesh = common::assets().join("meshes/bunny.obj");
+    if mesh.exists() {
+        assert_refused(&octovox(&["import", s(&mesh), "-o", s(&out), "--size", "16"]), "already exists");
+    }
+}
+
+#[test]
+fn record_refuses_the_model_and_the_script_it_plays() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = model_in(dir.path());
+    let before = std::fs::read(&model).unwrap();
+    // Refused before any window opens, so no display is needed.
+    assert_refused(&octovox(&[s(&model), "--record", s(&model)]), "is an input");
+    assert_eq!(std::fs::read(&model).unwrap(), before, "--record truncated the model");
+    let script = dir.path().join("s.ovr");
+    std::fs::write(&script, "demo\n").unwrap();
+    assert_refused(&octovox(&["--replay", s(&script), "--record", s(&script)]), "is an input");
+    assert_eq!(std::fs::read_to_string(&script).unwrap(), "demo\n");
+    let other = dir.path().join("other.ovr");
+    std::fs::write(&other, "new\n").unwrap();
+    assert_refused(&octovox(&["--record", s(&other)]), "already exists");
+}
+
+#[test]
+fn replay_save_and_render_follow_the_same_rule() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = model_in(dir.path());
+    let before = std::fs::read(&model).unwrap();
+    let script = dir.path().join("overwrite.ovr");
+    std::fs::write(&script, "load model.vox\nsave model.vox\n").unwrap();
+    assert_refused(&octovox(&["replay", "--cpu", s(&script)]), "is an input");
+    assert_eq!(std::fs::read(&model).unwrap(), before);
+    // A file the run wrote itself may be written again.
+    std::fs::write(
+        &script,
+        "new\nplace 0 0 0\nsave again.vox\nplace 1 0 0\nsave again.vox\nrender r.png\nrender r.png\n",
+    )
+    .unwrap();
+    let out = octovox(&["replay", "--cpu", s(&script)]);
+    assert!(out.status.success(), "{}", text(&out));
+    // A second run finds again.vox from the first: refused without --force.
+    assert_refused(&octovox(&["replay", "--cpu", s(&script)]), "already exists");
+    let out = octovox(&["replay", "--cpu", "--force", s(&script)]);
+    assert!(out.status.success(), "{}", text(&out));
+}
+
+// ----- 3: where a save writes ------------------------------------------------------
+
+fn write_bytes(path: &Path, bytes: &[u8], options: WriteOptions) -> std::io::Result<()> {
+    write_atomically(path, options, |file| std::io::Write::write_all(file, bytes))
+}
+
+#[cfg(unix)]
+#[test]
+fn saves_follow_links_and_refuse_devices_fifos_and_read_only_files() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().unwrap();
+    let target = dir.path().join("real.vox");
+    std::fs::write(&target, b"old").unwrap();
+    let link = dir.path().join("link.vox");
+    std::os::unix::fs::symlink("real.vox", &link).unwrap();
+    write_bytes(&link, b"new", WriteOptions::default()).unwrap();
+    assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink(), "the link became a file");
+    assert_eq!(std::fs::read(&target).unwrap(), b"new", "the link's target was not updated");
+
+    let err = write_bytes(Path::new("/dev/null"), b"x", WriteOptions::default()).unwrap_err();
+    assert!(err.to_string().contains("not a regular file"), "{err}");
+    let fifo = dir.path().join("pipe.vox");
+    assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
+    let err = write_bytes(&fifo, b"x", WriteOptions::default()).unwrap_err();
+    assert!(err.to_string().contains("not a regular file"), "{err}");
+    assert!(!std::fs::symlink_metadata(&fifo).unwrap().is_file(), "the FIFO was replaced");
+
+    let locked = dir.path().join("locked.vox");
+    std::fs::write(&locked, b"mine").unwrap();
+    std::fs::set_permissions(&locked, std::fs::Permissions::from_mode(0o444)).unwrap();
+    let err = write_bytes(&locked, b"x", WriteOptions::default()).unwrap_err();
+    assert!(err.to_string().contains("read-only"), "{err}");
+    assert_eq!(std::fs::read(&locked).unwrap(), b"mine");
+    write_bytes(&locked, b"forced", WriteOptions { overwrite_read_only: true }).unwrap();
+    assert_eq!(std::fs::read(&locked).unwrap(), b"forced");
+    assert_eq!(std::fs::metadata(&locked).unwrap().permissions().mode() & 0o777, 0o444, "still read-only");
+    // The CLI: refused, and --force overwrites.
+    let png = dir.path().join("ro.png");
+    std::fs::write(&png, b"mine").unwrap();
+    std::fs::set_permissions(&png, std::fs::Permissions::from_mode(0o444)).unwrap();
+    assert_refused(&octovox(&["render", "--cpu", "--size", "8x8", "-o", s(&png)]), "read-only");
+    assert_eq!(std::fs::read(&png).unwrap(), b"mine");
+    let out = octovox(&["render", "--cpu", "--size", "8x8", "-o", s(&png), "--force"]);
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(octovox::io::png::load_png(&png).is_ok());
+}
+
+#[test]
+fn a_save_cleans_up_what_a_killed_save_of_the_same_file_left() {
+    let dir = tempfile::tempdir().unwrap();
+    let stale = dir.path().join(".scene.vox.octovox-save-AbC123.tmp");
+    let unrelated = dir.path().join(".other.vox.octovox-save-AbC123.tmp");
+    std::fs::write(&stale, b"half a file").unwrap();
+    std::fs::write(&unrelated, b"another document's").unwrap();
+    write_bytes(&dir.path().join("scene.vox"), b"VOX ", WriteOptions::default()).unwrap();
+    assert!(!stale.exists(), "the stale temporary file is still there");
+    assert!(unrelated.exists(), "another document's temporary file was removed");
+}
+
+// ----- 4, 5, 6: memory ------------------------------------------------------------------
+
+#[test]
+fn a_scene_too_large_for_a_vox_file_is_an_error_not_an_abort() {
+    let dir = tempfile::tempdir().unwrap();
+    let script = dir.path().join("big.ovr");
+    // 4/3·π·300³ ≈ 113 M voxels: more than a .vox file octovox reads back.
+    std::fs::write(&script, "new\nbrush sphere 300\nplace 0 0 0\nsave big.vox\n").unwrap();
+    assert_refused(&octovox(&["replay", "--cpu", s(&script)]), "a .vox file octovox can read back holds at most");
+    assert!(!dir.path().join("big.vox").exists());
+}
+
+#[test]
+fn imports_are_checked_against_the_budget_and_what_can_be_read_back() {
+    let dir = tempfile::tempdir().unwrap();
+    let cube = dir.path().join("cube.obj");
+    let faces =
+        "f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n";
+    let vertices = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n";
+    std::fs::write(&cube, format!("{vertices}{faces}")).unwrap();
+    let out = dir.path().join("cube.vox");
+    assert_refused(
+        &octovox(&["--memory-budget", "256M", "import", s(&cube), "-o", s(&out), "--size", "1024"]),
+        "--memory-budget raises it",
+    );
+    // 416³ = 72 M voxels fits the budget but not a file octovox reads back.
+    assert_refused(&octovox(&["import", s(&cube), "-o", s(&out), "--size", "416"]), "can read back");
+    assert!(!out.exists(), "a file octovox cannot read was written");
+}
+
+#[test]
+fn loads_brushes_and_renders_are_checked_against_the_budget() {
+    let torus = torus();
+    assert_refused(&octovox(&["--memory-budget", "64K", "info", s(&torus)]), "over the 64.0 KiB budget");
+    assert_refused(
+        &octovox(&["render", "--cpu", "--size", "16384x16384", "-o", "/tmp/octovox-never.png"]),
+        "a 16384x16384 render would need about",
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let script = dir.path().join("sphere.ovr");
+    std::fs::write(&script, "new\nplace 0 0 0\nbrush sphere 4096\nplace 0 0 0\n").unwrap();
+    assert_refused(&octovox(&["--memory-budget", "1G", "replay", "--cpu", s(&script)]), "over the 1.0 GiB budget");
+    // The refused edit changed nothing.
+    // Over the default budget too; the refused edit changed nothing.
+    let mut tree = Octree::default();
+    tree.apply_brush(&Shape::Voxel(IVec3::ZERO), Op::Place(1)).unwrap();
+    let before = tree.voxels();
+    let big = Shape::Sphere { center: IVec3::ZERO, radius: 4096 };
+    let err = tree.apply_brush(&big, Op::Place(2)).unwrap_err();
+    assert!(err.to_string().contains("budget"), "{err}");
+    assert_eq!(tree.voxels(), before);
+    assert_eq!((tree.origin(), tree.depth()), (IVec3::ZERO, 2));
+}
+
+#[cfg(unix)]
+#[test]
+fn devices_are_refused_as_inputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("z.vox");
+    assert_refused(&octovox(&["import", "/dev/zero", "-o", s(&out)]), "not a regular file");
+    assert_refused(&octovox(&["replay", "--cpu", "/dev/zero"]), "not a regular file");
+    assert_refused(&octovox(&["info", "/dev/zero"]), "not a regular file");
+}
+
+// ----- 7, 8: GPU limits: a clear error or a real image, never a blank one -----------
+
+/// Fraction of pixels that are not pure black.
+fn lit_fraction(path: &Path) -> f64 {
+    let image = octovox::io::png::load_png(path).unwrap();
+    image.pixels().filter(|p| p.0[..3] != [0, 0, 0]).count() as f64 / f64::from(image.width() * image.height())
+}
+
+#[test]
+fn large_gpu_renders_draw_the_scene_or_fail() {
+    let dir = tempfile::tempdir().unwrap();
+    // 2900² pixels of hit records were 134 MB, over lavapipe's 128 MiB
+    // binding limit: the image came out black with exit 0.
+    let big = dir.path().join("big.png");
+    let out = octovox(&["render", s(&torus()), "--size", "2900x2900", "-o", s(&big)]);
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(lit_fraction(&big) > 0.99, "the render is black");
+    // Past the default 8192 texture limit wgpu panicked.
+    let wide = dir.path().join("wide.png");
+    let out = octovox(&["render", s(&torus()), "--size", "8193x48", "-o", s(&wide)]);
+    if out.status.success() {
+        assert!(lit_fraction(&wide) > 0.99, "the render is black");
+    } else {
+        assert_refused(&out, "limit for an image");
+    }
+    // A dense grid over the binding limit fails the command.
+    let script = dir.path().join("wide.ovr");
+    std::fs::write(&script, "new\nplace 0 0 0\nplace 600 600 600\nsave wide.vox\n").unwrap();
+    let made = octovox(&["replay", "--cpu", s(&script)]);
+    assert!(made.status.success(), "{}", text(&made));
+    let grid = dir.path().join("grid.png");
+    let out = octovox(&["render", s(&dir.path().join("wide.vox")), "--mode", "grid", "-o", s(&grid)]);
+    assert_refused(&out, "the dense grid needs a");
+    assert!(!grid.exists());
+}
+
+// ----- 9, 10: a ray that gives up, a refused edit ----------------------------------
+
+/// A row of 2000 voxels one voxel beside a ray along +x, and a wall 4010
+/// voxels away: the traversal passes more than 4096 cells before the wall.
+fn comb() -> Octree {
+    let mut tree = Octree::default();
+    for i in 0..2000 {
+        tree.apply_brush(&Shape::Voxel(IVec3::new(2 * i, 1, 0)), Op::Place(5)).unwrap();
+    }
+    tree.apply_brush(&Shape::Box { min: IVec3::new(4010, -8, -8), max: IVec3::new(4010, 8, 8) }, Op::Place(9)).unwrap();
+    tree
+}
+
+#[test]
+fn a_pick_that_gives_up_says_so() {
+    let tree = comb();
+    let camera = octovox::camera::Camera {
+        eye: glam::DVec3::new(-2.0, 0.5, 0.5),
+        target: glam::DVec3::new(100.0, 0.5, 0.5),
+        fov_y_deg: 1.0,
+    };
+    // Today's bound of 4096 iterations gives up before the wall (the
+    // accuracy issue will make this ray reach it); it must say so.
+    let gave_up = octovox::trace::svo::pick(&tree, &camera, (1, 1), 0, 0).unwrap_err();
+    assert!(gave_up.to_string().contains("gave up after 4096 steps"), "{gave_up}");
+    let basis = camera.basis(1, 1, tree.origin());
+    let (origin, dir) = basis.ray(0, 0);
+    let hit = octovox::trace::svo::trace(&tree, &octovox::trace::Ray::new(origin, dir));
+    let color = octovox::trace::render::shade(&hit, dir, &Default::default(), Default::default(), false);
+    assert_eq!(color, [255, 0, 255, 255], "a give-up is drawn magenta, not as sky");
+}
+
+#[test]
+fn a_refused_edit_leaves_the_scene_exactly_as_it_was() {
+    let mut tree = Octree::default();
+    tree.apply_brush(&Shape::Voxel(IVec3::ZERO), Op::Place(1)).unwrap();
+    let before = (tree.voxels(), tree.origin(), tree.depth(), tree.node_count());
+    let err = tree.apply_brush(&Shape::Voxel(IVec3::new(1 << 20, 0, 0)), Op::Place(1)).unwrap_err();
+    assert!(err.to_string().contains("wider than 2^20"), "{err}");
+    assert_eq!((tree.voxels(), tree.origin(), tree.depth(), tree.node_count()), before, "the refusal changed the tree");
+    tree.apply_brush(&Shape::Voxel(IVec3::new(-2, 0, 0)), Op::Place(1)).unwrap();
+    assert_eq!(tree.solid_voxels(), 2);
+}
+
+#[test]
+fn any_edit_that_fits_the_2_pow_20_world_is_accepted() {
+    // Growing toward -4 first leaves the root's alignment short on +x; the
+    // root moves instead of refusing an edit the world has room for.
+    let mut tree = Octree::default();
+    tree.apply_brush(&Shape::Voxel(IVec3::new(-1, 0, 0)), Op::Place(1)).unwrap();
+    tree.apply_brush(&Shape::Voxel(IVec3::new(0, 0, 0)), Op::Place(2)).unwrap();
+    let far = IVec3::new((1 << 20) - 2, 0, 0);
+    tree.apply_brush(&Shape::Voxel(far), Op::Place(3)).unwrap();
+    assert_eq!(tree.get(far), 3);
+    assert_eq!(tree.get(IVec3::new(-1, 0, 0)), 1);
+    assert_eq!(tree.solid_voxels(), 3);
+    tree.check_invariants().unwrap();
+    assert!(tree.apply_brush(&Shape::Voxel(IVec3::new(-2, 0, 0)), Op::Place(1)).is_err());
+}
+
+// ----- 11, 14: field of view, negative numbers -----------------------------------------
+
+#[test]
+fn fields_of_view_outside_the_range_are_refused_and_narrow_ones_frame_the_model() {
+    for fov in ["nan", "inf", "180", "360", "0", "-5"] {
+        let out = octovox(&["render", "--cpu", "--fov", fov, "-o", "/tmp/octovox-fov.png"]);
+        assert_refused(&out, "1..=179");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("narrow.png");
+    let out = octovox(&["render", "--cpu", "--fov", "2", "--size", "48x32", "-o", s(&png)]);
+    assert!(out.status.success(), "{}", text(&out));
+    let image = octovox::io::png::load_png(&png).unwrap();
+    let sky = image.get_pixel(0, 0).0;
+    let model = image.pixels().filter(|p| p.0 != sky).count();
+    // Framed: the demo scene fills much of the view, but not all of it.
+    assert!(model > 48 * 32 / 8 && model < 48 * 32, "{model} pixels of the model");
+}
+
+#[test]
+fn negative_numbers_are_accepted_in_numeric_options() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("neg.png");
+    let out = octovox(&["render", "--cpu", "--size", "16x16", "--camera", "-5,3,4:0,0,0", "-o", s(&png)]);
+    assert!(out.status.success(), "{}", text(&out));
+    let out = octovox(&["import", "x.obj", "-o", "x.vox", "--size", "-5"]);
+    let t = text(&out);
+    assert!(!out.status.success() && !t.contains("unexpected argument"), "{t}");
+}
+
+// ----- 12: quoting in scripts ------------------------------------------------------------
+
+#[test]
+fn a_quoted_path_with_a_hash_saves_where_it_says() {
+    let dir = tempfile::tempdir().unwrap();
+    let script = dir.path().join("hash.ovr");
+    std::fs::write(&script, "\u{feff}new\nplace 0 0 0\nsave \"has#hash and space.vox\" # saved\n").unwrap();
+    let out = octovox(&["replay", "--cpu", s(&script)]);
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(dir.path().join("has#hash and space.vox").exists());
+    assert!(!dir.path().join("has").exists());
+}
+
+// ----- 13: files the loader accepts with a warning -------------------------------------
+
+/// A .vox of `models` one-voxel models and no scene graph, then `tail`.
+fn vox_without_scene_graph(models: usize, extra_voxel_bytes: usize, tail: &[u8]) -> Vec<u8> {
+    let mut children = Vec::new();
+    for _ in 0..models {
+        children.extend(b"SIZE");
+        children.extend(12u32.to_le_bytes());
+        children.extend(0u32.to_le_bytes());
+        children.extend([1u32, 1, 1].iter().flat_map(|v| v.to_le_bytes()));
+        children.extend(b"XYZI");
+        children.extend(u32::try_from(8 + extra_voxel_bytes).unwrap().to_le_bytes());
+        children.extend(0u32.to_le_bytes());
+        children.extend(1u32.to_le_bytes());
+        children.extend([0, 0, 0, 1]);
+        children.extend(std::iter::repeat_n(7u8, extra_voxel_bytes));
+    }
+    let mut bytes = b"VOX ".to_vec();
+    bytes.extend(150u32.to_le_bytes());
+    bytes.extend(b"MAIN");
+    bytes.extend(0u32.to_le_bytes());
+    bytes.extend(u32::try_from(children.len()).unwrap().to_le_bytes());
+    bytes.extend(children);
+    bytes.extend(tail);
+    bytes
+}
+
+#[test]
+fn ignored_bytes_are_reported_and_models_counted() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("odd.vox");
+    std::fs::write(&path, vox_without_scene_graph(3000, 0, b"trailing junk")).unwrap();
+    let out = octovox(&["info", "--json", s(&path)]);
+    assert!(out.status.success(), "{}", text(&out));
+    let info: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(info["stored_models"], 3000);
+    assert_eq!(info["models"], 1);
+    let warnings = info["warnings"].to_string();
+    assert!(warnings.contains("13 bytes after the MAIN chunk"), "{warnings}");
+
+    std::fs::write(&path, vox_without_scene_graph(1, 8, b"")).unwrap();
+    let out = octovox(&["info", s(&path)]);
+    let t = text(&out);
+    assert!(out.status.success() && t.contains("holds 8 bytes past its 1 voxels"), "{t}");
+}
+
+// ----- 17: .obj errors ----------------------------------------------------------------
+
+#[test]
+fn obj_errors_name_the_line_and_the_cause() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.vox");
+    let bad = dir.path().join("bad.obj");
+    std::fs::write(&bad, "# a mesh\nv 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+    assert_refused(
+        &octovox(&["import", s(&bad), "-o", s(&out)]),
+        "bad.obj:3: vertex coordinate 'zero' is not a number",
+    );
+    let huge = dir.path().join("huge.obj");
+    std::fs::write(&huge, "v -3e38 0 0\nv 3e38 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\nf 1 2 4\nf 2 3 4\n").unwrap();
+    assert_refused(&octovox(&["import", s(&huge), "-o", s(&out)]), "huge.obj:1: vertex coordinate -3e38 is so large");
+}
+
+// ----- 18, 19, 20: files and pipes ------------------------------------------------------
+
+#[cfg(unix)]
+#[test]
+fn images_and_scenes_are_written_alike() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("a.png");
+    let vox = dir.path().join("a.vox");
+    let cmd = format!(
+        "umask 022 && '{bin}' render --cpu --size 8x8 -o '{png}' && '{bin}' convert '{torus}' '{vox}'",
+        bin = env!("CARGO_BIN_EXE_octovox"),
+        png = s(&png),
+        vox = s(&vox),
+        torus = s(&torus())
+    );
+    assert!(Command::new("sh").args(["-c", &cmd]).status().unwrap().success());
+    for file in [&png, &vox] {
+        assert_eq!(std::fs::metadata(file).unwrap().permissions().mode() & 0o777, 0o644, "{}", file.display());
+    }
+    let deep = dir.path().join("a/b/c/x.png");
+    assert_refused(&octovox(&["render", "--cpu", "--size", "8x8", "-o", s(&deep)]), "does not exist");
+    let deep_vox = dir.path().join("a/b/c/x.vox");
+    assert_refused(&octovox(&["convert", s(&torus()), s(&deep_vox)]), "does not exist");
+    assert_refused(&octovox(&["render", "--cpu", "-o", s(&dir.path().join("x.jpg"))]), "names a .jpg file");
+}
+
+#[test]
+fn convert_is_deterministic() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = common::assets().join("vox/format/metal-material.vox");
+    let (a, b) = (dir.path().join("a.vox"), dir.path().join("b.vox"));
+    for out in [&a, &b] {
+        let done = octovox(&["convert", s(&input), s(out)]);
+        assert!(done.status.success(), "{}", text(&done));
+    }
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+}
+
+#[test]
+fn a_closed_pipe_is_a_normal_end() {
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = Command::new(env!("CARGO_BIN_EXE_octovox"))
+        .args(["info", s(&torus())])
+        .stdout(writer)
+        .stderr(std::process::Stdio::piped())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
