@@ -224,3 +224,28 @@ fn set_read_only(file: &std::path::Path, read_only: bool) {
     let mode = if read_only { 0o444 } else { 0o644 };
     std::fs::set_permissions(file, std::fs::Permissions::from_mode(mode)).unwrap();
 }
+
+/// A window wider than wgpu's default texture limit (8192) panicked inside
+/// wgpu; now the device asks for the adapter's limit and the surface is
+/// clamped to it, so the window opens and draws.
+#[test]
+fn a_window_wider_than_8192_pixels_opens_and_draws() {
+    for tool in ["Xvfb", "xdotool"] {
+        require_tool(tool);
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (_xvfb, display) = start_xvfb(2);
+    let args = ["--size", "8193x300", "--render-scale", "0.25", "--no-shadows", "--bench-frames", "3"].map(String::from);
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
+    lines.wait_for("octovox: ready", Duration::from_secs(90));
+    let deadline = Instant::now() + Duration::from_secs(90);
+    let status = loop {
+        if let Some(status) = app.0.try_wait().unwrap() {
+            break status;
+        }
+        assert!(Instant::now() < deadline, "the benchmark frames did not finish");
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    let stderr = std::fs::read_to_string(&stderr_path).unwrap_or_default();
+    assert!(status.success() && !stderr.contains("panicked"), "{status}: {stderr}");
+}
