@@ -144,14 +144,7 @@ fn click_attach_save_erase_save_in_a_real_window() {
 
     // Ctrl+Q quits without a prompt: everything was saved.
     xdotool(&display, &["key", "ctrl+q"]);
-    let deadline = Instant::now() + Duration::from_secs(30);
-    let status = loop {
-        if let Some(status) = app.0.try_wait().unwrap() {
-            break status;
-        }
-        assert!(Instant::now() < deadline, "octovox did not quit on Ctrl+Q");
-        std::thread::sleep(Duration::from_millis(100));
-    };
+    let status = wait_for_exit(&mut app, Duration::from_secs(30), "Ctrl+Q");
     assert!(status.success(), "octovox exited with {status}");
     for line in lines.seen.iter().filter(|l| l.starts_with("edit:")) {
         let n: u64 = line.split_whitespace().nth(1).and_then(|n| n.parse().ok()).unwrap();
@@ -235,17 +228,11 @@ fn a_window_wider_than_8192_pixels_opens_and_draws() {
     }
     let dir = tempfile::tempdir().unwrap();
     let (_xvfb, display) = start_xvfb(2);
-    let args = ["--size", "8193x300", "--render-scale", "0.25", "--no-shadows", "--bench-frames", "3"].map(String::from);
+    let args =
+        ["--size", "8193x300", "--render-scale", "0.25", "--no-shadows", "--bench-frames", "3"].map(String::from);
     let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
     lines.wait_for("octovox: ready", Duration::from_secs(90));
-    let deadline = Instant::now() + Duration::from_secs(90);
-    let status = loop {
-        if let Some(status) = app.0.try_wait().unwrap() {
-            break status;
-        }
-        assert!(Instant::now() < deadline, "the benchmark frames did not finish");
-        std::thread::sleep(Duration::from_millis(100));
-    };
+    let status = wait_for_exit(&mut app, Duration::from_secs(90), "the end of its benchmark frames");
     let stderr = std::fs::read_to_string(&stderr_path).unwrap_or_default();
     assert!(status.success() && !stderr.contains("panicked"), "{status}: {stderr}");
 }

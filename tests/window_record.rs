@@ -6,22 +6,15 @@
 mod common;
 
 use std::path::PathBuf;
-use std::process::{Child, Command};
-use std::time::{Duration, Instant};
+use std::process::Command;
+use std::time::Duration;
 
 use common::window::*;
 use octovox::camera::Camera;
 
-fn wait_exit(app: &mut Child) {
-    let deadline = Instant::now() + Duration::from_secs(30);
-    loop {
-        if let Some(status) = app.try_wait().unwrap() {
-            assert!(status.success(), "octovox exited with {status}");
-            return;
-        }
-        assert!(Instant::now() < deadline, "octovox did not quit");
-        std::thread::sleep(Duration::from_millis(100));
-    }
+fn wait_exit(app: &mut KillOnDrop) {
+    let status = wait_for_exit(app, Duration::from_secs(30), "quit");
+    assert!(status.success(), "octovox exited with {status}");
 }
 
 #[test]
@@ -63,7 +56,7 @@ fn recorded_window_session_replays_to_the_same_voxels() {
     lines.wait_for("undo:", Duration::from_secs(30));
     save(&display, &mut lines, &file);
     xdotool(&display, &["key", "ctrl+q"]);
-    wait_exit(&mut app.0);
+    wait_exit(&mut app);
 
     // Replay the recording headless and save what it built.
     let recorded = std::fs::read_to_string(&script).unwrap();

@@ -43,6 +43,18 @@ pub fn require_tool(name: &str) {
     );
 }
 
+/// Waits for the app to exit by itself; `what` says what should end it.
+pub fn wait_for_exit(app: &mut KillOnDrop, timeout: Duration, what: &str) -> std::process::ExitStatus {
+    let deadline = Instant::now() + timeout;
+    loop {
+        if let Some(status) = app.0.try_wait().expect("wait for octovox") {
+            return status;
+        }
+        assert!(Instant::now() < deadline, "octovox did not exit on {what}");
+        std::thread::sleep(Duration::from_millis(100));
+    }
+}
+
 /// Starts Xvfb on a free display number derived from the process id and
 /// waits until it accepts connections.
 /// `slot` separates the tests of this binary, which run in parallel.
