@@ -238,6 +238,22 @@ fn loads_brushes_and_renders_are_checked_against_the_budget() {
     assert_eq!((tree.origin(), tree.depth()), (IVec3::ZERO, 2));
 }
 
+#[test]
+fn a_small_obj_of_many_stacked_planes_is_checked_against_the_budget() {
+    // 3000 planes over the whole footprint: 3000 crossings in each of the
+    // 256² columns, about 1.5 GB for a 200 KB file.
+    let dir = tempfile::tempdir().unwrap();
+    let mut text = String::new();
+    for k in 0..3000 {
+        let y = f64::from(k) / 3000.0;
+        text += &format!("v 0 {y} 0\nv 1 {y} 0\nv 0 {y} 1\nf -3 -2 -1\n");
+    }
+    let planes = dir.path().join("planes.obj");
+    std::fs::write(&planes, text).unwrap();
+    let out = dir.path().join("planes.vox");
+    assert_refused(&octovox(&["--memory-budget", "1G", "import", s(&planes), "-o", s(&out)]), "voxelizing");
+}
+
 #[cfg(unix)]
 #[test]
 fn devices_are_refused_as_inputs() {
@@ -314,6 +330,28 @@ fn a_pick_that_gives_up_says_so() {
     let hit = octovox::trace::svo::trace(&tree, &octovox::trace::Ray::new(origin, dir));
     let color = octovox::trace::render::shade(&hit, dir, &Default::default(), Default::default(), false);
     assert_eq!(color, [255, 0, 255, 255], "a give-up is drawn magenta, not as sky");
+}
+
+#[test]
+fn render_counts_the_rays_that_gave_up() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut script = String::from("new\n");
+    for i in 0..2000 {
+        script += &format!("place {} 1 0\n", 2 * i);
+    }
+    script += "brush box 1 17 17\nplace 4010 0 0\nsave comb.vox\n";
+    let path = dir.path().join("comb.ovr");
+    std::fs::write(&path, script).unwrap();
+    let made = octovox(&["replay", "--cpu", s(&path)]);
+    assert!(made.status.success(), "{}", text(&made));
+    let png = dir.path().join("comb.png");
+    let comb = dir.path().join("comb.vox");
+    let args = ["render", "--cpu", s(&comb), "--camera", "-2,0.5,0.5:100,0.5,0.5", "--fov", "1", "--size", "3x3"];
+    let out = octovox(&[&args[..], &["-o", s(&png)]].concat());
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(text(&out).contains("rays gave up after 4096 steps"), "{}", text(&out));
+    let magenta = octovox::io::png::load_png(&png).unwrap().pixels().filter(|p| p.0 == [255, 0, 255, 255]).count();
+    assert!(magenta >= 1, "no give-up drawn magenta");
 }
 
 #[test]
