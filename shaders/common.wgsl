@@ -36,14 +36,9 @@ struct FrameUniforms {
 // Sun shadows are compiled in only when the scene and settings ask for them.
 override SHADOWS: bool = true;
 
-const MAX_ITERATIONS: u32 = 4096u;
-const NO_AXIS: u32 = 3u;
-const MIN_DIRECTION: f32 = 1.1920929e-7; // 2^-23
-const POINTER_BIT: u32 = 0x80000000u;
-const SUN_DIR: vec3<f32> = vec3<f32>(0.4548588, 0.7960029, 0.3980015);
-// Twin of GAVE_UP_COLOR in src/trace/render.rs: a ray that ran out of
-// iterations is drawn in it, never as sky.
-const GAVE_UP_COLOR: vec3<f32> = vec3<f32>(1.0, 0.0, 1.0);
+// MAX_ITERATIONS, NO_AXIS, MIN_DIRECTION, POINTER_BIT, SUN_DIR,
+// GAVE_UP_COLOR and the VIEW_* codes come from their Rust definitions,
+// prepended by src/gpu/prelude.rs.
 
 struct Ray {
     o: vec3<f32>,
@@ -203,13 +198,13 @@ fn in_highlight(hit: Hit) -> bool {
 fn shade(hit: Hit, d: vec3<f32>, in_shadow: bool) -> vec3<f32> {
     let n = normal_vector(hit.normal_code);
     switch (u.view) {
-        case 1u: {
+        case VIEW_ITERATIONS: {
             return heat(f32(hit.iterations) / 160.0);
         }
-        case 2u: {
+        case VIEW_DEPTH: {
             return select(vec3<f32>(0.0), heat((f32(hit.level) + 1.0) / 8.0), hit.value != 0u);
         }
-        case 3u: {
+        case VIEW_NORMALS: {
             return select(vec3<f32>(0.0), n * 0.5 + vec3<f32>(0.5), hit.value != 0u);
         }
         default: {

@@ -286,7 +286,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         hit = trace_svo(r, t_start);
     }
     var in_shadow = false;
-    if (SHADOWS && u.view == 0u && hit.value != 0u && hit.normal_code != 0u) {
+    if (SHADOWS && u.view == VIEW_SHADED && hit.value != 0u && hit.normal_code != 0u) {
         in_shadow = trace_svo(shadow_ray(hit), 0.0).value != 0u;
     }
     write_pixel(gid.xy, hit, r.d, in_shadow);

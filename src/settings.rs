@@ -35,6 +35,16 @@ impl View {
         }
     }
 
+    /// Name of its code in WGSL (see `crate::gpu::prelude`).
+    pub fn wgsl_name(self) -> &'static str {
+        match self {
+            View::Shaded => "VIEW_SHADED",
+            View::Iterations => "VIEW_ITERATIONS",
+            View::Depth => "VIEW_DEPTH",
+            View::Normals => "VIEW_NORMALS",
+        }
+    }
+
     pub const ALL: [View; 4] = [View::Shaded, View::Iterations, View::Depth, View::Normals];
 }
 

@@ -350,8 +350,15 @@ fn render_counts_the_rays_that_gave_up() {
     let out = octovox(&[&args[..], &["-o", s(&png)]].concat());
     assert!(out.status.success(), "{}", text(&out));
     assert!(text(&out).contains("rays gave up after 4096 steps"), "{}", text(&out));
-    let magenta = octovox::io::png::load_png(&png).unwrap().pixels().filter(|p| p.0 == [255, 0, 255, 255]).count();
-    assert!(magenta >= 1, "no give-up drawn magenta");
+    let magenta =
+        |png: &Path| octovox::io::png::load_png(png).unwrap().pixels().filter(|p| p.0 == [255, 0, 255, 255]).count();
+    assert!(magenta(&png) >= 1, "no give-up drawn magenta");
+    // The shader draws the same pixels in the same colour.
+    let gpu_png = dir.path().join("comb-gpu.png");
+    let out =
+        octovox(&[&args[..], &["-o", s(&gpu_png)]].concat().into_iter().filter(|a| *a != "--cpu").collect::<Vec<_>>());
+    assert!(out.status.success(), "{}", text(&out));
+    assert_eq!(magenta(&gpu_png), magenta(&png), "GPU and CPU disagree on the give-ups");
 }
 
 #[test]

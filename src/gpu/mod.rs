@@ -3,6 +3,7 @@
 
 pub mod blit_pass;
 pub mod context;
+pub mod prelude;
 pub mod readback;
 pub mod renderer;
 pub mod scene_buffers;

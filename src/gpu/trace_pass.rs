@@ -4,6 +4,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::IVec3;
 
+use super::prelude::with_prelude;
 use super::readback::{read_buffer, read_texture_rgba8, staging_buffer};
 use super::{GpuContext, GpuError, SceneBuffers};
 use crate::camera::RayBasis;
@@ -154,8 +155,8 @@ impl TracePass {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let svo = gpu.shader("trace_svo.wgsl", &format!("{COMMON_WGSL}\n{SVO_WGSL}"))?;
-        let grid = gpu.shader("trace_grid.wgsl", &format!("{COMMON_WGSL}\n{GRID_WGSL}"))?;
+        let svo = gpu.shader("trace_svo.wgsl", &with_prelude(&[COMMON_WGSL, SVO_WGSL]))?;
+        let grid = gpu.shader("trace_grid.wgsl", &with_prelude(&[COMMON_WGSL, GRID_WGSL]))?;
         let pipeline = |module: &wgpu::ShaderModule, entry: &str, constants: &[(&str, f64)], label: &str| {
             gpu.validated(label, |device| {
                 device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {

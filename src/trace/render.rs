@@ -65,7 +65,7 @@ pub fn shadow_ray(hit: &Hit) -> Option<Ray> {
 }
 
 /// Colour of a ray that ran out of iterations before it hit or left the
-/// scene (twin of `GAVE_UP_COLOR` in `shaders/common.wgsl`): magenta, so a
+/// scene (the shaders get it from `crate::gpu::prelude`): magenta, so a
 /// give-up never looks like sky.
 pub const GAVE_UP_COLOR: Vec3 = Vec3::new(1.0, 0.0, 1.0);
 

@@ -1,0 +1,54 @@
+//! The constants Rust and WGSL share, written as WGSL from their Rust
+//! definitions and put in front of the shaders: one source, no copies kept
+//! in step by hand.
+
+use std::fmt::Write as _;
+
+use crate::gpu_pool::POINTER_BIT;
+use crate::settings::{SUN_DIR, View};
+use crate::trace::render::GAVE_UP_COLOR;
+use crate::trace::{MAX_ITERATIONS, MIN_DIRECTION, NO_AXIS};
+
+/// WGSL `const` declarations of every shared constant.
+pub fn shared_constants() -> String {
+    let vec3 = |v: [f32; 3]| format!("vec3<f32>({:?}, {:?}, {:?})", v[0], v[1], v[2]);
+    let mut wgsl = String::from("// Generated from the Rust constants by src/gpu/prelude.rs.\n");
+    let mut line = |name: &str, ty: &str, value: String| {
+        // Writing to a String cannot fail.
+        let _ = writeln!(wgsl, "const {name}: {ty} = {value};");
+    };
+    line("MAX_ITERATIONS", "u32", format!("{MAX_ITERATIONS}u"));
+    line("NO_AXIS", "u32", format!("{NO_AXIS}u"));
+    line("MIN_DIRECTION", "f32", format!("{MIN_DIRECTION:?}"));
+    line("POINTER_BIT", "u32", format!("{POINTER_BIT:#x}u"));
+    line("SUN_DIR", "vec3<f32>", vec3(SUN_DIR));
+    line("GAVE_UP_COLOR", "vec3<f32>", vec3(GAVE_UP_COLOR.to_array()));
+    for view in View::ALL {
+        line(view.wgsl_name(), "u32", format!("{}u", view.code()));
+    }
+    wgsl
+}
+
+/// A shader's source with the shared constants in front.
+pub fn with_prelude(parts: &[&str]) -> String {
+    let mut source = shared_constants();
+    for part in parts {
+        source.push('\n');
+        source.push_str(part);
+    }
+    source
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn constants_are_written_as_wgsl() {
+        let wgsl = shared_constants();
+        assert!(wgsl.contains("const MAX_ITERATIONS: u32 = 4096u;"), "{wgsl}");
+        assert!(wgsl.contains("const POINTER_BIT: u32 = 0x80000000u;"), "{wgsl}");
+        assert!(wgsl.contains("const MIN_DIRECTION: f32 = 1.1920929e-7;"), "{wgsl}");
+        assert!(wgsl.contains("const VIEW_NORMALS: u32 = 3u;"), "{wgsl}");
+    }
+}
