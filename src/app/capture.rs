@@ -30,15 +30,9 @@ impl App {
             Path::new(SCREENSHOT_DIR).join(format!("octovox-{stamp}.png"))
         });
         let base = view_path.with_extension("");
-        let (w, h) = gfx.trace.size();
-        let result = gfx
-            .trace
-            .read_color(&gfx.gpu)
-            .map_err(anyhow::Error::from)
-            .and_then(|bytes| image::RgbaImage::from_raw(w, h, bytes).context("trace readback has the wrong size"))
-            .and_then(|image| {
-                octovox::io::png::save_png(&image, &view_path, Default::default()).map_err(anyhow::Error::from)
-            });
+        let result = gfx.renderer.read_image().map_err(anyhow::Error::from).and_then(|image| {
+            octovox::io::png::save_png(&image, &view_path, Default::default()).map_err(anyhow::Error::from)
+        });
         match result {
             Ok(()) => report!("screenshot: {}", view_path.display()),
             Err(err) => {
@@ -48,7 +42,7 @@ impl App {
         }
         if let Some((buffer, width, height, bgra)) = window_copy {
             let window_path = PathBuf::from(format!("{}-window.png", base.display()));
-            let result = read_buffer(&gfx.gpu, &buffer).map_err(anyhow::Error::from).and_then(|bytes| {
+            let result = read_buffer(&gfx.renderer.gpu, &buffer).map_err(anyhow::Error::from).and_then(|bytes| {
                 let row = (width * 4) as usize;
                 let mut pixels: Vec<u8> =
                     bytes.chunks(padded_row_bytes(width) as usize).flat_map(|r| &r[..row]).copied().collect();
@@ -73,7 +67,7 @@ impl App {
             return;
         }
         let (w, h) = self.trace_size();
-        let clock = self.gfx.as_ref().map_or("", |g| if g.gpu.timestamps { "GPU timestamps" } else { "wall" });
+        let clock = self.gfx.as_ref().map_or("", |g| if g.renderer.gpu.timestamps { "GPU timestamps" } else { "wall" });
         let Some(bench) = &mut self.bench else { return };
         match bench.started {
             // The first ready frame warms up; timing starts after it.
@@ -103,7 +97,7 @@ impl App {
 pub(super) fn copy_frame(gfx: &Gfx, encoder: &mut wgpu::CommandEncoder, texture: &wgpu::Texture) -> WindowCopy {
     let (width, height) = (texture.width(), texture.height());
     let padded = padded_row_bytes(width);
-    let buffer = staging_buffer(&gfx.gpu.device, "window screenshot", u64::from(padded) * u64::from(height));
+    let buffer = staging_buffer(&gfx.renderer.gpu.device, "window screenshot", u64::from(padded) * u64::from(height));
     encoder.copy_texture_to_buffer(
         texture.as_image_copy(),
         wgpu::TexelCopyBufferInfo {

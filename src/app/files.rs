@@ -34,7 +34,7 @@ impl App {
         self.state.color = first_used_color(&self.scene).unwrap_or(self.state.color);
         self.grid_stale = true;
         if let Some(gfx) = &self.gfx {
-            gfx.buffers.upload_palette(&gfx.gpu.queue, &self.scene.palette);
+            gfx.renderer.buffers.upload_palette(&gfx.renderer.gpu.queue, &self.scene.palette);
         }
         let upload = self.upload();
         log::info!("scene uploaded: {} bytes", upload.bytes);

@@ -7,7 +7,6 @@ use std::time::{Duration, Instant};
 
 use winit::event_loop::ActiveEventLoop;
 
-use octovox::gpu::FrameUniforms;
 use octovox::settings::TraceMode;
 use octovox::trace::grid::DenseGrid;
 
@@ -75,8 +74,8 @@ impl App {
                 palette: &self.scene.palette,
                 tree: &self.scene.tree,
                 stats: &self.stats,
-                adapter: &gfx.gpu.adapter_name,
-                timestamps: gfx.gpu.timestamps,
+                adapter: &gfx.renderer.gpu.adapter_name,
+                timestamps: gfx.renderer.gpu.timestamps,
                 loading: loading.as_ref().map(|(p, s)| (p.as_path(), *s)),
                 can_undo: self.history.can_undo(),
                 can_redo: self.history.can_redo(),
@@ -117,7 +116,7 @@ impl App {
         let mut textures = full.textures_delta;
         for (id, deltas) in textures.set.drain() {
             for delta in deltas {
-                gfx.egui_renderer.update_texture(&gfx.gpu.device, &gfx.gpu.queue, id, &delta);
+                gfx.egui_renderer.update_texture(&gfx.renderer.gpu.device, &gfx.renderer.gpu.queue, id, &delta);
             }
         }
         // Freed only after a frame that no longer uses them was submitted.
@@ -127,38 +126,28 @@ impl App {
             pixels_per_point: full.pixels_per_point,
         };
 
-        // Trace.
-        let tree = &self.scene.tree;
-        // The surface is never larger than the GPU's textures, so neither is
-        // the trace; the check stays for a GPU that refuses anyway.
-        if let Err(err) = gfx.trace.resize(&gfx.gpu, &gfx.buffers, trace_size, false) {
-            log::error!("{err}");
-        }
-        let basis = self.state.camera.basis(trace_size.0, trace_size.1, tree.origin());
-        let highlight = self.pick.map(|pick| {
-            let (lo, hi) = self.state.preview_box(&pick);
-            (lo - tree.origin(), hi - tree.origin())
-        });
-        let uniforms = FrameUniforms::new(&basis, tree, &gfx.buffers, self.state.settings.view, highlight);
-        gfx.trace.prepare(&gfx.gpu.device, &gfx.gpu.queue, &gfx.buffers, &uniforms);
-        let mut encoder =
-            gfx.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("trace") });
-        gfx.trace.encode(&mut encoder, &self.state.settings, gfx.timer.pass_writes());
-        gfx.timer.resolve(&mut encoder);
-        match gfx.timer.submit_and_measure(&gfx.gpu, encoder) {
+        // Trace: the one encode path that headless rendering uses too.
+        let highlight = self.pick.map(|pick| self.state.preview_box(&pick));
+        let settings = &self.state.settings;
+        match gfx.renderer.render(&self.scene.tree, &self.state.camera, trace_size, settings, highlight) {
             Ok(ms) => self.stats.trace_ms = ms,
-            Err(err) => log::warn!("trace timing failed: {err}"),
+            Err(err) => log::error!("trace failed: {err}"),
         }
 
         // Blit + egui onto the swapchain image.
         let frame = acquire_frame(gfx, &self.redraw_wanted)?;
         let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
-        gfx.blit.prepare(&gfx.gpu.device, gfx.trace.output_view());
+        gfx.blit.prepare(&gfx.renderer.gpu.device, gfx.renderer.pass.output_view());
         let mut encoder =
-            gfx.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("present") });
+            gfx.renderer.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("present") });
         gfx.blit.encode(&mut encoder, &view);
-        let user_buffers =
-            gfx.egui_renderer.update_buffers(&gfx.gpu.device, &gfx.gpu.queue, &mut encoder, &prims, &screen);
+        let user_buffers = gfx.egui_renderer.update_buffers(
+            &gfx.renderer.gpu.device,
+            &gfx.renderer.gpu.queue,
+            &mut encoder,
+            &prims,
+            &screen,
+        );
         {
             let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("egui"),
@@ -177,9 +166,9 @@ impl App {
         }
         let window_copy = (self.screenshot_requested && gfx.can_copy_frame)
             .then(|| capture::copy_frame(gfx, &mut encoder, &frame.texture));
-        gfx.gpu.queue.submit(user_buffers.into_iter().chain([encoder.finish()]));
+        gfx.renderer.gpu.queue.submit(user_buffers.into_iter().chain([encoder.finish()]));
         gfx.window.pre_present_notify();
-        gfx.gpu.queue.present(frame);
+        gfx.renderer.gpu.queue.present(frame);
         for id in std::mem::take(&mut gfx.textures_to_free) {
             gfx.egui_renderer.free_texture(&id);
         }
@@ -208,12 +197,12 @@ impl App {
         let Some(gfx) = &mut self.gfx else { return };
         match DenseGrid::from_octree(&self.scene.tree) {
             Ok(grid) => {
-                if let Err(err) = gfx.gpu.check_binding("the dense grid", grid.data.len() as u64) {
+                if let Err(err) = gfx.renderer.gpu.check_binding("the dense grid", grid.data.len() as u64) {
                     self.state.settings.mode = TraceMode::Svo;
                     self.ui.error(format!("{err}; back to SVO"));
                     return;
                 }
-                gfx.buffers.upload_grid(&gfx.gpu.device, &gfx.gpu.queue, &grid);
+                gfx.renderer.buffers.upload_grid(&gfx.renderer.gpu.device, &gfx.renderer.gpu.queue, &grid);
                 self.grid_stale = false;
             }
             Err(err) => {
@@ -235,7 +224,7 @@ fn acquire_frame(gfx: &mut Gfx, redraw_wanted: &Cell<bool>) -> Option<wgpu::Surf
         wgpu::CurrentSurfaceTexture::Success(frame) | wgpu::CurrentSurfaceTexture::Suboptimal(frame) => Some(frame),
         wgpu::CurrentSurfaceTexture::Outdated => {
             log::debug!("surface outdated; reconfiguring");
-            gfx.surface.configure(&gfx.gpu.device, &gfx.config);
+            gfx.surface.configure(&gfx.renderer.gpu.device, &gfx.config);
             retry(gfx);
             None
         }
@@ -243,11 +232,11 @@ fn acquire_frame(gfx: &mut Gfx, redraw_wanted: &Cell<bool>) -> Option<wgpu::Surf
             // A lost surface must be made again; if that fails too, keep
             // the old one and retry on the next frame.
             log::warn!("surface lost; creating it again");
-            match gfx.gpu.instance.create_surface(gfx.window.clone()) {
+            match gfx.renderer.gpu.instance.create_surface(gfx.window.clone()) {
                 Ok(surface) => gfx.surface = surface,
                 Err(err) => log::error!("cannot re-create the surface: {err}"),
             }
-            gfx.surface.configure(&gfx.gpu.device, &gfx.config);
+            gfx.surface.configure(&gfx.renderer.gpu.device, &gfx.config);
             retry(gfx);
             None
         }
@@ -258,7 +247,7 @@ fn acquire_frame(gfx: &mut Gfx, redraw_wanted: &Cell<bool>) -> Option<wgpu::Surf
         }
         wgpu::CurrentSurfaceTexture::Validation => {
             log::error!("surface validation error; reconfiguring");
-            gfx.surface.configure(&gfx.gpu.device, &gfx.config);
+            gfx.surface.configure(&gfx.renderer.gpu.device, &gfx.config);
             None
         }
     }

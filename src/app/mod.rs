@@ -39,8 +39,7 @@ use winit::window::{Window, WindowId};
 use octovox::camera::Camera;
 use octovox::edit::{Edit, History};
 use octovox::gpu::scene_buffers::UploadStats;
-use octovox::gpu::timer::PassTimer;
-use octovox::gpu::{BlitPass, GpuContext, SceneBuffers, TracePass};
+use octovox::gpu::{BlitPass, GpuContext, Renderer};
 use octovox::io::atomic::WriteOptions;
 use octovox::scene::Scene;
 use octovox::trace::svo;
@@ -78,11 +77,10 @@ struct Gfx {
     config: wgpu::SurfaceConfiguration,
     /// The swapchain can be copied from (window screenshots).
     can_copy_frame: bool,
-    gpu: GpuContext,
-    buffers: SceneBuffers,
-    trace: TracePass,
+    /// The scene's buffers and the trace pass: the same renderer as headless
+    /// `render` and `replay` use.
+    renderer: Renderer,
     blit: BlitPass,
-    timer: PassTimer,
     egui_state: egui_winit::State,
     egui_renderer: egui_wgpu::Renderer,
     textures_to_free: Vec<egui::TextureId>,
@@ -215,10 +213,9 @@ impl App {
         config.present_mode =
             if self.bench.is_some() { wgpu::PresentMode::AutoNoVsync } else { wgpu::PresentMode::AutoVsync };
         surface.configure(&gpu.device, &config);
-        let buffers = SceneBuffers::new(&gpu.device);
-        let trace = TracePass::new(&gpu, &buffers, config.width, config.height)?;
         let blit = BlitPass::new(&gpu, config.format)?;
-        let timer = PassTimer::new(&gpu);
+        let renderer = Renderer::new(gpu)?;
+        let gpu = &renderer.gpu;
         let egui_state = egui_winit::State::new(
             egui::Context::default(),
             egui::ViewportId::ROOT,
@@ -234,11 +231,8 @@ impl App {
             surface,
             config,
             can_copy_frame,
-            gpu,
-            buffers,
-            trace,
+            renderer,
             blit,
-            timer,
             egui_state,
             egui_renderer,
             textures_to_free: Vec::new(),
@@ -293,7 +287,11 @@ impl App {
     /// Flushes the pool's dirty ranges (only those) to the GPU buffers.
     fn upload(&mut self) -> UploadStats {
         match &mut self.gfx {
-            Some(gfx) => gfx.buffers.upload_pool(&gfx.gpu.device, &gfx.gpu.queue, &mut self.scene.tree),
+            Some(gfx) => gfx.renderer.buffers.upload_pool(
+                &gfx.renderer.gpu.device,
+                &gfx.renderer.gpu.queue,
+                &mut self.scene.tree,
+            ),
             // No device yet: the ranges stay dirty and go up with the first frame.
             None => UploadStats::default(),
         }
@@ -481,7 +479,7 @@ impl ApplicationHandler for App {
         }
         match self.init_gfx(event_loop) {
             Ok(gfx) => {
-                gfx.buffers.upload_palette(&gfx.gpu.queue, &self.scene.palette);
+                gfx.renderer.buffers.upload_palette(&gfx.renderer.gpu.queue, &self.scene.palette);
                 self.gfx = Some(gfx);
                 // Whatever was built before the device existed goes up now.
                 self.upload();
@@ -513,8 +511,8 @@ impl ApplicationHandler for App {
                 // Minimised windows report 0×0: keep the old configuration
                 // and draw nothing until there is a size again.
                 if size.width > 0 && size.height > 0 {
-                    (gfx.config.width, gfx.config.height) = surface_size(*size, &gfx.gpu);
-                    gfx.surface.configure(&gfx.gpu.device, &gfx.config);
+                    (gfx.config.width, gfx.config.height) = surface_size(*size, &gfx.renderer.gpu);
+                    gfx.surface.configure(&gfx.renderer.gpu.device, &gfx.config);
                     self.redraw_wanted.set(true);
                     gfx.window.request_redraw();
                 }

@@ -1,6 +1,6 @@
-//! A scene renderer without a window: device, scene buffers and the trace
-//! pass together. `render`, `replay`, `bench` and the GPU tests use it; the
-//! window uses the same parts with a surface.
+//! The scene renderer: device, scene buffers and the trace pass together,
+//! with the one encode path of a frame. `render`, `replay`, `bench`, the GPU
+//! tests and the window (which blits its output to a surface) all use it.
 
 use glam::IVec3;
 
@@ -28,7 +28,7 @@ pub struct Renderer {
 impl Renderer {
     pub fn new(gpu: GpuContext) -> Result<Renderer, GpuError> {
         let buffers = SceneBuffers::new(&gpu.device);
-        let pass = TracePass::new(&gpu, &buffers, 1, 1)?;
+        let pass = TracePass::new(&gpu, &buffers)?;
         let timer = PassTimer::new(&gpu);
         Ok(Renderer { gpu, buffers, pass, timer, hit_records: false, records_written: false })
     }

@@ -118,7 +118,8 @@ fn buffer_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
 }
 
 impl TracePass {
-    pub fn new(gpu: &GpuContext, buffers: &SceneBuffers, width: u32, height: u32) -> Result<TracePass, GpuError> {
+    /// The pipelines and a 1×1 output; [`TracePass::resize`] sizes it.
+    pub fn new(gpu: &GpuContext, buffers: &SceneBuffers) -> Result<TracePass, GpuError> {
         let device = &gpu.device;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("trace bind group layout"),
@@ -186,7 +187,7 @@ impl TracePass {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let target = Self::make_target(device, width, height, false);
+        let target = Self::make_target(device, 1, 1, false);
         let bind_group = Self::make_bind_group(device, &layout, &uniform_buf, buffers, &target);
         Ok(TracePass { layout, pipelines, beam, uniform_buf, target, bind_group, bound_generation: buffers.generation })
     }
