@@ -120,6 +120,27 @@ impl Octree {
         word as u8
     }
 
+    /// The largest uniform cell holding `p` as (min corner, level, value): a
+    /// cell of level `l` is 2^l voxels wide. `None` outside the root.
+    pub fn uniform_cell(&self, p: IVec3) -> Option<(IVec3, u32, u8)> {
+        if !self.contains(p) {
+            return None;
+        }
+        let rel = p - self.origin;
+        let (mut word, mut level) = (self.root, self.depth);
+        while is_pointer(word) {
+            let bit = level - 1;
+            let octant = (((rel.x >> bit) & 1) | (((rel.y >> bit) & 1) << 1) | (((rel.z >> bit) & 1) << 2)) as usize;
+            if level == 1 {
+                return Some((p, 0, self.brick(word)[octant]));
+            }
+            word = self.node(word)[octant];
+            level -= 1;
+        }
+        let min = self.origin + ((rel >> level) << level);
+        Some((min, level, word as u8))
+    }
+
     /// Visits every maximal uniform solid cell as (min corner, size, value).
     pub fn for_each_solid_cell(&self, mut f: impl FnMut(IVec3, i32, u8)) {
         self.visit_cells(self.root, self.origin, self.depth, &mut f);

@@ -2,6 +2,7 @@
 //! comparison.
 #![allow(dead_code)] // each test binary uses a different subset
 
+pub mod exact;
 pub mod window;
 
 use std::path::PathBuf;
