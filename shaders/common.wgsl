@@ -23,6 +23,9 @@ struct FrameUniforms {
     highlight_max: vec3<i32>,
     // Word index of the first brick in `pool` (nodes come first).
     brick_base: u32,
+    // No valid ray takes this many iterations (src/trace/mod.rs,
+    // `iteration_bound`); one that does is reported as a give-up.
+    max_iterations: u32,
 }
 
 @group(0) @binding(0) var<uniform> u: FrameUniforms;
@@ -36,8 +39,8 @@ struct FrameUniforms {
 // Sun shadows are compiled in only when the scene and settings ask for them.
 override SHADOWS: bool = true;
 
-// MAX_ITERATIONS, NO_AXIS, MIN_DIRECTION, POINTER_BIT, SUN_DIR,
-// GAVE_UP_COLOR and the VIEW_* codes come from their Rust definitions,
+// NO_AXIS, MIN_DIRECTION, POINTER_BIT, SUN_DIR, GAVE_UP_COLOR,
+// GAVE_UP_RECORD and the VIEW_* codes come from their Rust definitions,
 // prepended by src/gpu/prelude.rs.
 
 struct Ray {
@@ -194,6 +197,11 @@ fn in_highlight(hit: Hit) -> bool {
     return hit.value != 0u && all(hit.voxel >= u.highlight_min) && all(hit.voxel <= u.highlight_max);
 }
 
+// A ray that ran out of iterations before it hit or left the tree.
+fn gave_up(hit: Hit) -> bool {
+    return hit.value == 0u && hit.iterations >= u.max_iterations;
+}
+
 // Twin of `shade` in src/trace/render.rs.
 fn shade(hit: Hit, d: vec3<f32>, in_shadow: bool) -> vec3<f32> {
     let n = normal_vector(hit.normal_code);
@@ -209,7 +217,7 @@ fn shade(hit: Hit, d: vec3<f32>, in_shadow: bool) -> vec3<f32> {
         }
         default: {
             if (hit.value == 0u) {
-                return select(sky_color(d), GAVE_UP_COLOR, hit.iterations >= MAX_ITERATIONS);
+                return select(sky_color(d), GAVE_UP_COLOR, gave_up(hit));
             }
             let albedo = unpack4x8unorm(palette[hit.value]).rgb;
             let lambert = max(dot(n, SUN_DIR), 0.0);
@@ -232,6 +240,7 @@ fn write_pixel(px: vec2<u32>, hit: Hit, d: vec3<f32>, in_shadow: bool) {
     if (u.hit_records == 0u) {
         return;
     }
-    let info = hit.value | (hit.normal_code << 8u) | (min(hit.level, 31u) << 11u) | (min(hit.iterations, 0xffffu) << 16u);
+    let iterations = select(min(hit.iterations, GAVE_UP_RECORD - 1u), GAVE_UP_RECORD, gave_up(hit));
+    let info = hit.value | (hit.normal_code << 8u) | (min(hit.level, 31u) << 11u) | (iterations << 16u);
     hit_records[px.y * u.width + px.x] = vec4<u32>(bitcast<u32>(hit.voxel.x), bitcast<u32>(hit.voxel.y), bitcast<u32>(hit.voxel.z), info);
 }

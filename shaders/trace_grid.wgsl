@@ -28,7 +28,7 @@ fn trace_grid(r: Ray) -> Hit {
     let far_offset = select(vec3<f32>(0.0), vec3<f32>(1.0), r.d > vec3<f32>(0.0));
     var iterations = 0u;
     loop {
-        if (iterations >= MAX_ITERATIONS) {
+        if (iterations >= u.max_iterations) {
             break;
         }
         iterations += 1u;

@@ -96,7 +96,7 @@ fn trace_svo(r: Ray, t_min: f32) -> Hit {
     var iterations = 0u;
     var value = 0u;
     loop {
-        if (iterations >= MAX_ITERATIONS) {
+        if (iterations >= u.max_iterations) {
             break;
         }
         iterations += 1u;

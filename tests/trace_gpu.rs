@@ -11,7 +11,6 @@ use octovox::gpu::Renderer;
 use octovox::io::mesh::{MESH_COLOR, UpAxis, voxelize_obj};
 use octovox::scene::{Octree, Op, Palette, Scene, Shape};
 use octovox::settings::{RenderSettings, TraceMode, View};
-use octovox::trace::MAX_ITERATIONS;
 use octovox::trace::grid::DenseGrid;
 use octovox::trace::render::{Tracer, trace_image};
 
@@ -48,7 +47,7 @@ fn check_scene(tree: &mut Octree, cameras: &[Camera], size: (u32, u32)) {
         let basis = camera.basis(size.0, size.1, tree.origin());
         let gpu_svo = gpu_hits(&mut renderer, tree, camera, size, TraceMode::Svo);
         let gpu_grid = gpu_hits(&mut renderer, tree, camera, size, TraceMode::Grid);
-        assert!(gpu_svo.iter().chain(&gpu_grid).all(|h| h.iterations <= MAX_ITERATIONS));
+        assert!(gpu_svo.iter().chain(&gpu_grid).all(|h| !h.gave_up()));
         vs_cpu_svo.add(&gpu_svo, &trace_image(Tracer::Svo(tree), &basis));
         vs_cpu_grid.add(&gpu_svo, &trace_image(Tracer::Grid(&grid), &basis));
         gpu_grid_vs_svo.add(&gpu_grid, &gpu_svo);

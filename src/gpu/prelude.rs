@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 use crate::gpu_pool::POINTER_BIT;
 use crate::settings::{SUN_DIR, View};
 use crate::trace::render::GAVE_UP_COLOR;
-use crate::trace::{MAX_ITERATIONS, MIN_DIRECTION, NO_AXIS};
+use crate::trace::{GAVE_UP_RECORD, MIN_DIRECTION, NO_AXIS};
 
 /// WGSL `const` declarations of every shared constant.
 pub fn shared_constants() -> String {
@@ -17,7 +17,7 @@ pub fn shared_constants() -> String {
         // Writing to a String cannot fail.
         let _ = writeln!(wgsl, "const {name}: {ty} = {value};");
     };
-    line("MAX_ITERATIONS", "u32", format!("{MAX_ITERATIONS}u"));
+    line("GAVE_UP_RECORD", "u32", format!("{GAVE_UP_RECORD:#x}u"));
     line("NO_AXIS", "u32", format!("{NO_AXIS}u"));
     line("MIN_DIRECTION", "f32", format!("{MIN_DIRECTION:?}"));
     line("POINTER_BIT", "u32", format!("{POINTER_BIT:#x}u"));
@@ -46,7 +46,7 @@ mod tests {
     #[test]
     fn constants_are_written_as_wgsl() {
         let wgsl = shared_constants();
-        assert!(wgsl.contains("const MAX_ITERATIONS: u32 = 4096u;"), "{wgsl}");
+        assert!(wgsl.contains("const GAVE_UP_RECORD: u32 = 0xffffu;"), "{wgsl}");
         assert!(wgsl.contains("const POINTER_BIT: u32 = 0x80000000u;"), "{wgsl}");
         assert!(wgsl.contains("const MIN_DIRECTION: f32 = 1.1920929e-7;"), "{wgsl}");
         assert!(wgsl.contains("const VIEW_NORMALS: u32 = 3u;"), "{wgsl}");

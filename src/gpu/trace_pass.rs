@@ -38,6 +38,9 @@ pub struct FrameUniforms {
     pub highlight_max: [i32; 3],
     /// Word index of the first brick in the pool buffer.
     pub brick_base: u32,
+    /// `crate::trace::iteration_bound` of the tree: no valid ray reaches it.
+    pub max_iterations: u32,
+    pub _pad: [u32; 3],
 }
 
 impl FrameUniforms {
@@ -68,6 +71,8 @@ impl FrameUniforms {
             hit_records: 0,
             highlight_max: hi.into(),
             brick_base: buffers.brick_base(),
+            max_iterations: crate::trace::iteration_bound(tree.depth()),
+            _pad: [0; 3],
         }
     }
 }

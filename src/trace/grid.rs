@@ -4,7 +4,7 @@
 
 use glam::{IVec3, UVec3, Vec3};
 
-use super::{Hit, MAX_ITERATIONS, NO_AXIS, Ray, argmin};
+use super::{Hit, NO_AXIS, Ray, argmin};
 use crate::scene::Octree;
 
 /// Largest dense grid built (1 GiB): the baseline is for comparison, and a
@@ -83,13 +83,15 @@ pub fn trace(grid: &DenseGrid, ray: &Ray) -> Hit {
     let mut voxel = ray.voxel_in_box(lo, hi, t, axis);
     let step = IVec3::select(ray.dir.cmpgt(Vec3::ZERO), IVec3::ONE, IVec3::NEG_ONE);
     let far_offset = Vec3::select(ray.dir.cmpgt(Vec3::ZERO), Vec3::ONE, Vec3::ZERO);
+    // A DDA through a box crosses at most the box's planes.
+    let bound = u32::try_from(grid.dims.as_u64vec3().element_sum() + 1).unwrap_or(u32::MAX);
     let mut iterations = 0;
-    while iterations < MAX_ITERATIONS {
+    while iterations < bound {
         iterations += 1;
         let value = grid.at(voxel);
         if value != 0 {
             let normal = if axis == NO_AXIS { IVec3::ZERO } else { ray.entry_normal(axis) };
-            return Hit { value, voxel, normal, cell_level: 0, iterations };
+            return Hit { value, voxel, normal, cell_level: 0, iterations, gave_up: false };
         }
         // Exit t of each plane, recomputed from the plane (not accumulated).
         let exits = (voxel.as_vec3() + far_offset - ray.origin) * ray.inv;
@@ -100,5 +102,5 @@ pub fn trace(grid: &DenseGrid, ray: &Ray) -> Hit {
             break;
         }
     }
-    Hit { iterations, ..Hit::default() }
+    Hit::miss(iterations, bound)
 }

@@ -8,8 +8,23 @@ pub mod svo;
 
 use glam::{IVec3, Vec3};
 
-/// Hard bound on traversal steps per ray (SVO and grid alike).
-pub const MAX_ITERATIONS: u32 = 4096;
+/// The most loop iterations a ray may take in a tree `2^depth` voxels wide
+/// (SVO and grid alike), chosen so that no valid ray reaches it.
+///
+/// Every iteration of the SVO loop descends a level, steps across a plane
+/// into the next cell, or ends the ray. Inside the root a ray crosses at most
+/// 3·2^depth planes (2^depth per axis), and after each crossing, or at the
+/// start, it descends at most `depth` levels (a pop goes straight to the
+/// common ancestor; the GPU's restart from the root re-descends at most
+/// `depth` levels too). So a ray takes at most (3·2^depth + 1)·(depth + 1)
+/// iterations. The grid DDA inside the same cube takes at most 3·2^depth + 1.
+/// A ray that reaches the bound is a bug; it is reported as a give-up,
+/// never as a miss.
+pub fn iteration_bound(depth: u32) -> u32 {
+    let planes = 3u64 << depth.min(40);
+    let bound = (planes + 1) * (u64::from(depth) + 1);
+    u32::try_from(bound).unwrap_or(u32::MAX)
+}
 
 /// Entry axis of a ray that starts inside a cell (no face entered).
 pub const NO_AXIS: usize = 3;
@@ -29,6 +44,9 @@ pub struct Hit {
     /// node-depth debug view shows it.
     pub cell_level: u32,
     pub iterations: u32,
+    /// The ray ran out of iterations ([`iteration_bound`]) before it hit a
+    /// voxel or left the tree: not a miss, an unknown.
+    pub gave_up: bool,
 }
 
 impl Hit {
@@ -36,18 +54,20 @@ impl Hit {
         self.value != 0
     }
 
-    /// The ray ran out of iterations ([`MAX_ITERATIONS`]) before it hit a
-    /// voxel or left the tree: not a miss, an unknown.
     pub fn gave_up(&self) -> bool {
-        !self.is_hit() && self.iterations >= MAX_ITERATIONS
+        self.gave_up
     }
 
-    /// Packs normal, value and iterations the way the shader's hit record does.
+    /// A miss after `iterations`, a give-up when they reached `bound`.
+    pub fn miss(iterations: u32, bound: u32) -> Hit {
+        Hit { iterations, gave_up: iterations >= bound, ..Hit::default() }
+    }
+
+    /// Packs normal, value and iterations the way the shader's hit record
+    /// does; the iteration field's largest value, 0xffff, marks a give-up.
     pub fn pack_info(&self) -> u32 {
-        u32::from(self.value)
-            | normal_code(self.normal) << 8
-            | self.cell_level.min(31) << 11
-            | self.iterations.min(0xffff) << 16
+        let iterations = if self.gave_up { GAVE_UP_RECORD } else { self.iterations.min(GAVE_UP_RECORD - 1) };
+        u32::from(self.value) | normal_code(self.normal) << 8 | self.cell_level.min(31) << 11 | iterations << 16
     }
 
     /// Inverse of the shader's hit record `[x, y, z, info]`.
@@ -59,9 +79,14 @@ impl Hit {
             normal: normal_from_code((info >> 8) & 7),
             cell_level: (info >> 11) & 31,
             iterations: info >> 16,
+            gave_up: info >> 16 == GAVE_UP_RECORD,
         }
     }
 }
+
+/// The iteration field of a hit record that marks a give-up (the shaders
+/// get it from `crate::gpu::prelude`).
+pub const GAVE_UP_RECORD: u32 = 0xffff;
 
 /// 0 = none, 1..=6 = +x, −x, +y, −y, +z, −z.
 pub fn normal_code(n: IVec3) -> u32 {

@@ -130,9 +130,9 @@ pub fn render_scene_cpu(
     let gave_up = hits.iter().filter(|hit| hit.gave_up()).count();
     if gave_up > 0 {
         log::warn!(
-            "{gave_up} of {} rays gave up after {} steps; they are drawn magenta, not as sky",
-            hits.len(),
-            super::MAX_ITERATIONS
+            "{gave_up} of {} rays ran out of iterations before they hit or left the scene \
+             (a traversal bug: no valid ray should); they are drawn magenta, not as sky",
+            hits.len()
         );
     }
     let shadows: Vec<bool> = if settings.shadows {

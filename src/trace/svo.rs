@@ -13,7 +13,7 @@
 
 use glam::{IVec3, Vec3};
 
-use super::{Hit, MAX_ITERATIONS, NO_AXIS, Ray, argmin};
+use super::{Hit, NO_AXIS, Ray, argmin, iteration_bound};
 use crate::camera::Camera;
 use crate::gpu_pool::{is_pointer, slot_of};
 use crate::scene::octree::{MAX_DEPTH, Octree};
@@ -63,8 +63,9 @@ pub fn trace(tree: &Octree, ray: &Ray) -> Hit {
     nodes[level as usize] = root;
     // The child cell the ray is in: min corner, size 2^(level - 1).
     let mut cell = child_cell(ray, IVec3::ZERO, level, t, axis);
+    let bound = iteration_bound(depth);
     let mut iterations = 0;
-    while iterations < MAX_ITERATIONS {
+    while iterations < bound {
         iterations += 1;
         let word = child_word(tree, nodes[level as usize], level, octant_of(cell, level));
         if is_pointer(word) {
@@ -95,7 +96,7 @@ pub fn trace(tree: &Octree, ray: &Ray) -> Hit {
         level = new_level;
         cell = next & IVec3::splat(!((1 << (level - 1)) - 1));
     }
-    Hit { iterations, ..Hit::default() }
+    Hit::miss(iterations, bound)
 }
 
 /// Octant of a cell of size 2^(level - 1) within its node: one coordinate
@@ -136,5 +137,5 @@ fn hit_cell(ray: &Ray, value: u8, min: IVec3, level: u32, t: f32, axis: usize, i
     }
     let voxel = ray.voxel_in_box(min, min + IVec3::splat((1 << level) - 1), t, axis);
     let normal = if axis == NO_AXIS { IVec3::ZERO } else { ray.entry_normal(axis) };
-    Hit { value, voxel, normal, cell_level: level, iterations }
+    Hit { value, voxel, normal, cell_level: level, iterations, gave_up: false }
 }
