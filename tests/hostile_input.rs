@@ -325,6 +325,7 @@ fn the_comb_ray_reaches_the_wall_in_the_pick() {
     };
     let hit = octovox::trace::svo::pick(&tree, &camera, (1, 1), 0, 0).unwrap().expect("the wall");
     assert_eq!(hit.voxel.x, 4010);
+    println!("the comb ray took {} iterations", hit.iterations);
     assert!(hit.iterations > 4096, "{} iterations", hit.iterations);
     assert!(hit.iterations < octovox::trace::iteration_bound(tree.depth()));
     // Were a ray ever to give up, it is drawn magenta, not as sky.
