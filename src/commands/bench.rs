@@ -241,6 +241,9 @@ struct RenderRow {
     height: u32,
     grid_ms: f64,
     svo_ms: f64,
+    /// The floor kernel: everything a frame does but the traversal.
+    floor_ms: f64,
+    svo_over_floor: f64,
     grid_over_svo: f64,
     svo_mrays_per_s: f64,
     grid_mean_iterations: f64,
@@ -263,16 +266,20 @@ fn bench_render(quick: bool) -> anyhow::Result<(String, String)> {
         let frames = if quick { 2 } else { 9 };
         let settings = |mode| RenderSettings { mode, view: View::Shaded, shadows: false, render_scale: 1.0 };
         let modes = [TraceMode::Grid, TraceMode::Svo];
-        // Warm up both, then alternate frames so machine noise hits both alike.
+        // Warm up all three, then alternate frames so machine noise hits them alike.
         for mode in modes {
             renderer.render(&scene.tree, &camera, (width, height), &settings(mode), None)?;
         }
+        renderer.render_floor(&scene.tree, &camera, (width, height))?;
         let mut times = [Vec::new(), Vec::new()];
+        let mut floor_times = Vec::new();
         for _ in 0..frames {
             for (i, mode) in modes.into_iter().enumerate() {
                 times[i].push(renderer.render(&scene.tree, &camera, (width, height), &settings(mode), None)?);
             }
+            floor_times.push(renderer.render_floor(&scene.tree, &camera, (width, height))?);
         }
+        let floor_ms = median(floor_times);
         // Hit records (for the step counts) only outside the timed frames.
         renderer.hit_records = true;
         let mut mean_iterations = [0.0; 2];
@@ -292,6 +299,8 @@ fn bench_render(quick: bool) -> anyhow::Result<(String, String)> {
             height,
             grid_ms,
             svo_ms,
+            floor_ms,
+            svo_over_floor: svo_ms / floor_ms,
             grid_over_svo: grid_ms / svo_ms,
             svo_mrays_per_s: f64::from(width * height) / (svo_ms * 1e3),
             grid_mean_iterations: grid_iter,
@@ -301,16 +310,18 @@ fn bench_render(quick: bool) -> anyhow::Result<(String, String)> {
     }
     let mut md = header(&format!("Grid DDA vs SVO, {width}×{height}"));
     md += &format!(
-        "Adapter: **{}**; GPU time from timestamp queries where available, else wall time of submit + wait; median of the frames after one warm-up. Shadows off (the report's shading had none). Camera frames each whole model. The SVO time covers both of its dispatches: the beam prepass (one thread per 16×16-pixel tile) and the per-pixel traversal; its mean steps count the traversal's loop iterations per pixel. The report's 10 M-voxel scene is the Pietà, which is not public: `nefertiti512` is DESIGN.md's stand-in for it (the solid voxelization of meshes/nefertiti.obj, 512 voxels tall, 12.8 M voxels) and `sculpture10M` a smooth procedural shape with the Pietà's extent (11.6 M voxels); both rows compare with the report's Pietà.\n\n",
+        "Adapter: **{}**; GPU time from timestamp queries where available, else wall time of submit + wait; median of the frames after one warm-up. Shadows off (the report's shading had none). Camera frames each whole model. The SVO time covers both of its dispatches: the beam prepass (one thread per 16×16-pixel tile) and the per-pixel traversal; its mean steps count the traversal's loop iterations per pixel. The report's 10 M-voxel scene is the Pietà, which is not public: `nefertiti512` is DESIGN.md's stand-in for it (the solid voxelization of meshes/nefertiti.obj, 512 voxels tall, 12.8 M voxels) and `sculpture10M` a smooth procedural shape with the Pietà's extent (11.6 M voxels); both rows compare with the report's Pietà. *Floor*: a kernel that does everything the per-pixel pass does except the traversal (the pixel's ray, shading, one store per pixel, the same dispatch shape): no traversal on this adapter can be faster, and *SVO / floor* says how far above it the SVO is.\n\n",
         renderer.gpu.adapter_name
     );
-    md += "| model | grid ms | SVO ms | grid / SVO | report grid / SVO | SVO Mrays/s | mean steps grid | mean steps SVO |\n|---|---|---|---|---|---|---|---|\n";
+    md += "| model | grid ms | SVO ms | floor ms | SVO / floor | grid / SVO | report grid / SVO | SVO Mrays/s | mean steps grid | mean steps SVO |\n|---|---|---|---|---|---|---|---|---|---|\n";
     for r in &rows {
         md += &format!(
-            "| {} | {:.2} | {:.2} | {:.2}× | {:.2}× | {:.2} | {:.1} | {:.1} |\n",
+            "| {} | {:.2} | {:.2} | {:.2} | {:.2}× | {:.2}× | {:.2}× | {:.2} | {:.1} | {:.1} |\n",
             r.model,
             r.grid_ms,
             r.svo_ms,
+            r.floor_ms,
+            r.svo_over_floor,
             r.grid_over_svo,
             r.report_grid_over_svo,
             r.svo_mrays_per_s,

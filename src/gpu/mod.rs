@@ -14,4 +14,4 @@ pub use blit_pass::BlitPass;
 pub use context::{GpuContext, GpuError};
 pub use renderer::Renderer;
 pub use scene_buffers::SceneBuffers;
-pub use trace_pass::{FrameUniforms, TracePass};
+pub use trace_pass::{FrameUniforms, Kernel, TracePass};

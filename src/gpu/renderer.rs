@@ -6,7 +6,7 @@ use glam::IVec3;
 
 use super::scene_buffers::UploadStats;
 use super::timer::PassTimer;
-use super::{FrameUniforms, GpuContext, GpuError, SceneBuffers, TracePass};
+use super::{FrameUniforms, GpuContext, GpuError, Kernel, SceneBuffers, TracePass};
 use crate::camera::Camera;
 use crate::scene::{Octree, Palette};
 use crate::settings::RenderSettings;
@@ -68,6 +68,29 @@ impl Renderer {
         settings: &RenderSettings,
         highlight: Option<(IVec3, IVec3)>,
     ) -> Result<f64, GpuError> {
+        self.frame(tree, camera, size, settings.view, highlight, Kernel::from(settings))
+    }
+
+    /// A frame of the floor kernel (everything but the traversal, see
+    /// `shaders/floor.wgsl`); returns its milliseconds.
+    ///
+    /// # Errors
+    /// As [`Renderer::render`].
+    pub fn render_floor(&mut self, tree: &Octree, camera: &Camera, size: (u32, u32)) -> Result<f64, GpuError> {
+        self.frame(tree, camera, size, crate::settings::View::Shaded, None, Kernel::Floor)
+    }
+
+    /// The one encode path of a frame: outputs sized, uniforms written, the
+    /// kernel dispatched and timed, all inside a validation scope.
+    fn frame(
+        &mut self,
+        tree: &Octree,
+        camera: &Camera,
+        size: (u32, u32),
+        view: crate::settings::View,
+        highlight: Option<(IVec3, IVec3)>,
+        kernel: Kernel,
+    ) -> Result<f64, GpuError> {
         let gpu = &self.gpu;
         gpu.checked(|| {
             self.pass.resize(gpu, &self.buffers, size, self.hit_records)?;
@@ -75,13 +98,13 @@ impl Renderer {
             let local = highlight.map(|(lo, hi)| (lo - tree.origin(), hi - tree.origin()));
             let uniforms = FrameUniforms {
                 hit_records: u32::from(self.hit_records),
-                ..FrameUniforms::new(&basis, tree, &self.buffers, settings.view, local)
+                ..FrameUniforms::new(&basis, tree, &self.buffers, view, local)
             };
             self.records_written = self.hit_records;
             self.pass.prepare(&gpu.device, &gpu.queue, &self.buffers, &uniforms);
             let mut encoder =
                 gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
-            self.pass.encode(&mut encoder, settings, self.timer.pass_writes());
+            self.pass.encode(&mut encoder, kernel, self.timer.pass_writes());
             self.timer.resolve(&mut encoder);
             self.timer.submit_and_measure(gpu, encoder)
         })

@@ -15,6 +15,22 @@ use crate::trace::Hit;
 const COMMON_WGSL: &str = include_str!("../../shaders/common.wgsl");
 const SVO_WGSL: &str = include_str!("../../shaders/trace_svo.wgsl");
 const GRID_WGSL: &str = include_str!("../../shaders/trace_grid.wgsl");
+const FLOOR_WGSL: &str = include_str!("../../shaders/floor.wgsl");
+
+/// What a frame dispatches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kernel {
+    /// The scene, traced (the SVO with its beam prepass, or the grid).
+    Trace { mode: TraceMode, shadows: bool },
+    /// Everything but the traversal: the floor a frame cannot go below.
+    Floor,
+}
+
+impl From<&RenderSettings> for Kernel {
+    fn from(settings: &RenderSettings) -> Kernel {
+        Kernel::Trace { mode: settings.mode, shadows: settings.shadows }
+    }
+}
 
 /// Twin of `FrameUniforms` in `shaders/common.wgsl`.
 #[repr(C)]
@@ -103,6 +119,7 @@ pub struct TracePass {
     /// [svo without shadows, svo with, grid without, grid with].
     pipelines: [wgpu::ComputePipeline; 4],
     beam: wgpu::ComputePipeline,
+    floor: wgpu::ComputePipeline,
     uniform_buf: wgpu::Buffer,
     target: Target,
     bind_group: wgpu::BindGroup,
@@ -186,6 +203,8 @@ impl TracePass {
             pipeline(&grid, "main", &[("SHADOWS", 1.0)], "trace grid + shadows")?,
         ];
         let beam = pipeline(&svo, "beam", &[tile], "beam prepass")?;
+        let floor_module = gpu.shader("floor.wgsl", &with_prelude(&[COMMON_WGSL, FLOOR_WGSL]))?;
+        let floor = pipeline(&floor_module, "main", &[], "floor")?;
         let uniform_buf = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("frame uniforms"),
             size: std::mem::size_of::<FrameUniforms>() as u64,
@@ -194,7 +213,8 @@ impl TracePass {
         });
         let target = Self::make_target(device, 1, 1, false);
         let bind_group = Self::make_bind_group(device, &layout, &uniform_buf, buffers, &target);
-        Ok(TracePass { layout, pipelines, beam, uniform_buf, target, bind_group, bound_generation: buffers.generation })
+        let bound_generation = buffers.generation;
+        Ok(TracePass { layout, pipelines, beam, floor, uniform_buf, target, bind_group, bound_generation })
     }
 
     /// The outputs; the hit records (16 bytes a pixel) only when asked for,
@@ -307,21 +327,30 @@ impl TracePass {
         queue.write_buffer(&self.uniform_buf, 0, bytemuck::bytes_of(uniforms));
     }
 
-    /// Records the dispatches: the beam prepass (SVO only), then the trace.
+    /// Records the dispatches: the beam prepass (SVO only), then the
+    /// per-pixel kernel.
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        settings: &RenderSettings,
+        kernel: Kernel,
         timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) {
-        let index = match settings.mode {
-            TraceMode::Svo => 0,
-            TraceMode::Grid => 2,
-        } + usize::from(settings.shadows);
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("trace"), timestamp_writes: timestamps });
         pass.set_bind_group(0, &self.bind_group, &[]);
-        if settings.mode == TraceMode::Svo {
+        let (mode, shadows) = match kernel {
+            Kernel::Trace { mode, shadows } => (mode, shadows),
+            Kernel::Floor => {
+                pass.set_pipeline(&self.floor);
+                pass.dispatch_workgroups(self.target.width.div_ceil(8), self.target.height.div_ceil(8), 1);
+                return;
+            }
+        };
+        let index = match mode {
+            TraceMode::Svo => 0,
+            TraceMode::Grid => 2,
+        } + usize::from(shadows);
+        if mode == TraceMode::Svo {
             let (tiles_x, tiles_y) = (self.target.width.div_ceil(BEAM_TILE), self.target.height.div_ceil(BEAM_TILE));
             pass.set_pipeline(&self.beam);
             pass.dispatch_workgroups(tiles_x.div_ceil(8), tiles_y.div_ceil(8), 1);

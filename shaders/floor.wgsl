@@ -1,0 +1,14 @@
+// The floor of a frame on this adapter: everything the trace pass does per
+// pixel except the traversal (the pixel's ray, shading a miss, one store),
+// in the same dispatch shape. `octovox bench render` reports each model's
+// SVO time as a multiple of it.
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= u.width || gid.y >= u.height) {
+        return;
+    }
+    let r = pixel_ray(gid.xy);
+    var miss: Hit;
+    write_pixel(gid.xy, miss, r.d, false);
+}
