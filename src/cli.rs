@@ -81,6 +81,22 @@ pub enum Command {
     /// Voxelize a closed .obj mesh (solid inside) and save it as .vox.
     #[command(allow_negative_numbers = true)]
     Import(ImportArgs),
+    /// Export the visible faces as a mesh (.obj with .mtl, or .ply), greedy-meshed.
+    #[command(allow_negative_numbers = true)]
+    Export {
+        /// A .vox (or .obj, voxelized) scene.
+        file: PathBuf,
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Mesh units per voxel.
+        #[arg(long, default_value_t = 1.0, value_parser = parse_scale)]
+        scale: f32,
+        #[arg(long, default_value_t = 0)]
+        frame: usize,
+        /// Replace OUTPUT even if it exists or is the input.
+        #[arg(long)]
+        force: bool,
+    },
     /// Ray-trace a scene to a PNG (GPU, or the CPU reference with --cpu).
     #[command(allow_negative_numbers = true)]
     Render(RenderArgs),
@@ -183,6 +199,14 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
         return Err(format!("size '{s}' must be between 1x1 and 16384x16384"));
     }
     Ok((w, h))
+}
+
+/// Parses a positive, finite scale.
+pub fn parse_scale(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!("scale '{s}' must be a positive number")),
+    }
 }
 
 /// Parses a field of view in degrees, within [`octovox::camera::FOV_RANGE_DEG`].

@@ -75,9 +75,12 @@ pub enum Command {
     /// Save As, replacing the file even though it is read-only (the user
     /// said so in the prompt).
     SaveOver(PathBuf),
-    /// Show the Open or Save As path dialog.
+    /// Write the visible faces as an .obj or .ply mesh.
+    Export(PathBuf),
+    /// Show the Open, Save As or Export path dialog.
     AskOpen,
     AskSaveAs,
+    AskExport,
     Screenshot,
     Quit,
     /// Answer to the unsaved-changes prompt.

@@ -135,6 +135,24 @@ impl App {
         }
     }
 
+    /// Exports the scene as a mesh, by the rules of `octovox export`: an
+    /// existing mesh or the open document is never replaced.
+    pub(super) fn export(&mut self, path: &Path) {
+        let inputs: Vec<&Path> = self.state.path.iter().map(PathBuf::as_path).collect();
+        let result =
+            octovox::io::export::check_outputs(path, &inputs, false).map_err(|e| e.to_string()).and_then(|()| {
+                octovox::io::export::export_mesh(path, &self.scene, 1.0, WriteOptions::default())
+                    .map_err(|e| e.to_string())
+            });
+        match result {
+            Ok(stats) => {
+                report!("exported: {} ({} triangles)", path.display(), stats.triangles);
+                self.ui.info(format!("exported {} triangles to {}", stats.triangles, path.display()));
+            }
+            Err(err) => self.ui.error(format!("export failed: {err}")),
+        }
+    }
+
     /// Reads a .vox (or voxelizes an .obj) on a background thread; the
     /// window keeps drawing.
     pub(super) fn start_loading(&mut self, path: PathBuf) {

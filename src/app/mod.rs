@@ -361,6 +361,11 @@ impl App {
                 let start = self.state.path.as_ref().map_or("saves/untitled.vox".into(), |p| p.display().to_string());
                 self.ui.dialog = Some((DialogKind::SaveAs, start));
             }
+            Command::AskExport => {
+                let start = self.state.path.as_ref().map_or("saves/untitled.obj".into(), |p| p.with_extension("obj"));
+                self.ui.dialog = Some((DialogKind::Export, start.display().to_string()));
+            }
+            Command::Export(path) => self.export(&path),
             Command::Screenshot => self.screenshot_requested = true,
             Command::Resolve(choice) => self.resolve(choice, event_loop),
         }

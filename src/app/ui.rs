@@ -52,6 +52,7 @@ pub struct Info<'a> {
 pub enum DialogKind {
     Open,
     SaveAs,
+    Export,
 }
 
 /// UI-only state: open dialogs, the prompt, the message line.
@@ -119,6 +120,9 @@ fn menu_bar(ui: &mut egui::Ui, info: &Info, ui_state: &mut UiState, out: &mut Ve
             }
             if ui.button("Save As…     Ctrl+Shift+S").clicked() {
                 out.push(Command::AskSaveAs);
+            }
+            if ui.button("Export mesh…").clicked() {
+                out.push(Command::AskExport);
             }
             if ui.button("Screenshot   F12").clicked() {
                 out.push(Command::Screenshot);
@@ -286,8 +290,12 @@ fn nearby_files(kind: DialogKind) -> Vec<PathBuf> {
         .filter_map(Result::ok)
         .map(|e| e.path())
         .filter(|p| {
-            p.extension().is_some_and(|e| e.eq_ignore_ascii_case("vox"))
-                || (kind == DialogKind::Open && octovox::io::is_mesh_path(p))
+            let vox = p.extension().is_some_and(|e| e.eq_ignore_ascii_case("vox"));
+            match kind {
+                DialogKind::Open => vox || octovox::io::is_mesh_path(p),
+                DialogKind::SaveAs => vox,
+                DialogKind::Export => octovox::io::export::MeshFormat::of(p).is_some(),
+            }
         })
         .collect();
     files.sort();
@@ -299,6 +307,7 @@ fn dialog(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
     let title = match kind {
         DialogKind::Open => "Open .vox or .obj",
         DialogKind::SaveAs => "Save as .vox",
+        DialogKind::Export => "Export a mesh (.obj or .ply)",
     };
     let mut close = false;
     egui::Window::new(title).collapsible(false).resizable(false).show(ctx, |ui| {
@@ -315,12 +324,18 @@ fn dialog(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
             }
         }
         ui.horizontal(|ui| {
-            let ok = ui.button(if *kind == DialogKind::Open { "Open" } else { "Save" }).clicked();
+            let verb = match kind {
+                DialogKind::Open => "Open",
+                DialogKind::SaveAs => "Save",
+                DialogKind::Export => "Export",
+            };
+            let ok = ui.button(verb).clicked();
             if (ok || entered) && !path.trim().is_empty() {
                 let chosen = PathBuf::from(path.trim());
                 out.push(match kind {
                     DialogKind::Open => Command::Open(chosen),
                     DialogKind::SaveAs => Command::SaveAs(chosen),
+                    DialogKind::Export => Command::Export(chosen),
                 });
                 close = true;
             }

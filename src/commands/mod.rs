@@ -11,6 +11,7 @@ macro_rules! say {
 
 mod bench;
 mod convert;
+mod export;
 mod import;
 mod info;
 pub mod render;
@@ -32,6 +33,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Some(Command::Info { file, json, frame }) => info::run(&file, json, frame),
         Some(Command::Convert { input, output, frame, force }) => convert::run(&input, &output, frame, force),
         Some(Command::Import(args)) => import::run(&args),
+        Some(Command::Export { file, output, scale, frame, force }) => export::run(&file, &output, scale, frame, force),
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
         Some(Command::Replay { scripts, cpu, force }) => replay::run(&scripts, cpu, force, update_images()),

@@ -1,6 +1,7 @@
 //! File formats: MagicaVoxel .vox in and out, .obj meshes in (voxelized).
 
 pub mod atomic;
+pub mod export;
 mod guard;
 pub mod input;
 pub mod mesh;

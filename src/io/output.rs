@@ -1,6 +1,6 @@
 //! Which outputs a command may write: never one of its inputs, never over an
-//! existing document (.vox, .obj, .ovr) unless the user said `--force`, and
-//! only in the format the file's extension names.
+//! existing document (.vox, .obj, .ovr, .ply, .mtl) unless the user said
+//! `--force`, and only in the format the file's extension names.
 
 use std::path::{Path, PathBuf};
 
@@ -13,21 +13,29 @@ pub enum OutputKind {
     Scene,
     /// A replay script (`--record`): any name, `.ovr` by convention.
     Script,
+    /// An exported mesh: `.obj` or `.ply`.
+    Mesh,
+    /// The materials of an exported .obj: `.mtl`.
+    Materials,
 }
 
 impl OutputKind {
-    fn extension(self) -> Option<&'static str> {
+    /// The extensions it may have; empty for any.
+    fn extensions(self) -> &'static [&'static str] {
         match self {
-            OutputKind::Image => Some("png"),
-            OutputKind::Scene => Some("vox"),
-            OutputKind::Script => None,
+            OutputKind::Image => &["png"],
+            OutputKind::Scene => &["vox"],
+            OutputKind::Script => &[],
+            OutputKind::Mesh => &["obj", "ply"],
+            OutputKind::Materials => &["mtl"],
         }
     }
 }
 
-/// Extensions of the files users make by hand or with other tools; an
-/// existing one is only replaced with `--force`.
-const DOCUMENT_EXTENSIONS: [&str; 3] = ["vox", "obj", "ovr"];
+/// Extensions of the files users make by hand or with other tools (meshes
+/// and their materials included); an existing one is only replaced with
+/// `--force`.
+const DOCUMENT_EXTENSIONS: [&str; 5] = ["vox", "obj", "ovr", "ply", "mtl"];
 
 /// Why an output was refused.
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]
@@ -36,8 +44,8 @@ pub enum OutputError {
     IsInput { path: PathBuf },
     #[error("{} already exists; refusing to replace it (--force replaces it)", path.display())]
     Exists { path: PathBuf },
-    #[error("{} names a .{found} file, but this command writes .{expected} files", path.display())]
-    WrongExtension { path: PathBuf, found: String, expected: &'static str },
+    #[error("{} names a .{found} file, but this command writes {expected} files", path.display())]
+    WrongExtension { path: PathBuf, found: String, expected: String },
 }
 
 /// Checks that `output` may be written by a command that read `inputs`.
@@ -46,9 +54,9 @@ pub enum OutputError {
 /// [`OutputError::WrongExtension`] always; the others unless `force`.
 pub fn check_output(output: &Path, kind: OutputKind, inputs: &[&Path], force: bool) -> Result<(), OutputError> {
     let extension = extension_of(output);
-    if let Some(expected) = kind.extension()
-        && extension != expected
-    {
+    let allowed = kind.extensions();
+    if !allowed.is_empty() && !allowed.contains(&extension.as_str()) {
+        let expected = allowed.iter().map(|e| format!(".{e}")).collect::<Vec<_>>().join(" or ");
         return Err(OutputError::WrongExtension { path: output.to_path_buf(), found: extension, expected });
     }
     if force {
