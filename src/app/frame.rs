@@ -10,7 +10,7 @@ use winit::event_loop::ActiveEventLoop;
 use octovox::settings::TraceMode;
 use octovox::trace::grid::DenseGrid;
 
-use super::{App, Gfx, camera_control, capture, ui};
+use super::{App, Gfx, camera_control, capture, motion, ui};
 
 impl App {
     pub(super) fn frame(&mut self, event_loop: &ActiveEventLoop) {
@@ -25,6 +25,12 @@ impl App {
         }
         // Panels first: they may change settings and produce commands.
         let Some((ctx, full)) = self.run_panels(event_loop) else { return };
+        // The camera is final for this frame: pick how many pixels to trace.
+        let screenshot = self.screenshot_requested || self.screenshot_path.is_some();
+        let last = motion::FrameTimes { frame_ms: self.stats.frame_ms, trace_ms: self.stats.trace_ms };
+        self.motion.update(&self.state.camera, last, self.state.frame_target_ms, screenshot);
+        self.stats.scale = self.state.settings.render_scale.clamp(0.25, 1.0) * self.motion.factor();
+        self.stats.moving = self.motion.moving();
         // Hover pick: what a click would edit, highlighted before any click.
         self.pick = match self.input.cursor() {
             // A hover over a ray that gave up highlights nothing; a click says why.
@@ -135,6 +141,7 @@ impl App {
         }
 
         // Blit + egui onto the swapchain image.
+        let present_started = Instant::now();
         let frame = acquire_frame(gfx, &self.redraw_wanted)?;
         let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
         gfx.blit.prepare(&gfx.renderer.gpu.device, gfx.renderer.pass.output_view());
@@ -172,13 +179,16 @@ impl App {
         for id in std::mem::take(&mut gfx.textures_to_free) {
             gfx.egui_renderer.free_texture(&id);
         }
+        self.stats.present_ms = present_started.elapsed().as_secs_f64() * 1e3;
         Some(window_copy)
     }
 
     /// Keeps drawing while something moves; otherwise waits for input (or
     /// for when egui asks to be drawn again).
     fn schedule_repaint(&mut self, repaint_delay: Option<Duration>) {
-        let animating = self.loading.is_some()
+        // A moving camera asks for one more frame: the resting view at full scale.
+        let animating = self.motion.moving()
+            || self.loading.is_some()
             || self.input.fly_direction().is_some()
             || self.bench.is_some()
             || self.player.is_some();

@@ -18,6 +18,7 @@ mod command;
 mod files;
 mod frame;
 mod input;
+mod motion;
 mod script;
 mod state;
 mod ui;
@@ -120,6 +121,8 @@ struct App {
     input: Input,
     stats: Stats,
     pick: Option<Pick>,
+    /// The render scale while the camera moves.
+    motion: motion::MotionScale,
     pointer_over_ui: bool,
     stroke: Option<Stroke>,
     loading: Option<Loading>,
@@ -152,6 +155,7 @@ impl App {
             input: Input::default(),
             stats: Stats::default(),
             pick: None,
+            motion: motion::MotionScale::default(),
             pointer_over_ui: false,
             stroke: None,
             loading: None,
@@ -386,7 +390,7 @@ impl App {
     /// The trace resolution for the current window size and render scale.
     fn trace_size(&self) -> (u32, u32) {
         let (w, h) = self.gfx.as_ref().map_or(self.args.size, |g| (g.config.width, g.config.height));
-        let scale = self.state.settings.render_scale.clamp(0.25, 1.0);
+        let scale = self.state.settings.render_scale.clamp(0.25, 1.0) * self.motion.factor();
         (((w as f32 * scale).round() as u32).max(1), ((h as f32 * scale).round() as u32).max(1))
     }
 

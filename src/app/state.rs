@@ -45,6 +45,9 @@ pub struct EditorState {
     pub path: Option<PathBuf>,
     /// Edits since the last save or load.
     pub dirty: bool,
+    /// Frame time to hold while the camera moves (the render scale drops
+    /// as far as needed), milliseconds.
+    pub frame_target_ms: f32,
 }
 
 impl Default for EditorState {
@@ -59,6 +62,7 @@ impl Default for EditorState {
             settings: RenderSettings::default(),
             path: None,
             dirty: false,
+            frame_target_ms: super::motion::DEFAULT_TARGET_MS,
         }
     }
 }

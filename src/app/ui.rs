@@ -29,6 +29,12 @@ pub struct Stats {
     pub frame_ms: f64,
     /// Trace pass time: GPU timestamps when available, else wall time.
     pub trace_ms: f64,
+    /// Wall time of acquire, blit, egui, submit and present, milliseconds.
+    pub present_ms: f64,
+    /// Render scale of the last frame (lower while the camera moves).
+    pub scale: f32,
+    /// Whether the camera moved since the frame before.
+    pub moving: bool,
     /// Bytes the last edit (or undo/redo) wrote to the GPU.
     pub last_edit_bytes: u64,
     /// Byte ranges of the last edit.
@@ -240,6 +246,8 @@ fn render(ui: &mut egui::Ui, state: &mut EditorState) {
     });
     ui.checkbox(&mut settings.shadows, "Sun shadows");
     ui.add(egui::Slider::new(&mut settings.render_scale, 0.25..=1.0).text("scale"));
+    ui.add(egui::Slider::new(&mut state.frame_target_ms, 10.0..=100.0).text("ms target"))
+        .on_hover_text("frame time to hold while the camera moves: the render scale drops as far as needed");
 }
 
 fn stats(ui: &mut egui::Ui, info: &Info) {
@@ -257,6 +265,8 @@ fn stats(ui: &mut egui::Ui, info: &Info) {
         row("fps", format!("{:.1}", s.fps));
         row("frame", format!("{:.2} ms", s.frame_ms));
         row("trace", format!("{:.2} ms ({trace})", s.trace_ms));
+        row("present", format!("{:.2} ms", s.present_ms));
+        row("scale", format!("{:.2}{}", s.scale, if s.moving { " (moving)" } else { "" }));
         row("voxels", format!("{}", tree.solid_voxels()));
         row("nodes", format!("{} + {} bricks", tree.node_count(), tree.brick_count()));
         row("pool", format!("{} bytes", pool.live_bytes()));
