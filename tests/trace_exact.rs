@@ -170,49 +170,57 @@ fn local(tree: &Octree, p: Vec3) -> Vec3 {
 
 const AXES: [Vec3; 6] = [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_Z];
 
+/// Sends `count` rays from `ray` (tree-local origin and direction; `None`
+/// skips one) through the CPU tracer and checks them against the reference:
+/// no failure, at most `max_percent` near ties, at least `min_hits` hits.
+fn sweep(
+    tree: &Octree,
+    class: &str,
+    (seed, count): (u64, usize),
+    (max_percent, min_hits): (usize, usize),
+    mut ray: impl FnMut(&mut Rng) -> Option<(Vec3, Vec3)>,
+) {
+    let mut rng = Rng(seed);
+    let mut tally = Tally::default();
+    for _ in 0..count {
+        if let Some((origin, dir)) = ray(&mut rng) {
+            check(tree, origin, dir, &mut tally);
+        }
+    }
+    tally.assert_clean(class, max_percent);
+    assert!(tally.hits >= min_hits, "{class}: {} hits", tally.hits);
+}
+
 #[test]
 fn axis_parallel_rays_from_integer_and_half_integer_origins() {
     let tree = scene();
-    let mut rng = Rng(1);
-    let mut tally = Tally::default();
-    for _ in 0..3000 {
+    sweep(&tree, "axis-parallel", (1, 3000), (0, 500), |rng| {
         let half = rng.pick(&[0.0, 0.5]);
         let p = Vec3::new(rng.int(-30, 30) as f32, rng.int(-10, 40) as f32, rng.int(-30, 30) as f32);
         let origin = p + Vec3::new(rng.pick(&[0.0, half]), rng.pick(&[0.0, half]), rng.pick(&[0.0, half]));
         // Exactly parallel, or off by a component too small to matter.
         let tiny = rng.pick(&[0.0, -0.0, 1e-30, -1e-30]);
         let dir = rng.pick(&AXES) + Vec3::splat(tiny) * rng.pick(&[Vec3::X, Vec3::Y, Vec3::Z]);
-        check(&tree, local(&tree, origin), dir, &mut tally);
-    }
-    tally.assert_clean("axis-parallel", 0);
-    assert!(tally.hits > 500);
+        Some((local(&tree, origin), dir))
+    });
 }
 
 #[test]
 fn rays_through_edges_and_corners() {
     let tree = scene();
-    let mut rng = Rng(2);
-    let mut tally = Tally::default();
-    for _ in 0..3000 {
+    sweep(&tree, "edges and corners", (2, 3000), (0, 300), |rng| {
         // From a lattice point along small integer directions: every plane
         // it meets, it meets at an edge or a corner of the voxel grid.
         let origin = Vec3::new(rng.int(-40, 40) as f32, rng.int(-20, 50) as f32, rng.int(-40, 40) as f32);
         let dir = Vec3::new(rng.int(-3, 4) as f32, rng.int(-3, 4) as f32, rng.int(-3, 4) as f32);
-        if dir == Vec3::ZERO {
-            continue;
-        }
-        check(&tree, local(&tree, origin), dir, &mut tally);
-    }
-    tally.assert_clean("edges and corners", 0);
-    assert!(tally.hits > 300);
+        (dir != Vec3::ZERO).then(|| (local(&tree, origin), dir))
+    });
 }
 
 #[test]
 fn grazing_rays_along_faces() {
     let tree = scene();
-    let mut rng = Rng(3);
-    let mut tally = Tally::default();
-    for _ in 0..3000 {
+    sweep(&tree, "grazing", (3, 3000), (1, 300), |rng| {
         // In a voxel face plane (one coordinate an integer, its direction
         // component zero or nearly), anywhere else.
         let axis = rng.int(0, 3) as usize;
@@ -220,51 +228,35 @@ fn grazing_rays_along_faces() {
         origin[axis] = rng.int(-25, 35) as f32;
         let mut dir = Vec3::new(rng.unit(), rng.unit(), rng.unit());
         dir[axis] = rng.pick(&[0.0, 1e-7, -1e-7, 2f32.powi(-23)]);
-        if dir.abs().max_element() < 1e-3 {
-            continue;
-        }
-        check(&tree, local(&tree, origin), dir, &mut tally);
-    }
-    tally.assert_clean("grazing", 1);
-    assert!(tally.hits > 300);
+        (dir.abs().max_element() >= 1e-3).then(|| (local(&tree, origin), dir))
+    });
 }
 
 #[test]
 fn cameras_inside_solid_voxels_and_on_boundaries() {
     let tree = scene();
     let solid: Vec<IVec3> = tree.voxels().into_iter().map(|(p, _)| p).collect();
-    let mut rng = Rng(4);
-    let mut tally = Tally::default();
-    for _ in 0..3000 {
+    sweep(&tree, "inside and on boundaries", (4, 3000), (0, 2000), |rng| {
         let v = solid[(rng.next() % solid.len() as u64) as usize].as_vec3();
         // Inside the voxel, on one of its faces, edges or corners.
         let offset =
             Vec3::new(rng.pick(&[0.0, 0.25, 0.5, 1.0]), rng.pick(&[0.0, 0.5, 0.75, 1.0]), rng.pick(&[0.0, 0.5, 1.0]));
         let dir = Vec3::new(rng.unit(), rng.unit(), rng.unit());
-        if dir.abs().max_element() < 1e-3 {
-            continue;
-        }
-        check(&tree, local(&tree, v + offset), dir, &mut tally);
-    }
-    tally.assert_clean("inside and on boundaries", 0);
-    assert!(tally.hits > 2000);
+        (dir.abs().max_element() >= 1e-3).then(|| (local(&tree, v + offset), dir))
+    });
 }
 
 #[test]
 fn cameras_a_million_voxels_away() {
     let tree = scene();
-    let mut rng = Rng(5);
-    let mut tally = Tally::default();
     let target = Vec3::new(0.0, 8.0, 0.0);
-    for _ in 0..2000 {
+    sweep(&tree, "a million voxels away", (5, 2000), (5, 300), |rng| {
         let direction = Vec3::new(rng.unit(), rng.unit(), rng.unit()).normalize_or(Vec3::X);
         // The eye as the tracer sees it: tree-local and already f32.
         let eye = local(&tree, target + direction * 1.0e6);
         let aim = local(&tree, target + Vec3::new(rng.unit(), rng.unit(), rng.unit()) * 20.0);
-        check(&tree, eye, aim - eye, &mut tally);
-    }
-    tally.assert_clean("a million voxels away", 5);
-    assert!(tally.hits > 300);
+        Some((eye, aim - eye))
+    });
 }
 
 #[test]
@@ -273,17 +265,13 @@ fn a_tree_two_to_the_twenty_wide() {
     let far = IVec3::new((1 << 20) - 40, 3, -7);
     tree.apply_brush(&Shape::Box { min: far, max: far + IVec3::new(3, 9, 5) }, Op::Place(8)).unwrap();
     assert_eq!(tree.depth(), 20);
-    let mut rng = Rng(6);
-    let mut tally = Tally::default();
-    for _ in 0..2000 {
+    sweep(&tree, "2^20 wide", (6, 2000), (1, 300), |rng| {
         let origin = Vec3::new(rng.unit() * 30.0, rng.unit() * 20.0 + 8.0, rng.unit() * 30.0);
         let goal =
             if rng.next().is_multiple_of(2) { far.as_vec3() + Vec3::splat(2.0) } else { Vec3::new(0.0, 8.0, 0.0) };
         let aim = goal + Vec3::new(rng.unit(), rng.unit(), rng.unit()) * 4.0;
-        check(&tree, local(&tree, origin), aim - origin, &mut tally);
-    }
-    tally.assert_clean("2^20 wide", 1);
-    assert!(tally.hits > 300);
+        Some((local(&tree, origin), aim - origin))
+    });
 }
 
 /// The same classes through the WGSL tracer, in batches: one camera a class,
