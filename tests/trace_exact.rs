@@ -11,7 +11,10 @@ mod common;
 use common::exact::{ExactRay, first_hit, gap_to_voxel};
 use glam::{IVec3, Vec3};
 use num_traits::ToPrimitive;
+use octovox::camera::Camera;
+use octovox::gpu::Renderer;
 use octovox::scene::{Octree, Op, Shape};
+use octovox::settings::{RenderSettings, TraceMode, View};
 use octovox::trace::{Hit, Ray, svo};
 
 /// splitmix64: a fixed, portable sequence, so every run tests the same rays.
@@ -274,6 +277,20 @@ fn a_tree_two_to_the_twenty_wide() {
     });
 }
 
+/// Each pixel's GPU hit (SVO, no shadows) against the reference for that
+/// pixel's ray as the CPU computes it.
+fn gpu_tally(renderer: &mut Renderer, tree: &Octree, camera: &Camera, size: (u32, u32)) -> Tally {
+    let settings = RenderSettings { mode: TraceMode::Svo, view: View::Shaded, shadows: false, render_scale: 1.0 };
+    renderer.render(tree, camera, size, &settings, None).unwrap();
+    let basis = camera.basis(size.0, size.1, tree.origin());
+    let mut tally = Tally::default();
+    for (i, hit) in renderer.read_hits().unwrap().iter().enumerate() {
+        let (origin, dir) = basis.ray(i as u32 % size.0, i as u32 / size.0);
+        classify(tree, &Ray::new(origin, dir), hit, &mut tally);
+    }
+    tally
+}
+
 /// The same classes through the WGSL tracer, in batches: one camera a class,
 /// each pixel's ray (as the CPU computes it) against the reference. The GPU
 /// may fuse a multiply-add where the CPU rounds twice, so a near tie here
@@ -281,8 +298,6 @@ fn a_tree_two_to_the_twenty_wide() {
 #[test]
 fn gpu_hard_cases_against_the_reference() {
     use glam::DVec3;
-    use octovox::camera::Camera;
-    use octovox::settings::{RenderSettings, TraceMode, View};
 
     let mut tree = scene();
     let far = IVec3::new((1 << 20) - 40, 3, -7);
@@ -290,7 +305,6 @@ fn gpu_hard_cases_against_the_reference() {
     let mut renderer = octovox::gpu::Renderer::headless().expect("a GPU adapter (lavapipe on CI)");
     renderer.hit_records = true;
     renderer.sync(&mut tree, &octovox::scene::Palette::default());
-    let settings = RenderSettings { mode: TraceMode::Svo, view: View::Shaded, shadows: false, render_scale: 1.0 };
     let camera = |eye: [f64; 3], target: [f64; 3], fov: f32| Camera {
         eye: DVec3::from_array(eye),
         target: DVec3::from_array(target),
@@ -305,16 +319,7 @@ fn gpu_hard_cases_against_the_reference() {
         ("2^20 wide", camera([f64::from(far.x) - 30.0, 12.0, 20.0], [f64::from(far.x) + 2.0, 5.0, -4.0], 40.0), 1),
     ];
     for (class, camera, max_percent) in classes {
-        let size = (96, 64);
-        renderer.render(&tree, &camera, size, &settings, None).unwrap();
-        let hits = renderer.read_hits().unwrap();
-        let basis = camera.basis(size.0, size.1, tree.origin());
-        let mut tally = Tally::default();
-        for (i, hit) in hits.iter().enumerate() {
-            let (x, y) = (i as u32 % size.0, i as u32 / size.0);
-            let (origin, dir) = basis.ray(x, y);
-            classify(&tree, &Ray::new(origin, dir), hit, &mut tally);
-        }
+        let tally = gpu_tally(&mut renderer, &tree, &camera, (96, 64));
         tally.assert_clean(&format!("GPU {class}"), max_percent);
         assert!(tally.hits > 100, "{class}: the camera sees too little ({} hits)", tally.hits);
     }
@@ -329,16 +334,8 @@ fn gpu_hard_cases_against_the_reference() {
         terrain.apply_brush(&Shape::Sphere { center, radius: 40 + i * 7 }, Op::Place(3)).unwrap();
     }
     renderer.sync(&mut terrain, &octovox::scene::Palette::default());
-    let camera = camera([3.0e5, 9.0e5, 3.0e5], [0.0, 0.0, 0.0], 1.0);
-    let size = (192, 128);
-    renderer.render(&terrain, &camera, size, &settings, None).unwrap();
-    let hits = renderer.read_hits().unwrap();
-    let basis = camera.basis(size.0, size.1, terrain.origin());
-    let mut tally = Tally::default();
-    for (i, hit) in hits.iter().enumerate() {
-        let (origin, dir) = basis.ray(i as u32 % size.0, i as u32 / size.0);
-        classify(&terrain, &Ray::new(origin, dir), hit, &mut tally);
-    }
+    let far_camera = camera([3.0e5, 9.0e5, 3.0e5], [0.0, 0.0, 0.0], 1.0);
+    let tally = gpu_tally(&mut renderer, &terrain, &far_camera, (192, 128));
     tally.assert_clean("GPU a million voxels away", 5);
     assert!(tally.hits > 500, "the far camera sees too little ({} hits)", tally.hits);
 }
