@@ -44,6 +44,10 @@ pub struct WindowArgs {
     /// Start with sun shadows off (the UI can turn them on).
     #[arg(long)]
     pub no_shadows: bool,
+    /// On exit, print the frame rate and the worst frame while the camera
+    /// moved (benches/window_orbit.sh drags the real mouse and reads it).
+    #[arg(long)]
+    pub frame_stats: bool,
     /// Play a replay script visibly, one line per frame (docs/replay.md).
     #[arg(long, value_name = "SCRIPT")]
     pub replay: Option<PathBuf>,

@@ -15,6 +15,7 @@ use super::{App, Gfx, camera_control, capture, motion, ui};
 impl App {
     pub(super) fn frame(&mut self, event_loop: &ActiveEventLoop) {
         let started = Instant::now();
+        let interval_ms = self.last_frame.map(|last| started.duration_since(last).as_secs_f64() * 1e3);
         let seconds = self.measure_interval(started);
         self.poll_loading();
         if self.ready {
@@ -31,6 +32,9 @@ impl App {
         self.motion.update(&self.state.camera, last, self.state.frame_target_ms, screenshot);
         self.stats.scale = self.state.settings.render_scale.clamp(0.25, 1.0) * self.motion.factor();
         self.stats.moving = self.motion.moving();
+        if let (Some(frames), Some(interval_ms), true) = (&mut self.moving_frames, interval_ms, self.motion.moving()) {
+            frames.push(interval_ms, self.stats.trace_ms, self.stats.present_ms, self.stats.scale);
+        }
         // Hover pick: what a click would edit, highlighted before any click.
         self.pick = match self.input.cursor() {
             // A hover over a ray that gave up highlights nothing; a click says why.

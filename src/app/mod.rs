@@ -65,6 +65,9 @@ pub fn run(args: WindowArgs) -> anyhow::Result<ExitCode> {
     let instance = GpuContext::window_instance(Box::new(event_loop.owned_display_handle()));
     let mut app = App::new(args, instance);
     event_loop.run_app(&mut app).context("the event loop failed")?;
+    if let Some(frames) = &app.moving_frames {
+        report!("frame-stats: {}", frames.summary());
+    }
     match app.fatal.take() {
         Some(err) => Err(err),
         None => Ok(ExitCode::SUCCESS),
@@ -123,6 +126,8 @@ struct App {
     pick: Option<Pick>,
     /// The render scale while the camera moves.
     motion: motion::MotionScale,
+    /// Frame intervals while the camera moved (`--frame-stats`).
+    moving_frames: Option<motion::MovingFrames>,
     pointer_over_ui: bool,
     stroke: Option<Stroke>,
     loading: Option<Loading>,
@@ -156,6 +161,7 @@ impl App {
             stats: Stats::default(),
             pick: None,
             motion: motion::MotionScale::default(),
+            moving_frames: args.frame_stats.then(motion::MovingFrames::default),
             pointer_over_ui: false,
             stroke: None,
             loading: None,

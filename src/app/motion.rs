@@ -10,6 +10,48 @@ pub const MIN_FACTOR: f32 = 0.25;
 /// Default frame-time target while the camera moves, milliseconds.
 pub const DEFAULT_TARGET_MS: f32 = 33.0;
 
+/// Frame intervals while the camera moved, for `--frame-stats`.
+#[derive(Clone, Debug, Default)]
+pub struct MovingFrames {
+    intervals_ms: Vec<f64>,
+    trace_ms: Vec<f64>,
+    present_ms: Vec<f64>,
+    scales: Vec<f64>,
+}
+
+impl MovingFrames {
+    /// One moving frame: the time since the frame before, and the last
+    /// frame's trace and present times and scale.
+    pub fn push(&mut self, interval_ms: f64, trace_ms: f64, present_ms: f64, scale: f32) {
+        self.intervals_ms.push(interval_ms);
+        self.trace_ms.push(trace_ms);
+        self.present_ms.push(present_ms);
+        self.scales.push(f64::from(scale));
+    }
+
+    /// "N frames while moving: F fps, median M ms, worst W ms; median trace
+    /// T ms, present P ms, scale S".
+    pub fn summary(&self) -> String {
+        let n = self.intervals_ms.len();
+        let total: f64 = self.intervals_ms.iter().sum();
+        let fps = if total > 0.0 { n as f64 * 1e3 / total } else { 0.0 };
+        let worst = self.intervals_ms.iter().copied().fold(0.0, f64::max);
+        format!(
+            "{n} frames while moving: {fps:.1} fps, median {:.1} ms, worst {worst:.1} ms; median trace {:.1} ms, present {:.1} ms, scale {:.2}",
+            median(&self.intervals_ms),
+            median(&self.trace_ms),
+            median(&self.present_ms),
+            median(&self.scales)
+        )
+    }
+}
+
+fn median(values: &[f64]) -> f64 {
+    let mut sorted = values.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    sorted.get(sorted.len() / 2).copied().unwrap_or(0.0)
+}
+
 /// What the last frame took, milliseconds.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct FrameTimes {
