@@ -136,3 +136,45 @@ fn convert_writes_a_file_that_loads_the_same() {
         assert_eq!(before[key], after[key], "{key}");
     }
 }
+
+/// A MATL with values octovox cannot use as they are (out of range, not a
+/// number, an unknown type) loads, clamps them, never yields NaN, and
+/// `info` says what it did.
+#[test]
+fn odd_material_values_are_clamped_and_reported() {
+    use octovox::scene::{Material, MaterialKind, Palette};
+    let mut palette = Palette::default();
+    let mut metal = Material::new(MaterialKind::Metal);
+    metal.params.insert("_rough".into(), "nan".into());
+    metal.params.insert("_metal".into(), "7".into());
+    metal.params.insert("_ri".into(), "1.33".into());
+    palette.materials[5] = metal;
+    let mut odd = Material::new(MaterialKind::Diffuse);
+    odd.params.insert("_flux".into(), "-2".into());
+    palette.materials[6] = odd;
+    let mut bytes = octovox::io::vox::encode_vox(&palette, &[(glam::IVec3::ZERO, 5), (glam::IVec3::ONE, 6)]).unwrap();
+    // An unknown type, written the way MagicaVoxel writes `_blend`.
+    let at = bytes.windows(8).position(|w| w == b"_diffuse").unwrap();
+    bytes[at..at + 8].copy_from_slice(b"_blendxx");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("odd.vox");
+    std::fs::write(&path, &bytes).unwrap();
+
+    let model = octovox::io::vox::load_vox_file(&path, 0).unwrap();
+    let metal = model.palette.material(5);
+    assert_eq!((metal.roughness(), metal.metalness(), metal.ior()), (0.1, 1.0, 1.33));
+    assert_eq!(model.palette.material(6).kind, MaterialKind::Diffuse);
+    assert_eq!(model.palette.material(6).flux(), 0.0);
+    let out =
+        std::process::Command::new(env!("CARGO_BIN_EXE_octovox")).args(["info", "--json"]).arg(&path).output().unwrap();
+    let info: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let warnings = info["warnings"].to_string();
+    for expected in [
+        "material 5: _rough 'nan' is not a number, read as 0.1",
+        "material 5: _metal '7' is outside 0..=1, read as 1",
+        "material 6: type '_blendxx' is not one octovox renders; treated as diffuse",
+        "material 6: _flux '-2' is outside 0..=4, read as 0",
+    ] {
+        assert!(warnings.contains(expected), "missing '{expected}' in {warnings}");
+    }
+}

@@ -30,17 +30,36 @@ impl MaterialKind {
         }
     }
 
-    /// Parses a `_type` value; unknown names (e.g. `_blend`) fall back to diffuse.
-    pub fn from_vox_name(name: &str) -> MaterialKind {
+    /// Parses a `_type` value; `None` for a name octovox does not render
+    /// (e.g. `_blend`), which loaders treat as diffuse with a warning.
+    pub fn from_vox_name(name: &str) -> Option<MaterialKind> {
         match name {
-            "_metal" => MaterialKind::Metal,
-            "_glass" => MaterialKind::Glass,
-            "_emit" => MaterialKind::Emit,
-            "_media" | "_cloud" => MaterialKind::Media,
-            _ => MaterialKind::Diffuse,
+            "_diffuse" => Some(MaterialKind::Diffuse),
+            "_metal" => Some(MaterialKind::Metal),
+            "_glass" => Some(MaterialKind::Glass),
+            "_emit" => Some(MaterialKind::Emit),
+            "_media" | "_cloud" => Some(MaterialKind::Media),
+            _ => None,
         }
     }
 }
+
+/// The MATL keys octovox reads as numbers: (key, range MagicaVoxel's UI
+/// allows, value when absent). `_ior` is the refractive index minus one;
+/// `_ri`, where present, is the index itself.
+const NUMERIC_PARAMS: [(&str, std::ops::RangeInclusive<f32>, f32); 11] = [
+    ("_rough", 0.0..=1.0, 0.1),
+    ("_metal", 0.0..=1.0, 0.0),
+    ("_sp", 0.0..=2.0, 0.5),
+    ("_ior", 0.0..=2.0, 0.5),
+    ("_ri", 1.0..=3.0, 1.5),
+    ("_trans", 0.0..=1.0, 0.0),
+    ("_alpha", 0.0..=1.0, 0.0),
+    ("_emit", 0.0..=1.0, 0.0),
+    ("_flux", 0.0..=4.0, 0.0),
+    ("_ldr", 0.0..=1.0, 0.0),
+    ("_d", 0.0..=1.0, 0.0),
+];
 
 /// One palette entry's material: the kind plus MagicaVoxel's MATL parameters.
 ///
@@ -60,27 +79,61 @@ impl Material {
         Material { kind, params: BTreeMap::new() }
     }
 
-    fn param(&self, key: &str) -> Option<f32> {
-        self.params.get(key).and_then(|v| v.trim().parse().ok())
+    /// A numeric parameter, clamped into its range; its default when it is
+    /// absent or not a finite number. Never NaN.
+    fn param(&self, key: &str) -> f32 {
+        let Some((_, range, default)) = NUMERIC_PARAMS.iter().find(|(k, _, _)| *k == key) else { return 0.0 };
+        match self.params.get(key).map(|v| v.trim().parse::<f32>()) {
+            Some(Ok(v)) if v.is_finite() => v.clamp(*range.start(), *range.end()),
+            _ => *default,
+        }
     }
 
     pub fn roughness(&self) -> f32 {
-        self.param("_rough").unwrap_or(0.1)
+        self.param("_rough")
     }
     pub fn metalness(&self) -> f32 {
-        self.param("_metal").unwrap_or(0.0)
+        self.param("_metal")
     }
+    /// The refractive index: `_ri` where present, else from `_ior`, which
+    /// MATL stores as the index minus one (old MATT chunks store the index
+    /// itself, 1 or more).
     pub fn ior(&self) -> f32 {
-        self.param("_ior").map_or(1.5, |ior| if ior < 1.0 { ior + 1.0 } else { ior })
+        if self.params.get("_ri").is_some_and(|v| v.trim().parse::<f32>().is_ok_and(f32::is_finite)) {
+            return self.param("_ri");
+        }
+        let ior = self.param("_ior");
+        if ior < 1.0 { ior + 1.0 } else { ior }
     }
     pub fn transparency(&self) -> f32 {
-        self.param("_trans").unwrap_or(0.0)
+        self.param("_trans")
     }
     pub fn emission(&self) -> f32 {
-        self.param("_emit").unwrap_or(0.0)
+        self.param("_emit")
     }
     pub fn flux(&self) -> f32 {
-        self.param("_flux").unwrap_or(0.0)
+        self.param("_flux")
+    }
+
+    /// The numeric parameters that are not numbers or lie outside their
+    /// range, each as "key 'value' …, read as X" (what the accessors use).
+    pub fn problems(&self) -> Vec<String> {
+        NUMERIC_PARAMS
+            .iter()
+            .filter_map(|(key, range, default)| {
+                let text = self.params.get(*key)?;
+                match text.trim().parse::<f32>() {
+                    Ok(v) if v.is_finite() && range.contains(&v) => None,
+                    Ok(v) if v.is_finite() => Some(format!(
+                        "{key} '{text}' is outside {}..={}, read as {}",
+                        range.start(),
+                        range.end(),
+                        self.param(key)
+                    )),
+                    _ => Some(format!("{key} '{text}' is not a number, read as {default}")),
+                }
+            })
+            .collect()
     }
 }
 

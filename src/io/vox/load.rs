@@ -53,13 +53,9 @@ pub fn load_vox(bytes: &[u8], frame: usize) -> Result<VoxelModel, VoxError> {
         scene::placements(&data.scenes, &layout.node_ids, &layout.model_voxels, frame)?
     };
     let voxels = place_voxels(&data, &layout, &placements)?;
-    Ok(VoxelModel {
-        palette: palette_of(&data, &layout),
-        voxels,
-        models: placements.len(),
-        stored_models: data.models.len(),
-        warnings: layout.warnings,
-    })
+    let mut warnings = layout.warnings.clone();
+    let palette = palette_of(&data, &layout, &mut warnings);
+    Ok(VoxelModel { palette, voxels, models: placements.len(), stored_models: data.models.len(), warnings })
 }
 
 /// Runs `dot_vox::load_bytes`, turning a panic into [`VoxError::ParserPanic`].
@@ -156,8 +152,9 @@ pub(super) fn sort_and_dedup(voxels: &mut Vec<Voxel>) {
     });
 }
 
-/// Colours from RGBA (or MagicaVoxel's default), materials from MATT then MATL.
-fn palette_of(data: &DotVoxData, layout: &Layout) -> Palette {
+/// Colours from RGBA (or MagicaVoxel's default), materials from MATT then
+/// MATL; problems with the materials go to `warnings`.
+fn palette_of(data: &DotVoxData, layout: &Layout, warnings: &mut Vec<String>) -> Palette {
     let mut palette = Palette::default_magicavoxel();
     for (entry, color) in data.palette.iter().take(256).enumerate() {
         // Entry k of the RGBA chunk is palette index k + 1; the last is index 0.
@@ -170,18 +167,28 @@ fn palette_of(data: &DotVoxData, layout: &Layout) -> Palette {
     for matl in &data.materials {
         // MagicaVoxel numbers materials 1..=256, where 256 is palette index 0.
         let index = usize::from(matl.id.to_le_bytes()[0]);
-        materials[index] = material_from_properties(&matl.properties);
+        materials[index] = material_from_properties(index, &matl.properties, warnings);
     }
     palette.materials = materials;
     palette
 }
 
-fn material_from_properties(properties: &dot_vox::Dict) -> Material {
-    let kind = properties.get("_type").map_or(MaterialKind::Diffuse, |t| MaterialKind::from_vox_name(t));
+/// A MATL's material; what it holds that octovox cannot use as it is goes
+/// to `warnings`, naming the palette index.
+fn material_from_properties(index: usize, properties: &dot_vox::Dict, warnings: &mut Vec<String>) -> Material {
+    let kind = match properties.get("_type") {
+        None => MaterialKind::Diffuse,
+        Some(name) => MaterialKind::from_vox_name(name).unwrap_or_else(|| {
+            warnings.push(format!("material {index}: type '{name}' is not one octovox renders; treated as diffuse"));
+            MaterialKind::Diffuse
+        }),
+    };
     let params: BTreeMap<String, String> = properties
         .iter()
         .filter(|(key, _)| key.as_str() != "_type")
         .map(|(key, value)| (key.clone(), value.clone()))
         .collect();
-    Material { kind, params }
+    let material = Material { kind, params };
+    warnings.extend(material.problems().into_iter().map(|p| format!("material {index}: {p}")));
+    material
 }
