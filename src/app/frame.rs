@@ -30,7 +30,7 @@ impl App {
         let screenshot = self.screenshot_requested || self.screenshot_path.is_some();
         let last = motion::FrameTimes { frame_ms: self.stats.frame_ms, trace_ms: self.stats.trace_ms };
         self.motion.update(&self.state.camera, last, self.state.frame_target_ms, screenshot);
-        self.stats.scale = self.state.settings.render_scale.clamp(0.25, 1.0) * self.motion.factor();
+        self.stats.scale = self.render_scale();
         self.stats.moving = self.motion.moving();
         if let (Some(frames), Some(interval_ms), true) = (&mut self.moving_frames, interval_ms, self.motion.moving()) {
             frames.push(interval_ms, self.stats.trace_ms, self.stats.present_ms, self.stats.scale);
@@ -210,15 +210,13 @@ impl App {
         }
         let Some(gfx) = &mut self.gfx else { return };
         match DenseGrid::from_octree(&self.scene.tree) {
-            Ok(grid) => {
-                if let Err(err) = gfx.renderer.gpu.check_binding("the dense grid", grid.data.len() as u64) {
+            Ok(grid) => match gfx.renderer.set_grid(&grid) {
+                Ok(()) => self.grid_stale = false,
+                Err(err) => {
                     self.state.settings.mode = TraceMode::Svo;
                     self.ui.error(format!("{err}; back to SVO"));
-                    return;
                 }
-                gfx.renderer.buffers.upload_grid(&gfx.renderer.gpu.device, &gfx.renderer.gpu.queue, &grid);
-                self.grid_stale = false;
-            }
+            },
             Err(err) => {
                 self.state.settings.mode = TraceMode::Svo;
                 self.ui.error(format!("{err}; back to SVO"));

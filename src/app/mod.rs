@@ -393,10 +393,16 @@ impl App {
 
     // ----- picking and mouse edits ---------------------------------------------------
 
+    /// The render scale this frame traces at: the user's, lowered while the
+    /// camera moves.
+    fn render_scale(&self) -> f32 {
+        self.state.settings.render_scale.clamp(0.25, 1.0) * self.motion.factor()
+    }
+
     /// The trace resolution for the current window size and render scale.
     fn trace_size(&self) -> (u32, u32) {
         let (w, h) = self.gfx.as_ref().map_or(self.args.size, |g| (g.config.width, g.config.height));
-        let scale = self.state.settings.render_scale.clamp(0.25, 1.0) * self.motion.factor();
+        let scale = self.render_scale();
         (((w as f32 * scale).round() as u32).max(1), ((h as f32 * scale).round() as u32).max(1))
     }
 

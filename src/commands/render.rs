@@ -47,7 +47,6 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<ExitCode> {
     } else {
         let mut renderer = Renderer::headless().context("no GPU for rendering (try --cpu)")?;
         log::info!("rendering on {}", renderer.gpu.adapter_name);
-        renderer.gpu.check_image_size(args.size.0, args.size.1)?;
         renderer.sync(&mut scene.tree, &scene.palette);
         if let Some(grid) = &grid {
             renderer.set_grid(grid)?;

@@ -108,8 +108,7 @@ pub fn parse_obj(bytes: &[u8], path: &Path, up: UpAxis) -> Result<Vec<[Vec3; 3]>
     if triangles.is_empty() {
         return Err(MeshError::Empty { path: path.to_path_buf() });
     }
-    let lo = triangles.iter().flatten().copied().fold(Vec3::INFINITY, Vec3::min);
-    let hi = triangles.iter().flatten().copied().fold(Vec3::NEG_INFINITY, Vec3::max);
+    let (lo, hi) = bounds(&triangles);
     let all_finite = triangles.iter().flatten().all(|p| p.is_finite());
     if !all_finite || !(hi - lo).is_finite() {
         let (line, reason) = largest_vertex(bytes);
@@ -194,10 +193,16 @@ pub fn voxelize_obj(path: &Path, size: u32, up: UpAxis, color: u8) -> Result<Den
     Ok(dense)
 }
 
-/// The scale and the block size in voxels of `triangles` at `size`.
-fn placement(triangles: &[[Vec3; 3]], size: u32) -> (Vec3, f32, UVec3) {
+/// The min and max corners of the triangles' vertices.
+fn bounds(triangles: &[[Vec3; 3]]) -> (Vec3, Vec3) {
     let lo = triangles.iter().flatten().copied().fold(Vec3::INFINITY, Vec3::min);
     let hi = triangles.iter().flatten().copied().fold(Vec3::NEG_INFINITY, Vec3::max);
+    (lo, hi)
+}
+
+/// The scale and the block size in voxels of `triangles` at `size`.
+fn placement(triangles: &[[Vec3; 3]], size: u32) -> (Vec3, f32, UVec3) {
+    let (lo, hi) = bounds(triangles);
     let scale = size as f32 / (hi - lo).max_element().max(f32::MIN_POSITIVE);
     let dims = ((hi - lo) * scale).ceil().as_uvec3().clamp(UVec3::ONE, UVec3::splat(size));
     (lo, scale, dims)

@@ -200,13 +200,11 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
                 *slot = c.float(what)?;
             }
             let fov = match c.optional() {
-                Some(t) => match t.text.parse::<f32>().map_err(|_| ()).and_then(|f| check_fov(f).map_err(|_| ())) {
-                    Ok(f) => Some(f),
-                    Err(()) => {
-                        let (lo, hi) = (FOV_RANGE_DEG.start(), FOV_RANGE_DEG.end());
-                        return Err((t.column, format!("field of view '{}' must be {lo}..={hi} degrees", t.text)));
-                    }
-                },
+                Some(t) => {
+                    let fov = t.text.parse::<f32>().ok().and_then(|f| check_fov(f).ok());
+                    let (lo, hi) = (FOV_RANGE_DEG.start(), FOV_RANGE_DEG.end());
+                    Some(fov.ok_or((t.column, format!("field of view '{}' must be {lo}..={hi} degrees", t.text)))?)
+                }
                 None => None,
             };
             let (eye, target) = (DVec3::new(v[0], v[1], v[2]), DVec3::new(v[3], v[4], v[5]));
