@@ -28,6 +28,7 @@ const CHUNK_HEADER_BYTES: u64 = 12;
 /// wider than the octree holds, or one octovox could not read back.
 pub fn encode_vox(palette: &Palette, voxels: &[Voxel]) -> Result<Vec<u8>, VoxError> {
     let tree = tree_of(voxels)?;
+    check_savable(&tree)?;
     let mut bytes = std::io::Cursor::new(Vec::new());
     write_vox(&mut bytes, palette, &tree).map_err(|e| match e {
         WriteError::Vox(e) => e,
@@ -105,9 +106,8 @@ fn check_savable(tree: &Octree) -> Result<(), VoxError> {
 /// nSHP), a layer, the RGBA palette and a MATL chunk for every palette entry
 /// whose material is not plain diffuse (parameters kept verbatim, in key
 /// order, so the same scene always gives the same bytes). An empty scene is
-/// written as one empty 1×1×1 model.
+/// written as one empty 1×1×1 model. Callers have run [`check_savable`].
 fn write_vox<W: Write + Seek>(out: &mut W, palette: &Palette, tree: &Octree) -> Result<(), WriteError> {
-    check_savable(tree).map_err(WriteError::Vox)?;
     out.write_all(b"VOX ")?;
     out.write_all(&200u32.to_le_bytes())?;
     let main_at = out.stream_position()?;
