@@ -147,15 +147,15 @@ impl Octree {
             return word;
         }
         self.record(patch, min, 1, word);
-        let solid = |b: &Brick| b.iter().filter(|v| **v != 0).count() as u64;
-        self.solid_voxels = self.solid_voxels + solid(&new) - solid(&old);
+        old.iter().for_each(|v| self.counts.remove(*v, 1));
+        new.iter().for_each(|v| self.counts.add(*v, 1));
         self.make_brick(new, is_pointer(word).then_some(word))
     }
 
     /// Replaces a whole cell by a uniform word, recording the old content.
     fn replace_with(&mut self, old: u32, min: IVec3, level: u32, new: u32, patch: &mut Patch) -> u32 {
         self.record(patch, min, level, old);
-        self.solid_voxels = self.solid_voxels - self.count_word(old, level) + self.count_word(new, level);
+        self.recount(old, new, level);
         self.release(old, level);
         new
     }
@@ -219,7 +219,7 @@ impl Octree {
         if level <= target.1 {
             self.record(inverse, min, level, word);
             let new = self.deserialize(subtree, level);
-            self.solid_voxels = self.solid_voxels - self.count_word(word, level) + self.count_word(new, level);
+            self.recount(word, new, level);
             self.release(word, level);
             return new;
         }

@@ -4,6 +4,7 @@
 use glam::{IVec3, UVec3};
 use rayon::prelude::*;
 
+use super::counts::VoxelCounts;
 use super::octree::{MAX_DEPTH, MIN_DEPTH, Octree, octant_offset};
 use crate::gpu_pool::{Brick, Node, POINTER_BIT, is_pointer, pointer_to, slot_of};
 
@@ -60,7 +61,7 @@ impl Octree {
                 values[(keyed[i].0 & 7) as usize] = keyed[i].1;
                 i += 1;
             }
-            tree.solid_voxels += values.iter().filter(|v| **v != 0).count() as u64;
+            values.iter().for_each(|v| tree.counts.add(*v, 1));
             level.push((parent, tree.make_brick(values, None)));
         }
         for _ in 2..=tree.depth {
@@ -108,7 +109,7 @@ impl Octree {
             .collect();
         let mut children: Node = [0; 8];
         for (octant, part) in parts.into_iter().enumerate() {
-            tree.solid_voxels += part.solid;
+            tree.counts.add_counts(&part.counts);
             children[octant] = tree.adopt(part);
         }
         tree.root = tree.make_node(children, None);
@@ -157,7 +158,7 @@ struct LocalArena {
     nodes: Vec<Node>,
     bricks: Vec<Brick>,
     root: u32,
-    solid: u64,
+    counts: VoxelCounts,
 }
 
 impl LocalArena {
@@ -167,7 +168,7 @@ impl LocalArena {
         }
         if level == 1 {
             let values: Brick = std::array::from_fn(|o| grid.at(min + octant_offset(o)));
-            self.solid += values.iter().filter(|v| **v != 0).count() as u64;
+            values.iter().for_each(|v| self.counts.add(*v, 1));
             if values.iter().all(|v| *v == values[0]) {
                 return u32::from(values[0]);
             }

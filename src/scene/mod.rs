@@ -2,6 +2,7 @@
 
 pub mod apply;
 pub mod build;
+pub mod counts;
 pub mod demo;
 pub mod octree;
 pub mod palette;
@@ -10,6 +11,7 @@ pub mod shape;
 
 pub use apply::{EditError, Patch};
 pub use build::BuildError;
+pub use counts::VoxelCounts;
 pub use octree::Octree;
 pub use palette::{Material, MaterialKind, Palette};
 pub use shape::{Op, Overlap, Shape};

@@ -10,6 +10,7 @@
 
 use glam::IVec3;
 
+use super::counts::VoxelCounts;
 use crate::gpu_pool::{self, Brick, Node, NodePool, is_pointer, pointer_to, slot_of};
 
 /// Smallest root: a 4³ cube (the root is then a node of bricks).
@@ -31,7 +32,8 @@ pub struct Octree {
     pub(crate) root: u32,
     pub(crate) origin: IVec3,
     pub(crate) depth: u32,
-    pub(crate) solid_voxels: u64,
+    /// Voxels per palette index, kept by builds and edits.
+    pub(crate) counts: VoxelCounts,
 }
 
 impl Default for Octree {
@@ -43,7 +45,7 @@ impl Default for Octree {
 impl Octree {
     /// An empty tree whose root cube starts at `origin` with `2^depth` voxels per side.
     pub fn empty(origin: IVec3, depth: u32) -> Octree {
-        Octree { pool: NodePool::default(), root: 0, origin, depth: depth.clamp(MIN_DEPTH, MAX_DEPTH), solid_voxels: 0 }
+        Octree { pool: NodePool::default(), root: 0, origin, depth: depth.clamp(MIN_DEPTH, MAX_DEPTH), counts: VoxelCounts::default() }
     }
 
     pub fn pool(&self) -> &NodePool {
@@ -75,7 +77,18 @@ impl Octree {
 
     /// Number of solid voxels.
     pub fn solid_voxels(&self) -> u64 {
-        self.solid_voxels
+        self.counts.solid()
+    }
+
+    /// Voxels per palette index.
+    pub fn counts(&self) -> &VoxelCounts {
+        &self.counts
+    }
+
+    /// Replaces the count of a cell's old content by its new content's.
+    pub(crate) fn recount(&mut self, old: u32, new: u32, level: u32) {
+        self.counts.remove_word(&self.pool, old, level);
+        self.counts.add_word(&self.pool, new, level);
     }
 
     pub fn node_count(&self) -> usize {
@@ -195,7 +208,7 @@ impl Octree {
 
     /// Every solid voxel as (position, palette index), uniform cells expanded.
     pub fn voxels(&self) -> Vec<(IVec3, u8)> {
-        let mut out = Vec::with_capacity(usize::try_from(self.solid_voxels).unwrap_or(0));
+        let mut out = Vec::with_capacity(usize::try_from(self.solid_voxels()).unwrap_or(0));
         self.for_each_solid_cell(|min, size, v| {
             for z in 0..size {
                 for y in 0..size {
@@ -219,17 +232,6 @@ impl Octree {
             });
         });
         bounds
-    }
-
-    /// Solid voxels under a child word of the given level.
-    pub(crate) fn count_word(&self, word: u32, level: u32) -> u64 {
-        if !is_pointer(word) {
-            return if word == 0 { 0 } else { 1u64 << (3 * level) };
-        }
-        if level == 1 {
-            return self.brick(word).iter().filter(|v| **v != 0).count() as u64;
-        }
-        self.node(word).iter().map(|&w| self.count_word(w, level - 1)).sum()
     }
 
     /// Frees every slot under `word`.
@@ -298,9 +300,10 @@ impl Octree {
                 (self.pool.nodes.live(), self.pool.bricks.live())
             ));
         }
-        let counted = self.count_word(self.root, self.depth);
-        if counted != self.solid_voxels {
-            return Err(format!("cached voxel count {} != counted {counted}", self.solid_voxels));
+        let mut counted = VoxelCounts::default();
+        counted.add_word(&self.pool, self.root, self.depth);
+        if counted != self.counts {
+            return Err(format!("cached voxel counts {} != counted {}", self.solid_voxels(), counted.solid()));
         }
         Ok(())
     }
