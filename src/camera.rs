@@ -90,8 +90,14 @@ impl RayBasis {
     /// Origin and (unnormalised) direction through the centre of pixel (x, y),
     /// with (0, 0) the top-left pixel. Same arithmetic as `pixel_ray` in WGSL.
     pub fn ray(&self, x: u32, y: u32) -> (Vec3, Vec3) {
-        let ndc_x = 2.0 * (x as f32 + 0.5) / self.width as f32 - 1.0;
-        let ndc_y = 1.0 - 2.0 * (y as f32 + 0.5) / self.height as f32;
+        self.ray_through(x as f32 + 0.5, y as f32 + 0.5)
+    }
+
+    /// Origin and direction through a point of the image given in pixels
+    /// (pixel (x, y) spans x..x + 1, y..y + 1).
+    pub fn ray_through(&self, px: f32, py: f32) -> (Vec3, Vec3) {
+        let ndc_x = 2.0 * px / self.width as f32 - 1.0;
+        let ndc_y = 1.0 - 2.0 * py / self.height as f32;
         (self.eye, self.forward + self.right * ndc_x + self.up * ndc_y)
     }
 }

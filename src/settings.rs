@@ -67,3 +67,59 @@ impl Default for RenderSettings {
 
 /// Direction toward the sun (normalised), shared with the shaders.
 pub const SUN_DIR: [f32; 3] = [0.454_858_8, 0.796_002_9, 0.398_001_5];
+
+/// The sky a path-traced frame sees.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Sky {
+    /// Horizon to zenith, the preview's background.
+    #[default]
+    Gradient,
+    /// Radiance 1 in every direction (the white furnace).
+    White,
+    /// No sky light.
+    Black,
+}
+
+impl Sky {
+    /// Radiance at the horizon and at the zenith.
+    pub fn colors(self) -> ([f32; 3], [f32; 3]) {
+        match self {
+            Sky::Gradient => ([0.86, 0.89, 0.95], [0.32, 0.5, 0.82]),
+            Sky::White => ([1.0; 3], [1.0; 3]),
+            Sky::Black => ([0.0; 3], [0.0; 3]),
+        }
+    }
+}
+
+/// Which effects a path-traced frame is compiled with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum EffectsChoice {
+    /// The effects the scene calls for (its materials, the lights on).
+    #[default]
+    Auto,
+    /// Every effect, for comparison.
+    All,
+}
+
+/// Knobs of the path tracer, shared by the window, `render` and replay.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathSettings {
+    /// Scattering events after the camera ray (passing through glass does
+    /// not count).
+    pub bounces: u32,
+    /// Shadow rays toward the sun per diffuse hit.
+    pub shadow_samples: u32,
+    pub effects: EffectsChoice,
+    pub sun: bool,
+    pub sky: Sky,
+}
+
+impl Default for PathSettings {
+    fn default() -> PathSettings {
+        PathSettings { bounces: 4, shadow_samples: 1, effects: EffectsChoice::Auto, sun: true, sky: Sky::Gradient }
+    }
+}
+
+/// Most bounces and shadow samples accepted.
+pub const MAX_BOUNCES: u32 = 64;
+pub const MAX_SHADOW_SAMPLES: u32 = 64;

@@ -3,6 +3,7 @@
 //! truth, and the report's baseline). Both work in tree-local coordinates.
 
 pub mod grid;
+pub mod path;
 pub mod render;
 pub mod svo;
 

@@ -44,17 +44,38 @@ pub struct GaveUp {
 
 /// The first solid voxel along `ray` (tree-local coordinates).
 pub fn trace(tree: &Octree, ray: &Ray) -> Hit {
+    trace_through(tree, ray, 0).hit
+}
+
+/// Where a ray leaves its medium: the first voxel whose value differs from
+/// the medium's, and the ray's t on entering it. Inside glass the medium is
+/// the glass's palette index, and the voxel found may be empty (value 0).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Crossing {
+    pub hit: Hit,
+    pub t: f32,
+    /// Whether such a voxel lies inside the tree (a miss otherwise).
+    pub found: bool,
+}
+
+/// The first voxel along `ray` whose value is not `medium` (0 for rays in
+/// empty space): the traversal of [`trace`] with "solid" read as "not the
+/// medium". Twin of `trace_svo` in `shaders/trace_svo.wgsl`.
+pub fn trace_through(tree: &Octree, ray: &Ray, medium: u8) -> Crossing {
     let depth = tree.depth();
     let size = (1u32 << depth) as f32;
     let (t_enter, t_exit, entry_axis) = ray.slab(Vec3::ZERO, Vec3::splat(size));
     if t_enter > t_exit || t_exit < 0.0 {
-        return Hit::default();
+        return Crossing::default();
     }
     let mut t = t_enter.max(0.0);
     // NO_AXIS: the ray starts inside the root, so no face was entered yet.
     let mut axis = if t_enter >= 0.0 { entry_axis } else { NO_AXIS };
     let root = tree.root_word();
     if !is_pointer(root) {
+        if root == u32::from(medium) {
+            return Crossing { hit: Hit { iterations: 1, ..Hit::default() }, ..Crossing::default() };
+        }
         return hit_cell(ray, root as u8, IVec3::ZERO, depth, t, axis, 1);
     }
     // The stack: the node word at every level of the current path.
@@ -74,10 +95,10 @@ pub fn trace(tree: &Octree, ray: &Ray) -> Hit {
             cell = child_cell(ray, cell, level, t, axis);
             continue;
         }
-        if word != 0 {
+        if word != u32::from(medium) {
             return hit_cell(ray, word as u8, cell, level - 1, t, axis, iterations);
         }
-        // Empty cell: leave it through its nearest exit plane.
+        // A cell of the medium: leave it through its nearest exit plane.
         let half = 1 << (level - 1);
         let positive = ray.dir.cmpgt(Vec3::ZERO);
         let far = cell + IVec3::select(positive, IVec3::splat(half), IVec3::ZERO);
@@ -96,7 +117,7 @@ pub fn trace(tree: &Octree, ray: &Ray) -> Hit {
         level = new_level;
         cell = next & IVec3::splat(!((1 << (level - 1)) - 1));
     }
-    Hit::miss(iterations, bound)
+    Crossing { hit: Hit::miss(iterations, bound), ..Crossing::default() }
 }
 
 /// Octant of a cell of size 2^(level - 1) within its node: one coordinate
@@ -129,13 +150,10 @@ fn child_cell(ray: &Ray, min: IVec3, level: u32, t: f32, entry_axis: usize) -> I
     cell
 }
 
-/// The hit inside a uniform cell: the voxel of the cell where the ray is at
-/// `t`, on the entered face.
-fn hit_cell(ray: &Ray, value: u8, min: IVec3, level: u32, t: f32, axis: usize, iterations: u32) -> Hit {
-    if value == 0 {
-        return Hit { iterations, ..Hit::default() };
-    }
+/// The crossing into a uniform cell: the voxel of the cell where the ray is
+/// at `t`, on the entered face.
+fn hit_cell(ray: &Ray, value: u8, min: IVec3, level: u32, t: f32, axis: usize, iterations: u32) -> Crossing {
     let voxel = ray.voxel_in_box(min, min + IVec3::splat((1 << level) - 1), t, axis);
     let normal = if axis == NO_AXIS { IVec3::ZERO } else { ray.entry_normal(axis) };
-    Hit { value, voxel, normal, cell_level: level, iterations, gave_up: false }
+    Crossing { hit: Hit { value, voxel, normal, cell_level: level, iterations, gave_up: false }, t, found: true }
 }

@@ -1,0 +1,430 @@
+//! The path tracer's CPU reference, twin of `shaders/path.wgsl`: the same
+//! sampling, the same random numbers ([`rng`]), the same order of draws, so
+//! `render --cpu --spp N` and the GPU agree up to rounding.
+//!
+//! Per sample: a jittered camera ray, then up to `bounces` scattering events
+//! (diffuse, metal, glass), with next-event estimation toward the sun (a
+//! cone of [`SUN_ANGULAR_RADIUS`]) and toward emissive voxels at diffuse
+//! events. A light reached by a ray after a diffuse event is not added again
+//! (the estimate already holds it); after a specular event it is.
+//! Continuation rays start exactly on the hit face's plane, where the
+//! traversal's tie rule puts them in the voxel on the side they go to: no
+//! epsilon offsets.
+
+pub mod lights;
+pub mod materials;
+pub mod rng;
+
+use std::f32::consts::PI;
+
+use glam::{IVec3, Vec3};
+use rayon::prelude::*;
+
+use self::lights::Emitter;
+use self::materials::{Effects, GpuMaterial, MATERIAL_EMIT, MATERIAL_GLASS, MATERIAL_METAL};
+use self::rng::Rng;
+use super::render::GAVE_UP_COLOR;
+use super::svo::{Crossing, trace_through};
+use super::{Hit, Ray, argmin};
+use crate::camera::{Camera, RayBasis};
+use crate::scene::{Octree, Palette};
+use crate::settings::{EffectsChoice, PathSettings, SUN_DIR};
+
+/// Angular radius of the sun (radians): soft shadows of a few voxels.
+pub const SUN_ANGULAR_RADIUS: f32 = 0.05;
+/// Irradiance of the sun on a surface facing it.
+pub const SUN_IRRADIANCE: f32 = 1.8;
+/// Largest radiance one sample may add to a pixel: fireflies are clamped,
+/// and NaN or infinity never reach the accumulation.
+pub const MAX_SAMPLE_RADIANCE: f32 = 32.0;
+/// Most passes through glass surfaces in one path (they do not count as
+/// bounces, so that clear glass does not darken what lies behind it).
+pub const MAX_TRANSMISSIONS: u32 = 16;
+
+/// Cosine of the sun's angular radius.
+pub fn sun_cos() -> f32 {
+    SUN_ANGULAR_RADIUS.cos()
+}
+
+/// Radiance of the sun's disk.
+pub fn sun_radiance() -> f32 {
+    SUN_IRRADIANCE / (2.0 * PI * (1.0 - sun_cos()))
+}
+
+/// The effect set of a frame: the scene's, or all of them.
+pub fn effects_for(tree: &Octree, palette: &Palette, settings: &PathSettings) -> Effects {
+    let sky = settings.sky != crate::settings::Sky::Black;
+    match settings.effects {
+        EffectsChoice::Auto => Effects::of_scene(tree.counts(), palette, settings.sun, sky),
+        EffectsChoice::All => Effects::ALL,
+    }
+}
+
+/// A scene prepared for path tracing.
+pub struct PathScene<'a> {
+    pub tree: &'a Octree,
+    pub materials: Vec<GpuMaterial>,
+    pub albedo: Vec<Vec3>,
+    pub lights: Vec<Emitter>,
+    pub effects: Effects,
+    pub settings: PathSettings,
+}
+
+impl PathScene<'_> {
+    pub fn new<'a>(tree: &'a Octree, palette: &Palette, settings: &PathSettings) -> PathScene<'a> {
+        let effects = effects_for(tree, palette, settings);
+        let lights = if effects.emit { lights::emitters(tree, palette) } else { Vec::new() };
+        PathScene {
+            tree,
+            materials: materials::material_table(palette),
+            albedo: (0..=255u8).map(|i| materials::albedo(palette, i)).collect(),
+            lights,
+            effects,
+            settings: *settings,
+        }
+    }
+
+    /// One sample of pixel (x, y): the radiance, finite and clamped.
+    pub fn sample(&self, basis: &RayBasis, x: u32, y: u32, sample: u32) -> Vec3 {
+        let mut rng = Rng::new(y * basis.width + x, sample);
+        let (jx, jy) = (rng.next(), rng.next());
+        let (origin, dir) = basis.ray_through(x as f32 + jx, y as f32 + jy);
+        clamp_sample(self.radiance(Ray::new(origin, dir), &mut rng))
+    }
+
+    fn radiance(&self, mut ray: Ray, rng: &mut Rng) -> Vec3 {
+        let mut radiance = Vec3::ZERO;
+        let mut beta = Vec3::ONE;
+        let mut medium = 0u8;
+        let mut lights_counted = false;
+        let (mut bounces, mut transmissions) = (0, 0);
+        loop {
+            let c = self.cross(&ray, medium);
+            if c.hit.gave_up {
+                return radiance + beta * GAVE_UP_COLOR;
+            }
+            if !c.found {
+                return radiance + beta * self.environment(ray.dir, lights_counted);
+            }
+            if c.hit.normal == IVec3::ZERO {
+                // The ray started inside a solid voxel: nothing to see.
+                return radiance;
+            }
+            let p = surface_point(&ray, &c);
+            let n = c.hit.normal.as_vec3();
+            let d = ray.dir.normalize();
+            let value = c.hit.value;
+            let material = self.materials[usize::from(value)];
+            let glass = |index: u8| self.materials[usize::from(index)].kind == MATERIAL_GLASS;
+            let dir;
+            if self.effects.glass && medium != 0 && (value == 0 || glass(value)) {
+                // Leaving glass, into empty space or other glass.
+                transmissions += 1;
+                let Some((next, to)) = self.interface(d, n, medium, value, rng) else { return radiance };
+                (dir, medium) = (next, to.0);
+                beta *= to.1;
+                lights_counted = false;
+            } else if self.effects.emit && material.kind == MATERIAL_EMIT {
+                if !lights_counted {
+                    radiance += beta * self.albedo[usize::from(value)] * material.emission;
+                }
+                return radiance;
+            } else if self.effects.glass && material.kind == MATERIAL_GLASS && rng.next() < material.transparency {
+                transmissions += 1;
+                let Some((next, to)) = self.interface(d, n, medium, value, rng) else { return radiance };
+                (dir, medium) = (next, to.0);
+                beta *= to.1;
+                lights_counted = false;
+            } else if bounces == self.settings.bounces {
+                return radiance;
+            } else if self.effects.metal && material.kind == MATERIAL_METAL {
+                bounces += 1;
+                let albedo = self.albedo[usize::from(value)];
+                let p_spec = 0.5 + 0.5 * material.metalness;
+                if rng.next() < p_spec {
+                    let Some((next, weight)) = metal_lobe(d, n, albedo, &material, rng) else { return radiance };
+                    dir = next;
+                    beta *= weight / p_spec;
+                    lights_counted = false;
+                } else {
+                    let albedo = albedo * (1.0 - material.metalness) / (1.0 - p_spec);
+                    radiance += beta * albedo * self.direct(p, n, rng);
+                    dir = cosine_direction(n, rng.next(), rng.next());
+                    beta *= albedo;
+                    lights_counted = true;
+                }
+            } else {
+                bounces += 1;
+                let albedo = self.albedo[usize::from(value)];
+                radiance += beta * albedo * self.direct(p, n, rng);
+                dir = cosine_direction(n, rng.next(), rng.next());
+                beta *= albedo;
+                lights_counted = true;
+            }
+            if transmissions > MAX_TRANSMISSIONS {
+                return radiance;
+            }
+            ray = Ray::new(p, dir);
+        }
+    }
+
+    /// The next voxel that is not the medium; a ray inside glass that leaves
+    /// the tree leaves the glass at the root's face.
+    fn cross(&self, ray: &Ray, medium: u8) -> Crossing {
+        let c = trace_through(self.tree, ray, medium);
+        if c.found || c.hit.gave_up || medium == 0 {
+            return c;
+        }
+        root_exit(ray, self.tree.size() as f32, c.hit.iterations)
+    }
+
+    /// A glass surface between `medium` and `value` (0: empty space):
+    /// Fresnel reflection or refraction about a normal roughened by the
+    /// glass's GGX roughness. Returns the new direction and the medium it
+    /// travels in with the colour it is tinted by, or `None` when a rough
+    /// normal sends it to the wrong side.
+    fn interface(&self, d: Vec3, n: Vec3, medium: u8, value: u8, rng: &mut Rng) -> Option<(Vec3, (u8, Vec3))> {
+        let glass = if medium != 0 { medium } else { value };
+        let material = self.materials[usize::from(glass)];
+        let ior = |index: u8| if index == 0 { 1.0 } else { self.materials[usize::from(index)].ior };
+        let alpha = material.roughness * material.roughness;
+        let (u1, u2) = (rng.next(), rng.next());
+        let mut h = if alpha > 1e-4 { ggx_half_vector(n, alpha, u1, u2) } else { n };
+        if h.dot(d) >= 0.0 {
+            h = n;
+        }
+        let eta = ior(medium) / ior(value);
+        let cos_i = -d.dot(h);
+        let sin2_t = eta * eta * (1.0 - cos_i * cos_i).max(0.0);
+        let fresnel = if sin2_t >= 1.0 { 1.0 } else { fresnel_dielectric(cos_i, (1.0 - sin2_t).sqrt(), eta) };
+        if rng.next() < fresnel {
+            let dir = reflect(d, h);
+            return (dir.dot(n) > 0.0).then_some((dir, (medium, Vec3::ONE)));
+        }
+        let cos_t = (1.0 - sin2_t).sqrt();
+        let dir = eta * d + (eta * cos_i - cos_t) * h;
+        // Entering glass tints by its colour; leaving does not.
+        let tint = if value != 0 { self.albedo[usize::from(value)] } else { Vec3::ONE };
+        (dir.dot(n) < 0.0).then_some((dir, (value, tint)))
+    }
+
+    /// Light arriving at a diffuse point, times 1/π: the sun's cone and one
+    /// emissive voxel face, each with a shadow ray.
+    fn direct(&self, p: Vec3, n: Vec3, rng: &mut Rng) -> Vec3 {
+        let mut light = Vec3::ZERO;
+        if self.effects.sun {
+            let samples = self.settings.shadow_samples.max(1);
+            let mut sum = 0.0;
+            for _ in 0..samples {
+                let l = cone_direction(Vec3::from(SUN_DIR), sun_cos(), rng.next(), rng.next());
+                let cos = n.dot(l);
+                if cos > 0.0 && !self.cross(&Ray::new(p, l), 0).found {
+                    sum += SUN_IRRADIANCE * cos / PI;
+                }
+            }
+            light += Vec3::splat(sum / samples as f32);
+        }
+        if self.effects.emit && !self.lights.is_empty() {
+            light += self.emitter_light(p, n, rng);
+        }
+        light
+    }
+
+    /// One sample of an emissive cell: a cell picked by power, one of its
+    /// faces that faces `p`, a point on it.
+    fn emitter_light(&self, p: Vec3, n: Vec3, rng: &mut Rng) -> Vec3 {
+        let (u0, u1, u2, u3) = (rng.next(), rng.next(), rng.next(), rng.next());
+        let i = lights::pick(&self.lights, u0);
+        let light = self.lights[i];
+        let Some((q, face_axis, faces)) = emitter_point(&light, p, u1, u2, u3) else { return Vec3::ZERO };
+        let w = q - p;
+        let dist2 = w.length_squared();
+        let l = w / dist2.sqrt();
+        let cos_s = n.dot(l);
+        let cos_l = l[face_axis].abs();
+        if cos_s <= 0.0 || dist2 <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let c = self.cross(&Ray::new(p, l), 0);
+        if !c.found || !lights::contains(&light, c.hit.voxel) {
+            return Vec3::ZERO;
+        }
+        let size = light.size as f32;
+        let pdf = lights::pick_probability(&self.lights, i) / (faces as f32 * size * size);
+        let index = light.index as usize;
+        let radiance = self.albedo[index] * self.materials[index].emission;
+        radiance * (cos_s * cos_l / (PI * dist2 * pdf))
+    }
+
+    /// What a ray that leaves the scene sees: the sky, and the sun's disk
+    /// unless a diffuse event already sampled it.
+    fn environment(&self, dir: Vec3, lights_counted: bool) -> Vec3 {
+        let d = dir.normalize();
+        let mut radiance = Vec3::ZERO;
+        if self.effects.sky {
+            let (horizon, zenith) = self.settings.sky.colors();
+            radiance += Vec3::from(horizon).lerp(Vec3::from(zenith), (d.y * 0.5 + 0.5).clamp(0.0, 1.0));
+        }
+        if self.effects.sun && !lights_counted && d.dot(Vec3::from(SUN_DIR)) >= sun_cos() {
+            radiance += Vec3::splat(sun_radiance());
+        }
+        radiance
+    }
+}
+
+/// A point on a face of the emissive cell that faces `p`: the point, the
+/// face's axis and how many faces face `p`; `None` if none does.
+fn emitter_point(light: &Emitter, p: Vec3, u1: f32, u2: f32, u3: f32) -> Option<(Vec3, usize, u32)> {
+    let lo = IVec3::from(light.min).as_vec3();
+    let hi = lo + Vec3::splat(light.size as f32);
+    let below = p.cmplt(lo);
+    let above = p.cmpgt(hi);
+    let faces = (0..3).filter(|a| below.test(*a) || above.test(*a)).count() as u32;
+    if faces == 0 {
+        return None;
+    }
+    let pick = ((u1 * faces as f32) as u32).min(faces - 1);
+    let axis = (0..3).filter(|a| below.test(*a) || above.test(*a)).nth(pick as usize)?;
+    let (b, c) = ((axis + 1) % 3, (axis + 2) % 3);
+    let mut q = Vec3::ZERO;
+    q[axis] = if below.test(axis) { lo[axis] } else { hi[axis] };
+    q[b] = lo[b] + u2 * (hi[b] - lo[b]);
+    q[c] = lo[c] + u3 * (hi[c] - lo[c]);
+    Some((q, axis, faces))
+}
+
+/// The point where a ray enters the voxel it found: on the entered face's
+/// plane exactly, inside the face.
+pub fn surface_point(ray: &Ray, c: &Crossing) -> Vec3 {
+    let hit: &Hit = &c.hit;
+    let lo = hit.voxel.as_vec3();
+    let mut p = (ray.origin + ray.dir * c.t).clamp(lo, lo + Vec3::ONE);
+    let axis = argmin(-hit.normal.abs().as_vec3());
+    p[axis] = lo[axis] + if hit.normal[axis] > 0 { 1.0 } else { 0.0 };
+    p
+}
+
+/// A ray inside glass that leaves the root cube: it crosses into empty
+/// space at the root's face.
+fn root_exit(ray: &Ray, size: f32, iterations: u32) -> Crossing {
+    let far = (Vec3::select(ray.dir.cmpgt(Vec3::ZERO), Vec3::splat(size), Vec3::ZERO) - ray.origin) * ray.inv;
+    let axis = argmin(far);
+    let t = far[axis].max(0.0);
+    let p = ray.origin + ray.dir * t;
+    let mut voxel = p.floor().as_ivec3();
+    let mut normal = IVec3::ZERO;
+    normal[axis] = if ray.dir[axis] > 0.0 { -1 } else { 1 };
+    voxel[axis] = if ray.dir[axis] > 0.0 { size as i32 } else { -1 };
+    Crossing { hit: Hit { voxel, normal, iterations, ..Hit::default() }, t, found: true }
+}
+
+/// Finite, non-negative, at most [`MAX_SAMPLE_RADIANCE`] per channel.
+pub fn clamp_sample(v: Vec3) -> Vec3 {
+    if !v.is_finite() {
+        return Vec3::ZERO;
+    }
+    v.clamp(Vec3::ZERO, Vec3::splat(MAX_SAMPLE_RADIANCE))
+}
+
+/// An orthonormal basis around a unit vector (Duff et al., 2017).
+fn basis(n: Vec3) -> (Vec3, Vec3) {
+    let sign = if n.z >= 0.0 { 1.0 } else { -1.0 };
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    (Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x), Vec3::new(b, sign + n.y * n.y * a, -n.y))
+}
+
+fn around(n: Vec3, cos_theta: f32, phi: f32) -> Vec3 {
+    let (t, b) = basis(n);
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    (t * phi.cos() + b * phi.sin()) * sin_theta + n * cos_theta
+}
+
+/// Cosine-weighted direction about `n`.
+pub fn cosine_direction(n: Vec3, u1: f32, u2: f32) -> Vec3 {
+    around(n, (1.0 - u1).sqrt(), 2.0 * PI * u2)
+}
+
+/// Uniform direction in the cone about `axis` of half-angle cosine `cos_max`.
+pub fn cone_direction(axis: Vec3, cos_max: f32, u1: f32, u2: f32) -> Vec3 {
+    around(axis, 1.0 - u1 * (1.0 - cos_max), 2.0 * PI * u2)
+}
+
+/// A microfacet normal drawn from the GGX distribution D(h)·(n·h).
+fn ggx_half_vector(n: Vec3, alpha: f32, u1: f32, u2: f32) -> Vec3 {
+    let cos2 = (1.0 - u1) / (1.0 + (alpha * alpha - 1.0) * u1);
+    around(n, cos2.max(0.0).sqrt(), 2.0 * PI * u2)
+}
+
+fn reflect(d: Vec3, n: Vec3) -> Vec3 {
+    d - 2.0 * d.dot(n) * n
+}
+
+/// Unpolarised Fresnel reflectance of a dielectric surface, `eta` = n_i/n_t.
+fn fresnel_dielectric(cos_i: f32, cos_t: f32, eta: f32) -> f32 {
+    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    0.5 * (rs * rs + rp * rp)
+}
+
+/// Smith's masking term for GGX.
+fn smith_g1(cos: f32, alpha: f32) -> f32 {
+    let a2 = alpha * alpha;
+    2.0 * cos / (cos + (a2 + (1.0 - a2) * cos * cos).sqrt())
+}
+
+/// The specular lobe of a metal: a mirror at roughness 0, GGX above it,
+/// tinted by the colour as far as `_metal` says (Schlick's Fresnel from
+/// F0 = mix(0.04, colour, metalness)). Returns the direction and weight.
+fn metal_lobe(d: Vec3, n: Vec3, albedo: Vec3, material: &GpuMaterial, rng: &mut Rng) -> Option<(Vec3, Vec3)> {
+    let alpha = material.roughness * material.roughness;
+    let (u1, u2) = (rng.next(), rng.next());
+    let smooth = alpha <= 1e-4;
+    let h = if smooth { n } else { ggx_half_vector(n, alpha, u1, u2) };
+    let dir = reflect(d, h);
+    let (cos_v, cos_l, cos_h) = (-d.dot(n), dir.dot(n), h.dot(n));
+    let cos_vh = -d.dot(h);
+    if cos_l <= 0.0 || cos_vh <= 0.0 {
+        return None;
+    }
+    let f0 = Vec3::splat(0.04).lerp(albedo, material.metalness);
+    let x = 1.0 - cos_vh;
+    let fresnel = f0 + (Vec3::ONE - f0) * (x * x * x * x * x);
+    if smooth {
+        return Some((dir, fresnel));
+    }
+    let g = smith_g1(cos_v, alpha) * smith_g1(cos_l, alpha);
+    Some((dir, fresnel * (g * cos_vh / (cos_v * cos_h).max(1e-6))))
+}
+
+/// The mean radiance of `spp` samples of every pixel, row-major: the CPU
+/// reference for path-traced frames (`render --cpu --spp N`).
+pub fn render_cpu(
+    tree: &Octree,
+    palette: &Palette,
+    camera: &Camera,
+    size: (u32, u32),
+    settings: &PathSettings,
+    spp: u32,
+) -> (Vec<Vec3>, Effects) {
+    let scene = PathScene::new(tree, palette, settings);
+    let basis = camera.basis(size.0, size.1, tree.origin());
+    let pixels = (0..basis.height)
+        .into_par_iter()
+        .flat_map_iter(|y| {
+            let scene = &scene;
+            (0..basis.width).map(move |x| {
+                let sum: Vec3 = (0..spp).map(|s| scene.sample(&basis, x, y, s)).sum();
+                sum / spp.max(1) as f32
+            })
+        })
+        .collect();
+    (pixels, scene.effects)
+}
+
+/// Radiance to display bytes: clamped to 0..=1, as the preview's colours.
+pub fn to_image(pixels: &[Vec3], width: u32, height: u32) -> image::RgbaImage {
+    let to_byte = |v: f32| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+    let bytes = pixels.iter().flat_map(|p| [to_byte(p.x), to_byte(p.y), to_byte(p.z), 255]).collect();
+    image::RgbaImage::from_raw(width, height, bytes).unwrap_or_default()
+}
