@@ -55,6 +55,10 @@ struct Hit {
     normal_code: u32, // 0 none, 1..6 = +x -x +y -y +z -z
     level: u32,
     iterations: u32,
+    // The ray's t on entering the voxel, and whether a voxel was found (it
+    // may be empty when the ray walks through a medium: see trace_svo).
+    t: f32,
+    found: bool,
 }
 
 struct Slab {
@@ -146,17 +150,16 @@ fn entry_normal_code(r: Ray, axis: u32) -> u32 {
     return 1u + 2u * axis + select(0u, 1u, r.d[axis] > 0.0);
 }
 
-// The hit inside a uniform cell: the voxel where the ray is at t.
+// The crossing into a uniform cell: the voxel where the ray is at t.
 fn hit_cell(r: Ray, value: u32, mn: vec3<i32>, level: u32, t: f32, axis: u32, iterations: u32) -> Hit {
     var hit: Hit;
     hit.iterations = iterations;
-    if (value == 0u) {
-        return hit;
-    }
     hit.voxel = voxel_in_box(r, mn, mn + vec3<i32>((1 << level) - 1), t, axis);
     hit.value = value;
     hit.normal_code = entry_normal_code(r, axis);
     hit.level = level;
+    hit.t = t;
+    hit.found = true;
     return hit;
 }
 

@@ -58,8 +58,10 @@ fn argmin3_select(t: vec3<f32>) -> u32 {
     return select(select(2u, 1u, t.y <= t.z), 0u, t.x <= t.y && t.x <= t.z);
 }
 
-// The first solid voxel along `r` at or after `t_min`.
-fn trace_svo(r: Ray, t_min: f32) -> Hit {
+// The first voxel along `r`, at or after `t_min`, whose value is not
+// `medium`: the first solid voxel for rays in empty space (medium 0), the
+// way out for rays inside glass. Twin of `trace_through` in src/trace/svo.rs.
+fn trace_svo(r: Ray, t_min: f32, medium: u32) -> Hit {
     var miss: Hit;
     let depth = u.depth;
     let size = f32(1u << depth);
@@ -75,6 +77,10 @@ fn trace_svo(r: Ray, t_min: f32) -> Hit {
         axis = NO_AXIS;
     }
     if ((u.root & POINTER_BIT) == 0u) {
+        if (u.root == medium) {
+            miss.iterations = 1u;
+            return miss;
+        }
         return hit_cell(r, u.root, vec3<i32>(0), depth, t, axis, 1u);
     }
     let positive = r.d > vec3<f32>(0.0);
@@ -95,6 +101,7 @@ fn trace_svo(r: Ray, t_min: f32) -> Hit {
     var cell = child_cell(r, vec3<i32>(0), level, t, axis);
     var iterations = 0u;
     var value = 0u;
+    var found = false;
     loop {
         if (iterations >= u.max_iterations) {
             break;
@@ -102,8 +109,9 @@ fn trace_svo(r: Ray, t_min: f32) -> Hit {
         iterations += 1u;
         let word = child_word(node, level, octant_of(cell, level));
         let push = (word & POINTER_BIT) != 0u;
-        if (!push && word != 0u) {
+        if (!push && word != medium) {
             value = word;
+            found = true;
             break;
         }
         // Push: the child cell of the new node holding the ray point.
@@ -140,7 +148,7 @@ fn trace_svo(r: Ray, t_min: f32) -> Hit {
         level = select(select(new_level, depth, restart), child_level, push);
         cached = select(select(cached - climbed, 0u, restart), min(cached + 1u, 3u), push);
     }
-    if (value == 0u) {
+    if (!found) {
         miss.iterations = iterations;
         return miss;
     }
@@ -283,11 +291,11 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var hit: Hit;
     let t_start = beam_start(gid.xy, r);
     if (t_start < BEAM_NONE) {
-        hit = trace_svo(r, t_start);
+        hit = trace_svo(r, t_start, 0u);
     }
     var in_shadow = false;
     if (SHADOWS && u.view == VIEW_SHADED && hit.value != 0u && hit.normal_code != 0u) {
-        in_shadow = trace_svo(shadow_ray(hit), 0.0).value != 0u;
+        in_shadow = trace_svo(shadow_ray(hit), 0.0, 0u).value != 0u;
     }
     write_pixel(gid.xy, hit, r.d, in_shadow);
 }

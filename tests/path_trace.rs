@@ -10,6 +10,7 @@ use octovox::camera::Camera;
 use octovox::edit::Edit;
 use octovox::scene::{Material, MaterialKind, Octree, Op, Palette, Shape};
 use octovox::settings::{PathSettings, Sky};
+use octovox::gpu::Renderer;
 use octovox::trace::path::render_cpu;
 
 const WHITE: u8 = 1;
@@ -172,4 +173,79 @@ fn a_mirror_shows_the_reflected_colour() {
         let got = pixels[(y * size.0 + x) as usize];
         assert!((got - expected).abs().max_element() < 0.01, "pixel ({x}, {y}): {got}, the sky says {expected}");
     }
+}
+
+/// Renders `spp` samples on the GPU and returns the mean radiance.
+fn render_gpu(
+    tree: &mut Octree,
+    palette: &Palette,
+    camera: &Camera,
+    size: (u32, u32),
+    settings: &PathSettings,
+    spp: u32,
+) -> (Vec<Vec3>, octovox::trace::path::materials::Effects) {
+    let mut renderer = Renderer::headless().expect("a GPU adapter (lavapipe on CI)");
+    renderer.sync(tree, palette);
+    let mut effects = None;
+    for i in 0..spp {
+        let frame = renderer.render_path(tree, palette, camera, size, settings, i == 0).unwrap();
+        assert_eq!(frame.samples, i + 1);
+        effects = Some(frame.effects);
+    }
+    (renderer.read_radiance().unwrap(), effects.unwrap())
+}
+
+#[test]
+fn gpu_white_furnace_converges_to_the_sky() {
+    let mut tree = build(&[
+        (Shape::Sphere { center: IVec3::new(0, 6, 0), radius: 6 }, Op::Place(WHITE)),
+        (Shape::Box { min: IVec3::new(-12, -2, -12), max: IVec3::new(12, -1, 12) }, Op::Place(WHITE)),
+    ]);
+    let camera = look(DVec3::new(20.0, 16.0, 24.0), DVec3::new(0.0, 4.0, 0.0));
+    let size = (48, 36);
+    let (pixels, effects) = render_gpu(&mut tree, &palette(), &camera, size, &furnace(), 16);
+    assert_eq!(effects.names(), ["sky"]);
+    let object = object_pixels(&tree, &camera, size, &pixels);
+    let m = mean(&object);
+    assert!((m - Vec3::ONE).abs().max_element() < 0.01, "object mean {m}");
+    let worst = object.iter().map(|p| (*p - Vec3::ONE).abs().max_element()).fold(0.0, f32::max);
+    assert!(worst < 0.08, "worst pixel off by {worst}");
+}
+
+/// A scene with every material: diffuse floor, metal, glass, a lamp.
+fn material_scene() -> (Octree, Palette) {
+    let mut palette = palette();
+    palette.materials[5] = material(MaterialKind::Metal, &[("_rough", "0.3"), ("_metal", "0.8")]);
+    palette.materials[6] = material(MaterialKind::Glass, &[("_ri", "1.5"), ("_trans", "0.9"), ("_rough", "0.05")]);
+    palette.materials[7] = material(MaterialKind::Emit, &[("_emit", "1"), ("_flux", "1")]);
+    palette.colors[6] = [200, 230, 255, 255];
+    palette.colors[7] = [255, 220, 160, 255];
+    let tree = build(&[
+        (Shape::Box { min: IVec3::new(-16, -2, -16), max: IVec3::new(16, -1, 16) }, Op::Place(WHITE)),
+        (Shape::Box { min: IVec3::new(-16, 0, -16), max: IVec3::new(16, 12, -15) }, Op::Place(RED)),
+        (Shape::Sphere { center: IVec3::new(-6, 5, -4), radius: 5 }, Op::Place(5)),
+        (Shape::Box { min: IVec3::new(2, 0, -2), max: IVec3::new(10, 9, 1) }, Op::Place(6)),
+        (Shape::Box { min: IVec3::new(-2, 0, 6), max: IVec3::new(0, 2, 8) }, Op::Place(7)),
+    ]);
+    (tree, palette)
+}
+
+#[test]
+fn gpu_and_cpu_path_tracers_agree() {
+    // The same random numbers feed both; rounding differences (sin and cos
+    // are not bit-identical) can send a path another way, so compare the
+    // means and the share of pixels that differ by more than the noise.
+    let (mut tree, palette) = material_scene();
+    let camera = look(DVec3::new(18.0, 14.0, 26.0), DVec3::new(0.0, 3.0, 0.0));
+    let settings = PathSettings { bounces: 3, ..PathSettings::default() };
+    let size = (40, 30);
+    let spp = 8;
+    let (cpu, cpu_effects) = render_cpu(&tree, &palette, &camera, size, &settings, spp);
+    let (gpu, gpu_effects) = render_gpu(&mut tree, &palette, &camera, size, &settings, spp);
+    assert_eq!(cpu_effects, gpu_effects);
+    assert_eq!(gpu_effects.names(), ["sun", "sky", "emit", "metal", "glass"]);
+    let (mc, mg) = (mean(&cpu), mean(&gpu));
+    assert!((mc - mg).abs().max_element() < 0.01, "CPU mean {mc}, GPU mean {mg}");
+    let differing = cpu.iter().zip(&gpu).filter(|(a, b)| (**a - **b).abs().max_element() > 0.02).count();
+    assert!(differing * 20 <= cpu.len(), "{differing} of {} pixels differ by more than 0.02", cpu.len());
 }

@@ -148,7 +148,7 @@ impl App {
         let present_started = Instant::now();
         let frame = acquire_frame(gfx, &self.redraw_wanted)?;
         let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
-        gfx.blit.prepare(&gfx.renderer.gpu.device, gfx.renderer.pass.output_view());
+        gfx.blit.prepare(&gfx.renderer.gpu.device, gfx.renderer.output_view());
         let mut encoder =
             gfx.renderer.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("present") });
         gfx.blit.encode(&mut encoder, &view);

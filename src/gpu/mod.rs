@@ -3,6 +3,7 @@
 
 pub mod blit_pass;
 pub mod context;
+pub mod path_pass;
 pub mod prelude;
 pub mod readback;
 pub mod renderer;
@@ -12,6 +13,7 @@ pub mod trace_pass;
 
 pub use blit_pass::BlitPass;
 pub use context::{GpuContext, GpuError};
-pub use renderer::Renderer;
+pub use path_pass::{PathPass, PathUniforms};
+pub use renderer::{PathFrame, Renderer};
 pub use scene_buffers::SceneBuffers;
 pub use trace_pass::{FrameUniforms, Kernel, TracePass};

@@ -6,6 +6,7 @@ use std::fmt::Write as _;
 
 use crate::gpu_pool::POINTER_BIT;
 use crate::settings::{SUN_DIR, View};
+use crate::trace::path::{self, materials};
 use crate::trace::render::GAVE_UP_COLOR;
 use crate::trace::{GAVE_UP_RECORD, MIN_DIRECTION, NO_AXIS};
 
@@ -23,6 +24,15 @@ pub fn shared_constants() -> String {
     line("POINTER_BIT", "u32", format!("{POINTER_BIT:#x}u"));
     line("SUN_DIR", "vec3<f32>", vec3(SUN_DIR));
     line("GAVE_UP_COLOR", "vec3<f32>", vec3(GAVE_UP_COLOR.to_array()));
+    line("SUN_COS", "f32", format!("{:?}", path::sun_cos()));
+    line("SUN_IRRADIANCE", "f32", format!("{:?}", path::SUN_IRRADIANCE));
+    line("SUN_RADIANCE", "f32", format!("{:?}", path::sun_radiance()));
+    line("MAX_SAMPLE_RADIANCE", "f32", format!("{:?}", path::MAX_SAMPLE_RADIANCE));
+    line("MAX_TRANSMISSIONS", "u32", format!("{}u", path::MAX_TRANSMISSIONS));
+    line("MATERIAL_DIFFUSE", "u32", format!("{}u", materials::MATERIAL_DIFFUSE));
+    line("MATERIAL_METAL", "u32", format!("{}u", materials::MATERIAL_METAL));
+    line("MATERIAL_GLASS", "u32", format!("{}u", materials::MATERIAL_GLASS));
+    line("MATERIAL_EMIT", "u32", format!("{}u", materials::MATERIAL_EMIT));
     for view in View::ALL {
         line(view.wgsl_name(), "u32", format!("{}u", view.code()));
     }

@@ -6,18 +6,53 @@ use glam::IVec3;
 
 use super::scene_buffers::UploadStats;
 use super::timer::PassTimer;
-use super::{FrameUniforms, GpuContext, GpuError, Kernel, SceneBuffers, TracePass};
-use crate::camera::Camera;
+use super::{FrameUniforms, GpuContext, GpuError, Kernel, PathPass, PathUniforms, SceneBuffers, TracePass};
+use crate::camera::{Camera, RayBasis};
 use crate::scene::{Octree, Palette};
-use crate::settings::RenderSettings;
+use crate::settings::{PathSettings, RenderSettings, View};
 use crate::trace::Hit;
 use crate::trace::grid::DenseGrid;
+use crate::trace::path::materials::{Effects, material_table};
+use crate::trace::path::{effects_for, lights};
+
+/// Which pass drew the last frame (the one the window shows).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Shown {
+    Trace,
+    Path,
+}
+
+/// What a path-traced frame did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathFrame {
+    /// Milliseconds of this frame's sample.
+    pub ms: f64,
+    /// Samples accumulated so far, this one included.
+    pub samples: u32,
+    pub effects: Effects,
+    /// Emissive cells sampled as lights.
+    pub lights: usize,
+}
+
+/// What an accumulation is of: a change restarts it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct PathKey {
+    basis: RayBasis,
+    settings: PathSettings,
+    effects: Effects,
+}
 
 pub struct Renderer {
     pub gpu: GpuContext,
     pub buffers: SceneBuffers,
     pub pass: TracePass,
+    pub path: PathPass,
     timer: PassTimer,
+    shown: Shown,
+    /// The accumulation's key and sample count.
+    path_key: Option<PathKey>,
+    path_samples: u32,
+    path_lights: usize,
     /// Whether frames write the per-pixel hit records that
     /// [`Renderer::read_hits`] returns; off by default, as they cost time.
     pub hit_records: bool,
@@ -29,8 +64,21 @@ impl Renderer {
     pub fn new(gpu: GpuContext) -> Result<Renderer, GpuError> {
         let buffers = SceneBuffers::new(&gpu.device);
         let pass = TracePass::new(&gpu, &buffers)?;
+        let path = PathPass::new(&gpu, &buffers)?;
         let timer = PassTimer::new(&gpu);
-        Ok(Renderer { gpu, buffers, pass, timer, hit_records: false, records_written: false })
+        Ok(Renderer {
+            gpu,
+            buffers,
+            pass,
+            path,
+            timer,
+            shown: Shown::Trace,
+            path_key: None,
+            path_samples: 0,
+            path_lights: 0,
+            hit_records: false,
+            records_written: false,
+        })
     }
 
     /// A renderer on the default headless adapter.
@@ -101,6 +149,7 @@ impl Renderer {
                 ..FrameUniforms::new(&basis, tree, &self.buffers, view, local)
             };
             self.records_written = self.hit_records;
+            self.shown = Shown::Trace;
             self.pass.prepare(&gpu.device, &gpu.queue, &self.buffers, &uniforms);
             let mut encoder =
                 gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
@@ -108,6 +157,75 @@ impl Renderer {
             self.timer.resolve(&mut encoder);
             self.timer.submit_and_measure(gpu, encoder)
         })
+    }
+
+    /// Adds one path-traced sample per pixel to the accumulation and shows
+    /// the mean. The accumulation restarts when the camera, the size, the
+    /// settings or the effect set change, and when `scene_changed` says the
+    /// voxels or the palette did (the materials and lights are then sent
+    /// again).
+    ///
+    /// # Errors
+    /// As [`Renderer::render`].
+    pub fn render_path(
+        &mut self,
+        tree: &Octree,
+        palette: &Palette,
+        camera: &Camera,
+        size: (u32, u32),
+        settings: &PathSettings,
+        scene_changed: bool,
+    ) -> Result<PathFrame, GpuError> {
+        let gpu = &self.gpu;
+        gpu.checked(|| {
+            let resized = self.path.resize(gpu, &self.buffers, size)?;
+            let basis = camera.basis(size.0.max(1), size.1.max(1), tree.origin());
+            let effects = effects_for(tree, palette, settings);
+            let key = PathKey { basis, settings: *settings, effects };
+            if scene_changed || resized || self.path_key.is_none_or(|k| k.effects != effects) {
+                let lights = if effects.emit { lights::emitters(tree, palette) } else { Vec::new() };
+                self.path.upload_scene(gpu, &self.buffers, &material_table(palette), &lights);
+                self.path_lights = lights.len();
+                self.path_samples = 0;
+            }
+            if self.path_key != Some(key) {
+                self.path_samples = 0;
+                self.path_key = Some(key);
+            }
+            let (sky_horizon, sky_zenith) = settings.sky.colors();
+            let path = PathUniforms {
+                sky_horizon,
+                sample_index: self.path_samples,
+                sky_zenith,
+                bounces: settings.bounces,
+                shadow_samples: settings.shadow_samples,
+                emitter_count: self.path_lights as u32,
+                _pad: [0; 2],
+            };
+            let frame = FrameUniforms::new(&basis, tree, &self.buffers, View::Shaded, None);
+            self.path.prepare(gpu, &self.buffers, &frame, &path);
+            let mut encoder =
+                gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("path frame") });
+            self.path.encode(gpu, &mut encoder, effects, self.timer.pass_writes())?;
+            self.timer.resolve(&mut encoder);
+            let ms = self.timer.submit_and_measure(gpu, encoder)?;
+            self.path_samples += 1;
+            self.shown = Shown::Path;
+            Ok(PathFrame { ms, samples: self.path_samples, effects, lights: self.path_lights })
+        })
+    }
+
+    /// The mean radiance per pixel of the path tracer's accumulation.
+    pub fn read_radiance(&self) -> Result<Vec<glam::Vec3>, GpuError> {
+        self.path.read_radiance(&self.gpu)
+    }
+
+    /// The output of the last frame, for the window's blit.
+    pub fn output_view(&self) -> &wgpu::TextureView {
+        match self.shown {
+            Shown::Trace => self.pass.output_view(),
+            Shown::Path => self.path.output_view(),
+        }
     }
 
     /// The hit records of the last frame, which must have been rendered with
@@ -121,8 +239,10 @@ impl Renderer {
 
     /// The last frame as an RGBA image.
     pub fn read_image(&self) -> Result<image::RgbaImage, GpuError> {
-        let (w, h) = self.pass.size();
-        let bytes = self.pass.read_color(&self.gpu)?;
+        let ((w, h), bytes) = match self.shown {
+            Shown::Trace => (self.pass.size(), self.pass.read_color(&self.gpu)?),
+            Shown::Path => (self.path.size(), self.path.read_color(&self.gpu)?),
+        };
         image::RgbaImage::from_raw(w, h, bytes).ok_or_else(|| GpuError::Readback("texture size mismatch".into()))
     }
 }

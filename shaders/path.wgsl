@@ -1,0 +1,458 @@
+// The progressive path tracer: one sample per pixel per dispatch, added to
+// an accumulation buffer; the display texture gets the mean. Twin of
+// src/trace/path/mod.rs (the CPU reference): the same draws from the same
+// counter-based random numbers, in the same order, so change both
+// together. Prefixed with common.wgsl and trace_svo.wgsl.
+//
+// The effects are override constants: a kernel built for a scene of diffuse
+// voxels has no metal, glass or emitter code at all.
+
+override SUN: bool = true;
+override SKY: bool = true;
+override EMIT: bool = true;
+override METAL: bool = true;
+override GLASS: bool = true;
+
+const PI: f32 = 3.14159265358979;
+
+// Twin of `PathUniforms` in src/gpu/path_pass.rs.
+struct PathUniforms {
+    sky_horizon: vec3<f32>,
+    // Index of this frame's sample: 0 restarts the accumulation.
+    sample_index: u32,
+    sky_zenith: vec3<f32>,
+    bounces: u32,
+    shadow_samples: u32,
+    emitter_count: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+// Twin of `GpuMaterial` in src/trace/path/materials.rs.
+struct Material {
+    kind: u32,
+    roughness: f32,
+    metalness: f32,
+    ior: f32,
+    transparency: f32,
+    emission: f32,
+    _pad0: f32,
+    _pad1: f32,
+}
+
+// Twin of `Emitter` in src/trace/path/lights.rs.
+struct Emitter {
+    min: vec3<i32>,
+    size: u32,
+    cdf: f32,
+    index: u32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+@group(0) @binding(8) var<uniform> pu: PathUniforms;
+@group(0) @binding(9) var<storage, read> materials: array<Material>;
+@group(0) @binding(10) var<storage, read> emitters: array<Emitter>;
+@group(0) @binding(11) var<storage, read_write> accum: array<vec4<f32>>;
+
+// ---- random numbers (twin of src/trace/path/rng.rs) ----
+
+fn pcg(v: u32) -> u32 {
+    let state = v * 747796405u + 2891336453u;
+    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+var<private> rng_state: u32;
+
+fn rng_init(pixel: u32, sample: u32) {
+    rng_state = pcg(pixel ^ pcg(sample + 0x9e3779b9u));
+}
+
+fn rng_next() -> f32 {
+    rng_state = pcg(rng_state);
+    return f32(rng_state >> 8u) * (1.0 / 16777216.0);
+}
+
+// ---- directions ----
+
+// An orthonormal basis around a unit vector (Duff et al., 2017).
+fn around(n: vec3<f32>, cos_theta: f32, phi: f32) -> vec3<f32> {
+    let sign = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    let t = vec3<f32>(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+    let bt = vec3<f32>(b, sign + n.y * n.y * a, -n.y);
+    let sin_theta = sqrt(max(1.0 - cos_theta * cos_theta, 0.0));
+    return (t * cos(phi) + bt * sin(phi)) * sin_theta + n * cos_theta;
+}
+
+fn cosine_direction(n: vec3<f32>, u1: f32, u2: f32) -> vec3<f32> {
+    return around(n, sqrt(1.0 - u1), 2.0 * PI * u2);
+}
+
+fn cone_direction(axis: vec3<f32>, cos_max: f32, u1: f32, u2: f32) -> vec3<f32> {
+    return around(axis, 1.0 - u1 * (1.0 - cos_max), 2.0 * PI * u2);
+}
+
+fn ggx_half_vector(n: vec3<f32>, alpha: f32, u1: f32, u2: f32) -> vec3<f32> {
+    let cos2 = (1.0 - u1) / (1.0 + (alpha * alpha - 1.0) * u1);
+    return around(n, sqrt(max(cos2, 0.0)), 2.0 * PI * u2);
+}
+
+fn reflect_about(d: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    return d - 2.0 * dot(d, n) * n;
+}
+
+fn fresnel_dielectric(cos_i: f32, cos_t: f32, eta: f32) -> f32 {
+    let rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    return 0.5 * (rs * rs + rp * rp);
+}
+
+fn smith_g1(c: f32, alpha: f32) -> f32 {
+    let a2 = alpha * alpha;
+    return 2.0 * c / (c + sqrt(a2 + (1.0 - a2) * c * c));
+}
+
+// ---- the scene ----
+
+fn albedo_of(index: u32) -> vec3<f32> {
+    return unpack4x8unorm(palette[index]).rgb;
+}
+
+fn is_glass(index: u32) -> bool {
+    return materials[index].kind == MATERIAL_GLASS;
+}
+
+fn ior_of(index: u32) -> f32 {
+    return select(materials[index].ior, 1.0, index == 0u);
+}
+
+// A ray inside glass that leaves the root cube crosses into empty space at
+// the root's face (twin of `root_exit`).
+fn root_exit(r: Ray, iterations: u32) -> Hit {
+    let size = f32(1u << u.depth);
+    let far = (select(vec3<f32>(0.0), vec3<f32>(size), r.d > vec3<f32>(0.0)) - r.o) * r.inv;
+    let axis = argmin3(far);
+    let t = max(far[axis], 0.0);
+    let p = r.o + r.d * t;
+    var hit: Hit;
+    hit.voxel = vec3<i32>(floor(p));
+    hit.voxel[axis] = select(-1, i32(1u << u.depth), r.d[axis] > 0.0);
+    hit.normal_code = 1u + 2u * axis + select(0u, 1u, r.d[axis] > 0.0);
+    hit.iterations = iterations;
+    hit.t = t;
+    hit.found = true;
+    return hit;
+}
+
+fn cross_medium(r: Ray, medium: u32) -> Hit {
+    let hit = trace_svo(r, 0.0, medium);
+    if (hit.found || medium == 0u || hit.iterations >= u.max_iterations) {
+        return hit;
+    }
+    return root_exit(r, hit.iterations);
+}
+
+// The point where the ray enters the voxel it found: on the entered face's
+// plane exactly (twin of `surface_point`).
+fn surface_point(r: Ray, hit: Hit) -> vec3<f32> {
+    let lo = vec3<f32>(hit.voxel);
+    var p = clamp(r.o + r.d * hit.t, lo, lo + vec3<f32>(1.0));
+    let axis = (hit.normal_code - 1u) / 2u;
+    p[axis] = lo[axis] + select(0.0, 1.0, hit.normal_code % 2u == 1u);
+    return p;
+}
+
+fn environment(dir: vec3<f32>, lights_counted: bool) -> vec3<f32> {
+    let d = normalize(dir);
+    var radiance = vec3<f32>(0.0);
+    if (SKY) {
+        radiance += mix(pu.sky_horizon, pu.sky_zenith, clamp(d.y * 0.5 + 0.5, 0.0, 1.0));
+    }
+    if (SUN && !lights_counted && dot(d, SUN_DIR) >= SUN_COS) {
+        radiance += vec3<f32>(SUN_RADIANCE);
+    }
+    return radiance;
+}
+
+// ---- lights ----
+
+fn pick_emitter(u0: f32) -> u32 {
+    let count = pu.emitter_count;
+    let target_cdf = u0 * emitters[count - 1u].cdf;
+    var lo = 0u;
+    var hi = count - 1u;
+    while (lo < hi) {
+        let mid = (lo + hi) / 2u;
+        if (emitters[mid].cdf <= target_cdf) {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo;
+}
+
+fn emitter_light(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let u0 = rng_next();
+    let u1 = rng_next();
+    let u2 = rng_next();
+    let u3 = rng_next();
+    let i = pick_emitter(u0);
+    let e = emitters[i];
+    let lo = vec3<f32>(e.min);
+    let hi = lo + vec3<f32>(f32(e.size));
+    let below = p < lo;
+    let above = p > hi;
+    let facing = below | above;
+    let faces = u32(facing.x) + u32(facing.y) + u32(facing.z);
+    if (faces == 0u) {
+        return vec3<f32>(0.0);
+    }
+    let pick = min(u32(u1 * f32(faces)), faces - 1u);
+    // The pick-th facing axis.
+    var axis = 0u;
+    var seen = 0u;
+    for (var a = 0u; a < 3u; a++) {
+        if (facing[a]) {
+            if (seen == pick) {
+                axis = a;
+            }
+            seen += 1u;
+        }
+    }
+    let b = (axis + 1u) % 3u;
+    let c = (axis + 2u) % 3u;
+    var q = vec3<f32>(0.0);
+    q[axis] = select(hi[axis], lo[axis], below[axis]);
+    q[b] = lo[b] + u2 * (hi[b] - lo[b]);
+    q[c] = lo[c] + u3 * (hi[c] - lo[c]);
+    let w = q - p;
+    let dist2 = dot(w, w);
+    let l = w / sqrt(dist2);
+    let cos_s = dot(n, l);
+    let cos_l = abs(l[axis]);
+    if (cos_s <= 0.0 || dist2 <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let shadow = cross_medium(make_ray(p, l), 0u);
+    let rel = shadow.voxel - e.min;
+    if (!shadow.found || any(rel < vec3<i32>(0)) || any(rel >= vec3<i32>(i32(e.size)))) {
+        return vec3<f32>(0.0);
+    }
+    let before = select(emitters[max(i, 1u) - 1u].cdf, 0.0, i == 0u);
+    let size = f32(e.size);
+    let pdf = (e.cdf - before) / emitters[pu.emitter_count - 1u].cdf / (f32(faces) * size * size);
+    let radiance = albedo_of(e.index) * materials[e.index].emission;
+    return radiance * (cos_s * cos_l / (PI * dist2 * pdf));
+}
+
+// Light arriving at a diffuse point, times 1/pi.
+fn direct(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    var light = vec3<f32>(0.0);
+    if (SUN) {
+        let samples = max(pu.shadow_samples, 1u);
+        var sum = 0.0;
+        for (var k = 0u; k < samples; k++) {
+            let u1 = rng_next();
+            let u2 = rng_next();
+            let l = cone_direction(SUN_DIR, SUN_COS, u1, u2);
+            let c = dot(n, l);
+            if (c > 0.0 && !cross_medium(make_ray(p, l), 0u).found) {
+                sum += SUN_IRRADIANCE * c / PI;
+            }
+        }
+        light += vec3<f32>(sum / f32(samples));
+    }
+    if (EMIT && pu.emitter_count > 0u) {
+        light += emitter_light(p, n);
+    }
+    return light;
+}
+
+// ---- scattering ----
+
+// Result of a scattering event: the new direction and the throughput
+// factor, or no continuation.
+struct Scatter {
+    dir: vec3<f32>,
+    weight: vec3<f32>,
+    medium: u32,
+    ok: bool,
+}
+
+fn glass_interface(d: vec3<f32>, n: vec3<f32>, medium: u32, value: u32) -> Scatter {
+    var s: Scatter;
+    let glass = select(value, medium, medium != 0u);
+    let m = materials[glass];
+    let alpha = m.roughness * m.roughness;
+    let u1 = rng_next();
+    let u2 = rng_next();
+    var h = select(n, ggx_half_vector(n, alpha, u1, u2), alpha > 1e-4);
+    if (dot(h, d) >= 0.0) {
+        h = n;
+    }
+    let eta = ior_of(medium) / ior_of(value);
+    let cos_i = -dot(d, h);
+    let sin2_t = eta * eta * max(1.0 - cos_i * cos_i, 0.0);
+    var fresnel = 1.0;
+    if (sin2_t < 1.0) {
+        fresnel = fresnel_dielectric(cos_i, sqrt(1.0 - sin2_t), eta);
+    }
+    if (rng_next() < fresnel) {
+        s.dir = reflect_about(d, h);
+        s.weight = vec3<f32>(1.0);
+        s.medium = medium;
+        s.ok = dot(s.dir, n) > 0.0;
+        return s;
+    }
+    let cos_t = sqrt(1.0 - sin2_t);
+    s.dir = eta * d + (eta * cos_i - cos_t) * h;
+    s.weight = select(vec3<f32>(1.0), albedo_of(value), value != 0u);
+    s.medium = value;
+    s.ok = dot(s.dir, n) < 0.0;
+    return s;
+}
+
+fn metal_lobe(d: vec3<f32>, n: vec3<f32>, albedo: vec3<f32>, m: Material) -> Scatter {
+    var s: Scatter;
+    let alpha = m.roughness * m.roughness;
+    let u1 = rng_next();
+    let u2 = rng_next();
+    let smooth_surface = alpha <= 1e-4;
+    let h = select(ggx_half_vector(n, alpha, u1, u2), n, smooth_surface);
+    s.dir = reflect_about(d, h);
+    let cos_v = -dot(d, n);
+    let cos_l = dot(s.dir, n);
+    let cos_h = dot(h, n);
+    let cos_vh = -dot(d, h);
+    s.ok = cos_l > 0.0 && cos_vh > 0.0;
+    let f0 = mix(vec3<f32>(0.04), albedo, m.metalness);
+    let x = 1.0 - cos_vh;
+    let fresnel = f0 + (vec3<f32>(1.0) - f0) * (x * x * x * x * x);
+    if (smooth_surface) {
+        s.weight = fresnel;
+    } else {
+        let g = smith_g1(cos_v, alpha) * smith_g1(cos_l, alpha);
+        s.weight = fresnel * (g * cos_vh / max(cos_v * cos_h, 1e-6));
+    }
+    return s;
+}
+
+// One path from the camera ray `ray_in` (twin of `PathScene::radiance`).
+fn radiance(ray_in: Ray) -> vec3<f32> {
+    var ray = ray_in;
+    var radiance = vec3<f32>(0.0);
+    var beta = vec3<f32>(1.0);
+    var medium = 0u;
+    var lights_counted = false;
+    var bounces = 0u;
+    var transmissions = 0u;
+    loop {
+        let hit = cross_medium(ray, medium);
+        if (hit.iterations >= u.max_iterations && !hit.found) {
+            return radiance + beta * GAVE_UP_COLOR;
+        }
+        if (!hit.found) {
+            return radiance + beta * environment(ray.d, lights_counted);
+        }
+        if (hit.normal_code == 0u) {
+            return radiance;
+        }
+        let p = surface_point(ray, hit);
+        let n = normal_vector(hit.normal_code);
+        let d = normalize(ray.d);
+        let value = hit.value;
+        let m = materials[value];
+        var dir: vec3<f32>;
+        if (GLASS && medium != 0u && (value == 0u || is_glass(value))) {
+            transmissions += 1u;
+            let s = glass_interface(d, n, medium, value);
+            if (!s.ok) {
+                return radiance;
+            }
+            dir = s.dir;
+            medium = s.medium;
+            beta *= s.weight;
+            lights_counted = false;
+        } else if (EMIT && m.kind == MATERIAL_EMIT) {
+            if (!lights_counted) {
+                radiance += beta * albedo_of(value) * m.emission;
+            }
+            return radiance;
+        } else if (GLASS && m.kind == MATERIAL_GLASS && rng_next() < m.transparency) {
+            transmissions += 1u;
+            let s = glass_interface(d, n, medium, value);
+            if (!s.ok) {
+                return radiance;
+            }
+            dir = s.dir;
+            medium = s.medium;
+            beta *= s.weight;
+            lights_counted = false;
+        } else if (bounces == pu.bounces) {
+            return radiance;
+        } else if (METAL && m.kind == MATERIAL_METAL) {
+            bounces += 1u;
+            let albedo = albedo_of(value);
+            let p_spec = 0.5 + 0.5 * m.metalness;
+            if (rng_next() < p_spec) {
+                let s = metal_lobe(d, n, albedo, m);
+                if (!s.ok) {
+                    return radiance;
+                }
+                dir = s.dir;
+                beta *= s.weight / p_spec;
+                lights_counted = false;
+            } else {
+                let diffuse = albedo * (1.0 - m.metalness) / (1.0 - p_spec);
+                radiance += beta * diffuse * direct(p, n);
+                let u1 = rng_next();
+                let u2 = rng_next();
+                dir = cosine_direction(n, u1, u2);
+                beta *= diffuse;
+                lights_counted = true;
+            }
+        } else {
+            bounces += 1u;
+            let albedo = albedo_of(value);
+            radiance += beta * albedo * direct(p, n);
+            let u1 = rng_next();
+            let u2 = rng_next();
+            dir = cosine_direction(n, u1, u2);
+            beta *= albedo;
+            lights_counted = true;
+        }
+        if (transmissions > MAX_TRANSMISSIONS) {
+            return radiance;
+        }
+        ray = make_ray(p, dir);
+    }
+    return radiance;
+}
+
+// Finite, non-negative, at most MAX_SAMPLE_RADIANCE per channel.
+fn clamp_sample(v: vec3<f32>) -> vec3<f32> {
+    let finite = all(abs(v) < vec3<f32>(3.0e38)) && all(v == v);
+    return select(vec3<f32>(0.0), clamp(v, vec3<f32>(0.0), vec3<f32>(MAX_SAMPLE_RADIANCE)), finite);
+}
+
+@compute @workgroup_size(8, 8)
+fn path(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= u.width || gid.y >= u.height) {
+        return;
+    }
+    let pixel = gid.y * u.width + gid.x;
+    rng_init(pixel, pu.sample_index);
+    let jx = rng_next();
+    let jy = rng_next();
+    let ndc_x = 2.0 * (f32(gid.x) + jx) / f32(u.width) - 1.0;
+    let ndc_y = 1.0 - 2.0 * (f32(gid.y) + jy) / f32(u.height);
+    let r = make_ray(u.eye, u.forward + u.right * ndc_x + u.up * ndc_y);
+    let sample = clamp_sample(radiance(r));
+    let sum = select(accum[pixel].rgb, vec3<f32>(0.0), pu.sample_index == 0u) + sample;
+    accum[pixel] = vec4<f32>(sum, f32(pu.sample_index + 1u));
+    textureStore(out_color, vec2<i32>(gid.xy), vec4<f32>(sum / f32(pu.sample_index + 1u), 1.0));
+}

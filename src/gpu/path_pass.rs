@@ -1,0 +1,275 @@
+//! The progressive path tracing pass: one sample per pixel per dispatch,
+//! accumulated in a float buffer, the mean written to a display texture.
+//!
+//! The kernel is compiled per effect set (override constants of
+//! `shaders/path.wgsl`) and the pipelines are cached, so a diffuse-only
+//! scene runs a kernel without metal, glass or emitter code.
+
+use std::collections::HashMap;
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+
+use super::prelude::with_prelude;
+use super::readback::{read_buffer, read_texture_rgba8, staging_buffer};
+use super::trace_pass::{FrameUniforms, buffer_entry, output_texture, uniform_entry};
+use super::{GpuContext, GpuError, SceneBuffers};
+use crate::trace::path::lights::Emitter;
+use crate::trace::path::materials::{Effects, GpuMaterial};
+
+const COMMON_WGSL: &str = include_str!("../../shaders/common.wgsl");
+const SVO_WGSL: &str = include_str!("../../shaders/trace_svo.wgsl");
+const PATH_WGSL: &str = include_str!("../../shaders/path.wgsl");
+
+/// Twin of `PathUniforms` in `shaders/path.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct PathUniforms {
+    pub sky_horizon: [f32; 3],
+    pub sample_index: u32,
+    pub sky_zenith: [f32; 3],
+    pub bounces: u32,
+    pub shadow_samples: u32,
+    pub emitter_count: u32,
+    pub _pad: [u32; 2],
+}
+
+const EMITTER_BYTES: u64 = std::mem::size_of::<Emitter>() as u64;
+
+/// Size-dependent outputs.
+struct Target {
+    texture: wgpu::Texture,
+    view: wgpu::TextureView,
+    /// RGB sums and the sample count, one vec4 per pixel.
+    accum: wgpu::Buffer,
+    width: u32,
+    height: u32,
+}
+
+pub struct PathPass {
+    layout: wgpu::BindGroupLayout,
+    pipeline_layout: wgpu::PipelineLayout,
+    module: wgpu::ShaderModule,
+    pipelines: HashMap<Effects, wgpu::ComputePipeline>,
+    frame_buf: wgpu::Buffer,
+    path_buf: wgpu::Buffer,
+    materials_buf: wgpu::Buffer,
+    emitters_buf: wgpu::Buffer,
+    target: Target,
+    bind_group: wgpu::BindGroup,
+    bound_generation: u64,
+}
+
+fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() }
+}
+
+fn uniform_buffer(device: &wgpu::Device, label: &str, size: usize) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size as u64,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+fn storage(device: &wgpu::Device, label: &str, size: u64, extra: wgpu::BufferUsages) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size.max(16),
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | extra,
+        mapped_at_creation: false,
+    })
+}
+
+impl PathPass {
+    pub fn new(gpu: &GpuContext, buffers: &SceneBuffers) -> Result<PathPass, GpuError> {
+        let device = &gpu.device;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("path bind group layout"),
+            entries: &[
+                uniform_entry(0, std::mem::size_of::<FrameUniforms>()),
+                buffer_entry(1, true),
+                buffer_entry(3, true),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 5,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format: wgpu::TextureFormat::Rgba8Unorm,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                    },
+                    count: None,
+                },
+                uniform_entry(8, std::mem::size_of::<PathUniforms>()),
+                buffer_entry(9, true),
+                buffer_entry(10, true),
+                buffer_entry(11, false),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("path pipeline layout"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let module = gpu.shader("path.wgsl", &with_prelude(&[COMMON_WGSL, SVO_WGSL, PATH_WGSL]))?;
+        let frame_buf = uniform_buffer(device, "path frame uniforms", std::mem::size_of::<FrameUniforms>());
+        let path_buf = uniform_buffer(device, "path uniforms", std::mem::size_of::<PathUniforms>());
+        let materials_buf =
+            storage(device, "materials", 256 * std::mem::size_of::<GpuMaterial>() as u64, wgpu::BufferUsages::empty());
+        // A binding holds at least one element, even when there are no lights.
+        let emitters_buf = storage(device, "emitters", EMITTER_BYTES, wgpu::BufferUsages::empty());
+        let target = Self::make_target(device, 1, 1);
+        let mut pass = PathPass {
+            bind_group: device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("placeholder"),
+                layout: &layout,
+                entries: &[],
+            }),
+            layout,
+            pipeline_layout,
+            module,
+            pipelines: HashMap::new(),
+            frame_buf,
+            path_buf,
+            materials_buf,
+            emitters_buf,
+            target,
+            bound_generation: u64::MAX,
+        };
+        pass.rebind(device, buffers);
+        Ok(pass)
+    }
+
+    fn make_target(device: &wgpu::Device, width: u32, height: u32) -> Target {
+        let (texture, view) = output_texture(device, "path output", width, height);
+        let accum =
+            storage(device, "accumulation", u64::from(width) * u64::from(height) * 16, wgpu::BufferUsages::COPY_SRC);
+        Target { texture, view, accum, width, height }
+    }
+
+    fn rebind(&mut self, device: &wgpu::Device, buffers: &SceneBuffers) {
+        self.bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("path bind group"),
+            layout: &self.layout,
+            entries: &[
+                entry(0, &self.frame_buf),
+                entry(1, &buffers.pool_buf),
+                entry(3, &buffers.palette_buf),
+                wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&self.target.view) },
+                entry(8, &self.path_buf),
+                entry(9, &self.materials_buf),
+                entry(10, &self.emitters_buf),
+                entry(11, &self.target.accum),
+            ],
+        });
+        self.bound_generation = buffers.generation;
+    }
+
+    /// The kernel for an effect set, compiled on first use.
+    fn pipeline(&mut self, gpu: &GpuContext, effects: Effects) -> Result<&wgpu::ComputePipeline, GpuError> {
+        if !self.pipelines.contains_key(&effects) {
+            let constants = effects.constants();
+            let pipeline = gpu.validated("path tracer", |device| {
+                device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some("path tracer"),
+                    layout: Some(&self.pipeline_layout),
+                    module: &self.module,
+                    entry_point: Some("path"),
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants: &constants,
+                        zero_initialize_workgroup_memory: false,
+                    },
+                    cache: None,
+                })
+            })?;
+            self.pipelines.insert(effects, pipeline);
+        }
+        Ok(&self.pipelines[&effects])
+    }
+
+    /// Re-creates the outputs for a new size; returns whether it did (the
+    /// accumulation then starts over).
+    ///
+    /// # Errors
+    /// [`GpuError::TooLarge`] when the image or its accumulation buffer
+    /// exceed the adapter's limits; the old outputs are kept.
+    pub fn resize(&mut self, gpu: &GpuContext, buffers: &SceneBuffers, (width, height): (u32, u32)) -> Result<bool, GpuError> {
+        let (width, height) = (width.max(1), height.max(1));
+        if (width, height) == (self.target.width, self.target.height) {
+            return Ok(false);
+        }
+        gpu.check_image_size(width, height)?;
+        gpu.check_binding("the accumulation buffer", u64::from(width) * u64::from(height) * 16)?;
+        self.target = Self::make_target(&gpu.device, width, height);
+        self.rebind(&gpu.device, buffers);
+        Ok(true)
+    }
+
+    pub fn size(&self) -> (u32, u32) {
+        (self.target.width, self.target.height)
+    }
+
+    pub fn output_view(&self) -> &wgpu::TextureView {
+        &self.target.view
+    }
+
+    /// Uploads the material table and the emitter list (on a restart).
+    pub fn upload_scene(&mut self, gpu: &GpuContext, buffers: &SceneBuffers, materials: &[GpuMaterial], lights: &[Emitter]) {
+        gpu.queue.write_buffer(&self.materials_buf, 0, bytemuck::cast_slice(materials));
+        let bytes: &[u8] = bytemuck::cast_slice(lights);
+        if bytes.len() as u64 > self.emitters_buf.size() {
+            self.emitters_buf = storage(&gpu.device, "emitters", bytes.len() as u64, wgpu::BufferUsages::empty());
+            self.rebind(&gpu.device, buffers);
+        }
+        if !bytes.is_empty() {
+            gpu.queue.write_buffer(&self.emitters_buf, 0, bytes);
+        }
+    }
+
+    /// Writes this sample's uniforms and rebinds re-created scene buffers.
+    pub fn prepare(&mut self, gpu: &GpuContext, buffers: &SceneBuffers, frame: &FrameUniforms, path: &PathUniforms) {
+        if buffers.generation != self.bound_generation {
+            self.rebind(&gpu.device, buffers);
+        }
+        gpu.queue.write_buffer(&self.frame_buf, 0, bytemuck::bytes_of(frame));
+        gpu.queue.write_buffer(&self.path_buf, 0, bytemuck::bytes_of(path));
+    }
+
+    /// Records one sample's dispatch with the kernel of `effects`.
+    pub fn encode(
+        &mut self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        effects: Effects,
+        timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>,
+    ) -> Result<(), GpuError> {
+        let (width, height) = self.size();
+        self.pipeline(gpu, effects)?;
+        let pipeline = &self.pipelines[&effects];
+        let mut pass = encoder
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("path"), timestamp_writes: timestamps });
+        pass.set_bind_group(0, &self.bind_group, &[]);
+        pass.set_pipeline(pipeline);
+        pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
+        Ok(())
+    }
+
+    /// The mean radiance of every pixel so far, row-major.
+    pub fn read_radiance(&self, gpu: &GpuContext) -> Result<Vec<Vec3>, GpuError> {
+        let size = self.target.accum.size();
+        let staging = staging_buffer(&gpu.device, "accumulation readback", size);
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("accum") });
+        encoder.copy_buffer_to_buffer(&self.target.accum, 0, &staging, 0, size);
+        gpu.queue.submit([encoder.finish()]);
+        let bytes = read_buffer(gpu, &staging)?;
+        let sums: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
+        let pixels = (self.target.width * self.target.height) as usize;
+        Ok(sums.iter().take(pixels).map(|s| Vec3::new(s[0], s[1], s[2]) / s[3].max(1.0)).collect())
+    }
+
+    /// The display texture as tightly packed RGBA8 rows.
+    pub fn read_color(&self, gpu: &GpuContext) -> Result<Vec<u8>, GpuError> {
+        read_texture_rgba8(gpu, &self.target.texture)
+    }
+}
