@@ -18,7 +18,7 @@ fn trace_grid(r: Ray) -> Hit {
     let lo = u.grid_min;
     let hi = u.grid_min + vec3<i32>(u.grid_dims) - vec3<i32>(1);
     let s = slab(r, vec3<f32>(lo), vec3<f32>(hi + vec3<i32>(1)));
-    if (s.t_enter > s.t_exit || s.t_exit < 0.0) {
+    if (s.t_enter > s.t_exit || s.t_exit <= 0.0) {
         return miss;
     }
     let t = max(s.t_enter, 0.0);

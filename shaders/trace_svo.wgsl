@@ -66,7 +66,8 @@ fn trace_svo(r: Ray, t_min: f32, medium: u32) -> Hit {
     let depth = u.depth;
     let size = f32(1u << depth);
     let s = slab(r, vec3<f32>(0.0), vec3<f32>(size));
-    if (s.t_enter > s.t_exit || s.t_exit < max(t_min, 0.0)) {
+    // t_exit = 0: the ray starts on the root's face and heads out.
+    if (s.t_enter > s.t_exit || s.t_exit <= max(t_min, 0.0)) {
         return miss;
     }
     var t = max(s.t_enter, 0.0);

@@ -161,7 +161,7 @@ pub struct RenderArgs {
     /// Use the CPU reference tracer instead of the GPU.
     #[arg(long)]
     pub cpu: bool,
-    /// Turn sun shadows off.
+    /// Turn sun shadows off (preview shading).
     #[arg(long)]
     pub no_shadows: bool,
     #[arg(long, default_value_t = 0)]
@@ -169,6 +169,46 @@ pub struct RenderArgs {
     /// Replace OUTPUT even if it is the input or an existing .vox/.obj/.ovr.
     #[arg(long)]
     pub force: bool,
+    #[command(flatten)]
+    pub path: PathArgs,
+    /// Print one JSON object on stdout: effects, spp, ms_per_sample, adapter.
+    #[arg(long)]
+    pub stats: bool,
+}
+
+/// The path tracer's knobs on the command line.
+#[derive(Args, Debug, Clone, Copy)]
+pub struct PathArgs {
+    /// Path trace with N samples per pixel (without it: the preview shading).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
+    pub spp: Option<u32>,
+    /// Scattering events per path (passing through glass does not count).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=i64::from(octovox::settings::MAX_BOUNCES)))]
+    pub bounces: u32,
+    /// Shadow rays toward the sun per diffuse hit.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=i64::from(octovox::settings::MAX_SHADOW_SAMPLES)))]
+    pub shadow_samples: u32,
+    /// Which effects the kernel simulates: what the scene calls for, or all.
+    #[arg(long, value_enum, default_value_t = octovox::settings::EffectsChoice::Auto)]
+    pub effects: octovox::settings::EffectsChoice,
+    /// The sky's light.
+    #[arg(long, value_enum, default_value_t = octovox::settings::Sky::Gradient)]
+    pub sky: octovox::settings::Sky,
+    /// No sunlight.
+    #[arg(long)]
+    pub no_sun: bool,
+}
+
+impl PathArgs {
+    pub fn settings(&self) -> octovox::settings::PathSettings {
+        octovox::settings::PathSettings {
+            bounces: self.bounces,
+            shadow_samples: self.shadow_samples,
+            effects: self.effects,
+            sun: !self.no_sun,
+            sky: self.sky,
+        }
+    }
 }
 
 #[derive(Args, Debug)]

@@ -1,6 +1,7 @@
 //! `octovox render`: one image of a scene, on the GPU or the CPU reference.
 
 use std::process::ExitCode;
+use std::time::Instant;
 
 use anyhow::Context;
 
@@ -9,8 +10,10 @@ use octovox::gpu::Renderer;
 use octovox::io::atomic::WriteOptions;
 use octovox::io::output::{OutputKind, check_output};
 use octovox::io::png::save_png;
+use octovox::camera::Camera;
 use octovox::scene::Scene;
-use octovox::settings::{RenderSettings, TraceMode};
+use octovox::settings::{RenderSettings, TraceMode, View};
+use octovox::trace::path::{lights, render_cpu, to_image};
 use octovox::trace::grid::DenseGrid;
 use octovox::trace::render::render_scene_cpu;
 
@@ -20,6 +23,10 @@ const CPU_BYTES_PER_PIXEL: u64 = 48;
 /// Bytes per pixel of a GPU render on the host: the read-back rows (padded)
 /// and the image.
 const GPU_BYTES_PER_PIXEL: u64 = 12;
+/// A CPU path-traced render keeps the mean radiance (12 bytes) and the image.
+const CPU_PATH_BYTES_PER_PIXEL: u64 = 24;
+/// A GPU path-traced render adds the accumulation buffer's readback.
+const GPU_PATH_BYTES_PER_PIXEL: u64 = 28;
 
 /// Opens FILE, or the built-in demo scene when there is none.
 pub fn open_scene(file: Option<&std::path::Path>, frame: usize) -> anyhow::Result<Scene> {
@@ -32,30 +39,96 @@ pub fn open_scene(file: Option<&std::path::Path>, frame: usize) -> anyhow::Resul
 pub fn run(args: &RenderArgs) -> anyhow::Result<ExitCode> {
     let inputs: Vec<&std::path::Path> = args.file.iter().map(|p| p.as_path()).collect();
     check_output(&args.output, OutputKind::Image, &inputs, args.force)?;
+    if args.path.spp.is_some() && (args.mode != TraceMode::Svo || args.view != View::Shaded) {
+        anyhow::bail!("the path tracer (--spp) walks the SVO and shades: it takes neither --mode grid nor --view");
+    }
     let pixels = u64::from(args.size.0) * u64::from(args.size.1);
-    let per_pixel = if args.cpu { CPU_BYTES_PER_PIXEL } else { GPU_BYTES_PER_PIXEL };
+    let per_pixel = match (args.cpu, args.path.spp.is_some()) {
+        (true, true) => CPU_PATH_BYTES_PER_PIXEL,
+        (true, false) => CPU_BYTES_PER_PIXEL,
+        (false, true) => GPU_PATH_BYTES_PER_PIXEL,
+        (false, false) => GPU_BYTES_PER_PIXEL,
+    };
     octovox::budget::check(|| format!("a {}x{} render", args.size.0, args.size.1), pixels * per_pixel)?;
     let mut scene = open_scene(args.file.as_deref(), args.frame)?;
     let camera = camera_or_framing(args.camera, args.fov, &scene);
+    let (image, stats) = match args.path.spp {
+        Some(spp) => path_traced(&mut scene, &camera, args, spp)?,
+        None => preview(&mut scene, &camera, args)?,
+    };
+    save_png(&image, &args.output, WriteOptions { overwrite_read_only: args.force })?;
+    if args.stats {
+        say!("{}", serde_json::to_string(&stats)?)?;
+    } else {
+        say!("wrote {} ({}x{})", args.output.display(), args.size.0, args.size.1)?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// What `--stats` prints.
+#[derive(serde::Serialize)]
+struct Stats {
+    effects: Vec<&'static str>,
+    spp: u32,
+    ms_per_sample: f64,
+    adapter: String,
+    /// Emissive cells sampled as lights.
+    lights: usize,
+}
+
+/// Today's deterministic shading (colour, Lambert, shadow), one frame.
+fn preview(scene: &mut Scene, camera: &Camera, args: &RenderArgs) -> anyhow::Result<(image::RgbaImage, Stats)> {
     let settings = RenderSettings { mode: args.mode, view: args.view, shadows: !args.no_shadows, render_scale: 1.0 };
     let grid = match args.mode {
         TraceMode::Grid => Some(DenseGrid::from_octree(&scene.tree).map_err(anyhow::Error::msg)?),
         TraceMode::Svo => None,
     };
-    let image = if args.cpu {
-        render_scene_cpu(&scene, grid.as_ref(), &camera, args.size, &settings)
-    } else {
-        let mut renderer = Renderer::headless().context("no GPU for rendering (try --cpu)")?;
-        log::info!("rendering on {}", renderer.gpu.adapter_name);
-        renderer.sync(&mut scene.tree, &scene.palette);
-        if let Some(grid) = &grid {
-            renderer.set_grid(grid)?;
-        }
-        let ms = renderer.render(&scene.tree, &camera, args.size, &settings, None)?;
-        log::info!("frame took {ms:.2} ms");
-        renderer.read_image()?
+    let stats = |ms, adapter| Stats { effects: Vec::new(), spp: 0, ms_per_sample: ms, adapter, lights: 0 };
+    if args.cpu {
+        let start = Instant::now();
+        let image = render_scene_cpu(scene, grid.as_ref(), camera, args.size, &settings);
+        return Ok((image, stats(start.elapsed().as_secs_f64() * 1e3, "cpu".into())));
+    }
+    let mut renderer = Renderer::headless().context("no GPU for rendering (try --cpu)")?;
+    log::info!("rendering on {}", renderer.gpu.adapter_name);
+    renderer.sync(&mut scene.tree, &scene.palette);
+    if let Some(grid) = &grid {
+        renderer.set_grid(grid)?;
+    }
+    let ms = renderer.render(&scene.tree, camera, args.size, &settings, None)?;
+    log::info!("frame took {ms:.2} ms");
+    Ok((renderer.read_image()?, stats(ms, renderer.gpu.adapter_name.clone())))
+}
+
+/// `spp` samples of the path tracer, on the GPU or the CPU reference.
+fn path_traced(scene: &mut Scene, camera: &Camera, args: &RenderArgs, spp: u32) -> anyhow::Result<(image::RgbaImage, Stats)> {
+    let settings = args.path.settings();
+    if args.cpu {
+        let start = Instant::now();
+        let (pixels, effects) = render_cpu(&scene.tree, &scene.palette, camera, args.size, &settings, spp);
+        let ms = start.elapsed().as_secs_f64() * 1e3 / f64::from(spp);
+        let lights = if effects.emit { lights::emitters(&scene.tree, &scene.palette).len() } else { 0 };
+        let image = to_image(&pixels, args.size.0, args.size.1);
+        return Ok((image, Stats { effects: effects.names(), spp, ms_per_sample: ms, adapter: "cpu".into(), lights }));
+    }
+    let mut renderer = Renderer::headless().context("no GPU for rendering (try --cpu)")?;
+    log::info!("path tracing on {}", renderer.gpu.adapter_name);
+    renderer.sync(&mut scene.tree, &scene.palette);
+    let mut total_ms = 0.0;
+    let mut last = None;
+    for sample in 0..spp {
+        let frame = renderer.render_path(&scene.tree, &scene.palette, camera, args.size, &settings, sample == 0)?;
+        total_ms += frame.ms;
+        last = Some(frame);
+    }
+    let frame = last.context("no samples")?;
+    let stats = Stats {
+        effects: frame.effects.names(),
+        spp,
+        ms_per_sample: total_ms / f64::from(spp),
+        adapter: renderer.gpu.adapter_name.clone(),
+        lights: frame.lights,
     };
-    save_png(&image, &args.output, WriteOptions { overwrite_read_only: args.force })?;
-    say!("wrote {} ({}x{})", args.output.display(), args.size.0, args.size.1)?;
-    Ok(ExitCode::SUCCESS)
+    log::info!("{spp} samples, {:.2} ms each", stats.ms_per_sample);
+    Ok((renderer.read_image()?, stats))
 }

@@ -64,6 +64,37 @@ fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
     wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() }
 }
 
+/// The pass's own buffers that its bind group holds.
+struct BindParts<'a> {
+    frame: &'a wgpu::Buffer,
+    path: &'a wgpu::Buffer,
+    materials: &'a wgpu::Buffer,
+    emitters: &'a wgpu::Buffer,
+}
+
+fn make_bind_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    buffers: &SceneBuffers,
+    parts: &BindParts,
+    target: &Target,
+) -> wgpu::BindGroup {
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("path bind group"),
+        layout,
+        entries: &[
+            entry(0, parts.frame),
+            entry(1, &buffers.pool_buf),
+            entry(3, &buffers.palette_buf),
+            wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&target.view) },
+            entry(8, parts.path),
+            entry(9, parts.materials),
+            entry(10, parts.emitters),
+            entry(11, &target.accum),
+        ],
+    })
+}
+
 fn uniform_buffer(device: &wgpu::Device, label: &str, size: usize) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {
         label: Some(label),
@@ -120,12 +151,9 @@ impl PathPass {
         // A binding holds at least one element, even when there are no lights.
         let emitters_buf = storage(device, "emitters", EMITTER_BYTES, wgpu::BufferUsages::empty());
         let target = Self::make_target(device, 1, 1);
-        let mut pass = PathPass {
-            bind_group: device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("placeholder"),
-                layout: &layout,
-                entries: &[],
-            }),
+        let parts = BindParts { frame: &frame_buf, path: &path_buf, materials: &materials_buf, emitters: &emitters_buf };
+        let bind_group = make_bind_group(device, &layout, buffers, &parts, &target);
+        Ok(PathPass {
             layout,
             pipeline_layout,
             module,
@@ -135,10 +163,9 @@ impl PathPass {
             materials_buf,
             emitters_buf,
             target,
-            bound_generation: u64::MAX,
-        };
-        pass.rebind(device, buffers);
-        Ok(pass)
+            bind_group,
+            bound_generation: buffers.generation,
+        })
     }
 
     fn make_target(device: &wgpu::Device, width: u32, height: u32) -> Target {
@@ -149,20 +176,13 @@ impl PathPass {
     }
 
     fn rebind(&mut self, device: &wgpu::Device, buffers: &SceneBuffers) {
-        self.bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("path bind group"),
-            layout: &self.layout,
-            entries: &[
-                entry(0, &self.frame_buf),
-                entry(1, &buffers.pool_buf),
-                entry(3, &buffers.palette_buf),
-                wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&self.target.view) },
-                entry(8, &self.path_buf),
-                entry(9, &self.materials_buf),
-                entry(10, &self.emitters_buf),
-                entry(11, &self.target.accum),
-            ],
-        });
+        let parts = BindParts {
+            frame: &self.frame_buf,
+            path: &self.path_buf,
+            materials: &self.materials_buf,
+            emitters: &self.emitters_buf,
+        };
+        self.bind_group = make_bind_group(device, &self.layout, buffers, &parts, &self.target);
         self.bound_generation = buffers.generation;
     }
 

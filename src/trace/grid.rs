@@ -75,7 +75,8 @@ pub fn trace(grid: &DenseGrid, ray: &Ray) -> Hit {
     let lo = grid.min;
     let hi = grid.min + grid.dims.as_ivec3() - IVec3::ONE;
     let (t_enter, t_exit, entry_axis) = ray.slab(lo.as_vec3(), (hi + IVec3::ONE).as_vec3());
-    if t_enter > t_exit || t_exit < 0.0 {
+    // t_exit = 0: the ray starts on the cube's face and heads out.
+    if t_enter > t_exit || t_exit <= 0.0 {
         return Hit::default();
     }
     let t = t_enter.max(0.0);

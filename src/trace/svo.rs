@@ -65,7 +65,9 @@ pub fn trace_through(tree: &Octree, ray: &Ray, medium: u8) -> Crossing {
     let depth = tree.depth();
     let size = (1u32 << depth) as f32;
     let (t_enter, t_exit, entry_axis) = ray.slab(Vec3::ZERO, Vec3::splat(size));
-    if t_enter > t_exit || t_exit < 0.0 {
+    // t_exit = 0: the ray starts on the root's face and heads out (a path
+    // leaving a voxel on the root's face), so it meets nothing.
+    if t_enter > t_exit || t_exit <= 0.0 {
         return Crossing::default();
     }
     let mut t = t_enter.max(0.0);

@@ -95,7 +95,9 @@ pub fn first_hit(tree: &Octree, ray: &Ray) -> Option<ExactHit> {
     let r = ExactRay::of(ray);
     let n = i64::from(tree.size());
     let (t_enter, t_exit, slab_axis) = r.slab([0; 3], [n; 3]);
-    if t_enter > t_exit || t_exit.is_negative() {
+    // t_exit = 0: the ray starts on the root's face heading out; by the
+    // crossing rule it has crossed that face, so it is outside.
+    if t_enter > t_exit || !t_exit.is_positive() {
         return None;
     }
     let inside = t_enter.is_negative();
