@@ -44,6 +44,10 @@ pub struct WindowArgs {
     /// Start with sun shadows off (the UI can turn them on).
     #[arg(long)]
     pub no_shadows: bool,
+    /// Preview shading only, the path tracer once the camera rests, or the
+    /// path tracer always (the UI can change it).
+    #[arg(long, value_enum, default_value_t = octovox::settings::Shading::Rest)]
+    pub shading: octovox::settings::Shading,
     /// On exit, print the frame rate and the worst frame while the camera
     /// moved (benches/window_orbit.sh drags the real mouse and reads it).
     #[arg(long)]

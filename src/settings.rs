@@ -123,3 +123,28 @@ impl Default for PathSettings {
 /// Most bounces and shadow samples accepted.
 pub const MAX_BOUNCES: u32 = 64;
 pub const MAX_SHADOW_SAMPLES: u32 = 64;
+
+/// How the window shades its frames.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Shading {
+    /// The preview only: colour, Lambert sun, optional shadow.
+    Preview,
+    /// The preview while the camera moves; the path tracer, accumulating,
+    /// once the view rests.
+    #[default]
+    Rest,
+    /// The path tracer on every frame, moving or not.
+    Path,
+}
+
+impl Shading {
+    pub const ALL: [Shading; 3] = [Shading::Preview, Shading::Rest, Shading::Path];
+
+    pub fn label(self) -> &'static str {
+        match self {
+            Shading::Preview => "preview",
+            Shading::Rest => "path trace at rest",
+            Shading::Path => "path trace always",
+        }
+    }
+}

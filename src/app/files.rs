@@ -33,6 +33,7 @@ impl App {
         self.state.dirty = false;
         self.state.color = first_used_color(&self.scene).unwrap_or(self.state.color);
         self.grid_stale = true;
+        self.path_stale = true;
         if let Some(gfx) = &self.gfx {
             gfx.renderer.buffers.upload_palette(&gfx.renderer.gpu.queue, &self.scene.palette);
         }

@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 
 use winit::event_loop::ActiveEventLoop;
 
-use octovox::settings::TraceMode;
+use octovox::settings::{Shading, TraceMode, View};
 use octovox::trace::grid::DenseGrid;
 
 use super::{App, Gfx, camera_control, capture, motion, ui};
@@ -137,11 +137,35 @@ impl App {
         };
 
         // Trace: the one encode path that headless rendering uses too.
-        let highlight = self.pick.map(|pick| self.state.preview_box(&pick));
-        let settings = &self.state.settings;
-        match gfx.renderer.render(&self.scene.tree, &self.state.camera, trace_size, settings, highlight) {
-            Ok(ms) => self.stats.trace_ms = ms,
-            Err(err) => log::error!("trace failed: {err}"),
+        if path_traced(&self.state, self.motion.moving()) {
+            let changed = std::mem::take(&mut self.path_stale);
+            gfx.renderer.sample_target = self.state.sample_target.max(1);
+            let (scene, state) = (&self.scene, &self.state);
+            let frame = gfx.renderer.render_path(
+                &scene.tree,
+                &scene.palette,
+                &state.camera,
+                trace_size,
+                &state.path_settings,
+                changed,
+            );
+            match frame {
+                Ok(frame) => {
+                    if frame.added {
+                        self.stats.trace_ms = frame.ms;
+                    }
+                    self.stats.path = Some(frame);
+                }
+                Err(err) => log::error!("path tracing failed: {err}"),
+            }
+        } else {
+            let highlight = self.pick.map(|pick| self.state.preview_box(&pick));
+            let settings = &self.state.settings;
+            match gfx.renderer.render(&self.scene.tree, &self.state.camera, trace_size, settings, highlight) {
+                Ok(ms) => self.stats.trace_ms = ms,
+                Err(err) => log::error!("trace failed: {err}"),
+            }
+            self.stats.path = None;
         }
 
         // Blit + egui onto the swapchain image.
@@ -191,7 +215,9 @@ impl App {
     /// for when egui asks to be drawn again).
     fn schedule_repaint(&mut self, repaint_delay: Option<Duration>) {
         // A moving camera asks for one more frame: the resting view at full scale.
+        let accumulating = self.stats.path.is_some_and(|p| p.samples < self.state.sample_target);
         let animating = self.motion.moving()
+            || accumulating
             || self.loading.is_some()
             || self.input.fly_direction().is_some()
             || self.bench.is_some()
@@ -222,6 +248,16 @@ impl App {
                 self.ui.error(format!("{err}; back to SVO"));
             }
         }
+    }
+}
+
+/// Whether this frame is path traced: by the user's choice, and at rest
+/// only in the default mode (the preview keeps a moving camera fluid).
+fn path_traced(state: &super::state::EditorState, moving: bool) -> bool {
+    match state.shading {
+        Shading::Preview => false,
+        Shading::Rest => !moving && state.settings.mode == TraceMode::Svo && state.settings.view == View::Shaded,
+        Shading::Path => state.settings.mode == TraceMode::Svo && state.settings.view == View::Shaded,
     }
 }
 

@@ -132,6 +132,8 @@ struct App {
     stroke: Option<Stroke>,
     loading: Option<Loading>,
     grid_stale: bool,
+    /// The voxels or palette changed since the path tracer last looked.
+    path_stale: bool,
     screenshot_requested: bool,
     ready: bool,
     last_frame: Option<Instant>,
@@ -166,6 +168,7 @@ impl App {
             stroke: None,
             loading: None,
             grid_stale: true,
+            path_stale: true,
             screenshot_requested: false,
             ready: false,
             last_frame: None,
@@ -181,6 +184,7 @@ impl App {
         app.open_script_files();
         app.state.settings.render_scale = app.args.render_scale.clamp(0.25, 1.0);
         app.state.settings.shadows = !app.args.no_shadows;
+        app.state.shading = app.args.shading;
         if let Some((eye, target)) = app.args.camera {
             app.state.camera = Camera { eye, target, fov_y_deg: app.state.camera.fov_y_deg };
         }
@@ -290,6 +294,7 @@ impl App {
         );
         self.state.dirty = true;
         self.grid_stale = true;
+        self.path_stale = true;
         self.update_title();
         self.request_redraw();
     }

@@ -136,6 +136,11 @@ impl App {
                 let got = self.stats.last_edit_bytes;
                 return Played::check(got <= *limit, format!("expected at most {limit} bytes written, got {got}"));
             }
+            Line::ExpectEffects(want) => {
+                let (ok, got) = octovox::replay::effects_match(&self.scene, &self.state.path_settings, want);
+                let message = format!("expected effects [{}], got [{}]", want.join(" "), got.join(" "));
+                return Played::check(ok, message);
+            }
             // The window's size and panels differ from a headless render.
             Line::ExpectImage(..) => {
                 report!("replay: 'expect image' is checked by `octovox replay`, not in the window")

@@ -9,7 +9,7 @@ use glam::IVec3;
 
 use octovox::camera::Camera;
 use octovox::edit::Edit;
-use octovox::settings::RenderSettings;
+use octovox::settings::{PathSettings, RenderSettings, Shading};
 pub use octovox::tool::{Brush, Tool, click_edit};
 
 /// The voxel and face under the cursor, in world coordinates.
@@ -30,6 +30,10 @@ pub enum BrushKind {
     Box,
 }
 
+/// Samples accumulated at rest by default: noise is below what 8-bit
+/// colour shows on most scenes well before this.
+pub const DEFAULT_SAMPLE_TARGET: u32 = 256;
+
 /// Everything the user chose, as plain data.
 #[derive(Clone, Debug)]
 pub struct EditorState {
@@ -48,7 +52,12 @@ pub struct EditorState {
     /// Frame time to hold while the camera moves (the render scale drops
     /// as far as needed), milliseconds.
     pub frame_target_ms: f32,
+    pub shading: Shading,
+    pub path_settings: PathSettings,
+    /// Samples the path tracer accumulates at rest before it stops.
+    pub sample_target: u32,
 }
+
 
 impl Default for EditorState {
     fn default() -> EditorState {
@@ -63,6 +72,9 @@ impl Default for EditorState {
             path: None,
             dirty: false,
             frame_target_ms: super::motion::DEFAULT_TARGET_MS,
+            shading: Shading::default(),
+            path_settings: PathSettings::default(),
+            sample_target: DEFAULT_SAMPLE_TARGET,
         }
     }
 }

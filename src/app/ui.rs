@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use egui::{Color32, Sense, Stroke, Vec2};
 
 use octovox::scene::{Octree, Palette};
-use octovox::settings::{TraceMode, View};
+use octovox::settings::{EffectsChoice, Shading, Sky, TraceMode, View};
 
 use super::command::{Choice, Command, Pending};
 use super::state::{BrushKind, EditorState, Pick, Tool};
@@ -39,6 +39,8 @@ pub struct Stats {
     pub last_edit_bytes: u64,
     /// Byte ranges of the last edit.
     pub last_edit_ranges: usize,
+    /// The path tracer's last frame, when it drew it.
+    pub path: Option<octovox::gpu::PathFrame>,
 }
 
 /// Read-only facts the panels show.
@@ -248,6 +250,34 @@ fn render(ui: &mut egui::Ui, state: &mut EditorState) {
     ui.add(egui::Slider::new(&mut settings.render_scale, 0.25..=1.0).text("scale"));
     ui.add(egui::Slider::new(&mut state.frame_target_ms, 10.0..=100.0).text("ms target"))
         .on_hover_text("frame time to hold while the camera moves: the render scale drops as far as needed");
+    path_tracing(ui, state);
+}
+
+fn path_tracing(ui: &mut egui::Ui, state: &mut EditorState) {
+    egui::ComboBox::from_id_salt("shading").selected_text(state.shading.label()).show_ui(ui, |ui| {
+        for shading in Shading::ALL {
+            ui.selectable_value(&mut state.shading, shading, shading.label());
+        }
+    });
+    if state.shading == Shading::Preview {
+        return;
+    }
+    let path = &mut state.path_settings;
+    ui.add(egui::Slider::new(&mut path.bounces, 0..=16).text("bounces"));
+    ui.add(egui::Slider::new(&mut path.shadow_samples, 1..=16).text("shadow samples"));
+    ui.add(egui::Slider::new(&mut state.sample_target, 1..=4096).logarithmic(true).text("samples"));
+    ui.horizontal(|ui| {
+        ui.checkbox(&mut path.sun, "Sun");
+        egui::ComboBox::from_id_salt("sky").selected_text(format!("sky: {:?}", path.sky)).show_ui(ui, |ui| {
+            for sky in [Sky::Gradient, Sky::White, Sky::Black] {
+                ui.selectable_value(&mut path.sky, sky, format!("{sky:?}"));
+            }
+        });
+    });
+    ui.horizontal(|ui| {
+        ui.radio_value(&mut path.effects, EffectsChoice::Auto, "effects: auto");
+        ui.radio_value(&mut path.effects, EffectsChoice::All, "all");
+    });
 }
 
 fn stats(ui: &mut egui::Ui, info: &Info) {
@@ -267,6 +297,12 @@ fn stats(ui: &mut egui::Ui, info: &Info) {
         row("trace", format!("{:.2} ms ({trace})", s.trace_ms));
         row("present", format!("{:.2} ms", s.present_ms));
         row("scale", format!("{:.2}{}", s.scale, if s.moving { " (moving)" } else { "" }));
+        if let Some(path) = &s.path {
+            let effects = path.effects.names();
+            row("effects", if effects.is_empty() { "none".into() } else { effects.join(" ") });
+            row("samples", format!("{}", path.samples));
+            row("per sample", format!("{:.2} ms", s.trace_ms));
+        }
         row("voxels", format!("{}", tree.solid_voxels()));
         row("nodes", format!("{} + {} bricks", tree.node_count(), tree.brick_count()));
         row("pool", format!("{} bytes", pool.live_bytes()));

@@ -32,6 +32,8 @@ pub struct PathFrame {
     pub effects: Effects,
     /// Emissive cells sampled as lights.
     pub lights: usize,
+    /// Whether this call added a sample (none once `sample_target` is reached).
+    pub added: bool,
 }
 
 /// What an accumulation is of: a change restarts it.
@@ -53,6 +55,9 @@ pub struct Renderer {
     path_key: Option<PathKey>,
     path_samples: u32,
     path_lights: usize,
+    /// The accumulation stops growing at this many samples (the window's
+    /// resting view); headless renders leave it unbounded.
+    pub sample_target: u32,
     /// Whether frames write the per-pixel hit records that
     /// [`Renderer::read_hits`] returns; off by default, as they cost time.
     pub hit_records: bool,
@@ -76,6 +81,7 @@ impl Renderer {
             path_key: None,
             path_samples: 0,
             path_lights: 0,
+            sample_target: u32::MAX,
             hit_records: false,
             records_written: false,
         })
@@ -192,6 +198,10 @@ impl Renderer {
                 self.path_samples = 0;
                 self.path_key = Some(key);
             }
+            if self.path_samples >= self.sample_target && self.shown == Shown::Path {
+                let lights = self.path_lights;
+                return Ok(PathFrame { ms: 0.0, samples: self.path_samples, effects, lights, added: false });
+            }
             let (sky_horizon, sky_zenith) = settings.sky.colors();
             let path = PathUniforms {
                 sky_horizon,
@@ -211,7 +221,7 @@ impl Renderer {
             let ms = self.timer.submit_and_measure(gpu, encoder)?;
             self.path_samples += 1;
             self.shown = Shown::Path;
-            Ok(PathFrame { ms, samples: self.path_samples, effects, lights: self.path_lights })
+            Ok(PathFrame { ms, samples: self.path_samples, effects, lights: self.path_lights, added: true })
         })
     }
 

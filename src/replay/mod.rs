@@ -48,6 +48,8 @@ pub enum Command {
     ExpectCount(u64),
     ExpectWritten(u64),
     ExpectImage(PathBuf, f64),
+    /// The path tracer's effect set for the scene, as names (any order).
+    ExpectEffects(Vec<String>),
 }
 
 /// A parsed command with its 1-based line number.
@@ -96,6 +98,8 @@ impl fmt::Display for Command {
             Command::ExpectCount(n) => write!(f, "expect count {n}"),
             Command::ExpectWritten(n) => write!(f, "expect written <= {n}"),
             Command::ExpectImage(path, tol) => write!(f, "expect image {} {tol}", quoted(path)),
+            Command::ExpectEffects(names) if names.is_empty() => write!(f, "expect effects none"),
+            Command::ExpectEffects(names) => write!(f, "expect effects {}", names.join(" ")),
         }
     }
 }
@@ -127,4 +131,19 @@ pub fn edit_command(tool: Tool, at: IVec3) -> Command {
         Tool::Erase => Command::Remove(at),
         Tool::Paint => Command::Paint(at),
     }
+}
+
+/// `expect effects`: whether the path tracer's effect set for this scene
+/// with `settings` is exactly `want` (in any order), and the set's names.
+pub fn effects_match(
+    scene: &crate::scene::Scene,
+    settings: &crate::settings::PathSettings,
+    want: &[String],
+) -> (bool, Vec<&'static str>) {
+    let names = crate::trace::path::effects_for(&scene.tree, &scene.palette, settings).names();
+    let mut got = names.clone();
+    let mut expected: Vec<&str> = want.iter().map(String::as_str).collect();
+    got.sort_unstable();
+    expected.sort_unstable();
+    (got == expected, names)
 }

@@ -264,7 +264,7 @@ fn parse_brush(c: &mut Cursor) -> Result<Brush, Fail> {
 }
 
 fn parse_expect(c: &mut Cursor) -> Result<Command, Fail> {
-    let what = c.word("voxel, count, written or image")?;
+    let what = c.word("voxel, count, written, image or effects")?;
     Ok(match what.text.as_str() {
         "voxel" => {
             let p = c.position()?;
@@ -291,8 +291,30 @@ fn parse_expect(c: &mut Cursor) -> Result<Command, Fail> {
             };
             Command::ExpectImage(path, tolerance)
         }
-        other => return Err((what.column, format!("expected voxel, count, written or image, found '{other}'"))),
+        "effects" => Command::ExpectEffects(parse_effect_names(c)?),
+        other => {
+            return Err((what.column, format!("expected voxel, count, written, image or effects, found '{other}'")));
+        }
     })
+}
+
+/// `none`, or one or more of the effect names.
+fn parse_effect_names(c: &mut Cursor) -> Result<Vec<String>, Fail> {
+    const NAMES: [&str; 5] = ["sun", "sky", "emit", "metal", "glass"];
+    let first = c.word("effect names (sun, sky, emit, metal, glass) or none")?;
+    if first.text == "none" {
+        return Ok(Vec::new());
+    }
+    let mut names = Vec::new();
+    let mut next = Some(first);
+    while let Some(token) = next {
+        if !NAMES.contains(&token.text.as_str()) {
+            return Err((token.column, format!("expected an effect (sun, sky, emit, metal, glass), found '{}'", token.text)));
+        }
+        names.push(token.text);
+        next = c.optional();
+    }
+    Ok(names)
 }
 
 #[cfg(test)]

@@ -186,6 +186,10 @@ impl Runner {
                 return Ok(check(got <= *limit, format!("at most {limit} bytes written"), || format!("{got} bytes")));
             }
             Command::ExpectImage(path, tolerance) => return self.expect_image(&resolve(path), *tolerance),
+            Command::ExpectEffects(want) => {
+                let (ok, got) = super::effects_match(&self.scene, &crate::settings::PathSettings::default(), want);
+                return Ok(check(ok, format!("effects [{}]", want.join(" ")), || format!("[{}]", got.join(" "))));
+            }
         }
         Ok(StepResult::Done)
     }
