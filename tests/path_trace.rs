@@ -259,3 +259,55 @@ fn gpu_and_cpu_path_tracers_agree() {
     let differing = cpu.iter().zip(&gpu).filter(|(a, b)| (**a - **b).abs().max_element() > 0.02).count();
     assert!(differing * 20 <= cpu.len(), "{differing} of {} pixels differ by more than 0.02", cpu.len());
 }
+
+fn all_finite(pixels: &[Vec3]) -> bool {
+    pixels.iter().all(|p| p.is_finite() && p.min_element() >= 0.0)
+}
+
+#[test]
+fn no_nan_or_infinity_from_the_hard_case_cameras() {
+    // Every effect on, cameras inside solid voxels, on boundaries, grazing,
+    // from below and a million voxels away.
+    let (mut tree, palette) = material_scene();
+    let (lo, hi) = tree.solid_bounds().unwrap();
+    let mut cameras = common::cameras_for(lo, hi);
+    cameras.push(look(DVec3::new(1.0e6, 3.0e5, -2.0e5), DVec3::new(0.0, 0.0, 0.0)));
+    // On the floor's top plane, grazing along it; inside a solid voxel; on
+    // an edge of the lattice inside the glass.
+    cameras.push(look(DVec3::new(0.0, 0.0, 0.0), DVec3::new(0.0, 0.0, 5.0)));
+    cameras.push(look(DVec3::new(0.5, -1.5, 0.5), DVec3::new(3.0, 2.0, 1.0)));
+    cameras.push(look(DVec3::new(4.0, 3.0, -1.0), DVec3::new(-4.0, 3.0, 8.0)));
+    let settings = PathSettings { bounces: 6, shadow_samples: 2, ..PathSettings::default() };
+    let mut renderer = Renderer::headless().expect("a GPU adapter (lavapipe on CI)");
+    renderer.sync(&mut tree, &palette);
+    for (i, camera) in cameras.iter().enumerate() {
+        let (cpu, _) = render_cpu(&tree, &palette, camera, (24, 18), &settings, 2);
+        assert!(all_finite(&cpu), "camera {i}: the CPU's accumulation holds NaN, infinity or a negative");
+        for sample in 0..2 {
+            renderer.render_path(&tree, &palette, camera, (24, 18), &settings, sample == 0).unwrap();
+        }
+        let gpu = renderer.read_radiance().unwrap();
+        assert!(all_finite(&gpu), "camera {i}: the GPU's accumulation holds NaN, infinity or a negative");
+    }
+}
+
+#[test]
+fn a_scene_of_255_emissive_materials_renders() {
+    let mut palette = palette();
+    for index in 1..=255u8 {
+        palette.materials[usize::from(index)] = material(MaterialKind::Emit, &[("_emit", "1"), ("_flux", "4")]);
+    }
+    let mut edits = vec![(Shape::Box { min: IVec3::new(0, -1, 0), max: IVec3::new(31, -1, 31) }, Op::Place(1))];
+    for index in 1..=255i32 {
+        edits.push((Shape::Voxel(IVec3::new(index % 16 * 2, index / 16 * 2, 4)), Op::Place(index as u8)));
+    }
+    let mut tree = build(&edits);
+    let camera = look(DVec3::new(16.0, 20.0, 40.0), DVec3::new(16.0, 10.0, 4.0));
+    let settings = PathSettings::default();
+    let (gpu, effects) = render_gpu(&mut tree, &palette, &camera, (32, 24), &settings, 2);
+    assert!(effects.emit);
+    assert!(all_finite(&gpu));
+    let lights = octovox::trace::path::lights::emitters(&tree, &palette);
+    assert!(lights.len() >= 255, "{} lights", lights.len());
+    assert!(mean(&gpu).min_element() > 0.1, "{}", mean(&gpu));
+}

@@ -98,3 +98,34 @@ fn a_missing_script_file_is_an_error_not_a_panic() {
     assert!(!out.status.success());
     assert!(text.contains("cannot read script"), "{text}");
 }
+
+#[test]
+fn the_effect_set_follows_edits_and_undo() {
+    // A diffuse scene whose palette also holds a glass entry (index 9).
+    let dir = tempfile::tempdir().unwrap();
+    let mut scene = octovox::scene::Scene::default();
+    let mut glass = octovox::scene::Material::new(octovox::scene::MaterialKind::Glass);
+    glass.params.insert("_ri".into(), "1.5".into());
+    scene.palette.materials[9] = glass;
+    scene.tree.apply_brush(&octovox::scene::Shape::Voxel(glam::IVec3::ZERO), octovox::scene::Op::Place(3)).unwrap();
+    let vox = dir.path().join("diffuse.vox");
+    octovox::io::save_scene(&vox, &scene, Default::default()).unwrap();
+    let script = "load diffuse.vox\nexpect effects sun sky\ncolor 9\nplace 0 1 0\nexpect effects sun sky glass\n\
+                  undo\nexpect effects sun sky\nredo\nremove 0 1 0\nexpect effects sky sun\n";
+    let path = dir.path().join("effects.ovr");
+    std::fs::write(&path, script).unwrap();
+    for mode in [&["replay"][..], &["replay", "--cpu"][..]] {
+        let mut args = mode.to_vec();
+        args.push(path.to_str().unwrap());
+        let out = octovox(&args);
+        let text = stdout(&out);
+        assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
+        assert!(text.contains("4 passed, 0 failed"), "{text}");
+    }
+    // A wrong expectation fails with both sets named.
+    std::fs::write(&path, "load diffuse.vox\nexpect effects sun sky glass\n").unwrap();
+    let out = octovox(&["replay", "--cpu", path.to_str().unwrap()]);
+    let text = stdout(&out);
+    assert!(!out.status.success());
+    assert!(text.contains("expected effects [sun sky glass], got [sun sky]"), "{text}");
+}
