@@ -195,7 +195,43 @@ fn pick_emitter(u0: f32) -> u32 {
     return lo;
 }
 
-fn emitter_light(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+// The reflectance a light sample is weighted by (twin of `Lobe`).
+struct Lobe {
+    glossy: bool,
+    alpha: f32,
+    f0: vec3<f32>,
+    v: vec3<f32>,
+}
+
+fn diffuse_lobe() -> Lobe {
+    return Lobe(false, 1.0, vec3<f32>(0.0), vec3<f32>(0.0));
+}
+
+fn glossy_lobe(v: vec3<f32>, albedo: vec3<f32>, m: Material) -> Lobe {
+    return Lobe(true, m.roughness * m.roughness, mix(vec3<f32>(0.04), albedo, m.metalness), v);
+}
+
+fn lobe_eval(lobe: Lobe, n: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
+    if (!lobe.glossy) {
+        return vec3<f32>(1.0 / PI);
+    }
+    let h = normalize(lobe.v + l);
+    let cos_v = dot(n, lobe.v);
+    let cos_l = dot(n, l);
+    let cos_h = dot(n, h);
+    if (cos_v <= 0.0 || cos_l <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let a2 = lobe.alpha * lobe.alpha;
+    let k = cos_h * cos_h * (a2 - 1.0) + 1.0;
+    let ggx = a2 / (PI * k * k);
+    let g = smith_g1(cos_v, lobe.alpha) * smith_g1(cos_l, lobe.alpha);
+    let x = 1.0 - max(dot(lobe.v, h), 0.0);
+    let fresnel = lobe.f0 + (vec3<f32>(1.0) - lobe.f0) * (x * x * x * x * x);
+    return fresnel * (ggx * g / (4.0 * cos_v * cos_l));
+}
+
+fn emitter_light(p: vec3<f32>, n: vec3<f32>, lobe: Lobe) -> vec3<f32> {
     let u0 = rng_next();
     let u1 = rng_next();
     let u2 = rng_next();
@@ -246,28 +282,28 @@ fn emitter_light(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let size = f32(e.size);
     let pdf = (e.cdf - before) / emitters[pu.emitter_count - 1u].cdf / (f32(faces) * size * size);
     let radiance = albedo_of(e.index) * materials[e.index].emission;
-    return radiance * (cos_s * cos_l / (PI * dist2 * pdf));
+    return radiance * lobe_eval(lobe, n, l) * (cos_s * cos_l / (dist2 * pdf));
 }
 
-// Light arriving at a diffuse point, times 1/pi.
-fn direct(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+// Light reflected at p by `lobe` toward the path (twin of `direct`).
+fn direct(p: vec3<f32>, n: vec3<f32>, lobe: Lobe) -> vec3<f32> {
     var light = vec3<f32>(0.0);
     if (SUN) {
         let samples = max(pu.shadow_samples, 1u);
-        var sum = 0.0;
+        var sum = vec3<f32>(0.0);
         for (var k = 0u; k < samples; k++) {
             let u1 = rng_next();
             let u2 = rng_next();
             let l = cone_direction(SUN_DIR, SUN_COS, u1, u2);
             let c = dot(n, l);
             if (c > 0.0 && !cross_medium(make_ray(p, l), 0u).found) {
-                sum += SUN_IRRADIANCE * c / PI;
+                sum += SUN_IRRADIANCE * c * lobe_eval(lobe, n, l);
             }
         }
-        light += vec3<f32>(sum / f32(samples));
+        light += sum / f32(samples);
     }
     if (EMIT && pu.emitter_count > 0u) {
-        light += emitter_light(p, n);
+        light += emitter_light(p, n, lobe);
     }
     return light;
 }
@@ -399,16 +435,21 @@ fn radiance(ray_in: Ray) -> vec3<f32> {
             let albedo = albedo_of(value);
             let p_spec = 0.5 + 0.5 * m.metalness;
             if (rng_next() < p_spec) {
+                let lobe = glossy_lobe(-d, albedo, m);
+                let sampled = lobe.alpha >= MIN_SAMPLED_ALPHA;
+                if (sampled) {
+                    radiance += beta * direct(p, n, lobe) / p_spec;
+                }
                 let s = metal_lobe(d, n, albedo, m);
                 if (!s.ok) {
                     return radiance;
                 }
                 dir = s.dir;
                 beta *= s.weight / p_spec;
-                lights_counted = false;
+                lights_counted = sampled;
             } else {
                 let diffuse = albedo * (1.0 - m.metalness) / (1.0 - p_spec);
-                radiance += beta * diffuse * direct(p, n);
+                radiance += beta * diffuse * direct(p, n, diffuse_lobe());
                 let u1 = rng_next();
                 let u2 = rng_next();
                 dir = cosine_direction(n, u1, u2);
@@ -418,7 +459,7 @@ fn radiance(ray_in: Ray) -> vec3<f32> {
         } else {
             bounces += 1u;
             let albedo = albedo_of(value);
-            radiance += beta * albedo * direct(p, n);
+            radiance += beta * albedo * direct(p, n, diffuse_lobe());
             let u1 = rng_next();
             let u2 = rng_next();
             dir = cosine_direction(n, u1, u2);

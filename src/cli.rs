@@ -148,6 +148,9 @@ pub struct ImportArgs {
 pub struct RenderArgs {
     /// A .vox file; without it, the built-in demo scene.
     pub file: Option<PathBuf>,
+    /// Which built-in scene to render when there is no FILE.
+    #[arg(long, value_enum, conflicts_with = "file")]
+    pub demo: Option<octovox::scene::demo::BuiltIn>,
     #[arg(short, long)]
     pub output: PathBuf,
     #[arg(long, value_parser = parse_size, default_value = "1280x720")]

@@ -257,6 +257,7 @@ fn gpu_and_cpu_path_tracers_agree() {
     let (mc, mg) = (mean(&cpu), mean(&gpu));
     assert!((mc - mg).abs().max_element() < 0.01, "CPU mean {mc}, GPU mean {mg}");
     let differing = cpu.iter().zip(&gpu).filter(|(a, b)| (**a - **b).abs().max_element() > 0.02).count();
+    println!("CPU mean {mc}, GPU mean {mg}, {differing} of {} pixels differ by more than 0.02", cpu.len());
     assert!(differing * 20 <= cpu.len(), "{differing} of {} pixels differ by more than 0.02", cpu.len());
 }
 

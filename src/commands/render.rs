@@ -12,6 +12,7 @@ use octovox::io::output::{OutputKind, check_output};
 use octovox::io::png::save_png;
 use octovox::camera::Camera;
 use octovox::scene::Scene;
+use octovox::scene::demo::BuiltIn;
 use octovox::settings::{RenderSettings, TraceMode, View};
 use octovox::trace::path::{lights, render_cpu, to_image};
 use octovox::trace::grid::DenseGrid;
@@ -28,11 +29,11 @@ const CPU_PATH_BYTES_PER_PIXEL: u64 = 24;
 /// A GPU path-traced render adds the accumulation buffer's readback.
 const GPU_PATH_BYTES_PER_PIXEL: u64 = 28;
 
-/// Opens FILE, or the built-in demo scene when there is none.
-pub fn open_scene(file: Option<&std::path::Path>, frame: usize) -> anyhow::Result<Scene> {
+/// Opens FILE, or a built-in scene when there is none.
+pub fn open_scene(file: Option<&std::path::Path>, frame: usize, demo: Option<BuiltIn>) -> anyhow::Result<Scene> {
     match file {
         Some(path) => octovox::io::load_scene(path, frame).with_context(|| format!("cannot open {}", path.display())),
-        None => Ok(octovox::scene::demo::demo_scene()),
+        None => Ok(demo.unwrap_or_default().scene()),
     }
 }
 
@@ -50,7 +51,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<ExitCode> {
         (false, false) => GPU_BYTES_PER_PIXEL,
     };
     octovox::budget::check(|| format!("a {}x{} render", args.size.0, args.size.1), pixels * per_pixel)?;
-    let mut scene = open_scene(args.file.as_deref(), args.frame)?;
+    let mut scene = open_scene(args.file.as_deref(), args.frame, args.demo)?;
     let camera = camera_or_framing(args.camera, args.fov, &scene);
     let (image, stats) = match args.path.spp {
         Some(spp) => path_traced(&mut scene, &camera, args, spp)?,

@@ -29,6 +29,7 @@ pub fn shared_constants() -> String {
     line("SUN_RADIANCE", "f32", format!("{:?}", path::sun_radiance()));
     line("MAX_SAMPLE_RADIANCE", "f32", format!("{:?}", path::MAX_SAMPLE_RADIANCE));
     line("MAX_TRANSMISSIONS", "u32", format!("{}u", path::MAX_TRANSMISSIONS));
+    line("MIN_SAMPLED_ALPHA", "f32", format!("{:?}", path::MIN_SAMPLED_ALPHA));
     line("MATERIAL_DIFFUSE", "u32", format!("{}u", materials::MATERIAL_DIFFUSE));
     line("MATERIAL_METAL", "u32", format!("{}u", materials::MATERIAL_METAL));
     line("MATERIAL_GLASS", "u32", format!("{}u", materials::MATERIAL_GLASS));

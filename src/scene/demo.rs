@@ -128,3 +128,29 @@ pub fn demo_scene() -> Scene {
     decorate(&mut tree);
     Scene { palette: demo_palette(), tree }
 }
+
+/// The scenes built in, for `--demo` and replay's `demo`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum BuiltIn {
+    /// Rolling terrain with a few shapes (the default).
+    #[default]
+    Terrain,
+    /// A metal floor, a glass pane, a lamp: every effect of the path tracer.
+    Showroom,
+}
+
+impl BuiltIn {
+    pub fn scene(self) -> Scene {
+        match self {
+            BuiltIn::Terrain => demo_scene(),
+            BuiltIn::Showroom => super::showroom::showroom_scene(),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            BuiltIn::Terrain => "terrain",
+            BuiltIn::Showroom => "showroom",
+        }
+    }
+}

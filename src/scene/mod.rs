@@ -8,6 +8,7 @@ pub mod octree;
 pub mod palette;
 pub mod sculpture;
 pub mod shape;
+pub mod showroom;
 
 pub use apply::{EditError, Patch};
 pub use build::BuildError;

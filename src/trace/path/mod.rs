@@ -142,13 +142,20 @@ impl PathScene<'_> {
                 let albedo = self.albedo[usize::from(value)];
                 let p_spec = 0.5 + 0.5 * material.metalness;
                 if rng.next() < p_spec {
+                    let lobe = Lobe::glossy(-d, albedo, &material);
+                    // Lights are sampled for a rough lobe; a sharp one finds
+                    // them by reflection.
+                    let sampled = lobe.alpha >= MIN_SAMPLED_ALPHA;
+                    if sampled {
+                        radiance += beta * self.direct(p, n, &lobe, rng) / p_spec;
+                    }
                     let Some((next, weight)) = metal_lobe(d, n, albedo, &material, rng) else { return radiance };
                     dir = next;
                     beta *= weight / p_spec;
-                    lights_counted = false;
+                    lights_counted = sampled;
                 } else {
                     let albedo = albedo * (1.0 - material.metalness) / (1.0 - p_spec);
-                    radiance += beta * albedo * self.direct(p, n, rng);
+                    radiance += beta * albedo * self.direct(p, n, &Lobe::DIFFUSE, rng);
                     dir = cosine_direction(n, rng.next(), rng.next());
                     beta *= albedo;
                     lights_counted = true;
@@ -156,7 +163,7 @@ impl PathScene<'_> {
             } else {
                 bounces += 1;
                 let albedo = self.albedo[usize::from(value)];
-                radiance += beta * albedo * self.direct(p, n, rng);
+                radiance += beta * albedo * self.direct(p, n, &Lobe::DIFFUSE, rng);
                 dir = cosine_direction(n, rng.next(), rng.next());
                 beta *= albedo;
                 lights_counted = true;
@@ -208,31 +215,32 @@ impl PathScene<'_> {
         (dir.dot(n) < 0.0).then_some((dir, (value, tint)))
     }
 
-    /// Light arriving at a diffuse point, times 1/π: the sun's cone and one
-    /// emissive voxel face, each with a shadow ray.
-    fn direct(&self, p: Vec3, n: Vec3, rng: &mut Rng) -> Vec3 {
+    /// Light reflected at `p` by `lobe` toward the path (for the diffuse
+    /// lobe, before the albedo): the sun's cone and one emissive voxel face,
+    /// each with a shadow ray.
+    fn direct(&self, p: Vec3, n: Vec3, lobe: &Lobe, rng: &mut Rng) -> Vec3 {
         let mut light = Vec3::ZERO;
         if self.effects.sun {
             let samples = self.settings.shadow_samples.max(1);
-            let mut sum = 0.0;
+            let mut sum = Vec3::ZERO;
             for _ in 0..samples {
                 let l = cone_direction(Vec3::from(SUN_DIR), sun_cos(), rng.next(), rng.next());
                 let cos = n.dot(l);
                 if cos > 0.0 && !self.cross(&Ray::new(p, l), 0).found {
-                    sum += SUN_IRRADIANCE * cos / PI;
+                    sum += SUN_IRRADIANCE * cos * lobe.eval(n, l);
                 }
             }
-            light += Vec3::splat(sum / samples as f32);
+            light += sum / samples as f32;
         }
         if self.effects.emit && !self.lights.is_empty() {
-            light += self.emitter_light(p, n, rng);
+            light += self.emitter_light(p, n, lobe, rng);
         }
         light
     }
 
     /// One sample of an emissive cell: a cell picked by power, one of its
     /// faces that faces `p`, a point on it.
-    fn emitter_light(&self, p: Vec3, n: Vec3, rng: &mut Rng) -> Vec3 {
+    fn emitter_light(&self, p: Vec3, n: Vec3, lobe: &Lobe, rng: &mut Rng) -> Vec3 {
         let (u0, u1, u2, u3) = (rng.next(), rng.next(), rng.next(), rng.next());
         let i = lights::pick(&self.lights, u0);
         let light = self.lights[i];
@@ -253,7 +261,7 @@ impl PathScene<'_> {
         let pdf = lights::pick_probability(&self.lights, i) / (faces as f32 * size * size);
         let index = light.index as usize;
         let radiance = self.albedo[index] * self.materials[index].emission;
-        radiance * (cos_s * cos_l / (PI * dist2 * pdf))
+        radiance * lobe.eval(n, l) * (cos_s * cos_l / (dist2 * pdf))
     }
 
     /// What a ray that leaves the scene sees: the sky, and the sun's disk
@@ -269,6 +277,47 @@ impl PathScene<'_> {
             radiance += Vec3::splat(sun_radiance());
         }
         radiance
+    }
+}
+
+/// Lights are sampled at a metal's specular lobe from this GGX alpha up
+/// (roughness 0.1); sharper lobes find them by reflection alone.
+pub const MIN_SAMPLED_ALPHA: f32 = 0.01;
+
+/// The reflectance a light sample is weighted by: Lambert's 1/π (the albedo
+/// applied by the caller), or a metal's GGX lobe seen from `v`.
+struct Lobe {
+    glossy: bool,
+    alpha: f32,
+    f0: Vec3,
+    v: Vec3,
+}
+
+impl Lobe {
+    const DIFFUSE: Lobe = Lobe { glossy: false, alpha: 1.0, f0: Vec3::ZERO, v: Vec3::ZERO };
+
+    fn glossy(v: Vec3, albedo: Vec3, material: &GpuMaterial) -> Lobe {
+        let f0 = Vec3::splat(0.04).lerp(albedo, material.metalness);
+        Lobe { glossy: true, alpha: material.roughness * material.roughness, f0, v }
+    }
+
+    /// The BRDF for light arriving from `l`.
+    fn eval(&self, n: Vec3, l: Vec3) -> Vec3 {
+        if !self.glossy {
+            return Vec3::splat(1.0 / PI);
+        }
+        let h = (self.v + l).normalize();
+        let (cos_v, cos_l, cos_h) = (n.dot(self.v), n.dot(l), n.dot(h));
+        if cos_v <= 0.0 || cos_l <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let a2 = self.alpha * self.alpha;
+        let k = cos_h * cos_h * (a2 - 1.0) + 1.0;
+        let ggx = a2 / (PI * k * k);
+        let g = smith_g1(cos_v, self.alpha) * smith_g1(cos_l, self.alpha);
+        let x = 1.0 - self.v.dot(h).max(0.0);
+        let fresnel = self.f0 + (Vec3::ONE - self.f0) * (x * x * x * x * x);
+        fresnel * (ggx * g / (4.0 * cos_v * cos_l))
     }
 }
 

@@ -1,0 +1,67 @@
+//! The built-in showroom: a polished metal floor, a glass pane, a lamp, a
+//! gold sphere and a red one, between two walls open to the sky. It shows
+//! every effect of the path tracer (`octovox render --demo showroom --spp 64`).
+
+use glam::IVec3;
+
+use super::{Material, MaterialKind, Octree, Op, Palette, Scene, Shape};
+
+const FLOOR: u8 = 1;
+const WALL: u8 = 2;
+const RED_WALL: u8 = 3;
+const GLASS: u8 = 4;
+const LAMP: u8 = 5;
+const RED: u8 = 6;
+const GOLD: u8 = 7;
+const STONE: u8 = 8;
+
+fn material(kind: MaterialKind, params: &[(&str, &str)]) -> Material {
+    let mut m = Material::new(kind);
+    for (key, value) in params {
+        m.params.insert((*key).to_string(), (*value).to_string());
+    }
+    m
+}
+
+fn showroom_palette() -> Palette {
+    let mut palette = Palette::default();
+    let colors: [(u8, [u8; 3]); 8] = [
+        (FLOOR, [190, 192, 200]),
+        (WALL, [232, 228, 220]),
+        (RED_WALL, [190, 70, 60]),
+        (GLASS, [200, 235, 245]),
+        (LAMP, [255, 214, 150]),
+        (RED, [210, 50, 40]),
+        (GOLD, [240, 190, 80]),
+        (STONE, [110, 110, 118]),
+    ];
+    for (index, [r, g, b]) in colors {
+        palette.colors[usize::from(index)] = [r, g, b, 255];
+    }
+    let m = &mut palette.materials;
+    m[usize::from(FLOOR)] = material(MaterialKind::Metal, &[("_metal", "1"), ("_rough", "0.35")]);
+    m[usize::from(GLASS)] = material(MaterialKind::Glass, &[("_ri", "1.5"), ("_trans", "1"), ("_rough", "0")]);
+    m[usize::from(LAMP)] = material(MaterialKind::Emit, &[("_emit", "1"), ("_flux", "1")]);
+    m[usize::from(GOLD)] = material(MaterialKind::Metal, &[("_metal", "1"), ("_rough", "0.2")]);
+    palette
+}
+
+/// The showroom scene.
+pub fn showroom_scene() -> Scene {
+    let mut tree = Octree::default();
+    let edits = [
+        (Shape::Box { min: IVec3::new(0, -1, 0), max: IVec3::new(63, 0, 63) }, FLOOR),
+        (Shape::Box { min: IVec3::new(0, 1, 0), max: IVec3::new(63, 28, 1) }, WALL),
+        (Shape::Box { min: IVec3::new(0, 1, 2), max: IVec3::new(1, 28, 63) }, RED_WALL),
+        (Shape::Box { min: IVec3::new(22, 1, 30), max: IVec3::new(46, 20, 31) }, GLASS),
+        (Shape::Sphere { center: IVec3::new(30, 8, 16), radius: 7 }, RED),
+        (Shape::Sphere { center: IVec3::new(44, 6, 46), radius: 5 }, GOLD),
+        (Shape::Box { min: IVec3::new(12, 1, 44), max: IVec3::new(13, 12, 45) }, STONE),
+        (Shape::Box { min: IVec3::new(10, 13, 42), max: IVec3::new(15, 16, 47) }, LAMP),
+    ];
+    for (shape, color) in edits {
+        // The shapes are fixed and well inside the world limits.
+        let _ = tree.apply_brush(&shape, Op::Place(color));
+    }
+    Scene { palette: showroom_palette(), tree }
+}
