@@ -239,6 +239,8 @@ pub enum BenchKind {
     Edit,
     /// Grid DDA vs SVO frame time at 1700×900.
     Render,
+    /// Path tracer time per sample: kernel per scene's effects vs all effects.
+    Effects,
 }
 
 /// Parses "WxH".

@@ -12,6 +12,7 @@ fn every_bench_runs_and_writes_its_tables() {
         ("build", &["torus64", "teapot256", "nefertiti512", "sculpture10M"][..]),
         ("edit", &["one voxel", "sphere r = 8", "sphere r = 32"][..]),
         ("render", &["torus64", "teapot256", "nefertiti512", "sculpture10M"][..]),
+        ("effects", &["terrain (diffuse only)", "showroom (mixed)", "interior (emissive, closed)"][..]),
     ] {
         let run = Command::new(env!("CARGO_BIN_EXE_octovox"))
             .args(["bench", kind, "--quick", "--out"])
@@ -26,4 +27,24 @@ fn every_bench_runs_and_writes_its_tables() {
         }
         assert!(json.trim_start().starts_with('['), "{json}");
     }
+}
+
+#[test]
+fn specialised_kernels_draw_the_same_images_as_the_full_one() {
+    let out = tempfile::tempdir().unwrap();
+    let run = Command::new(env!("CARGO_BIN_EXE_octovox"))
+        .args(["bench", "effects", "--quick", "--out"])
+        .arg(out.path())
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.path().join("effects.json")).unwrap()).unwrap();
+    let rows = json.as_array().unwrap();
+    assert_eq!(rows.len(), 3);
+    for row in rows {
+        assert_eq!(row["pixels_differing"], 0, "{row}");
+    }
+    assert_eq!(rows[0]["effects_auto"], serde_json::json!(["sun", "sky"]));
+    assert_eq!(rows[2]["effects_auto"], serde_json::json!(["sun", "sky", "emit"]));
 }

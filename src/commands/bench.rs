@@ -1,4 +1,4 @@
-//! `octovox bench build|edit|render`: the numbers the issues ask for,
+//! `octovox bench build|edit|render` (and `effects`, in `bench_effects`): the numbers the issues ask for,
 //! printed and written to docs/bench/ as markdown and JSON.
 
 use std::path::{Path, PathBuf};
@@ -68,7 +68,7 @@ fn build(source: &Source) -> anyhow::Result<Octree> {
     })
 }
 
-fn median(mut samples: Vec<f64>) -> f64 {
+pub(super) fn median(mut samples: Vec<f64>) -> f64 {
     samples.sort_by(f64::total_cmp);
     samples[samples.len() / 2]
 }
@@ -78,6 +78,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<ExitCode> {
         BenchKind::Build => bench_build(args.quick)?,
         BenchKind::Edit => bench_edit(args.quick)?,
         BenchKind::Render => bench_render(args.quick)?,
+        BenchKind::Effects => super::bench_effects::bench_effects(args.quick)?,
     };
     say!("{markdown}")?;
     let name = format!("{:?}", args.what).to_lowercase();
@@ -89,7 +90,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn header(title: &str) -> String {
+pub(super) fn header(title: &str) -> String {
     format!(
         "# {title}\n\nMeasured by `octovox bench` on {} ({} cores), {}.\n\n",
         std::env::consts::ARCH,

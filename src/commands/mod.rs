@@ -10,6 +10,7 @@ macro_rules! say {
 }
 
 mod bench;
+mod bench_effects;
 mod convert;
 mod export;
 mod import;

@@ -137,6 +137,8 @@ pub enum BuiltIn {
     Terrain,
     /// A metal floor, a glass pane, a lamp: every effect of the path tracer.
     Showroom,
+    /// A closed room lit by lamps only.
+    Interior,
 }
 
 impl BuiltIn {
@@ -144,6 +146,7 @@ impl BuiltIn {
         match self {
             BuiltIn::Terrain => demo_scene(),
             BuiltIn::Showroom => super::showroom::showroom_scene(),
+            BuiltIn::Interior => super::showroom::interior_scene(),
         }
     }
 
@@ -151,6 +154,7 @@ impl BuiltIn {
         match self {
             BuiltIn::Terrain => "terrain",
             BuiltIn::Showroom => "showroom",
+            BuiltIn::Interior => "interior",
         }
     }
 }

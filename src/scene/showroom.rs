@@ -65,3 +65,30 @@ pub fn showroom_scene() -> Scene {
     }
     Scene { palette: showroom_palette(), tree }
 }
+
+/// A closed room lit only by three lamps: a wooden floor, white walls, a
+/// table and a stool. No sunlight or sky reaches inside.
+pub fn interior_scene() -> Scene {
+    let mut palette = showroom_palette();
+    palette.colors[usize::from(FLOOR)] = [150, 105, 70, 255];
+    palette.materials[usize::from(FLOOR)] = Material::default();
+    let mut tree = Octree::default();
+    let edits = [
+        (Shape::Box { min: IVec3::new(-1, -1, -1), max: IVec3::new(40, 24, 40) }, Op::Place(WALL)),
+        (Shape::Box { min: IVec3::new(0, 0, 0), max: IVec3::new(39, 23, 39) }, Op::Remove),
+        (Shape::Box { min: IVec3::new(-1, -1, -1), max: IVec3::new(40, -1, 40) }, Op::Paint(FLOOR)),
+        (Shape::Box { min: IVec3::new(-1, 0, 0), max: IVec3::new(-1, 23, 39) }, Op::Paint(RED_WALL)),
+        (Shape::Box { min: IVec3::new(12, 8, 12), max: IVec3::new(27, 9, 27) }, Op::Place(STONE)),
+        (Shape::Box { min: IVec3::new(13, 0, 13), max: IVec3::new(14, 7, 14) }, Op::Place(STONE)),
+        (Shape::Box { min: IVec3::new(25, 0, 25), max: IVec3::new(26, 7, 26) }, Op::Place(STONE)),
+        (Shape::Sphere { center: IVec3::new(30, 3, 8), radius: 3 }, Op::Place(RED)),
+        (Shape::Box { min: IVec3::new(18, 22, 18), max: IVec3::new(21, 23, 21) }, Op::Place(LAMP)),
+        (Shape::Box { min: IVec3::new(4, 10, 34), max: IVec3::new(5, 11, 35) }, Op::Place(LAMP)),
+        (Shape::Box { min: IVec3::new(18, 10, 18), max: IVec3::new(19, 11, 19) }, Op::Place(LAMP)),
+    ];
+    for (shape, op) in edits {
+        // The shapes are fixed and well inside the world limits.
+        let _ = tree.apply_brush(&shape, op);
+    }
+    Scene { palette, tree }
+}
