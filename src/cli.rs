@@ -44,6 +44,12 @@ pub struct WindowArgs {
     /// Start with sun shadows off (the UI can turn them on).
     #[arg(long)]
     pub no_shadows: bool,
+    /// Which built-in scene to open when there is no FILE.
+    #[arg(long, value_enum, conflicts_with = "file")]
+    pub demo: Option<octovox::scene::demo::BuiltIn>,
+    /// Samples the path tracer accumulates once the camera rests (the UI can change it).
+    #[arg(long, default_value_t = octovox::settings::DEFAULT_SAMPLE_TARGET, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub samples: u32,
     /// Preview shading only, the path tracer once the camera rests, or the
     /// path tracer always (the UI can change it).
     #[arg(long, value_enum, default_value_t = octovox::settings::Shading::Rest)]

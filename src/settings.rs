@@ -120,6 +120,10 @@ impl Default for PathSettings {
     }
 }
 
+/// Samples the window accumulates at rest unless told otherwise: noise is
+/// below what 8-bit colour shows on most scenes well before this.
+pub const DEFAULT_SAMPLE_TARGET: u32 = 256;
+
 /// Most bounces and shadow samples accepted.
 pub const MAX_BOUNCES: u32 = 64;
 pub const MAX_SHADOW_SAMPLES: u32 = 64;

@@ -236,3 +236,22 @@ fn a_window_wider_than_8192_pixels_opens_and_draws() {
     let stderr = std::fs::read_to_string(&stderr_path).unwrap_or_default();
     assert!(status.success() && !stderr.contains("panicked"), "{status}: {stderr}");
 }
+
+/// At rest the window path traces: the showroom's effect set is compiled,
+/// the samples accumulate to the target, and the picture is not flat.
+#[test]
+fn the_window_path_traces_the_showroom_at_rest() {
+    for tool in ["Xvfb", "xdotool", "import"] {
+        require_tool(tool);
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (_xvfb, display) = start_xvfb(3);
+    let args = ["--demo", "showroom", "--size", "480x320", "--samples", "6"].map(String::from);
+    let (_app, mut lines, _stderr) = spawn_app(&display, dir.path(), &args);
+    lines.wait_for("octovox: ready", Duration::from_secs(90));
+    let line = lines.wait_for("path: 6 samples", Duration::from_secs(120));
+    assert!(line.contains("effects [sun sky emit metal glass]"), "{line}");
+    let shot = screenshot_x(&display, &dir.path().join("path.png"));
+    let (mean, variance) = grey_stats(&shot, 300, 60, 470, 300);
+    assert!(variance > 100.0 && mean > 20.0, "a flat or black path-traced view: mean {mean}, variance {variance}");
+}

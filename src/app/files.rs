@@ -16,12 +16,16 @@ use super::ui::DialogKind;
 use super::{App, Choice, Loading, Pending, camera_control, first_used_color};
 
 impl App {
-    /// Puts a new scene in place (load, New, start-up) and uploads it whole.
-    pub(super) fn replace_scene(&mut self, scene: Scene, path: Option<PathBuf>) {
-        let line = match &path {
-            Some(path) => octovox::replay::Command::Load(std::fs::canonicalize(path).unwrap_or_else(|_| path.clone())),
-            None if scene.tree.solid_voxels() == 0 => octovox::replay::Command::New,
-            None => octovox::replay::Command::Demo,
+    /// Puts a new scene in place (load, New, a built-in scene) and uploads
+    /// it whole; `source` is the script line that makes it (`load`, `new`,
+    /// `demo`), which the recorder writes.
+    pub(super) fn replace_scene(&mut self, scene: Scene, source: octovox::replay::Command) {
+        let (path, line) = match source {
+            octovox::replay::Command::Load(path) => {
+                let absolute = std::fs::canonicalize(&path).unwrap_or_else(|_| path.clone());
+                (Some(path), octovox::replay::Command::Load(absolute))
+            }
+            line => (None, line),
         };
         self.record(|r| r.scene(line));
         self.scene = scene;
@@ -80,7 +84,7 @@ impl App {
     pub(super) fn perform(&mut self, action: Pending, event_loop: &ActiveEventLoop) {
         match action {
             Pending::New => {
-                self.replace_scene(Scene::default(), None);
+                self.replace_scene(Scene::default(), octovox::replay::Command::New);
                 self.state.camera = Camera { fov_y_deg: self.state.camera.fov_y_deg, ..Camera::default() };
                 // A lone voxel to attach to: an empty scene gives the mouse nothing to hit.
                 let color = self.state.color.max(1);
@@ -183,7 +187,7 @@ impl App {
             Ok(scene) => {
                 let seconds = loading.started.elapsed().as_secs_f64();
                 report!("loaded: {} ({} voxels, {seconds:.2} s)", loading.path.display(), scene.tree.solid_voxels());
-                self.replace_scene(scene, Some(loading.path.clone()));
+                self.replace_scene(scene, octovox::replay::Command::Load(loading.path.clone()));
                 // A camera from the command line wins for the file it came with.
                 let keep_camera = self.args.camera.is_some() && self.args.file.as_ref() == Some(&loading.path);
                 if !keep_camera {

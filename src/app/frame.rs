@@ -153,6 +153,10 @@ impl App {
                 Ok(frame) => {
                     if frame.added {
                         self.stats.trace_ms = frame.ms;
+                        if frame.samples == gfx.renderer.sample_target {
+                            let effects = frame.effects.names().join(" ");
+                            report!("path: {} samples, effects [{effects}]", frame.samples);
+                        }
                     }
                     self.stats.path = Some(frame);
                 }

@@ -185,13 +185,15 @@ impl App {
         app.state.settings.render_scale = app.args.render_scale.clamp(0.25, 1.0);
         app.state.settings.shadows = !app.args.no_shadows;
         app.state.shading = app.args.shading;
+        app.state.sample_target = app.args.samples;
         if let Some((eye, target)) = app.args.camera {
             app.state.camera = Camera { eye, target, fov_y_deg: app.state.camera.fov_y_deg };
         }
         match app.args.file.clone() {
             Some(path) => app.start_loading(path),
             None => {
-                app.replace_scene(octovox::scene::demo::demo_scene(), None);
+                let built_in = app.args.demo.unwrap_or_default();
+                app.replace_scene(built_in.scene(), octovox::replay::Command::Demo(built_in));
                 if app.args.camera.is_none() {
                     app.frame_model();
                 }

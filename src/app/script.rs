@@ -85,8 +85,8 @@ impl App {
         let brush_edit = |at, op| Edit::Brush { shape: brush.shape_at(at), op };
         match line {
             Line::Load(path) => self.start_loading(base.join(path)),
-            Line::New => self.replace_scene(Scene::default(), None),
-            Line::Demo => self.replace_scene(octovox::scene::demo::demo_scene(), None),
+            Line::New => self.replace_scene(Scene::default(), Line::New),
+            Line::Demo(built_in) => self.replace_scene(built_in.scene(), Line::Demo(*built_in)),
             Line::Camera { eye, target, fov } => {
                 let fov_y_deg = fov.unwrap_or(self.state.camera.fov_y_deg);
                 self.execute(Command::SetCamera(Camera { eye: *eye, target: *target, fov_y_deg }), event_loop);

@@ -30,10 +30,6 @@ pub enum BrushKind {
     Box,
 }
 
-/// Samples accumulated at rest by default: noise is below what 8-bit
-/// colour shows on most scenes well before this.
-pub const DEFAULT_SAMPLE_TARGET: u32 = 256;
-
 /// Everything the user chose, as plain data.
 #[derive(Clone, Debug)]
 pub struct EditorState {
@@ -74,7 +70,7 @@ impl Default for EditorState {
             frame_target_ms: super::motion::DEFAULT_TARGET_MS,
             shading: Shading::default(),
             path_settings: PathSettings::default(),
-            sample_target: DEFAULT_SAMPLE_TARGET,
+            sample_target: octovox::settings::DEFAULT_SAMPLE_TARGET,
         }
     }
 }

@@ -23,7 +23,8 @@ pub enum Command {
     Load(PathBuf),
     New,
     /// The built-in demo scene (what the window opens without a file).
-    Demo,
+    /// A built-in scene (`demo` alone: the terrain).
+    Demo(crate::scene::demo::BuiltIn),
     Camera {
         eye: DVec3,
         target: DVec3,
@@ -73,7 +74,8 @@ impl fmt::Display for Command {
         match self {
             Command::Load(path) => write!(f, "load {}", quoted(path)),
             Command::New => write!(f, "new"),
-            Command::Demo => write!(f, "demo"),
+            Command::Demo(crate::scene::demo::BuiltIn::Terrain) => write!(f, "demo"),
+            Command::Demo(built_in) => write!(f, "demo {}", built_in.name()),
             Command::Camera { eye, target, fov } => {
                 write!(f, "camera {} {} {} {} {} {}", eye.x, eye.y, eye.z, target.x, target.y, target.z)?;
                 match fov {

@@ -7,7 +7,9 @@ use glam::{DVec3, IVec3};
 
 use super::{Command, Line, Script};
 use crate::camera::{FOV_RANGE_DEG, check_fov};
+use crate::scene::demo::BuiltIn;
 use crate::scene::shape::MAX_BRUSH_EXTENT;
+use clap::ValueEnum as _;
 use crate::tool::{Brush, Tool};
 
 /// A script that cannot be read or parsed, or a line that failed to run.
@@ -193,7 +195,11 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
     Ok(match name.text.as_str() {
         "load" => Command::Load(c.path()?),
         "new" => Command::New,
-        "demo" => Command::Demo,
+        "demo" => Command::Demo(match c.optional() {
+            None => BuiltIn::Terrain,
+            Some(t) => BuiltIn::from_str(&t.text, true)
+                .map_err(|_| (t.column, format!("expected terrain, showroom or interior, found '{}'", t.text)))?,
+        }),
         "camera" => {
             let mut v = [0.0; 6];
             for (slot, what) in v.iter_mut().zip(["EX", "EY", "EZ", "TX", "TY", "TZ"]) {
@@ -341,13 +347,19 @@ mod tests {
         assert_eq!(errors("expect written < 3"), vec!["expected '<=', found '<' at build.ovr:1:16"]);
         assert_eq!(errors("new extra"), vec!["unexpected 'extra' after the command at build.ovr:1:5"]);
         assert_eq!(errors("click 3 4 smash"), vec!["expected attach, erase or paint, found 'smash' at build.ovr:1:11"]);
+        assert_eq!(errors("demo castle"), vec!["expected terrain, showroom or interior, found 'castle' at build.ovr:1:6"]);
+        assert_eq!(
+            errors("expect effects sun shiny"),
+            vec!["expected an effect (sun, sky, emit, metal, glass), found 'shiny' at build.ovr:1:20"]
+        );
     }
 
     #[test]
     fn every_command_round_trips_through_display() {
         let text = "load a.vox\nnew\ndemo\ncamera 1 2 3 4 5 6.5 40\nviewport 64 48\nbrush voxel\nbrush sphere 3\nbrush box 1 2 3\n\
                     color 7\nplace -1 2 3\nremove 1 2 3\npaint 1 2 -3\nclick 3 4 erase\nundo 2\nredo 1\nsave b.vox\n\
-                    render c.png\nexpect voxel 1 2 3 0\nexpect count 5\nexpect written <= 512\nexpect image c.png 0.01\n";
+                    render c.png\nexpect voxel 1 2 3 0\nexpect count 5\nexpect written <= 512\nexpect image c.png 0.01\n\
+                    demo showroom\nexpect effects sun glass\nexpect effects none\n";
         let script = parse_script(Path::new("t.ovr"), text).unwrap();
         let printed: String = script.lines.iter().map(|l| format!("{}\n", l.command)).collect();
         let again = parse_script(Path::new("t.ovr"), &printed).unwrap();
@@ -355,7 +367,7 @@ mod tests {
             script.lines.iter().map(|l| &l.command).collect::<Vec<_>>(),
             again.lines.iter().map(|l| &l.command).collect::<Vec<_>>()
         );
-        assert_eq!(script.lines.len(), 21);
+        assert_eq!(script.lines.len(), 24);
     }
 
     #[test]

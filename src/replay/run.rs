@@ -135,7 +135,7 @@ impl Runner {
                 self.inputs.push(path);
             }
             Command::New => self.set_scene(Scene::default()),
-            Command::Demo => self.set_scene(crate::scene::demo::demo_scene()),
+            Command::Demo(built_in) => self.set_scene(built_in.scene()),
             Command::Camera { eye, target, fov } => {
                 self.camera = Camera { eye: *eye, target: *target, fov_y_deg: fov.unwrap_or(self.camera.fov_y_deg) };
             }
