@@ -8,7 +8,6 @@ use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::IVec3;
-use octovox::edit::Edit;
 use octovox::scene::{Octree, Op, Shape};
 
 fn teapot_voxels() -> Vec<(IVec3, u8)> {
@@ -44,7 +43,7 @@ fn edit(c: &mut Criterion) {
             b.iter(|| {
                 let op = if remove { Op::Remove } else { Op::Place(2) };
                 remove = !remove;
-                let undo = Edit::Brush { shape, op }.apply(&mut tree);
+                let undo = tree.apply_brush(&shape, op);
                 black_box((undo, tree.pool_mut().flush().byte_count()))
             })
         });

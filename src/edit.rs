@@ -1,12 +1,13 @@
 //! Edits as plain data, and the undo/redo history.
 //!
-//! The mouse, replay scripts and undo all produce an [`Edit`]; applying one is
-//! the single path from "the user wants this" to changed octree slots (which
-//! the node pool then flushes to the GPU).
+//! The mouse, the panels, replay scripts and undo all produce an [`Edit`];
+//! applying one is the single path from "the user wants this" to changed
+//! octree slots (which the node pool then flushes to the GPU) or a changed
+//! palette entry.
 
 use std::collections::VecDeque;
 
-use crate::scene::{EditError, Octree, Op, Patch, Shape};
+use crate::scene::{EditError, Material, Op, Patch, Scene, Shape};
 
 /// One change to the scene.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -15,16 +16,34 @@ pub enum Edit {
     Brush { shape: Shape, op: Op },
     /// Put back cells saved by an earlier edit (what undo sends).
     Restore(Patch),
+    /// Give a palette entry (1..=255) a colour and a material: every voxel of
+    /// that index changes look at once.
+    Palette { index: u8, color: [u8; 4], material: Box<Material> },
 }
 
 impl Edit {
-    /// Applies the edit; returns the edit that undoes it.
-    pub fn apply(&self, tree: &mut Octree) -> Result<Edit, EditError> {
-        let patch = match self {
-            Edit::Brush { shape, op } => tree.apply_brush(shape, *op)?,
-            Edit::Restore(patch) => tree.apply_patch(patch)?,
-        };
-        Ok(Edit::Restore(patch))
+    /// Applies the edit; returns the edit that undoes it. A refused edit
+    /// changes nothing.
+    pub fn apply(&self, scene: &mut Scene) -> Result<Edit, EditError> {
+        match self {
+            Edit::Brush { shape, op } => Ok(Edit::Restore(scene.tree.apply_brush(shape, *op)?)),
+            Edit::Restore(patch) => Ok(Edit::Restore(scene.tree.apply_patch(patch)?)),
+            Edit::Palette { index, color, material } => {
+                if *index == 0 {
+                    return Err(EditError::ZeroColor);
+                }
+                let i = usize::from(*index);
+                let palette = &mut scene.palette;
+                let old_color = std::mem::replace(&mut palette.colors[i], *color);
+                let old_material = std::mem::replace(&mut palette.materials[i], (**material).clone());
+                Ok(Edit::Palette { index: *index, color: old_color, material: Box::new(old_material) })
+            }
+        }
+    }
+
+    /// Whether applying it changes the palette (which then goes to the GPU).
+    pub fn changes_palette(&self) -> bool {
+        matches!(self, Edit::Palette { .. })
     }
 }
 
@@ -62,8 +81,8 @@ impl Default for History {
 
 impl History {
     /// Applies an edit and records it (into the open stroke, if any).
-    pub fn apply(&mut self, tree: &mut Octree, edit: Edit) -> Result<(), EditError> {
-        let inverse = edit.apply(tree)?;
+    pub fn apply(&mut self, scene: &mut Scene, edit: Edit) -> Result<(), EditError> {
+        let inverse = edit.apply(scene)?;
         self.undone.clear();
         match &mut self.stroke {
             Some(stroke) => {
@@ -99,12 +118,12 @@ impl History {
     }
 
     /// Undoes the last step; false when there is none.
-    pub fn undo(&mut self, tree: &mut Octree) -> Result<bool, EditError> {
+    pub fn undo(&mut self, scene: &mut Scene) -> Result<bool, EditError> {
         self.end_stroke();
         let Some(mut step) = self.done.pop_back() else { return Ok(false) };
         self.done_bytes -= step.bytes();
         for inverse in step.inverses.iter().rev() {
-            inverse.apply(tree)?;
+            inverse.apply(scene)?;
         }
         step.inverses.clear();
         self.undone.push(step);
@@ -112,11 +131,11 @@ impl History {
     }
 
     /// Re-applies the last undone step; false when there is none.
-    pub fn redo(&mut self, tree: &mut Octree) -> Result<bool, EditError> {
+    pub fn redo(&mut self, scene: &mut Scene) -> Result<bool, EditError> {
         self.end_stroke();
         let Some(mut step) = self.undone.pop() else { return Ok(false) };
         for edit in &step.edits {
-            step.inverses.push(edit.apply(tree)?);
+            step.inverses.push(edit.apply(scene)?);
         }
         self.push(step);
         Ok(true)
@@ -143,5 +162,8 @@ fn edit_bytes(edit: &Edit) -> usize {
     match edit {
         Edit::Brush { .. } => std::mem::size_of::<Edit>(),
         Edit::Restore(patch) => patch.heap_bytes(),
+        Edit::Palette { material, .. } => {
+            std::mem::size_of::<Edit>() + material.params.iter().map(|(k, v)| k.len() + v.len() + 48).sum::<usize>()
+        }
     }
 }

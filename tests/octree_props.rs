@@ -8,7 +8,7 @@ use glam::IVec3;
 use octovox::edit::{Edit, History};
 use octovox::gpu_pool::Upload;
 use octovox::scene::octree::decode_from_bytes;
-use octovox::scene::{Octree, Op, Shape};
+use octovox::scene::{Octree, Op, Palette, Scene, Shape};
 use proptest::prelude::*;
 
 /// A byte-for-byte copy of the GPU buffers, updated only through flushed ranges.
@@ -101,7 +101,7 @@ proptest! {
         let mut reference = HashMap::new();
         let mut mirror = Mirror::default();
         for (shape, op) in &edits {
-            Edit::Brush { shape: *shape, op: *op }.apply(&mut tree).unwrap();
+            tree.apply_brush(shape, *op).unwrap();
             apply_reference(&mut reference, shape, *op);
             let upload = tree.pool_mut().flush();
             mirror.apply(&tree, &upload);
@@ -116,23 +116,23 @@ proptest! {
         let base: Vec<(IVec3, u8)> = (0..300)
             .map(|i| (IVec3::new(i % 17 - 8, (i / 17) % 5, i % 13 - 6), (i % 7 + 1) as u8))
             .collect();
-        let mut tree = Octree::from_voxels(&base).unwrap();
-        let before = tree.voxels();
-        let (nodes, bricks) = (tree.node_count(), tree.brick_count());
+        let mut scene = Scene { tree: Octree::from_voxels(&base).unwrap(), ..Scene::default() };
+        let before = scene.tree.voxels();
+        let (nodes, bricks) = (scene.tree.node_count(), scene.tree.brick_count());
         let mut history = History::default();
         for (shape, op) in &edits {
-            history.apply(&mut tree, Edit::Brush { shape: *shape, op: *op }).unwrap();
+            history.apply(&mut scene, Edit::Brush { shape: *shape, op: *op }).unwrap();
         }
-        let after = tree.voxels();
-        let after_counts = (tree.node_count(), tree.brick_count());
-        while history.undo(&mut tree).unwrap() {}
-        tree.check_invariants().unwrap();
-        prop_assert_eq!(sorted(tree.voxels()), sorted(before));
-        prop_assert_eq!((tree.node_count(), tree.brick_count()), (nodes, bricks));
-        while history.redo(&mut tree).unwrap() {}
-        tree.check_invariants().unwrap();
-        prop_assert_eq!(sorted(tree.voxels()), sorted(after));
-        prop_assert_eq!((tree.node_count(), tree.brick_count()), after_counts);
+        let after = scene.tree.voxels();
+        let after_counts = (scene.tree.node_count(), scene.tree.brick_count());
+        while history.undo(&mut scene).unwrap() {}
+        scene.tree.check_invariants().unwrap();
+        prop_assert_eq!(sorted(scene.tree.voxels()), sorted(before));
+        prop_assert_eq!((scene.tree.node_count(), scene.tree.brick_count()), (nodes, bricks));
+        while history.redo(&mut scene).unwrap() {}
+        scene.tree.check_invariants().unwrap();
+        prop_assert_eq!(sorted(scene.tree.voxels()), sorted(after));
+        prop_assert_eq!((scene.tree.node_count(), scene.tree.brick_count()), after_counts);
     }
 }
 
@@ -180,30 +180,33 @@ fn duplicate_positions_keep_the_last_value() {
 
 #[test]
 fn edits_far_outside_grow_the_root_and_undo_shrinks_it() {
-    let mut tree = Octree::from_voxels(&[(IVec3::ZERO, 5)]).unwrap();
-    let (origin, depth) = (tree.origin(), tree.depth());
+    let mut scene = Scene { tree: Octree::from_voxels(&[(IVec3::ZERO, 5)]).unwrap(), ..Scene::default() };
+    let (origin, depth) = (scene.tree.origin(), scene.tree.depth());
     let mut history = History::default();
     let far = IVec3::new(-3000, 40, 9000);
-    history.apply(&mut tree, Edit::Brush { shape: Shape::Voxel(far), op: Op::Place(7) }).unwrap();
-    assert_eq!(tree.get(far), 7);
-    assert_eq!(tree.get(IVec3::ZERO), 5);
-    assert!(tree.depth() > depth);
-    history.undo(&mut tree).unwrap();
-    assert_eq!((tree.origin(), tree.depth()), (origin, depth));
-    assert_eq!(tree.get(far), 0);
-    tree.check_invariants().unwrap();
+    history.apply(&mut scene, Edit::Brush { shape: Shape::Voxel(far), op: Op::Place(7) }).unwrap();
+    assert_eq!(scene.tree.get(far), 7);
+    assert_eq!(scene.tree.get(IVec3::ZERO), 5);
+    assert!(scene.tree.depth() > depth);
+    history.undo(&mut scene).unwrap();
+    assert_eq!((scene.tree.origin(), scene.tree.depth()), (origin, depth));
+    assert_eq!(scene.tree.get(far), 0);
+    scene.tree.check_invariants().unwrap();
 }
 
 #[test]
 fn bad_edits_are_refused_without_change() {
-    let mut tree = Octree::from_voxels(&[(IVec3::ZERO, 5)]).unwrap();
+    let mut scene = Scene { tree: Octree::from_voxels(&[(IVec3::ZERO, 5)]).unwrap(), ..Scene::default() };
     let huge = Edit::Brush { shape: Shape::Voxel(IVec3::new(1 << 30, 0, 0)), op: Op::Place(1) };
-    assert!(huge.apply(&mut tree).is_err());
+    assert!(huge.apply(&mut scene).is_err());
     let zero = Edit::Brush { shape: Shape::Voxel(IVec3::ONE), op: Op::Place(0) };
-    assert!(zero.apply(&mut tree).is_err());
+    assert!(zero.apply(&mut scene).is_err());
     let radius = Edit::Brush { shape: Shape::Sphere { center: IVec3::ZERO, radius: 1_000_000_000 }, op: Op::Remove };
-    assert!(radius.apply(&mut tree).unwrap_err().to_string().contains("radius"));
-    assert_eq!(tree.voxels(), vec![(IVec3::ZERO, 5)]);
+    assert!(radius.apply(&mut scene).unwrap_err().to_string().contains("radius"));
+    let palette_zero = Edit::Palette { index: 0, color: [1, 2, 3, 255], material: Box::default() };
+    assert!(palette_zero.apply(&mut scene).is_err());
+    assert_eq!(scene.tree.voxels(), vec![(IVec3::ZERO, 5)]);
+    assert_eq!(scene.palette, Palette::default());
 }
 
 /// Edits on the report's teapot write bytes for the slots they touch, not
@@ -222,7 +225,7 @@ fn teapot_edits_write_only_what_they_touch() {
         (Shape::Sphere { center: wall, radius: 8 }, whole / 100),
     ] {
         for op in [Op::Remove, Op::Place(3), Op::Paint(4)] {
-            Edit::Brush { shape, op }.apply(&mut tree).unwrap();
+            tree.apply_brush(&shape, op).unwrap();
             let written = tree.pool_mut().flush().byte_count();
             assert!(written <= limit, "{shape:?} {op:?} wrote {written} bytes of {whole}");
         }

@@ -7,7 +7,6 @@ mod common;
 
 use glam::{DVec3, IVec3, Vec3};
 use octovox::camera::Camera;
-use octovox::edit::Edit;
 use octovox::scene::{Material, MaterialKind, Octree, Op, Palette, Shape};
 use octovox::settings::{PathSettings, Sky};
 use octovox::gpu::Renderer;
@@ -38,7 +37,7 @@ fn material(kind: MaterialKind, params: &[(&str, &str)]) -> Material {
 fn build(edits: &[(Shape, Op)]) -> Octree {
     let mut tree = Octree::default();
     for (shape, op) in edits {
-        Edit::Brush { shape: *shape, op: *op }.apply(&mut tree).unwrap();
+        tree.apply_brush(shape, *op).unwrap();
     }
     tree
 }

@@ -129,3 +129,38 @@ fn the_effect_set_follows_edits_and_undo() {
     assert!(!out.status.success());
     assert!(text.contains("expected effects [sun sky glass], got [sun sky]"), "{text}");
 }
+
+#[test]
+fn palette_edits_are_undoable_change_the_effects_and_are_saved() {
+    let dir = tempfile::tempdir().unwrap();
+    let script = "new\ncolor 9\nplace 0 0 0\nexpect effects sun sky\n\
+                  material 9 glass _ri 1.5 _trans 1\nexpect effects sun sky glass\n\
+                  rgb 9 10 20 30\nundo 2\nexpect effects sun sky\nredo 2\nexpect effects sun sky glass\nsave out.vox\n";
+    let path = dir.path().join("palette.ovr");
+    std::fs::write(&path, script).unwrap();
+    for mode in [&["replay"][..], &["replay", "--cpu", "--force"][..]] {
+        let mut args = mode.to_vec();
+        args.push(path.to_str().unwrap());
+        let out = octovox(&args);
+        let text = stdout(&out);
+        assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
+        assert!(text.contains("4 passed, 0 failed"), "{text}");
+        let scene = octovox::io::load_scene(&dir.path().join("out.vox"), 0).unwrap();
+        assert_eq!(scene.palette.color(9), [10, 20, 30, 255]);
+        let material = scene.palette.material(9);
+        assert_eq!(material.kind, octovox::scene::MaterialKind::Glass);
+        assert_eq!((material.ior(), material.transparency()), (1.5, 1.0));
+    }
+    // Bad palette lines name their line and column.
+    for (line, message) in [
+        ("material 9 velvet", "expected diffuse, metal, glass, emit or media, found 'velvet'"),
+        ("material 9 metal _shiny 1", "'_shiny' is not a material parameter"),
+        ("material 9 metal _rough", "missing a number for _rough"),
+        ("rgb 0 1 2 3", "palette index 0 is outside 1..=255"),
+        ("rgb 9 1 2 300", "blue 300 is outside 0..=255"),
+    ] {
+        let (out, text) = run_script(&format!("new\n{line}\n"));
+        assert!(!out.status.success(), "{line}");
+        assert!(text.contains(message) && text.contains("bad.ovr:2:"), "{line}: {text}");
+    }
+}

@@ -112,7 +112,7 @@ fn click_attach_save_erase_save_in_a_real_window() {
     let (x, y, top_voxel, _) = stable_pixel(&original.tree, &camera, |v, n| n == IVec3::Y && v.y == hi.y);
     let mut stroked = original.tree.clone();
     let first = octovox::scene::Shape::Voxel(top_voxel + IVec3::Y);
-    octovox::edit::Edit::Brush { shape: first, op: octovox::scene::Op::Place(1) }.apply(&mut stroked).unwrap();
+    stroked.apply_brush(&first, octovox::scene::Op::Place(1)).unwrap();
     let (ex, ey) = same_layer_pixel(&stroked, &camera, (x, y), top_voxel, IVec3::Y);
     eprintln!("stroke from ({x}, {y}) to ({ex}, {ey})");
     xdotool(&display, &["key", "t"]);

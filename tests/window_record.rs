@@ -83,7 +83,8 @@ fn window_plays_a_script_through_the_edit_path() {
         &script,
         "new\ncamera 20 15 25 0 0 0 50\ncolor 9\nbrush box 3 3 3\nplace 0 0 0\nexpect count 27\n\
          brush sphere 1\nremove 1 1 1\nexpect voxel 1 1 1 0\nexpect written <= 1024\nundo\nexpect count 27\n\
-         expect voxel 0 0 0 9\nsave out.vox\n",
+         expect voxel 0 0 0 9\nmaterial 9 metal _rough 0.2 _metal 1\nexpect effects sun sky metal\n\
+         rgb 9 200 100 50\nmaterial 9 emit _emit 1\nundo\nexpect effects sun sky metal\nsave out.vox\n",
     )
     .unwrap();
     let (_xvfb, display) = start_xvfb(1);
@@ -91,7 +92,11 @@ fn window_plays_a_script_through_the_edit_path() {
     let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
     find_window(&display, &mut app, &stderr_path);
     let summary = lines.wait_for("replay:", Duration::from_secs(120));
-    assert_eq!(summary, "replay: 5 passed, 0 failed", "{:?}", lines.seen);
+    assert_eq!(summary, "replay: 7 passed, 0 failed", "{:?}", lines.seen);
     let saved = octovox::io::load_scene(&dir.path().join("out.vox"), 0).unwrap();
     assert_eq!(saved.tree.solid_voxels(), 27);
+    // Palette edits went through the window's edit path, undo included.
+    assert_eq!(saved.palette.color(9), [200, 100, 50, 255]);
+    assert_eq!(saved.palette.material(9).kind, octovox::scene::MaterialKind::Metal);
+    assert_eq!(saved.palette.material(9).roughness(), 0.2);
 }

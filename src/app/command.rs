@@ -49,6 +49,12 @@ pub enum Command {
         x: f64,
         y: f64,
     },
+    /// A palette entry changed in the panel; while `dragging` (a slider or
+    /// the colour picker held), the changes join one undo step.
+    EditPalette {
+        edit: Edit,
+        dragging: bool,
+    },
     Undo,
     Redo,
     SetTool(Tool),

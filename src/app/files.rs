@@ -38,9 +38,6 @@ impl App {
         self.state.color = first_used_color(&self.scene).unwrap_or(self.state.color);
         self.grid_stale = true;
         self.path_stale = true;
-        if let Some(gfx) = &self.gfx {
-            gfx.renderer.buffers.upload_palette(&gfx.renderer.gpu.queue, &self.scene.palette);
-        }
         let upload = self.upload();
         log::info!("scene uploaded: {} bytes", upload.bytes);
         self.update_title();

@@ -107,6 +107,10 @@ impl App {
         for command in commands {
             self.execute(command, event_loop);
         }
+        // A palette control let go without a last change still ends its step.
+        if self.palette_stroke && !ctx.input(|i| i.pointer.any_down()) {
+            self.end_palette_stroke();
+        }
         Some((ctx, full))
     }
 

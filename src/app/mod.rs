@@ -134,6 +134,8 @@ struct App {
     grid_stale: bool,
     /// The voxels or palette changed since the path tracer last looked.
     path_stale: bool,
+    /// A palette control is held: its changes are one undo step.
+    palette_stroke: bool,
     screenshot_requested: bool,
     ready: bool,
     last_frame: Option<Instant>,
@@ -169,6 +171,7 @@ impl App {
             loading: None,
             grid_stale: true,
             path_stale: true,
+            palette_stroke: false,
             screenshot_requested: false,
             ready: false,
             last_frame: None,
@@ -270,7 +273,7 @@ impl App {
     /// Applies an edit the way every edit is applied: `History::apply` on the
     /// octree, then the pool's dirty ranges go to the GPU.
     pub fn apply_edit(&mut self, edit: Edit) -> bool {
-        match self.history.apply(&mut self.scene.tree, edit) {
+        match self.history.apply(&mut self.scene, edit) {
             Ok(()) => {
                 self.after_change("edit");
                 true
@@ -301,14 +304,11 @@ impl App {
         self.request_redraw();
     }
 
-    /// Flushes the pool's dirty ranges (only those) to the GPU buffers.
+    /// Flushes the pool's dirty ranges (only those) and the palette (1 KiB,
+    /// which palette edits change) to the GPU buffers; the stats count the pool.
     fn upload(&mut self) -> UploadStats {
         match &mut self.gfx {
-            Some(gfx) => gfx.renderer.buffers.upload_pool(
-                &gfx.renderer.gpu.device,
-                &gfx.renderer.gpu.queue,
-                &mut self.scene.tree,
-            ),
+            Some(gfx) => gfx.renderer.sync(&mut self.scene.tree, &self.scene.palette),
             // No device yet: the ranges stay dirty and go up with the first frame.
             None => UploadStats::default(),
         }
@@ -331,7 +331,8 @@ impl App {
                 self.apply_edit(edit);
             }
             Command::PointerEdit { phase, tool, x, y } if !busy_loading => self.pointer_edit(phase, tool, x, y),
-            Command::Undo if !busy_loading => match self.history.undo(&mut self.scene.tree) {
+            Command::EditPalette { edit, dragging } if !busy_loading => self.palette_edit(edit, dragging),
+            Command::Undo if !busy_loading => match self.history.undo(&mut self.scene) {
                 Ok(true) => {
                     self.record(|r| r.undo());
                     self.after_change("undo");
@@ -339,7 +340,7 @@ impl App {
                 Ok(false) => self.ui.info("nothing to undo"),
                 Err(err) => self.ui.error(format!("undo failed: {err}")),
             },
-            Command::Redo if !busy_loading => match self.history.redo(&mut self.scene.tree) {
+            Command::Redo if !busy_loading => match self.history.redo(&mut self.scene) {
                 Ok(true) => {
                     self.record(|r| r.redo());
                     self.after_change("redo");
@@ -347,7 +348,11 @@ impl App {
                 Ok(false) => self.ui.info("nothing to redo"),
                 Err(err) => self.ui.error(format!("redo failed: {err}")),
             },
-            Command::Edit(_) | Command::PointerEdit { .. } | Command::Undo | Command::Redo => {
+            Command::Edit(_)
+            | Command::PointerEdit { .. }
+            | Command::EditPalette { .. }
+            | Command::Undo
+            | Command::Redo => {
                 self.ui.info("still loading…");
             }
             Command::SetTool(tool) => self.state.tool = tool,
@@ -429,6 +434,36 @@ impl App {
         Ok(hit.map(|hit| Pick { voxel: hit.voxel, normal: hit.normal, value: hit.value }))
     }
 
+    /// A palette change from the panel, recorded as `rgb`/`material` lines;
+    /// changes while a control is held form one undo step.
+    fn palette_edit(&mut self, edit: Edit, dragging: bool) {
+        let Edit::Palette { index, .. } = &edit else { return };
+        let index = *index;
+        if dragging && !self.palette_stroke {
+            self.history.begin_stroke();
+            self.palette_stroke = true;
+        }
+        let before = (self.scene.palette.color(index), self.scene.palette.material(index).clone());
+        if self.apply_edit(edit) {
+            let after = (self.scene.palette.color(index), self.scene.palette.material(index).clone());
+            self.record(|r| r.palette(index, &before, &after));
+        }
+        if !dragging {
+            self.end_palette_stroke();
+        }
+    }
+
+    /// Closes the undo step of a held palette control.
+    pub(super) fn end_palette_stroke(&mut self) {
+        if std::mem::take(&mut self.palette_stroke) {
+            self.history.end_stroke();
+        }
+        self.record(|r| {
+            r.end_step();
+            Ok(())
+        });
+    }
+
     fn pointer_edit(&mut self, phase: StrokePhase, tool: Tool, x: f64, y: f64) {
         match phase {
             StrokePhase::Begin => {
@@ -495,9 +530,8 @@ impl App {
 
 /// The palette index used most often is a better first colour than 1.
 fn first_used_color(scene: &Scene) -> Option<u8> {
-    let mut counts = [0u64; 256];
-    scene.tree.for_each_solid_cell(|_, size, value| counts[usize::from(value)] += 1u64 << (3 * size.trailing_zeros()));
-    (1..=255u8).max_by_key(|v| counts[usize::from(*v)]).filter(|v| counts[usize::from(*v)] > 0)
+    let counts = scene.tree.counts();
+    counts.present().max_by_key(|v| counts.get(*v))
 }
 
 impl ApplicationHandler for App {
@@ -507,7 +541,6 @@ impl ApplicationHandler for App {
         }
         match self.init_gfx(event_loop) {
             Ok(gfx) => {
-                gfx.renderer.buffers.upload_palette(&gfx.renderer.gpu.queue, &self.scene.palette);
                 self.gfx = Some(gfx);
                 // Whatever was built before the device existed goes up now.
                 self.upload();

@@ -98,6 +98,11 @@ impl App {
                 self.with_player(|p| p.color = *c);
                 self.state.color = *c;
             }
+            Line::Rgb(..) | Line::Material(..) => {
+                if let Some(edit) = octovox::replay::palette_edit(line, &self.scene.palette) {
+                    self.execute(Command::Edit(edit), event_loop);
+                }
+            }
             Line::Place(at) => self.execute(Command::Edit(brush_edit(*at, Op::Place(color))), event_loop),
             Line::Remove(at) => self.execute(Command::Edit(brush_edit(*at, Op::Remove)), event_loop),
             Line::Paint(at) => self.execute(Command::Edit(brush_edit(*at, Op::Paint(color))), event_loop),

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 
 use egui::{Color32, Sense, Stroke, Vec2};
 
-use octovox::scene::{Octree, Palette};
+use octovox::scene::{Material, MaterialKind, Octree, Palette};
 use octovox::settings::{EffectsChoice, Shading, Sky, TraceMode, View};
 
 use super::command::{Choice, Command, Pending};
@@ -102,6 +102,7 @@ pub fn show(ui: &mut egui::Ui, state: &mut EditorState, ui_state: &mut UiState, 
             tools(ui, state);
             ui.separator();
             palette(ui, state, info.palette);
+            material_editor(ui, state.color, info.palette, &mut out);
             ui.separator();
             render(ui, state);
             ui.separator();
@@ -231,6 +232,60 @@ fn palette(ui: &mut egui::Ui, state: &mut EditorState, palette: &Palette) {
         material.params.iter().filter(|(k, _)| k.as_str() != "_type").map(|(k, v)| format!("{k}={v}")).collect();
     if !params.is_empty() {
         ui.small(params.join(" "));
+    }
+}
+
+/// The selected entry's colour, material kind and the parameters the path
+/// tracer reads; every change is an edit (undoable, saved in RGBA/MATL).
+fn material_editor(ui: &mut egui::Ui, index: u8, palette: &Palette, out: &mut Vec<Command>) {
+    let old_color = palette.color(index);
+    let old = palette.material(index);
+    let mut color = Color32::from_rgba_unmultiplied(old_color[0], old_color[1], old_color[2], old_color[3]);
+    let mut material = old.clone();
+    let mut changed = false;
+    ui.horizontal(|ui| {
+        changed |= ui.color_edit_button_srgba(&mut color).changed();
+        egui::ComboBox::from_id_salt("material kind").selected_text(material.kind.vox_name().trim_start_matches('_')).show_ui(
+            ui,
+            |ui| {
+                for kind in MaterialKind::ALL {
+                    let label = kind.vox_name().trim_start_matches('_');
+                    changed |= ui.selectable_value(&mut material.kind, kind, label).changed();
+                }
+            },
+        );
+    });
+    let sliders: &[(&str, &str, std::ops::RangeInclusive<f32>)] = match material.kind {
+        MaterialKind::Metal => &[("_rough", "roughness", 0.0..=1.0), ("_metal", "metalness", 0.0..=1.0)],
+        MaterialKind::Glass => {
+            &[("_rough", "roughness", 0.0..=1.0), ("_ri", "refractive index", 1.0..=3.0), ("_trans", "transparency", 0.0..=1.0)]
+        }
+        MaterialKind::Emit => &[("_emit", "emission", 0.0..=1.0), ("_flux", "power", 0.0..=4.0)],
+        MaterialKind::Diffuse | MaterialKind::Media => &[],
+    };
+    for (key, label, range) in sliders {
+        let mut value = material_value(&material, key);
+        if ui.add(egui::Slider::new(&mut value, range.clone()).text(*label)).changed() {
+            material.params.insert((*key).to_string(), format!("{value:.3}"));
+            changed = true;
+        }
+    }
+    if changed {
+        let edit = octovox::edit::Edit::Palette { index, color: color.to_srgba_unmultiplied(), material: Box::new(material) };
+        let dragging = ui.ctx().input(|i| i.pointer.any_down());
+        out.push(Command::EditPalette { edit, dragging });
+    }
+}
+
+/// The value the renderer uses for a MATL key (clamped, defaulted).
+fn material_value(material: &Material, key: &str) -> f32 {
+    match key {
+        "_rough" => material.roughness(),
+        "_metal" => material.metalness(),
+        "_ri" => material.ior(),
+        "_trans" => material.transparency(),
+        "_emit" => material.emission(),
+        _ => material.flux(),
     }
 }
 

@@ -11,7 +11,6 @@ use serde::Serialize;
 
 use crate::cli::{BenchArgs, BenchKind};
 use octovox::camera::Camera;
-use octovox::edit::Edit;
 use octovox::gpu::Renderer;
 use octovox::io::mesh::{DenseVoxels, MESH_COLOR, UpAxis, voxelize_obj};
 use octovox::scene::{Octree, Op, Palette, Scene, Shape, sculpture};
@@ -196,16 +195,13 @@ fn bench_edit(quick: bool) -> anyhow::Result<(String, String)> {
             // Alternate remove and place so each run changes the same cells.
             let op = if i % 2 == 0 { Op::Remove } else { Op::Place(2) };
             let start = Instant::now();
-            let undo = Edit::Brush { shape, op }.apply(&mut tree)?;
+            let patch = tree.apply_brush(&shape, op)?;
             let upload = tree.pool_mut().flush();
             times.push(start.elapsed().as_secs_f64() * 1e6);
             if i == 0 {
                 bytes = upload.byte_count();
                 ranges = upload.nodes.range_count() + upload.bricks.range_count();
-                cells = match undo {
-                    Edit::Restore(patch) => patch.cell_count(),
-                    Edit::Brush { .. } => 0,
-                };
+                cells = patch.cell_count();
             }
         }
         rows.push(EditRow {

@@ -51,6 +51,11 @@ pub enum Command {
     ExpectImage(PathBuf, f64),
     /// The path tracer's effect set for the scene, as names (any order).
     ExpectEffects(Vec<String>),
+    /// `rgb INDEX R G B`: a palette entry's colour (an undoable edit).
+    Rgb(u8, [u8; 3]),
+    /// `material INDEX KIND [KEY VALUE]...`: a palette entry's material,
+    /// with exactly these parameters (an undoable edit).
+    Material(u8, Box<crate::scene::Material>),
 }
 
 /// A parsed command with its 1-based line number.
@@ -100,6 +105,11 @@ impl fmt::Display for Command {
             Command::ExpectCount(n) => write!(f, "expect count {n}"),
             Command::ExpectWritten(n) => write!(f, "expect written <= {n}"),
             Command::ExpectImage(path, tol) => write!(f, "expect image {} {tol}", quoted(path)),
+            Command::Rgb(index, [r, g, b]) => write!(f, "rgb {index} {r} {g} {b}"),
+            Command::Material(index, material) => {
+                write!(f, "material {index} {}", &material.kind.vox_name()[1..])?;
+                material.params.iter().try_for_each(|(key, value)| write!(f, " {key} {value}"))
+            }
             Command::ExpectEffects(names) if names.is_empty() => write!(f, "expect effects none"),
             Command::ExpectEffects(names) => write!(f, "expect effects {}", names.join(" ")),
         }
@@ -148,4 +158,15 @@ pub fn effects_match(
     got.sort_unstable();
     expected.sort_unstable();
     (got == expected, names)
+}
+
+/// The edit a palette line (`rgb`, `material`) makes on `palette`; `None`
+/// for other lines. The replay runner and the window's player both use it.
+pub fn palette_edit(command: &Command, palette: &crate::scene::Palette) -> Option<crate::edit::Edit> {
+    let (index, color, material) = match command {
+        Command::Rgb(index, [r, g, b]) => (*index, [*r, *g, *b, 255], palette.material(*index).clone()),
+        Command::Material(index, material) => (*index, palette.color(*index), (**material).clone()),
+        _ => return None,
+    };
+    Some(crate::edit::Edit::Palette { index, color, material: Box::new(material) })
 }

@@ -222,6 +222,15 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
         "viewport" => Command::Viewport(c.int_in("width", 1..=8192)? as u32, c.int_in("height", 1..=8192)? as u32),
         "brush" => Command::Brush(parse_brush(c)?),
         "color" => Command::Color(c.int_in("palette index", 1..=255)? as u8),
+        "rgb" => {
+            let index = c.int_in("palette index", 1..=255)? as u8;
+            let mut rgb = [0u8; 3];
+            for (slot, what) in rgb.iter_mut().zip(["red", "green", "blue"]) {
+                *slot = c.int_in(what, 0..=255)? as u8;
+            }
+            Command::Rgb(index, rgb)
+        }
+        "material" => parse_material(c)?,
         "place" => Command::Place(c.position()?),
         "remove" => Command::Remove(c.position()?),
         "paint" => Command::Paint(c.position()?),
@@ -304,6 +313,24 @@ fn parse_expect(c: &mut Cursor) -> Result<Command, Fail> {
     })
 }
 
+/// `material INDEX KIND [KEY VALUE]...`: the keys MATL chunks hold as
+/// numbers (`_rough`, `_metal`, `_ri`, `_emit`, …), each with a number.
+fn parse_material(c: &mut Cursor) -> Result<Command, Fail> {
+    let index = c.int_in("palette index", 1..=255)? as u8;
+    let kind_token = c.word("a material kind (diffuse, metal, glass, emit, media)")?;
+    let kind = crate::scene::MaterialKind::from_vox_name(&format!("_{}", kind_token.text.trim_start_matches('_')))
+        .ok_or((kind_token.column, format!("expected diffuse, metal, glass, emit or media, found '{}'", kind_token.text)))?;
+    let mut material = crate::scene::Material::new(kind);
+    while let Some(key) = c.optional() {
+        if !crate::scene::palette::is_numeric_key(&key.text) {
+            return Err((key.column, format!("'{}' is not a material parameter (_rough, _metal, _ri, _trans, _emit, _flux, …)", key.text)));
+        }
+        let value = c.float(&format!("a number for {}", key.text))?;
+        material.params.insert(key.text, value.to_string());
+    }
+    Ok(Command::Material(index, Box::new(material)))
+}
+
 /// `none`, or one or more of the effect names.
 fn parse_effect_names(c: &mut Cursor) -> Result<Vec<String>, Fail> {
     const NAMES: [&str; 5] = ["sun", "sky", "emit", "metal", "glass"];
@@ -359,7 +386,8 @@ mod tests {
         let text = "load a.vox\nnew\ndemo\ncamera 1 2 3 4 5 6.5 40\nviewport 64 48\nbrush voxel\nbrush sphere 3\nbrush box 1 2 3\n\
                     color 7\nplace -1 2 3\nremove 1 2 3\npaint 1 2 -3\nclick 3 4 erase\nundo 2\nredo 1\nsave b.vox\n\
                     render c.png\nexpect voxel 1 2 3 0\nexpect count 5\nexpect written <= 512\nexpect image c.png 0.01\n\
-                    demo showroom\nexpect effects sun glass\nexpect effects none\n";
+                    demo showroom\nexpect effects sun glass\nexpect effects none\nrgb 4 1 2 3\n\
+                    material 4 glass _ri 1.45 _trans 0.5\nmaterial 5 diffuse\n";
         let script = parse_script(Path::new("t.ovr"), text).unwrap();
         let printed: String = script.lines.iter().map(|l| format!("{}\n", l.command)).collect();
         let again = parse_script(Path::new("t.ovr"), &printed).unwrap();
@@ -367,7 +395,7 @@ mod tests {
             script.lines.iter().map(|l| &l.command).collect::<Vec<_>>(),
             again.lines.iter().map(|l| &l.command).collect::<Vec<_>>()
         );
-        assert_eq!(script.lines.len(), 24);
+        assert_eq!(script.lines.len(), 27);
     }
 
     #[test]

@@ -9,6 +9,7 @@ use glam::IVec3;
 
 use super::{Command, edit_command};
 use crate::camera::Camera;
+use crate::scene::Material;
 use crate::tool::{Brush, Tool};
 
 /// Writes script lines as the user works. Lines are flushed as they are
@@ -93,6 +94,27 @@ impl Recorder {
         self.undone.clear();
         self.open_stroke += 1;
         self.command(&edit_command(tool, center))
+    }
+
+    /// A palette edit: an `rgb` line if the colour changed, a `material`
+    /// line if the material did (each one edit of the open step).
+    pub fn palette(
+        &mut self,
+        index: u8,
+        before: &([u8; 4], Material),
+        after: &([u8; 4], Material),
+    ) -> std::io::Result<()> {
+        self.undone.clear();
+        if before.0 != after.0 {
+            self.open_stroke += 1;
+            let [r, g, b, _] = after.0;
+            self.command(&Command::Rgb(index, [r, g, b]))?;
+        }
+        if before.1 != after.1 {
+            self.open_stroke += 1;
+            self.command(&Command::Material(index, Box::new(after.1.clone())))?;
+        }
+        Ok(())
     }
 
     /// Ends an undo step (a click or a whole drag).

@@ -142,6 +142,11 @@ impl Runner {
             Command::Viewport(w, h) => self.viewport = (*w, *h),
             Command::Brush(brush) => self.brush = *brush,
             Command::Color(c) => self.color = *c,
+            Command::Rgb(..) | Command::Material(..) => {
+                if let Some(edit) = super::palette_edit(&line.command, &self.scene.palette) {
+                    self.apply(edit)?;
+                }
+            }
             Command::Place(p) => self.brush_edit(*p, Op::Place(self.color))?,
             Command::Remove(p) => self.brush_edit(*p, Op::Remove)?,
             Command::Paint(p) => self.brush_edit(*p, Op::Paint(self.color))?,
@@ -220,15 +225,15 @@ impl Runner {
 
     /// The one edit path: history → octree → pool flush (→ GPU).
     pub fn apply(&mut self, edit: Edit) -> Result<(), String> {
-        self.history.apply(&mut self.scene.tree, edit).map_err(|e| e.to_string())?;
+        self.history.apply(&mut self.scene, edit).map_err(|e| e.to_string())?;
         self.last_written = Some(self.flush());
         Ok(())
     }
 
     fn repeat(&mut self, n: u32, undo: bool) -> Result<(), String> {
         for _ in 0..n {
-            let tree = &mut self.scene.tree;
-            let did = if undo { self.history.undo(tree) } else { self.history.redo(tree) };
+            let scene = &mut self.scene;
+            let did = if undo { self.history.undo(scene) } else { self.history.redo(scene) };
             if !did.map_err(|e| e.to_string())? {
                 return Err(format!("nothing to {}", if undo { "undo" } else { "redo" }));
             }

@@ -61,13 +61,18 @@ const NUMERIC_PARAMS: [(&str, std::ops::RangeInclusive<f32>, f32); 11] = [
     ("_d", 0.0..=1.0, 0.0),
 ];
 
+/// Whether `key` is a MATL parameter octovox reads as a number.
+pub fn is_numeric_key(key: &str) -> bool {
+    NUMERIC_PARAMS.iter().any(|(k, _, _)| *k == key)
+}
+
 /// One palette entry's material: the kind plus MagicaVoxel's MATL parameters.
 ///
 /// Parameters are kept as the key/value strings of the MATL dictionary
 /// (`_rough`, `_metal`, `_ior`, `_trans`, `_emit`, `_flux`, …) so that a
 /// load → save → load round trip keeps every one, including keys octovox does
 /// not interpret; typed accessors read the ones the renderer uses.
-#[derive(Clone, Debug, PartialEq, Default)]
+#[derive(Clone, Debug, PartialEq, Eq, Default)]
 pub struct Material {
     pub kind: MaterialKind,
     /// MATL dictionary without `_type` (the kind holds that).

@@ -9,7 +9,6 @@ use std::path::PathBuf;
 
 use glam::{DVec3, IVec3};
 use octovox::camera::Camera;
-use octovox::edit::Edit;
 use octovox::scene::{Octree, Op, Shape};
 use octovox::trace::Hit;
 
@@ -38,7 +37,7 @@ pub fn sculpture() -> Octree {
         (Shape::Voxel(IVec3::new(12, 31, -14)), Op::Place(1)),
     ];
     for (shape, op) in edits {
-        Edit::Brush { shape, op }.apply(&mut tree).unwrap();
+        tree.apply_brush(&shape, op).unwrap();
     }
     tree
 }
