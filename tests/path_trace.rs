@@ -3,13 +3,15 @@
 //! kernel against the CPU reference; no NaN anywhere. CPU tests run
 //! everywhere; GPU tests on lavapipe.
 
+#![allow(clippy::unwrap_used)] // in tests a panic is the failure report
+
 mod common;
 
 use glam::{DVec3, IVec3, Vec3};
 use octovox::camera::Camera;
+use octovox::gpu::Renderer;
 use octovox::scene::{Material, MaterialKind, Octree, Op, Palette, Shape};
 use octovox::settings::{PathSettings, Sky};
-use octovox::gpu::Renderer;
 use octovox::trace::path::render_cpu;
 
 const WHITE: u8 = 1;
@@ -170,7 +172,8 @@ fn a_mirror_shows_the_reflected_colour() {
     let mirror = material(MaterialKind::Metal, &[("_rough", "0"), ("_metal", "1")]);
     let mut palette = palette();
     palette.materials[usize::from(SPECIAL)] = mirror;
-    let tree = build(&[(Shape::Box { min: IVec3::new(-40, -1, -40), max: IVec3::new(40, -1, 40) }, Op::Place(SPECIAL))]);
+    let tree =
+        build(&[(Shape::Box { min: IVec3::new(-40, -1, -40), max: IVec3::new(40, -1, 40) }, Op::Place(SPECIAL))]);
     let settings = PathSettings { bounces: 3, sun: false, ..PathSettings::default() };
     let camera = look(DVec3::new(0.5, 10.0, 6.0), DVec3::new(0.5, -1.0, -3.0));
     let size = (16, 16);

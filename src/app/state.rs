@@ -54,7 +54,6 @@ pub struct EditorState {
     pub sample_target: u32,
 }
 
-
 impl Default for EditorState {
     fn default() -> EditorState {
         EditorState {

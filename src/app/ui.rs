@@ -245,21 +245,22 @@ fn material_editor(ui: &mut egui::Ui, index: u8, palette: &Palette, out: &mut Ve
     let mut changed = false;
     ui.horizontal(|ui| {
         changed |= ui.color_edit_button_srgba(&mut color).changed();
-        egui::ComboBox::from_id_salt("material kind").selected_text(material.kind.vox_name().trim_start_matches('_')).show_ui(
-            ui,
-            |ui| {
+        egui::ComboBox::from_id_salt("material kind")
+            .selected_text(material.kind.vox_name().trim_start_matches('_'))
+            .show_ui(ui, |ui| {
                 for kind in MaterialKind::ALL {
                     let label = kind.vox_name().trim_start_matches('_');
                     changed |= ui.selectable_value(&mut material.kind, kind, label).changed();
                 }
-            },
-        );
+            });
     });
     let sliders: &[(&str, &str, std::ops::RangeInclusive<f32>)] = match material.kind {
         MaterialKind::Metal => &[("_rough", "roughness", 0.0..=1.0), ("_metal", "metalness", 0.0..=1.0)],
-        MaterialKind::Glass => {
-            &[("_rough", "roughness", 0.0..=1.0), ("_ri", "refractive index", 1.0..=3.0), ("_trans", "transparency", 0.0..=1.0)]
-        }
+        MaterialKind::Glass => &[
+            ("_rough", "roughness", 0.0..=1.0),
+            ("_ri", "refractive index", 1.0..=3.0),
+            ("_trans", "transparency", 0.0..=1.0),
+        ],
         MaterialKind::Emit => &[("_emit", "emission", 0.0..=1.0), ("_flux", "power", 0.0..=4.0)],
         MaterialKind::Diffuse | MaterialKind::Media => &[],
     };
@@ -271,7 +272,8 @@ fn material_editor(ui: &mut egui::Ui, index: u8, palette: &Palette, out: &mut Ve
         }
     }
     if changed {
-        let edit = octovox::edit::Edit::Palette { index, color: color.to_srgba_unmultiplied(), material: Box::new(material) };
+        let edit =
+            octovox::edit::Edit::Palette { index, color: color.to_srgba_unmultiplied(), material: Box::new(material) };
         let dragging = ui.ctx().input(|i| i.pointer.any_down());
         out.push(Command::EditPalette { edit, dragging });
     }

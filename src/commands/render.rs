@@ -6,16 +6,16 @@ use std::time::Instant;
 use anyhow::Context;
 
 use crate::cli::{RenderArgs, camera_or_framing};
+use octovox::camera::Camera;
 use octovox::gpu::Renderer;
 use octovox::io::atomic::WriteOptions;
 use octovox::io::output::{OutputKind, check_output};
 use octovox::io::png::save_png;
-use octovox::camera::Camera;
 use octovox::scene::Scene;
 use octovox::scene::demo::BuiltIn;
 use octovox::settings::{RenderSettings, TraceMode, View};
-use octovox::trace::path::{lights, render_cpu, to_image};
 use octovox::trace::grid::DenseGrid;
+use octovox::trace::path::{lights, render_cpu, to_image};
 use octovox::trace::render::render_scene_cpu;
 
 /// Peak bytes per pixel of a CPU render: a hit record, a shadow flag, the
@@ -102,7 +102,12 @@ fn preview(scene: &mut Scene, camera: &Camera, args: &RenderArgs) -> anyhow::Res
 }
 
 /// `spp` samples of the path tracer, on the GPU or the CPU reference.
-fn path_traced(scene: &mut Scene, camera: &Camera, args: &RenderArgs, spp: u32) -> anyhow::Result<(image::RgbaImage, Stats)> {
+fn path_traced(
+    scene: &mut Scene,
+    camera: &Camera,
+    args: &RenderArgs,
+    spp: u32,
+) -> anyhow::Result<(image::RgbaImage, Stats)> {
     let settings = args.path.settings();
     if args.cpu {
         let start = Instant::now();

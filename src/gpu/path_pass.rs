@@ -151,7 +151,8 @@ impl PathPass {
         // A binding holds at least one element, even when there are no lights.
         let emitters_buf = storage(device, "emitters", EMITTER_BYTES, wgpu::BufferUsages::empty());
         let target = Self::make_target(device, 1, 1);
-        let parts = BindParts { frame: &frame_buf, path: &path_buf, materials: &materials_buf, emitters: &emitters_buf };
+        let parts =
+            BindParts { frame: &frame_buf, path: &path_buf, materials: &materials_buf, emitters: &emitters_buf };
         let bind_group = make_bind_group(device, &layout, buffers, &parts, &target);
         Ok(PathPass {
             layout,
@@ -214,7 +215,12 @@ impl PathPass {
     /// # Errors
     /// [`GpuError::TooLarge`] when the image or its accumulation buffer
     /// exceed the adapter's limits; the old outputs are kept.
-    pub fn resize(&mut self, gpu: &GpuContext, buffers: &SceneBuffers, (width, height): (u32, u32)) -> Result<bool, GpuError> {
+    pub fn resize(
+        &mut self,
+        gpu: &GpuContext,
+        buffers: &SceneBuffers,
+        (width, height): (u32, u32),
+    ) -> Result<bool, GpuError> {
         let (width, height) = (width.max(1), height.max(1));
         if (width, height) == (self.target.width, self.target.height) {
             return Ok(false);
@@ -235,7 +241,13 @@ impl PathPass {
     }
 
     /// Uploads the material table and the emitter list (on a restart).
-    pub fn upload_scene(&mut self, gpu: &GpuContext, buffers: &SceneBuffers, materials: &[GpuMaterial], lights: &[Emitter]) {
+    pub fn upload_scene(
+        &mut self,
+        gpu: &GpuContext,
+        buffers: &SceneBuffers,
+        materials: &[GpuMaterial],
+        lights: &[Emitter],
+    ) {
         gpu.queue.write_buffer(&self.materials_buf, 0, bytemuck::cast_slice(materials));
         let bytes: &[u8] = bytemuck::cast_slice(lights);
         if bytes.len() as u64 > self.emitters_buf.size() {

@@ -9,8 +9,8 @@ use super::{Command, Line, Script};
 use crate::camera::{FOV_RANGE_DEG, check_fov};
 use crate::scene::demo::BuiltIn;
 use crate::scene::shape::MAX_BRUSH_EXTENT;
-use clap::ValueEnum as _;
 use crate::tool::{Brush, Tool};
+use clap::ValueEnum as _;
 
 /// A script that cannot be read or parsed, or a line that failed to run.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -319,11 +319,17 @@ fn parse_material(c: &mut Cursor) -> Result<Command, Fail> {
     let index = c.int_in("palette index", 1..=255)? as u8;
     let kind_token = c.word("a material kind (diffuse, metal, glass, emit, media)")?;
     let kind = crate::scene::MaterialKind::from_vox_name(&format!("_{}", kind_token.text.trim_start_matches('_')))
-        .ok_or((kind_token.column, format!("expected diffuse, metal, glass, emit or media, found '{}'", kind_token.text)))?;
+        .ok_or((
+            kind_token.column,
+            format!("expected diffuse, metal, glass, emit or media, found '{}'", kind_token.text),
+        ))?;
     let mut material = crate::scene::Material::new(kind);
     while let Some(key) = c.optional() {
         if !crate::scene::palette::is_numeric_key(&key.text) {
-            return Err((key.column, format!("'{}' is not a material parameter (_rough, _metal, _ri, _trans, _emit, _flux, …)", key.text)));
+            return Err((
+                key.column,
+                format!("'{}' is not a material parameter (_rough, _metal, _ri, _trans, _emit, _flux, …)", key.text),
+            ));
         }
         let value = c.float(&format!("a number for {}", key.text))?;
         material.params.insert(key.text, value.to_string());
@@ -342,7 +348,10 @@ fn parse_effect_names(c: &mut Cursor) -> Result<Vec<String>, Fail> {
     let mut next = Some(first);
     while let Some(token) = next {
         if !NAMES.contains(&token.text.as_str()) {
-            return Err((token.column, format!("expected an effect (sun, sky, emit, metal, glass), found '{}'", token.text)));
+            return Err((
+                token.column,
+                format!("expected an effect (sun, sky, emit, metal, glass), found '{}'", token.text),
+            ));
         }
         names.push(token.text);
         next = c.optional();
@@ -374,7 +383,10 @@ mod tests {
         assert_eq!(errors("expect written < 3"), vec!["expected '<=', found '<' at build.ovr:1:16"]);
         assert_eq!(errors("new extra"), vec!["unexpected 'extra' after the command at build.ovr:1:5"]);
         assert_eq!(errors("click 3 4 smash"), vec!["expected attach, erase or paint, found 'smash' at build.ovr:1:11"]);
-        assert_eq!(errors("demo castle"), vec!["expected terrain, showroom or interior, found 'castle' at build.ovr:1:6"]);
+        assert_eq!(
+            errors("demo castle"),
+            vec!["expected terrain, showroom or interior, found 'castle' at build.ovr:1:6"]
+        );
         assert_eq!(
             errors("expect effects sun shiny"),
             vec!["expected an effect (sun, sky, emit, metal, glass), found 'shiny' at build.ovr:1:20"]

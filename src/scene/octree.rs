@@ -45,7 +45,13 @@ impl Default for Octree {
 impl Octree {
     /// An empty tree whose root cube starts at `origin` with `2^depth` voxels per side.
     pub fn empty(origin: IVec3, depth: u32) -> Octree {
-        Octree { pool: NodePool::default(), root: 0, origin, depth: depth.clamp(MIN_DEPTH, MAX_DEPTH), counts: VoxelCounts::default() }
+        Octree {
+            pool: NodePool::default(),
+            root: 0,
+            origin,
+            depth: depth.clamp(MIN_DEPTH, MAX_DEPTH),
+            counts: VoxelCounts::default(),
+        }
     }
 
     pub fn pool(&self) -> &NodePool {

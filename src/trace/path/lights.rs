@@ -29,7 +29,8 @@ pub struct Emitter {
 /// The lights of a scene: empty when it has no emitters or more than
 /// [`MAX_EMITTERS`] emissive cells.
 pub fn emitters(tree: &Octree, palette: &Palette) -> Vec<Emitter> {
-    let emissive: Vec<u8> = tree.counts().present().filter(|i| gpu_material(palette, *i).kind == MATERIAL_EMIT).collect();
+    let emissive: Vec<u8> =
+        tree.counts().present().filter(|i| gpu_material(palette, *i).kind == MATERIAL_EMIT).collect();
     if emissive.is_empty() {
         return Vec::new();
     }

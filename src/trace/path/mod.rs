@@ -87,7 +87,7 @@ impl PathScene<'_> {
     /// One sample of pixel (x, y): the radiance, finite and clamped.
     pub fn sample(&self, basis: &RayBasis, x: u32, y: u32, sample: u32) -> Vec3 {
         let mut rng = Rng::new(y * basis.width + x, sample);
-        let (jx, jy) = (rng.next(), rng.next());
+        let (jx, jy) = (rng.uniform(), rng.uniform());
         let (origin, dir) = basis.ray_through(x as f32 + jx, y as f32 + jy);
         clamp_sample(self.radiance(Ray::new(origin, dir), &mut rng))
     }
@@ -129,7 +129,7 @@ impl PathScene<'_> {
                     radiance += beta * self.albedo[usize::from(value)] * material.emission;
                 }
                 return radiance;
-            } else if self.effects.glass && material.kind == MATERIAL_GLASS && rng.next() < material.transparency {
+            } else if self.effects.glass && material.kind == MATERIAL_GLASS && rng.uniform() < material.transparency {
                 transmissions += 1;
                 let Some((next, to)) = self.interface(d, n, medium, value, rng) else { return radiance };
                 (dir, medium) = (next, to.0);
@@ -141,7 +141,7 @@ impl PathScene<'_> {
                 bounces += 1;
                 let albedo = self.albedo[usize::from(value)];
                 let p_spec = 0.5 + 0.5 * material.metalness;
-                if rng.next() < p_spec {
+                if rng.uniform() < p_spec {
                     let lobe = Lobe::glossy(-d, albedo, &material);
                     // Lights are sampled for a rough lobe; a sharp one finds
                     // them by reflection.
@@ -156,7 +156,7 @@ impl PathScene<'_> {
                 } else {
                     let albedo = albedo * (1.0 - material.metalness) / (1.0 - p_spec);
                     radiance += beta * albedo * self.direct(p, n, &Lobe::DIFFUSE, rng);
-                    dir = cosine_direction(n, rng.next(), rng.next());
+                    dir = cosine_direction(n, rng.uniform(), rng.uniform());
                     beta *= albedo;
                     lights_counted = true;
                 }
@@ -164,7 +164,7 @@ impl PathScene<'_> {
                 bounces += 1;
                 let albedo = self.albedo[usize::from(value)];
                 radiance += beta * albedo * self.direct(p, n, &Lobe::DIFFUSE, rng);
-                dir = cosine_direction(n, rng.next(), rng.next());
+                dir = cosine_direction(n, rng.uniform(), rng.uniform());
                 beta *= albedo;
                 lights_counted = true;
             }
@@ -195,7 +195,7 @@ impl PathScene<'_> {
         let material = self.materials[usize::from(glass)];
         let ior = |index: u8| if index == 0 { 1.0 } else { self.materials[usize::from(index)].ior };
         let alpha = material.roughness * material.roughness;
-        let (u1, u2) = (rng.next(), rng.next());
+        let (u1, u2) = (rng.uniform(), rng.uniform());
         let mut h = if alpha > 1e-4 { ggx_half_vector(n, alpha, u1, u2) } else { n };
         if h.dot(d) >= 0.0 {
             h = n;
@@ -204,7 +204,7 @@ impl PathScene<'_> {
         let cos_i = -d.dot(h);
         let sin2_t = eta * eta * (1.0 - cos_i * cos_i).max(0.0);
         let fresnel = if sin2_t >= 1.0 { 1.0 } else { fresnel_dielectric(cos_i, (1.0 - sin2_t).sqrt(), eta) };
-        if rng.next() < fresnel {
+        if rng.uniform() < fresnel {
             let dir = reflect(d, h);
             return (dir.dot(n) > 0.0).then_some((dir, (medium, Vec3::ONE)));
         }
@@ -224,7 +224,7 @@ impl PathScene<'_> {
             let samples = self.settings.shadow_samples.max(1);
             let mut sum = Vec3::ZERO;
             for _ in 0..samples {
-                let l = cone_direction(Vec3::from(SUN_DIR), sun_cos(), rng.next(), rng.next());
+                let l = cone_direction(Vec3::from(SUN_DIR), sun_cos(), rng.uniform(), rng.uniform());
                 let cos = n.dot(l);
                 if cos > 0.0 && !self.cross(&Ray::new(p, l), 0).found {
                     sum += SUN_IRRADIANCE * cos * lobe.eval(n, l);
@@ -241,7 +241,7 @@ impl PathScene<'_> {
     /// One sample of an emissive cell: a cell picked by power, one of its
     /// faces that faces `p`, a point on it.
     fn emitter_light(&self, p: Vec3, n: Vec3, lobe: &Lobe, rng: &mut Rng) -> Vec3 {
-        let (u0, u1, u2, u3) = (rng.next(), rng.next(), rng.next(), rng.next());
+        let (u0, u1, u2, u3) = (rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform());
         let i = lights::pick(&self.lights, u0);
         let light = self.lights[i];
         let Some((q, face_axis, faces)) = emitter_point(&light, p, u1, u2, u3) else { return Vec3::ZERO };
@@ -427,7 +427,7 @@ fn smith_g1(cos: f32, alpha: f32) -> f32 {
 /// F0 = mix(0.04, colour, metalness)). Returns the direction and weight.
 fn metal_lobe(d: Vec3, n: Vec3, albedo: Vec3, material: &GpuMaterial, rng: &mut Rng) -> Option<(Vec3, Vec3)> {
     let alpha = material.roughness * material.roughness;
-    let (u1, u2) = (rng.next(), rng.next());
+    let (u1, u2) = (rng.uniform(), rng.uniform());
     let smooth = alpha <= 1e-4;
     let h = if smooth { n } else { ggx_half_vector(n, alpha, u1, u2) };
     let dir = reflect(d, h);

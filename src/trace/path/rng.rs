@@ -23,7 +23,7 @@ impl Rng {
     }
 
     /// Uniform in [0, 1): the top 24 bits of the next hash.
-    pub fn next(&mut self) -> f32 {
+    pub fn uniform(&mut self) -> f32 {
         self.state = pcg(self.state);
         (self.state >> 8) as f32 * (1.0 / 16_777_216.0)
     }
@@ -37,7 +37,7 @@ mod tests {
     fn numbers_are_uniform_and_below_one() {
         let mut rng = Rng::new(12345, 7);
         let n = 100_000;
-        let values: Vec<f32> = (0..n).map(|_| rng.next()).collect();
+        let values: Vec<f32> = (0..n).map(|_| rng.uniform()).collect();
         assert!(values.iter().all(|v| (0.0..1.0).contains(v)));
         let mean = values.iter().sum::<f32>() / n as f32;
         assert!((mean - 0.5).abs() < 0.01, "mean {mean}");
@@ -47,7 +47,7 @@ mod tests {
 
     #[test]
     fn streams_differ_by_pixel_and_sample() {
-        let first = |p, s| Rng::new(p, s).next();
+        let first = |p, s| Rng::new(p, s).uniform();
         assert_ne!(first(0, 0), first(1, 0));
         assert_ne!(first(0, 0), first(0, 1));
         assert_eq!(first(5, 9), first(5, 9));
