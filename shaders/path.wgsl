@@ -403,22 +403,15 @@ fn radiance(ray_in: Ray) -> vec3<f32> {
         let value = hit.value;
         let m = materials[value];
         var dir: vec3<f32>;
-        if (GLASS && medium != 0u && (value == 0u || is_glass(value))) {
-            transmissions += 1u;
-            let s = glass_interface(d, n, medium, value);
-            if (!s.ok) {
-                return radiance;
-            }
-            dir = s.dir;
-            medium = s.medium;
-            beta *= s.weight;
-            lights_counted = false;
-        } else if (EMIT && m.kind == MATERIAL_EMIT) {
+        // Leaving glass (into empty space or other glass), or entering it.
+        let leaving = GLASS && medium != 0u && (value == 0u || is_glass(value));
+        if (!leaving && EMIT && m.kind == MATERIAL_EMIT) {
             if (!lights_counted) {
                 radiance += beta * albedo_of(value) * m.emission;
             }
             return radiance;
-        } else if (GLASS && m.kind == MATERIAL_GLASS && rng_next() < m.transparency) {
+        }
+        if (leaving || (GLASS && m.kind == MATERIAL_GLASS && rng_next() < m.transparency)) {
             transmissions += 1u;
             let s = glass_interface(d, n, medium, value);
             if (!s.ok) {

@@ -99,6 +99,20 @@ fn a_missing_script_file_is_an_error_not_a_panic() {
     assert!(text.contains("cannot read script"), "{text}");
 }
 
+/// Runs a script on the GPU or the CPU (letting it replace what an earlier
+/// run wrote) and checks that it passes with `summary`.
+fn replay_passes(script: &Path, cpu: bool, summary: &str) {
+    let mut args = vec!["replay", "--force"];
+    if cpu {
+        args.push("--cpu");
+    }
+    args.push(script.to_str().unwrap());
+    let out = octovox(&args);
+    let text = stdout(&out);
+    assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(text.contains(summary), "{text}");
+}
+
 #[test]
 fn the_effect_set_follows_edits_and_undo() {
     // A diffuse scene whose palette also holds a glass entry (index 9).
@@ -114,13 +128,8 @@ fn the_effect_set_follows_edits_and_undo() {
                   undo\nexpect effects sun sky\nredo\nremove 0 1 0\nexpect effects sky sun\n";
     let path = dir.path().join("effects.ovr");
     std::fs::write(&path, script).unwrap();
-    for mode in [&["replay"][..], &["replay", "--cpu"][..]] {
-        let mut args = mode.to_vec();
-        args.push(path.to_str().unwrap());
-        let out = octovox(&args);
-        let text = stdout(&out);
-        assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
-        assert!(text.contains("4 passed, 0 failed"), "{text}");
+    for cpu in [false, true] {
+        replay_passes(&path, cpu, "4 passed, 0 failed");
     }
     // A wrong expectation fails with both sets named.
     std::fs::write(&path, "load diffuse.vox\nexpect effects sun sky glass\n").unwrap();
@@ -138,13 +147,8 @@ fn palette_edits_are_undoable_change_the_effects_and_are_saved() {
                   rgb 9 10 20 30\nundo 2\nexpect effects sun sky\nredo 2\nexpect effects sun sky glass\nsave out.vox\n";
     let path = dir.path().join("palette.ovr");
     std::fs::write(&path, script).unwrap();
-    for mode in [&["replay"][..], &["replay", "--cpu", "--force"][..]] {
-        let mut args = mode.to_vec();
-        args.push(path.to_str().unwrap());
-        let out = octovox(&args);
-        let text = stdout(&out);
-        assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
-        assert!(text.contains("4 passed, 0 failed"), "{text}");
+    for cpu in [false, true] {
+        replay_passes(&path, cpu, "4 passed, 0 failed");
         let scene = octovox::io::load_scene(&dir.path().join("out.vox"), 0).unwrap();
         assert_eq!(scene.palette.color(9), [10, 20, 30, 255]);
         let material = scene.palette.material(9);

@@ -12,7 +12,7 @@ use glam::Vec3;
 
 use super::prelude::with_prelude;
 use super::readback::{read_buffer, read_texture_rgba8, staging_buffer};
-use super::trace_pass::{FrameUniforms, buffer_entry, output_texture, uniform_entry};
+use super::trace_pass::{FrameUniforms, buffer_entry, output_entry, output_texture, uniform_entry};
 use super::{GpuContext, GpuError, SceneBuffers};
 use crate::trace::path::lights::Emitter;
 use crate::trace::path::materials::{Effects, GpuMaterial};
@@ -122,16 +122,7 @@ impl PathPass {
                 uniform_entry(0, std::mem::size_of::<FrameUniforms>()),
                 buffer_entry(1, true),
                 buffer_entry(3, true),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 5,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::StorageTexture {
-                        access: wgpu::StorageTextureAccess::WriteOnly,
-                        format: wgpu::TextureFormat::Rgba8Unorm,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                    },
-                    count: None,
-                },
+                output_entry(5),
                 uniform_entry(8, std::mem::size_of::<PathUniforms>()),
                 buffer_entry(9, true),
                 buffer_entry(10, true),

@@ -140,6 +140,20 @@ pub(super) fn uniform_entry(binding: u32, size: usize) -> wgpu::BindGroupLayoutE
     }
 }
 
+/// The binding of the RGBA8 output texture a kernel writes.
+pub(super) fn output_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format: wgpu::TextureFormat::Rgba8Unorm,
+            view_dimension: wgpu::TextureViewDimension::D2,
+        },
+        count: None,
+    }
+}
+
 /// The RGBA8 texture a kernel writes and the blit (or a readback) reads.
 pub(super) fn output_texture(
     device: &wgpu::Device,
@@ -187,16 +201,7 @@ impl TracePass {
                 buffer_entry(1, true),
                 buffer_entry(3, true),
                 buffer_entry(4, true),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 5,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::StorageTexture {
-                        access: wgpu::StorageTextureAccess::WriteOnly,
-                        format: wgpu::TextureFormat::Rgba8Unorm,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                    },
-                    count: None,
-                },
+                output_entry(5),
                 buffer_entry(6, false),
                 buffer_entry(7, false),
             ],

@@ -117,19 +117,17 @@ impl PathScene<'_> {
             let material = self.materials[usize::from(value)];
             let glass = |index: u8| self.materials[usize::from(index)].kind == MATERIAL_GLASS;
             let dir;
-            if self.effects.glass && medium != 0 && (value == 0 || glass(value)) {
-                // Leaving glass, into empty space or other glass.
-                transmissions += 1;
-                let Some((next, to)) = self.interface(d, n, medium, value, rng) else { return radiance };
-                (dir, medium) = (next, to.0);
-                beta *= to.1;
-                lights_counted = false;
-            } else if self.effects.emit && material.kind == MATERIAL_EMIT {
+            // Leaving glass (into empty space or other glass), or entering it.
+            let leaving = self.effects.glass && medium != 0 && (value == 0 || glass(value));
+            if !leaving && self.effects.emit && material.kind == MATERIAL_EMIT {
                 if !lights_counted {
                     radiance += beta * self.albedo[usize::from(value)] * material.emission;
                 }
                 return radiance;
-            } else if self.effects.glass && material.kind == MATERIAL_GLASS && rng.uniform() < material.transparency {
+            }
+            if leaving
+                || (self.effects.glass && material.kind == MATERIAL_GLASS && rng.uniform() < material.transparency)
+            {
                 transmissions += 1;
                 let Some((next, to)) = self.interface(d, n, medium, value, rng) else { return radiance };
                 (dir, medium) = (next, to.0);
