@@ -218,3 +218,32 @@ fn teapot_picture_and_iteration_counts() {
     eprintln!("mean iterations per pixel: SVO {svo:.1}, grid {grid:.1}");
     assert!(svo < grid, "SVO {svo} vs grid {grid}");
 }
+
+/// The window's frames do not wait for the GPU: their times arrive a frame
+/// or two later, the queries are skipped while a read-back is under way (no
+/// validation error for a mapped buffer), and the images are the same as
+/// those of frames that wait.
+#[test]
+fn frames_that_do_not_wait_report_their_times_later() {
+    let mut tree = sculpture();
+    let (lo, hi) = tree.solid_bounds().unwrap();
+    let camera = Camera::framing(lo, hi, 50.0);
+    let settings = RenderSettings::default();
+    let mut renderer = Renderer::headless().unwrap();
+    renderer.wait_for_frames = false;
+    renderer.sync(&mut tree, &Palette::default());
+    let mut times = Vec::new();
+    for _ in 0..12 {
+        times.push(renderer.render(&tree, &camera, (96, 64), &settings, None).unwrap());
+    }
+    assert!(times.iter().all(|ms| ms.is_finite() && *ms >= 0.0), "{times:?}");
+    if renderer.gpu.timestamps {
+        assert_eq!(times[0], 0.0, "the first frame cannot know its own time yet: {times:?}");
+    }
+    assert!(times.iter().any(|ms| *ms > 0.0), "no time ever arrived: {times:?}");
+    let unwaited = renderer.read_image().unwrap();
+    // Waiting again works after frames that did not, and draws the same.
+    renderer.wait_for_frames = true;
+    assert!(renderer.render(&tree, &camera, (96, 64), &settings, None).unwrap() > 0.0);
+    assert_eq!(renderer.read_image().unwrap(), unwaited);
+}

@@ -233,7 +233,9 @@ impl App {
             if self.bench.is_some() { wgpu::PresentMode::AutoNoVsync } else { wgpu::PresentMode::AutoVsync };
         surface.configure(&gpu.device, &config);
         let blit = BlitPass::new(&gpu, config.format)?;
-        let renderer = Renderer::new(gpu)?;
+        let mut renderer = Renderer::new(gpu)?;
+        // The trace, blit and present are queued back to back; times shown are a frame old.
+        renderer.wait_for_frames = false;
         let gpu = &renderer.gpu;
         let egui_state = egui_winit::State::new(
             egui::Context::default(),

@@ -55,6 +55,10 @@ pub struct Renderer {
     path_key: Option<PathKey>,
     path_samples: u32,
     path_lights: usize,
+    /// Whether a frame waits for the GPU (headless renders, tests, benches);
+    /// the window turns it off, so its trace, blit and present are queued
+    /// back to back and the times shown are a frame old.
+    pub wait_for_frames: bool,
     /// The accumulation stops growing at this many samples (the window's
     /// resting view); headless renders leave it unbounded.
     pub sample_target: u32,
@@ -82,6 +86,7 @@ impl Renderer {
             path_samples: 0,
             path_lights: 0,
             sample_target: u32::MAX,
+            wait_for_frames: true,
             hit_records: false,
             records_written: false,
         })
@@ -161,7 +166,7 @@ impl Renderer {
                 gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
             self.pass.encode(&mut encoder, kernel, self.timer.pass_writes());
             self.timer.resolve(&mut encoder);
-            self.timer.submit_and_measure(gpu, encoder)
+            submit(&mut self.timer, gpu, self.wait_for_frames, encoder)
         })
     }
 
@@ -218,7 +223,7 @@ impl Renderer {
                 gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("path frame") });
             self.path.encode(gpu, &mut encoder, effects, self.timer.pass_writes())?;
             self.timer.resolve(&mut encoder);
-            let ms = self.timer.submit_and_measure(gpu, encoder)?;
+            let ms = submit(&mut self.timer, gpu, self.wait_for_frames, encoder)?;
             self.path_samples += 1;
             self.shown = Shown::Path;
             Ok(PathFrame { ms, samples: self.path_samples, effects, lights: self.path_lights, added: true })
@@ -255,4 +260,10 @@ impl Renderer {
         };
         image::RgbaImage::from_raw(w, h, bytes).ok_or_else(|| GpuError::Readback("texture size mismatch".into()))
     }
+}
+
+/// Submits a frame: waits for it and returns its milliseconds, or, without
+/// `wait`, returns at once with the latest time read back (an earlier frame's).
+fn submit(timer: &mut PassTimer, gpu: &GpuContext, wait: bool, encoder: wgpu::CommandEncoder) -> Result<f64, GpuError> {
+    if wait { timer.submit_and_measure(gpu, encoder) } else { timer.submit_without_waiting(gpu, encoder) }
 }

@@ -1,15 +1,32 @@
 //! GPU time of one pass: timestamp queries where the adapter has them,
 //! otherwise wall time around submit + wait.
+//!
+//! A frame that waits for the GPU reads its own timestamps; a frame that
+//! does not (the window's) maps them once the GPU is done and reads them on
+//! a later frame, skipping the queries of frames while the read-back buffer
+//! is still mapped.
 
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU8, Ordering};
 use std::time::Instant;
 
 use super::readback::{read_buffer, staging_buffer};
 use super::{GpuContext, GpuError};
 
+/// States of the read-back buffer.
+const FREE: u8 = 0;
+const WRITTEN: u8 = 1;
+const MAPPING: u8 = 2;
+const MAPPED: u8 = 3;
+
 /// Two timestamps around a compute pass, resolved and read back on demand.
 pub struct PassTimer {
     queries: Option<(wgpu::QuerySet, wgpu::Buffer, wgpu::Buffer)>,
     period_ns: f64,
+    /// Where the read-back buffer is in its cycle (see the constants above).
+    state: Arc<AtomicU8>,
+    /// The last pass time read back, for frames that do not wait.
+    last_ms: f64,
 }
 
 impl PassTimer {
@@ -29,11 +46,16 @@ impl PassTimer {
             let read = staging_buffer(&gpu.device, "timestamp readback", 2 * wgpu::QUERY_SIZE as u64);
             (set, resolve, read)
         });
-        PassTimer { queries, period_ns: f64::from(gpu.queue.get_timestamp_period()) }
+        let period_ns = f64::from(gpu.queue.get_timestamp_period());
+        PassTimer { queries, period_ns, state: Arc::new(AtomicU8::new(FREE)), last_ms: 0.0 }
     }
 
-    /// Timestamp writes for a compute pass descriptor (None without support).
+    /// Timestamp writes for a compute pass descriptor (None without support,
+    /// or while the last ones are still being read back).
     pub fn pass_writes(&self) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        if self.state.load(Ordering::Acquire) != FREE {
+            return None;
+        }
         self.queries.as_ref().map(|(set, _, _)| wgpu::ComputePassTimestampWrites {
             query_set: set,
             beginning_of_pass_write_index: Some(0),
@@ -43,26 +65,68 @@ impl PassTimer {
 
     /// Call after the pass, in the same encoder.
     pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
-        if let Some((set, resolve, read)) = &self.queries {
+        if let Some((set, resolve, read)) = &self.queries
+            && self.state.load(Ordering::Acquire) == FREE
+        {
             encoder.resolve_query_set(set, 0..2, resolve, 0);
             encoder.copy_buffer_to_buffer(resolve, 0, read, 0, None);
+            self.state.store(WRITTEN, Ordering::Release);
         }
+    }
+
+    /// Submits `encoder` and returns at once with the pass time of the
+    /// latest frame read back so far (the window's frames). Adapters without
+    /// timestamps measure wall time, which needs the wait.
+    pub fn submit_without_waiting(&mut self, gpu: &GpuContext, encoder: wgpu::CommandEncoder) -> Result<f64, GpuError> {
+        let Some((_, _, read)) = &self.queries else { return self.submit_and_measure(gpu, encoder) };
+        gpu.queue.submit([encoder.finish()]);
+        if self.state.compare_exchange(WRITTEN, MAPPING, Ordering::AcqRel, Ordering::Acquire).is_ok() {
+            let state = Arc::clone(&self.state);
+            read.slice(..).map_async(wgpu::MapMode::Read, move |result| {
+                state.store(if result.is_ok() { MAPPED } else { FREE }, Ordering::Release);
+            });
+        }
+        self.collect(gpu)?;
+        Ok(self.last_ms)
+    }
+
+    /// Reads timestamps a finished frame left mapped, if any.
+    pub fn collect(&mut self, gpu: &GpuContext) -> Result<(), GpuError> {
+        gpu.device.poll(wgpu::PollType::Poll).map_err(|e| GpuError::Readback(e.to_string()))?;
+        let Some((_, _, read)) = &self.queries else { return Ok(()) };
+        if self.state.load(Ordering::Acquire) != MAPPED {
+            return Ok(());
+        }
+        let ms = read.slice(..).get_mapped_range().ok().map(|bytes| self.milliseconds(&bytes));
+        read.unmap();
+        self.state.store(FREE, Ordering::Release);
+        self.last_ms = ms.unwrap_or(self.last_ms);
+        Ok(())
     }
 
     /// Submits `encoder`, waits, and returns the pass's milliseconds (GPU
     /// timestamps if available, else wall time of submit + wait).
-    pub fn submit_and_measure(&self, gpu: &GpuContext, encoder: wgpu::CommandEncoder) -> Result<f64, GpuError> {
+    pub fn submit_and_measure(&mut self, gpu: &GpuContext, encoder: wgpu::CommandEncoder) -> Result<f64, GpuError> {
         let start = Instant::now();
         gpu.queue.submit([encoder.finish()]);
         gpu.wait()?;
         let wall_ms = start.elapsed().as_secs_f64() * 1e3;
-        match &self.queries {
-            Some((_, _, read)) => {
-                let bytes = read_buffer(gpu, read)?;
-                let ticks: &[u64] = bytemuck::cast_slice(&bytes);
-                Ok(ticks[1].wrapping_sub(ticks[0]) as f64 * self.period_ns / 1e6)
-            }
-            None => Ok(wall_ms),
+        if let Some((_, _, read)) = &self.queries
+            && self.state.load(Ordering::Acquire) == WRITTEN
+        {
+            let bytes = read_buffer(gpu, read)?;
+            self.state.store(FREE, Ordering::Release);
+            self.last_ms = self.milliseconds(&bytes);
+            return Ok(self.last_ms);
         }
+        // No timestamps, or this pass had none (a read-back was under way).
+        self.collect(gpu)?;
+        Ok(wall_ms)
+    }
+
+    /// Milliseconds between the two timestamps in `bytes`.
+    fn milliseconds(&self, bytes: &[u8]) -> f64 {
+        let tick = |i: usize| bytes.get(i * 8..i * 8 + 8).and_then(|b| b.try_into().ok()).map_or(0, u64::from_le_bytes);
+        tick(1).wrapping_sub(tick(0)) as f64 * self.period_ns / 1e6
     }
 }
