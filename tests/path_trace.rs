@@ -314,3 +314,28 @@ fn a_scene_of_255_emissive_materials_renders() {
     assert!(lights.len() >= 255, "{} lights", lights.len());
     assert!(mean(&gpu).min_element() > 0.1, "{}", mean(&gpu));
 }
+
+#[test]
+fn a_new_effect_set_is_compiled_off_the_frame_path() {
+    // A diffuse scene, then one glass voxel: until the glass kernel is
+    // compiled (on a worker thread), frames run the all-effects kernel.
+    let mut palette = palette();
+    palette.materials[usize::from(SPECIAL)] = material(MaterialKind::Glass, &[("_ri", "1.5"), ("_trans", "1")]);
+    let mut tree = build(&[(Shape::Box { min: IVec3::ZERO, max: IVec3::splat(7) }, Op::Place(WHITE))]);
+    let camera = look(DVec3::new(20.0, 16.0, 24.0), DVec3::new(4.0, 4.0, 4.0));
+    let settings = PathSettings::default();
+    let mut renderer = Renderer::headless().unwrap();
+    renderer.sync(&mut tree, &palette);
+    let frame = renderer.render_path(&tree, &palette, &camera, (16, 12), &settings, true).unwrap();
+    assert_eq!((frame.effects.names(), frame.kernel), (vec!["sun", "sky"], frame.effects));
+    let all = PathSettings { effects: octovox::settings::EffectsChoice::All, ..settings };
+    renderer.compile_path_kernel(&tree, &palette, &all).unwrap();
+    tree.apply_brush(&Shape::Voxel(IVec3::new(3, 8, 3)), Op::Place(SPECIAL)).unwrap();
+    renderer.sync(&mut tree, &palette);
+    let frame = renderer.render_path(&tree, &palette, &camera, (16, 12), &settings, true).unwrap();
+    assert_eq!(frame.effects.names(), ["sun", "sky", "glass"]);
+    assert_eq!(frame.kernel, octovox::trace::path::materials::Effects::ALL, "the stand-in runs while glass compiles");
+    renderer.compile_path_kernel(&tree, &palette, &settings).unwrap();
+    let frame = renderer.render_path(&tree, &palette, &camera, (16, 12), &settings, false).unwrap();
+    assert_eq!(frame.kernel, frame.effects);
+}

@@ -356,7 +356,11 @@ fn stats(ui: &mut egui::Ui, info: &Info) {
         row("scale", format!("{:.2}{}", s.scale, if s.moving { " (moving)" } else { "" }));
         if let Some(path) = &s.path {
             let effects = path.effects.names();
-            row("effects", if effects.is_empty() { "none".into() } else { effects.join(" ") });
+            let compiling = if path.kernel == path.effects { "" } else { " (compiling; all run)" };
+            row(
+                "effects",
+                format!("{}{compiling}", if effects.is_empty() { "none".into() } else { effects.join(" ") }),
+            );
             row("samples", format!("{}", path.samples));
             row("per sample", format!("{:.2} ms", s.trace_ms));
         }

@@ -54,6 +54,10 @@ fn run(
     let mut times = Vec::new();
     for sample in 0..samples {
         let frame = renderer.render_path(&scene.tree, &scene.palette, camera, size, settings, sample == 0)?;
+        anyhow::ensure!(
+            frame.kernel == frame.effects || settings.effects == EffectsChoice::All,
+            "timed the stand-in kernel"
+        );
         times.push(frame.ms);
     }
     Ok((times, renderer.read_radiance()?))
@@ -74,6 +78,8 @@ pub fn bench_effects(quick: bool) -> anyhow::Result<(String, String)> {
         let (mut auto_times, mut all_times) = (Vec::new(), Vec::new());
         let (mut auto_image, mut all_image) = (Vec::new(), Vec::new());
         // Compile both kernels before timing anything.
+        renderer.compile_path_kernel(&scene.tree, &scene.palette, &auto)?;
+        renderer.compile_path_kernel(&scene.tree, &scene.palette, &all)?;
         run(&mut renderer, &scene, &camera, (width, height), &auto, 1)?;
         run(&mut renderer, &scene, &camera, (width, height), &all, 1)?;
         // Interleaved, so that a noisy machine weighs on both alike.

@@ -103,12 +103,7 @@ impl GpuContext {
     /// shader or pipeline is an error here rather than a pass that silently
     /// draws nothing later.
     pub fn validated<T>(&self, name: &str, create: impl FnOnce(&wgpu::Device) -> T) -> Result<T, GpuError> {
-        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let created = create(&self.device);
-        match pollster::block_on(scope.pop()) {
-            Some(err) => Err(GpuError::Shader { name: name.to_string(), message: err.to_string() }),
-            None => Ok(created),
-        }
+        validated_on(&self.device, name, create)
     }
 
     /// Runs `work` inside a validation error scope: any validation error
@@ -150,5 +145,19 @@ impl GpuContext {
     /// Blocks until the GPU has finished all submitted work.
     pub fn wait(&self) -> Result<(), GpuError> {
         self.device.poll(wgpu::PollType::wait_indefinitely()).map(|_| ()).map_err(|e| GpuError::Readback(e.to_string()))
+    }
+}
+
+/// [`GpuContext::validated`] on any thread (error scopes are per thread).
+pub fn validated_on<T>(
+    device: &wgpu::Device,
+    name: &str,
+    create: impl FnOnce(&wgpu::Device) -> T,
+) -> Result<T, GpuError> {
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let created = create(device);
+    match pollster::block_on(scope.pop()) {
+        Some(err) => Err(GpuError::Shader { name: name.to_string(), message: err.to_string() }),
+        None => Ok(created),
     }
 }

@@ -2,14 +2,18 @@
 //! accumulated in a float buffer, the mean written to a display texture.
 //!
 //! The kernel is compiled per effect set (override constants of
-//! `shaders/path.wgsl`) and the pipelines are cached, so a diffuse-only
-//! scene runs a kernel without metal, glass or emitter code.
+//! `shaders/path.wgsl`) on worker threads and kept, so a diffuse-only scene
+//! runs a kernel without metal, glass or emitter code, and a scene that
+//! gains an effect runs the kernel with every effect (the same image) until
+//! its own is compiled.
 
 use std::collections::HashMap;
+use std::sync::mpsc;
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
+use super::context::validated_on;
 use super::prelude::with_prelude;
 use super::readback::{read_buffer, read_texture_rgba8, staging_buffer};
 use super::trace_pass::{FrameUniforms, buffer_entry, output_entry, output_texture, uniform_entry};
@@ -34,6 +38,39 @@ pub struct PathUniforms {
     pub _pad: [u32; 2],
 }
 
+/// A kernel: compiled, or being compiled on a worker thread.
+enum Compiled {
+    Ready(wgpu::ComputePipeline),
+    Compiling(mpsc::Receiver<Result<wgpu::ComputePipeline, GpuError>>),
+}
+
+fn thread_gone() -> GpuError {
+    GpuError::Shader { name: "path tracer".into(), message: "the compile thread ended without a result".into() }
+}
+
+/// Compiles the path kernel for an effect set (on any thread).
+fn compile(
+    device: &wgpu::Device,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    effects: Effects,
+) -> Result<wgpu::ComputePipeline, GpuError> {
+    let constants = effects.constants();
+    validated_on(device, "path tracer", |device| {
+        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("path tracer"),
+            layout: Some(layout),
+            module,
+            entry_point: Some("path"),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants: &constants,
+                zero_initialize_workgroup_memory: false,
+            },
+            cache: None,
+        })
+    })
+}
+
 const EMITTER_BYTES: u64 = std::mem::size_of::<Emitter>() as u64;
 
 /// Size-dependent outputs.
@@ -50,7 +87,7 @@ pub struct PathPass {
     layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
     module: wgpu::ShaderModule,
-    pipelines: HashMap<Effects, wgpu::ComputePipeline>,
+    kernels: HashMap<Effects, Compiled>,
     frame_buf: wgpu::Buffer,
     path_buf: wgpu::Buffer,
     materials_buf: wgpu::Buffer,
@@ -149,7 +186,7 @@ impl PathPass {
             layout,
             pipeline_layout,
             module,
-            pipelines: HashMap::new(),
+            kernels: HashMap::new(),
             frame_buf,
             path_buf,
             materials_buf,
@@ -178,26 +215,62 @@ impl PathPass {
         self.bound_generation = buffers.generation;
     }
 
-    /// The kernel for an effect set, compiled on first use.
-    fn pipeline(&mut self, gpu: &GpuContext, effects: Effects) -> Result<&wgpu::ComputePipeline, GpuError> {
-        if !self.pipelines.contains_key(&effects) {
-            let constants = effects.constants();
-            let pipeline = gpu.validated("path tracer", |device| {
-                device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some("path tracer"),
-                    layout: Some(&self.pipeline_layout),
-                    module: &self.module,
-                    entry_point: Some("path"),
-                    compilation_options: wgpu::PipelineCompilationOptions {
-                        constants: &constants,
-                        zero_initialize_workgroup_memory: false,
-                    },
-                    cache: None,
-                })
-            })?;
-            self.pipelines.insert(effects, pipeline);
+    /// Starts compiling the kernel of an effect set on a worker thread.
+    fn start(&mut self, device: &wgpu::Device, effects: Effects) {
+        if self.kernels.contains_key(&effects) {
+            return;
         }
-        Ok(&self.pipelines[&effects])
+        let (tx, rx) = mpsc::channel();
+        let (device, layout, module) = (device.clone(), self.pipeline_layout.clone(), self.module.clone());
+        std::thread::spawn(move || {
+            // The receiver may be gone (the pass was dropped): nothing to do then.
+            let _ = tx.send(compile(&device, &layout, &module, effects));
+        });
+        self.kernels.insert(effects, Compiled::Compiling(rx));
+    }
+
+    /// Whether the kernel of `effects` is ready, taking a finished compile.
+    fn ready(&mut self, effects: Effects, wait: bool) -> Result<bool, GpuError> {
+        let Some(Compiled::Compiling(rx)) = self.kernels.get(&effects) else {
+            return Ok(self.kernels.contains_key(&effects));
+        };
+        let result = if wait {
+            rx.recv().map_err(|_| thread_gone())?
+        } else {
+            match rx.try_recv() {
+                Ok(result) => result,
+                Err(mpsc::TryRecvError::Empty) => return Ok(false),
+                Err(mpsc::TryRecvError::Disconnected) => Err(thread_gone()),
+            }
+        };
+        match result {
+            Ok(pipeline) => {
+                self.kernels.insert(effects, Compiled::Ready(pipeline));
+                Ok(true)
+            }
+            Err(err) => {
+                self.kernels.remove(&effects);
+                Err(err)
+            }
+        }
+    }
+
+    /// The effect set whose kernel runs now for `effects`: its own once
+    /// compiled; until then the kernel with every effect, if that one is
+    /// ready (it draws the same image, see `bench effects`), so a new set is
+    /// compiled off the frame path; on first use, its own after a wait.
+    fn kernel_for(&mut self, device: &wgpu::Device, effects: Effects) -> Result<Effects, GpuError> {
+        self.start(device, effects);
+        if self.ready(effects, false)? {
+            self.start(device, Effects::ALL);
+            return Ok(effects);
+        }
+        if self.ready(Effects::ALL, false)? {
+            return Ok(Effects::ALL);
+        }
+        self.ready(effects, true)?;
+        self.start(device, Effects::ALL);
+        Ok(effects)
     }
 
     /// Re-creates the outputs for a new size; returns whether it did (the
@@ -259,23 +332,31 @@ impl PathPass {
         gpu.queue.write_buffer(&self.path_buf, 0, bytemuck::bytes_of(path));
     }
 
-    /// Records one sample's dispatch with the kernel of `effects`.
+    /// Compiles the kernel of `effects` now if it is not ready (benchmarks
+    /// time the kernel of a set, not its stand-in).
+    pub fn compile_now(&mut self, device: &wgpu::Device, effects: Effects) -> Result<(), GpuError> {
+        self.start(device, effects);
+        self.ready(effects, true).map(|_| ())
+    }
+
+    /// Records one sample's dispatch for `effects`; returns the effect set
+    /// of the kernel that ran (see [`PathPass::kernel_for`]).
     pub fn encode(
         &mut self,
         gpu: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         effects: Effects,
         timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>,
-    ) -> Result<(), GpuError> {
+    ) -> Result<Effects, GpuError> {
         let (width, height) = self.size();
-        self.pipeline(gpu, effects)?;
-        let pipeline = &self.pipelines[&effects];
+        let used = self.kernel_for(&gpu.device, effects)?;
+        let Some(Compiled::Ready(pipeline)) = self.kernels.get(&used) else { return Err(thread_gone()) };
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("path"), timestamp_writes: timestamps });
         pass.set_bind_group(0, &self.bind_group, &[]);
         pass.set_pipeline(pipeline);
         pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
-        Ok(())
+        Ok(used)
     }
 
     /// The mean radiance of every pixel so far, row-major.

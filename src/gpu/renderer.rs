@@ -30,6 +30,9 @@ pub struct PathFrame {
     /// Samples accumulated so far, this one included.
     pub samples: u32,
     pub effects: Effects,
+    /// The effects of the kernel that ran: `effects`, or all of them while
+    /// the kernel of `effects` is being compiled.
+    pub kernel: Effects,
     /// Emissive cells sampled as lights.
     pub lights: usize,
     /// Whether this call added a sample (none once `sample_target` is reached).
@@ -205,7 +208,8 @@ impl Renderer {
             }
             if self.path_samples >= self.sample_target && self.shown == Shown::Path {
                 let lights = self.path_lights;
-                return Ok(PathFrame { ms: 0.0, samples: self.path_samples, effects, lights, added: false });
+                let samples = self.path_samples;
+                return Ok(PathFrame { ms: 0.0, samples, effects, kernel: effects, lights, added: false });
             }
             let (sky_horizon, sky_zenith) = settings.sky.colors();
             let path = PathUniforms {
@@ -221,13 +225,28 @@ impl Renderer {
             self.path.prepare(gpu, &self.buffers, &frame, &path);
             let mut encoder =
                 gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("path frame") });
-            self.path.encode(gpu, &mut encoder, effects, self.timer.pass_writes())?;
+            let kernel = self.path.encode(gpu, &mut encoder, effects, self.timer.pass_writes())?;
             self.timer.resolve(&mut encoder);
             let ms = submit(&mut self.timer, gpu, self.wait_for_frames, encoder)?;
             self.path_samples += 1;
             self.shown = Shown::Path;
-            Ok(PathFrame { ms, samples: self.path_samples, effects, lights: self.path_lights, added: true })
+            Ok(PathFrame { ms, samples: self.path_samples, effects, kernel, lights: self.path_lights, added: true })
         })
+    }
+
+    /// Compiles the path kernel a scene needs with `settings` now, so that the
+    /// next frames run it rather than the all-effects stand-in.
+    ///
+    /// # Errors
+    /// A kernel that does not compile.
+    pub fn compile_path_kernel(
+        &mut self,
+        tree: &Octree,
+        palette: &Palette,
+        settings: &PathSettings,
+    ) -> Result<(), GpuError> {
+        let effects = effects_for(tree, palette, settings);
+        self.path.compile_now(&self.gpu.device, effects)
     }
 
     /// The mean radiance per pixel of the path tracer's accumulation.
