@@ -110,8 +110,19 @@ impl Material {
         let ior = self.param("_ior");
         if ior < 1.0 { ior + 1.0 } else { ior }
     }
+    /// `_trans`, else the older `_alpha`; a glass entry with neither is
+    /// clear (what its kind promises), any other kind opaque.
     pub fn transparency(&self) -> f32 {
-        self.param("_trans")
+        let valid = |key: &str| self.params.get(key).is_some_and(|v| v.trim().parse::<f32>().is_ok_and(f32::is_finite));
+        if valid("_trans") {
+            self.param("_trans")
+        } else if valid("_alpha") {
+            self.param("_alpha")
+        } else if self.kind == MaterialKind::Glass {
+            1.0
+        } else {
+            0.0
+        }
     }
     pub fn emission(&self) -> f32 {
         self.param("_emit")
@@ -174,5 +185,26 @@ impl Palette {
 
     pub fn material(&self, index: u8) -> &Material {
         &self.materials[usize::from(index)]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn with(kind: MaterialKind, params: &[(&str, &str)]) -> Material {
+        let mut m = Material::new(kind);
+        m.params.extend(params.iter().map(|(k, v)| ((*k).to_string(), (*v).to_string())));
+        m
+    }
+
+    #[test]
+    fn transparency_comes_from_trans_then_alpha() {
+        assert_eq!(with(MaterialKind::Glass, &[("_trans", "0.3"), ("_alpha", "0.8")]).transparency(), 0.3);
+        assert_eq!(with(MaterialKind::Glass, &[("_alpha", "0.8")]).transparency(), 0.8);
+        assert_eq!(with(MaterialKind::Glass, &[("_trans", "nan")]).transparency(), 1.0);
+        assert_eq!(with(MaterialKind::Glass, &[]).transparency(), 1.0);
+        assert_eq!(with(MaterialKind::Diffuse, &[]).transparency(), 0.0);
+        assert_eq!(with(MaterialKind::Glass, &[("_trans", "7")]).transparency(), 1.0);
     }
 }
