@@ -1,0 +1,74 @@
+//! How far an image is from a reference: NVIDIA's FLIP (perceptual, mean
+//! over the pixels, 0 = identical, 1 = as different as can be) and PSNR;
+//! and which of a set of (time, error) points no other beats on both.
+
+use image::RgbaImage;
+
+/// Mean FLIP error of `test` against `reference` (same size; RGB, the
+/// alpha ignored), at FLIP's default viewing distance (67 pixels per degree).
+///
+/// # Panics
+/// If the sizes differ.
+pub fn flip(reference: &RgbaImage, test: &RgbaImage) -> f32 {
+    let rgb = |image: &RgbaImage| {
+        let bytes: Vec<u8> = image.pixels().flat_map(|p| [p[0], p[1], p[2]]).collect();
+        nv_flip::FlipImageRgb8::with_data(image.width(), image.height(), &bytes)
+    };
+    let error = nv_flip::flip(rgb(reference), rgb(test), nv_flip::DEFAULT_PIXELS_PER_DEGREE);
+    nv_flip::FlipPool::from_image(&error).mean()
+}
+
+/// Peak signal-to-noise ratio over the RGB bytes in dB; `None` for
+/// identical images (infinite).
+pub fn psnr(reference: &RgbaImage, test: &RgbaImage) -> Option<f64> {
+    let (mut sum, mut count) = (0.0f64, 0u64);
+    for (a, b) in reference.pixels().zip(test.pixels()) {
+        for c in 0..3 {
+            let d = f64::from(a[c]) - f64::from(b[c]);
+            sum += d * d;
+            count += 1;
+        }
+    }
+    let mse = sum / count.max(1) as f64;
+    (mse > 0.0).then(|| 10.0 * (255.0 * 255.0 / mse).log10())
+}
+
+/// For each (time, error) point, whether no other point is at least as good
+/// on both and better on one: the Pareto front.
+pub fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
+    points
+        .iter()
+        .map(|&(t, e)| !points.iter().any(|&(t2, e2)| t2 <= t && e2 <= e && (t2 < t || e2 < e)))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image(f: impl Fn(u32, u32) -> [u8; 4]) -> RgbaImage {
+        RgbaImage::from_fn(64, 48, |x, y| image::Rgba(f(x, y)))
+    }
+
+    #[test]
+    fn identical_images_have_no_error_and_noise_has_some() {
+        let a = image(|x, y| [(x * 3) as u8, (y * 5) as u8, 128, 255]);
+        assert_eq!(flip(&a, &a), 0.0);
+        assert_eq!(psnr(&a, &a), None);
+        let noisy = image(|x, y| {
+            let n = if (x * 7 + y * 13) % 5 == 0 { 40 } else { 0 };
+            [((x * 3) as u8).saturating_add(n), (y * 5) as u8, 128, 255]
+        });
+        let (f, p) = (flip(&a, &noisy), psnr(&a, &noisy).unwrap());
+        assert!(f > 0.01 && f < 0.5, "{f}");
+        assert!(p > 20.0 && p < 40.0, "{p}");
+        let black = image(|_, _| [0, 0, 0, 255]);
+        assert!(flip(&a, &black) > f);
+    }
+
+    #[test]
+    fn the_pareto_front_keeps_what_nothing_beats() {
+        let points = [(1.0, 0.5), (2.0, 0.2), (3.0, 0.3), (4.0, 0.1), (2.0, 0.5)];
+        assert_eq!(pareto_front(&points), [true, true, false, true, false]);
+    }
+}
