@@ -39,7 +39,7 @@ pub struct WindowArgs {
     #[arg(long, value_name = "N")]
     pub bench_frames: Option<u32>,
     /// Fraction of the window's pixels traced per axis (0.25..=1; the UI can change it).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, value_parser = parse_render_scale)]
     pub render_scale: f32,
     /// Start with sun shadows off (the UI can turn them on).
     #[arg(long)]
@@ -182,6 +182,9 @@ pub struct RenderArgs {
     /// Replace OUTPUT even if it is the input or an existing .vox/.obj/.ovr.
     #[arg(long)]
     pub force: bool,
+    /// Trace S × the image's pixels per axis (0.25..=1) and scale up.
+    #[arg(long, default_value_t = 1.0, value_parser = parse_render_scale)]
+    pub render_scale: f32,
     #[command(flatten)]
     pub path: PathArgs,
     /// Print one JSON object on stdout: effects, spp, ms_per_sample, adapter.
@@ -247,6 +250,8 @@ pub enum BenchKind {
     Render,
     /// Path tracer time per sample: kernel per scene's effects vs all effects.
     Effects,
+    /// Error (FLIP, PSNR) against time for each quality knob, and the plot.
+    Quality,
 }
 
 /// Parses "WxH".
@@ -272,6 +277,15 @@ pub fn parse_scale(s: &str) -> Result<f32, String> {
 pub fn parse_fov(s: &str) -> Result<f32, String> {
     let fov: f32 = s.trim().parse().map_err(|_| format!("field of view '{s}' is not a number"))?;
     octovox::camera::check_fov(fov)
+}
+
+/// Parses a render scale in `MIN_RENDER_SCALE..=1`.
+pub fn parse_render_scale(s: &str) -> Result<f32, String> {
+    let range = octovox::settings::MIN_RENDER_SCALE..=1.0;
+    match s.trim().parse::<f32>() {
+        Ok(v) if range.contains(&v) => Ok(v),
+        _ => Err(format!("render scale '{s}' is not a number in {}..=1", range.start())),
+    }
 }
 
 /// Parses "EX,EY,EZ:TX,TY,TZ".

@@ -48,6 +48,16 @@ impl View {
     pub const ALL: [View; 4] = [View::Shaded, View::Iterations, View::Depth, View::Normals];
 }
 
+/// Smallest render scale accepted (the window's slider and `--render-scale`).
+pub const MIN_RENDER_SCALE: f32 = 0.25;
+
+/// The pixels traced for an image of `size` at `scale` per axis (at least one).
+pub fn scaled_size(size: (u32, u32), scale: f32) -> (u32, u32) {
+    let scale = scale.clamp(MIN_RENDER_SCALE, 1.0);
+    let axis = |n: u32| ((n as f32 * scale).round() as u32).max(1);
+    (axis(size.0), axis(size.1))
+}
+
 /// Knobs of the renderer, edited by the UI.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderSettings {

@@ -51,3 +51,32 @@ fn specialised_kernels_draw_the_same_images_as_the_full_one() {
     assert_eq!(rows[0]["effects_auto"], serde_json::json!(["sun", "sky"]));
     assert_eq!(rows[2]["effects_auto"], serde_json::json!(["sun", "sky", "emit"]));
 }
+
+#[test]
+fn the_quality_bench_measures_every_knob_and_plots_them() {
+    let out = tempfile::tempdir().unwrap();
+    let run = Command::new(env!("CARGO_BIN_EXE_octovox"))
+        .args(["bench", "quality", "--quick", "--out"])
+        .arg(out.path())
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let md = std::fs::read_to_string(out.path().join("quality.md")).unwrap();
+    for knob in ["| base |", "| --spp |", "| --bounces |", "| --shadow-samples |", "| --render-scale |", "| --mode |"] {
+        assert!(md.contains(knob), "no row {knob}\n{md}");
+    }
+    let rows: Vec<serde_json::Value> =
+        serde_json::from_str(&std::fs::read_to_string(out.path().join("quality.json")).unwrap()).unwrap();
+    assert!(rows.iter().all(|r| r["flip"].as_f64().is_some_and(|f| (0.0..=1.0).contains(&f))), "{rows:?}");
+    assert!(rows.iter().any(|r| r["pareto"] == true));
+    // Fewer bounces cannot be closer to an 8-bounce reference on average than more.
+    let flip_of = |knob: &str, value: &str| {
+        let values: Vec<f64> = rows.iter().filter(|r| r["knob"] == knob && r["value"] == value).map(|r| r["flip"].as_f64().unwrap()).collect();
+        values.iter().sum::<f64>() / values.len() as f64
+    };
+    assert!(flip_of("--bounces", "0") > flip_of("--bounces", "6"));
+    let png = image::open(out.path().join("quality.png")).unwrap().to_rgb8();
+    assert_eq!(png.dimensions(), (1100, 700));
+    let coloured = png.pixels().filter(|p| p[0] != p[1] || p[1] != p[2]).count();
+    assert!(coloured > 500, "the plot has hardly any coloured pixels: {coloured}");
+}

@@ -185,7 +185,7 @@ impl App {
             args,
         };
         app.open_script_files();
-        app.state.settings.render_scale = app.args.render_scale.clamp(0.25, 1.0);
+        app.state.settings.render_scale = app.args.render_scale;
         app.state.settings.shadows = !app.args.no_shadows;
         app.state.shading = app.args.shading;
         app.state.sample_target = app.args.samples;
@@ -410,7 +410,7 @@ impl App {
     /// The render scale this frame traces at: the user's, lowered while the
     /// camera moves.
     fn render_scale(&self) -> f32 {
-        self.state.settings.render_scale.clamp(0.25, 1.0) * self.motion.factor()
+        self.state.settings.render_scale.clamp(octovox::settings::MIN_RENDER_SCALE, 1.0) * self.motion.factor()
     }
 
     /// The trace resolution for the current window size and render scale.

@@ -34,7 +34,7 @@ const MODELS: [Model; 4] = [
     Model { name: "sculpture10M", report: (12.12, 150.497, 3.702, 34.636) },
 ];
 
-fn assets() -> PathBuf {
+pub(super) fn assets() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets")
 }
 
@@ -60,6 +60,12 @@ fn source(model: &Model) -> anyhow::Result<Source> {
     })
 }
 
+/// The procedural 10 M-voxel sculpture as a scene (default palette).
+pub(super) fn sculpture_scene() -> anyhow::Result<Scene> {
+    let dense = sculpture::sculpture_dense();
+    Ok(Scene { palette: Palette::default(), tree: Octree::from_dense(sculpture::DIMS, IVec3::ZERO, &dense)? })
+}
+
 fn build(source: &Source) -> anyhow::Result<Octree> {
     Ok(match source {
         Source::List(model) => Octree::from_voxels(&model.voxels)?,
@@ -78,6 +84,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<ExitCode> {
         BenchKind::Edit => bench_edit(args.quick)?,
         BenchKind::Render => bench_render(args.quick)?,
         BenchKind::Effects => super::bench_effects::bench_effects(args.quick)?,
+        BenchKind::Quality => super::bench_quality::bench_quality(args.quick, &args.out)?,
     };
     say!("{markdown}")?;
     let name = format!("{:?}", args.what).to_lowercase();

@@ -11,6 +11,8 @@ macro_rules! say {
 
 mod bench;
 mod bench_effects;
+mod bench_quality;
+mod quality_plot;
 mod convert;
 mod export;
 mod import;

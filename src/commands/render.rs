@@ -53,10 +53,12 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<ExitCode> {
     octovox::budget::check(|| format!("a {}x{} render", args.size.0, args.size.1), pixels * per_pixel)?;
     let mut scene = open_scene(args.file.as_deref(), args.frame, args.demo)?;
     let camera = camera_or_framing(args.camera, args.fov, &scene);
+    let traced = octovox::settings::scaled_size(args.size, args.render_scale);
     let (image, stats) = match args.path.spp {
-        Some(spp) => path_traced(&mut scene, &camera, args, spp)?,
-        None => preview(&mut scene, &camera, args)?,
+        Some(spp) => path_traced(&mut scene, &camera, args, traced, spp)?,
+        None => preview(&mut scene, &camera, args, traced)?,
     };
+    let image = octovox::io::png::upscale(image, args.size);
     save_png(&image, &args.output, WriteOptions { overwrite_read_only: args.force })?;
     if args.stats {
         say!("{}", serde_json::to_string(&stats)?)?;
@@ -78,7 +80,12 @@ struct Stats {
 }
 
 /// Today's deterministic shading (colour, Lambert, shadow), one frame.
-fn preview(scene: &mut Scene, camera: &Camera, args: &RenderArgs) -> anyhow::Result<(image::RgbaImage, Stats)> {
+fn preview(
+    scene: &mut Scene,
+    camera: &Camera,
+    args: &RenderArgs,
+    size: (u32, u32),
+) -> anyhow::Result<(image::RgbaImage, Stats)> {
     let settings = RenderSettings { mode: args.mode, view: args.view, shadows: !args.no_shadows, render_scale: 1.0 };
     let grid = match args.mode {
         TraceMode::Grid => Some(DenseGrid::from_octree(&scene.tree).map_err(anyhow::Error::msg)?),
@@ -87,7 +94,7 @@ fn preview(scene: &mut Scene, camera: &Camera, args: &RenderArgs) -> anyhow::Res
     let stats = |ms, adapter| Stats { effects: Vec::new(), spp: 0, ms_per_sample: ms, adapter, lights: 0 };
     if args.cpu {
         let start = Instant::now();
-        let image = render_scene_cpu(scene, grid.as_ref(), camera, args.size, &settings);
+        let image = render_scene_cpu(scene, grid.as_ref(), camera, size, &settings);
         return Ok((image, stats(start.elapsed().as_secs_f64() * 1e3, "cpu".into())));
     }
     let mut renderer = Renderer::headless().context("no GPU for rendering (try --cpu)")?;
@@ -96,7 +103,7 @@ fn preview(scene: &mut Scene, camera: &Camera, args: &RenderArgs) -> anyhow::Res
     if let Some(grid) = &grid {
         renderer.set_grid(grid)?;
     }
-    let ms = renderer.render(&scene.tree, camera, args.size, &settings, None)?;
+    let ms = renderer.render(&scene.tree, camera, size, &settings, None)?;
     log::info!("frame took {ms:.2} ms");
     Ok((renderer.read_image()?, stats(ms, renderer.gpu.adapter_name.clone())))
 }
@@ -106,15 +113,16 @@ fn path_traced(
     scene: &mut Scene,
     camera: &Camera,
     args: &RenderArgs,
+    size: (u32, u32),
     spp: u32,
 ) -> anyhow::Result<(image::RgbaImage, Stats)> {
     let settings = args.path.settings();
     if args.cpu {
         let start = Instant::now();
-        let (pixels, effects) = render_cpu(&scene.tree, &scene.palette, camera, args.size, &settings, spp);
+        let (pixels, effects) = render_cpu(&scene.tree, &scene.palette, camera, size, &settings, spp);
         let ms = start.elapsed().as_secs_f64() * 1e3 / f64::from(spp);
         let lights = if effects.emit { lights::emitters(&scene.tree, &scene.palette).len() } else { 0 };
-        let image = to_image(&pixels, args.size.0, args.size.1);
+        let image = to_image(&pixels, size.0, size.1);
         return Ok((image, Stats { effects: effects.names(), spp, ms_per_sample: ms, adapter: "cpu".into(), lights }));
     }
     let mut renderer = Renderer::headless().context("no GPU for rendering (try --cpu)")?;
@@ -123,7 +131,7 @@ fn path_traced(
     let mut total_ms = 0.0;
     let mut last = None;
     for sample in 0..spp {
-        let frame = renderer.render_path(&scene.tree, &scene.palette, camera, args.size, &settings, sample == 0)?;
+        let frame = renderer.render_path(&scene.tree, &scene.palette, camera, size, &settings, sample == 0)?;
         total_ms += frame.ms;
         last = Some(frame);
     }

@@ -56,3 +56,12 @@ pub fn differing_fraction(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
         a.pixels().zip(b.pixels()).filter(|(p, q)| p.0.iter().zip(q.0).any(|(x, y)| x.abs_diff(y) > 2)).count();
     differing as f64 / (a.width() as f64 * a.height() as f64).max(1.0)
 }
+
+/// The image stretched to `size` (bilinear), or itself when it has that size:
+/// what the window's blit does to a frame traced at a lower render scale.
+pub fn upscale(image: image::RgbaImage, size: (u32, u32)) -> image::RgbaImage {
+    if image.dimensions() == size {
+        return image;
+    }
+    image::imageops::resize(&image, size.0, size.1, image::imageops::FilterType::Triangle)
+}

@@ -1,0 +1,199 @@
+//! `octovox bench quality`: what accuracy costs in time. For each scene a
+//! reference image at the highest settings, then one knob at a time turned
+//! down from a base setting; for each, the milliseconds a frame takes and
+//! its error against the reference (mean FLIP and PSNR), measured in one
+//! run. Writes `quality.md`, `quality.json` and `quality.png` (error against
+//! time, log scale, the Pareto front of each scene joined).
+
+use std::path::Path;
+
+use glam::DVec3;
+use image::RgbaImage;
+use serde::Serialize;
+
+use octovox::camera::Camera;
+use octovox::gpu::Renderer;
+use octovox::io::png::upscale;
+use octovox::quality::{flip, pareto_front, psnr};
+use octovox::scene::Scene;
+use octovox::scene::demo::BuiltIn;
+use octovox::settings::{PathSettings, RenderSettings, TraceMode, View, scaled_size};
+
+use super::bench::header;
+
+/// One way to draw a frame: the path tracer with its knobs, or the preview.
+#[derive(Clone, Copy, Debug)]
+enum Setting {
+    Path { spp: u32, bounces: u32, shadow_samples: u32, render_scale: f32 },
+    Preview { mode: TraceMode },
+}
+
+#[derive(Serialize)]
+struct QualityRow {
+    scene: &'static str,
+    /// The knob turned (its CLI flag) and its value; "base" for the base setting.
+    knob: &'static str,
+    value: String,
+    ms_per_frame: f64,
+    flip: f32,
+    /// dB; `None` when identical to the reference.
+    psnr: Option<f64>,
+    pareto: bool,
+}
+
+struct Sizes {
+    size: (u32, u32),
+    reference_spp: u32,
+    base_spp: u32,
+}
+
+/// The base setting and the knobs turned from it, by CLI flag.
+fn knobs(sizes: &Sizes) -> Vec<(&'static str, String, Setting)> {
+    let base = |spp, bounces, shadow_samples, render_scale| Setting::Path { spp, bounces, shadow_samples, render_scale };
+    let spp = sizes.base_spp;
+    let mut out = vec![("base", format!("--spp {spp} --bounces 3"), base(spp, 3, 1, 1.0))];
+    for s in [1, 4, spp * 4] {
+        out.push(("--spp", s.to_string(), base(s, 3, 1, 1.0)));
+    }
+    for b in [0, 1, 6] {
+        out.push(("--bounces", b.to_string(), base(spp, b, 1, 1.0)));
+    }
+    out.push(("--shadow-samples", "4".into(), base(spp, 3, 4, 1.0)));
+    for r in [0.25, 0.5] {
+        out.push(("--render-scale", r.to_string(), base(spp, 3, 1, r)));
+    }
+    out.push(("--mode", "svo (preview)".into(), Setting::Preview { mode: TraceMode::Svo }));
+    out.push(("--mode", "grid (preview)".into(), Setting::Preview { mode: TraceMode::Grid }));
+    out
+}
+
+fn scenes(quick: bool) -> anyhow::Result<Vec<(&'static str, Scene, Camera)>> {
+    let teapot = octovox::io::load_scene(&super::bench::assets().join("vox/seed/teapot256.vox"), 0)?;
+    let framing = |scene: &Scene, fov| {
+        let (lo, hi) = scene.tree.solid_bounds().unwrap_or_default();
+        Camera::framing(lo, hi, fov)
+    };
+    let teapot_camera = framing(&teapot, 50.0);
+    let mut out = vec![("teapot256 (small)", teapot, teapot_camera)];
+    if !quick {
+        let sculpture = super::bench::sculpture_scene()?;
+        let (lo, hi) = sculpture.tree.solid_bounds().unwrap_or_default();
+        let centre = (lo + hi).as_dvec3() * 0.5;
+        // Far away: the statue spans a fifth of the image's height.
+        let far = Camera { eye: centre + DVec3::new(1.0, 0.5, 1.4) * 2400.0, target: centre, fov_y_deg: 20.0 };
+        out.push(("sculpture10M (far)", sculpture, far));
+    }
+    let inside = Camera { eye: DVec3::new(36.0, 18.0, 36.0), target: DVec3::new(10.0, 4.0, 10.0), fov_y_deg: 60.0 };
+    out.push(("interior (path traced)", BuiltIn::Interior.scene(), inside));
+    Ok(out)
+}
+
+/// Draws one frame with `setting`; returns its milliseconds (the sum over
+/// its samples) and the image at `size`.
+fn frame(
+    renderer: &mut Renderer,
+    scene: &Scene,
+    camera: &Camera,
+    size: (u32, u32),
+    setting: Setting,
+) -> anyhow::Result<(f64, RgbaImage)> {
+    match setting {
+        Setting::Path { spp, bounces, shadow_samples, render_scale } => {
+            let settings = PathSettings { bounces, shadow_samples, ..PathSettings::default() };
+            let traced = scaled_size(size, render_scale);
+            renderer.compile_path_kernel(&scene.tree, &scene.palette, &settings)?;
+            let mut ms = 0.0;
+            for sample in 0..spp {
+                ms += renderer.render_path(&scene.tree, &scene.palette, camera, traced, &settings, sample == 0)?.ms;
+            }
+            Ok((ms, upscale(renderer.read_image()?, size)))
+        }
+        Setting::Preview { mode } => {
+            let settings = RenderSettings { mode, view: View::Shaded, shadows: true, render_scale: 1.0 };
+            if mode == TraceMode::Grid {
+                let grid = octovox::trace::grid::DenseGrid::from_octree(&scene.tree).map_err(anyhow::Error::msg)?;
+                renderer.set_grid(&grid)?;
+            }
+            // The first frame compiles nothing but warms caches; time the second.
+            renderer.render(&scene.tree, camera, size, &settings, None)?;
+            let ms = renderer.render(&scene.tree, camera, size, &settings, None)?;
+            Ok((ms, renderer.read_image()?))
+        }
+    }
+}
+
+pub fn bench_quality(quick: bool, out: &Path) -> anyhow::Result<(String, String)> {
+    let sizes = if quick {
+        Sizes { size: (64, 36), reference_spp: 8, base_spp: 2 }
+    } else {
+        Sizes { size: (320, 180), reference_spp: 256, base_spp: 16 }
+    };
+    let mut renderer = Renderer::headless()?;
+    let mut rows = Vec::new();
+    for (name, mut scene, camera) in scenes(quick)? {
+        renderer.sync(&mut scene.tree, &scene.palette);
+        let reference = Setting::Path { spp: sizes.reference_spp, bounces: 8, shadow_samples: 4, render_scale: 1.0 };
+        let (_, reference_image) = frame(&mut renderer, &scene, &camera, sizes.size, reference)?;
+        let mut scene_rows = Vec::new();
+        for (knob, value, setting) in knobs(&sizes) {
+            let (ms, image) = frame(&mut renderer, &scene, &camera, sizes.size, setting)?;
+            let row = QualityRow {
+                scene: name,
+                knob,
+                value,
+                ms_per_frame: ms,
+                flip: flip(&reference_image, &image),
+                psnr: psnr(&reference_image, &image),
+                pareto: false,
+            };
+            scene_rows.push(row);
+        }
+        let points: Vec<(f64, f64)> = scene_rows.iter().map(|r| (r.ms_per_frame, f64::from(r.flip))).collect();
+        for (row, on_front) in scene_rows.iter_mut().zip(pareto_front(&points)) {
+            row.pareto = on_front;
+        }
+        rows.extend(scene_rows);
+    }
+    std::fs::create_dir_all(out)?;
+    super::quality_plot::plot(&rows_for_plot(&rows), &out.join("quality.png"))?;
+    Ok((markdown(&rows, &sizes, renderer.gpu.adapter_name.as_str()), serde_json::to_string_pretty(&rows)?))
+}
+
+fn rows_for_plot(rows: &[QualityRow]) -> Vec<super::quality_plot::Point> {
+    rows.iter()
+        .map(|r| super::quality_plot::Point {
+            series: r.scene,
+            label: if r.knob == "base" { "base".to_string() } else { format!("{} {}", r.knob, r.value) },
+            ms: r.ms_per_frame,
+            error: f64::from(r.flip),
+            pareto: r.pareto,
+        })
+        .collect()
+}
+
+fn markdown(rows: &[QualityRow], sizes: &Sizes, adapter: &str) -> String {
+    let mut md = header("What accuracy costs in time");
+    md += &format!(
+        "On {adapter}, {}×{} pixels. The reference per scene: the path tracer at {} samples, 8 bounces, 4 shadow samples, full scale. \
+         The base: {} samples, 3 bounces, 1 shadow sample, full scale; each other row turns one knob from the base (by its CLI flag). \
+         `ms/frame` is the GPU time of all the frame's samples; FLIP is the mean of NVIDIA's FLIP error map (0 = identical; lower is better); \
+         PSNR over the 8-bit RGB. ★ marks the Pareto front: no other setting of that scene is both faster and closer. \
+         Plot: [quality.png](quality.png).\n\n",
+        sizes.size.0, sizes.size.1, sizes.reference_spp, sizes.base_spp
+    );
+    md += "| scene | knob | value | ms/frame | FLIP | PSNR (dB) | front |\n|---|---|---|---|---|---|---|\n";
+    for r in rows {
+        md += &format!(
+            "| {} | {} | {} | {:.1} | {:.4} | {} | {} |\n",
+            r.scene,
+            r.knob,
+            r.value,
+            r.ms_per_frame,
+            r.flip,
+            r.psnr.map_or("∞".into(), |p| format!("{p:.1}")),
+            if r.pareto { "★" } else { "" }
+        );
+    }
+    md += "\nThe level-of-detail knob (`--lod`) is not in this table: the SVO has no per-node aggregates yet (issue #11).\n";
+    md
+}
