@@ -36,10 +36,7 @@ pub fn psnr(reference: &RgbaImage, test: &RgbaImage) -> Option<f64> {
 /// For each (time, error) point, whether no other point is at least as good
 /// on both and better on one: the Pareto front.
 pub fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
-    points
-        .iter()
-        .map(|&(t, e)| !points.iter().any(|&(t2, e2)| t2 <= t && e2 <= e && (t2 < t || e2 < e)))
-        .collect()
+    points.iter().map(|&(t, e)| !points.iter().any(|&(t2, e2)| t2 <= t && e2 <= e && (t2 < t || e2 < e))).collect()
 }
 
 #[cfg(test)]

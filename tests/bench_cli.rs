@@ -71,7 +71,11 @@ fn the_quality_bench_measures_every_knob_and_plots_them() {
     assert!(rows.iter().any(|r| r["pareto"] == true));
     // Fewer bounces cannot be closer to an 8-bounce reference on average than more.
     let flip_of = |knob: &str, value: &str| {
-        let values: Vec<f64> = rows.iter().filter(|r| r["knob"] == knob && r["value"] == value).map(|r| r["flip"].as_f64().unwrap()).collect();
+        let values: Vec<f64> = rows
+            .iter()
+            .filter(|r| r["knob"] == knob && r["value"] == value)
+            .map(|r| r["flip"].as_f64().unwrap())
+            .collect();
         values.iter().sum::<f64>() / values.len() as f64
     };
     assert!(flip_of("--bounces", "0") > flip_of("--bounces", "6"));

@@ -247,3 +247,30 @@ fn frames_that_do_not_wait_report_their_times_later() {
     assert!(renderer.render(&tree, &camera, (96, 64), &settings, None).unwrap() > 0.0);
     assert_eq!(renderer.read_image().unwrap(), unwaited);
 }
+
+/// On lavapipe, once the path kernel has run, the timestamps of a grid
+/// trace that ran before it come back near zero (a 25 ms trace read
+/// 0.02 ms); the timer checks them against the wall clock and falls back to
+/// it. (This test fails without that check.)
+#[test]
+fn frame_times_stay_plausible_after_path_traced_frames() {
+    let mut scene = octovox::scene::demo::BuiltIn::Interior.scene();
+    let camera = Camera { eye: DVec3::new(36.0, 18.0, 36.0), target: DVec3::new(10.0, 4.0, 10.0), fov_y_deg: 60.0 };
+    let mut renderer = Renderer::headless().unwrap();
+    renderer.sync(&mut scene.tree, &scene.palette);
+    renderer.set_grid(&DenseGrid::from_octree(&scene.tree).unwrap()).unwrap();
+    let settings = RenderSettings { mode: TraceMode::Grid, ..RenderSettings::default() };
+    let size = (480, 270);
+    renderer.render(&scene.tree, &camera, size, &settings, None).unwrap();
+    renderer
+        .render_path(&scene.tree, &scene.palette, &camera, size, &octovox::settings::PathSettings::default(), true)
+        .unwrap();
+    for _ in 0..3 {
+        let start = std::time::Instant::now();
+        let ms = renderer.render(&scene.tree, &camera, size, &settings, None).unwrap();
+        let wall = start.elapsed().as_secs_f64() * 1e3;
+        if wall > 10.0 {
+            assert!(ms > wall * 0.05, "a {wall:.1} ms frame timed as {ms:.3} ms");
+        }
+    }
+}

@@ -67,7 +67,7 @@ impl App {
             return;
         }
         let (w, h) = self.trace_size();
-        let clock = self.gfx.as_ref().map_or("", |g| if g.renderer.gpu.timestamps { "GPU timestamps" } else { "wall" });
+        let clock = self.gfx.as_ref().map_or("", |g| if g.renderer.timed_by_gpu() { "GPU timestamps" } else { "wall" });
         let Some(bench) = &mut self.bench else { return };
         match bench.started {
             // The first ready frame warms up; timing starts after it.

@@ -85,7 +85,7 @@ impl App {
                 tree: &self.scene.tree,
                 stats: &self.stats,
                 adapter: &gfx.renderer.gpu.adapter_name,
-                timestamps: gfx.renderer.gpu.timestamps,
+                timestamps: gfx.renderer.timed_by_gpu(),
                 loading: loading.as_ref().map(|(p, s)| (p.as_path(), *s)),
                 can_undo: self.history.can_undo(),
                 can_redo: self.history.can_redo(),

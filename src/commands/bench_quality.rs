@@ -49,7 +49,8 @@ struct Sizes {
 
 /// The base setting and the knobs turned from it, by CLI flag.
 fn knobs(sizes: &Sizes) -> Vec<(&'static str, String, Setting)> {
-    let base = |spp, bounces, shadow_samples, render_scale| Setting::Path { spp, bounces, shadow_samples, render_scale };
+    let base =
+        |spp, bounces, shadow_samples, render_scale| Setting::Path { spp, bounces, shadow_samples, render_scale };
     let spp = sizes.base_spp;
     let mut out = vec![("base", format!("--spp {spp} --bounces 3"), base(spp, 3, 1, 1.0))];
     for s in [1, 4, spp * 4] {

@@ -12,11 +12,11 @@ macro_rules! say {
 mod bench;
 mod bench_effects;
 mod bench_quality;
-mod quality_plot;
 mod convert;
 mod export;
 mod import;
 mod info;
+mod quality_plot;
 pub mod render;
 mod replay;
 

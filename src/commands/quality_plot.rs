@@ -15,7 +15,8 @@ pub struct Point {
 }
 
 const SIZE: (u32, u32) = (1100, 700);
-const COLORS: [RGBColor; 4] = [RGBColor(31, 119, 180), RGBColor(214, 39, 40), RGBColor(44, 160, 44), RGBColor(148, 103, 189)];
+const COLORS: [RGBColor; 4] =
+    [RGBColor(31, 119, 180), RGBColor(214, 39, 40), RGBColor(44, 160, 44), RGBColor(148, 103, 189)];
 
 /// Draws the plot and writes it as a PNG.
 pub fn plot(points: &[Point], path: &Path) -> anyhow::Result<()> {

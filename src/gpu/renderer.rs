@@ -249,6 +249,12 @@ impl Renderer {
         self.path.compile_now(&self.gpu.device, effects)
     }
 
+    /// Whether frame times come from GPU timestamps (else the wall clock:
+    /// the adapter has none, or they proved implausible).
+    pub fn timed_by_gpu(&self) -> bool {
+        self.timer.uses_timestamps()
+    }
+
     /// The mean radiance per pixel of the path tracer's accumulation.
     pub fn read_radiance(&self) -> Result<Vec<glam::Vec3>, GpuError> {
         self.path.read_radiance(&self.gpu)

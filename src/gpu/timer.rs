@@ -27,7 +27,23 @@ pub struct PassTimer {
     state: Arc<AtomicU8>,
     /// The last pass time read back, for frames that do not wait.
     last_ms: f64,
+    /// Whether the timestamps agree with the wall clock. On lavapipe they
+    /// stop doing so once the path kernel has run (a trace of 25 ms reads as
+    /// 0.02 ms); from then on passes are timed by the wall clock.
+    trusted: bool,
+    /// Frames submitted without waiting: every `CHECK_EVERY`th waits, so
+    /// that the timestamps are checked against the wall clock.
+    unwaited: u32,
 }
+
+/// A frame that does not wait waits every this many frames, to check the
+/// timestamps against the wall clock.
+const CHECK_EVERY: u32 = 64;
+
+/// Timestamps below this share of a frame's wall time, in a frame of more
+/// than `IMPLAUSIBLE_ABOVE_MS`, cannot be the frame's.
+const IMPLAUSIBLE_SHARE: f64 = 0.05;
+const IMPLAUSIBLE_ABOVE_MS: f64 = 10.0;
 
 impl PassTimer {
     pub fn new(gpu: &GpuContext) -> PassTimer {
@@ -47,13 +63,13 @@ impl PassTimer {
             (set, resolve, read)
         });
         let period_ns = f64::from(gpu.queue.get_timestamp_period());
-        PassTimer { queries, period_ns, state: Arc::new(AtomicU8::new(FREE)), last_ms: 0.0 }
+        PassTimer { queries, period_ns, state: Arc::new(AtomicU8::new(FREE)), last_ms: 0.0, trusted: true, unwaited: 0 }
     }
 
     /// Timestamp writes for a compute pass descriptor (None without support,
     /// or while the last ones are still being read back).
     pub fn pass_writes(&self) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
-        if self.state.load(Ordering::Acquire) != FREE {
+        if self.state.load(Ordering::Acquire) != FREE || !self.trusted {
             return None;
         }
         self.queries.as_ref().map(|(set, _, _)| wgpu::ComputePassTimestampWrites {
@@ -66,6 +82,7 @@ impl PassTimer {
     /// Call after the pass, in the same encoder.
     pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
         if let Some((set, resolve, read)) = &self.queries
+            && self.trusted
             && self.state.load(Ordering::Acquire) == FREE
         {
             encoder.resolve_query_set(set, 0..2, resolve, 0);
@@ -78,6 +95,10 @@ impl PassTimer {
     /// latest frame read back so far (the window's frames). Adapters without
     /// timestamps measure wall time, which needs the wait.
     pub fn submit_without_waiting(&mut self, gpu: &GpuContext, encoder: wgpu::CommandEncoder) -> Result<f64, GpuError> {
+        self.unwaited += 1;
+        if !self.trusted || self.unwaited % CHECK_EVERY == 0 {
+            return self.submit_and_measure(gpu, encoder);
+        }
         let Some((_, _, read)) = &self.queries else { return self.submit_and_measure(gpu, encoder) };
         gpu.queue.submit([encoder.finish()]);
         if self.state.compare_exchange(WRITTEN, MAPPING, Ordering::AcqRel, Ordering::Acquire).is_ok() {
@@ -116,12 +137,27 @@ impl PassTimer {
         {
             let bytes = read_buffer(gpu, read)?;
             self.state.store(FREE, Ordering::Release);
-            self.last_ms = self.milliseconds(&bytes);
-            return Ok(self.last_ms);
+            let ms = self.milliseconds(&bytes);
+            if wall_ms > IMPLAUSIBLE_ABOVE_MS && ms < wall_ms * IMPLAUSIBLE_SHARE {
+                log::warn!(
+                    "GPU timestamps say {ms:.3} ms for a {wall_ms:.1} ms frame; timing by the wall clock from now on"
+                );
+                self.trusted = false;
+            } else {
+                self.last_ms = ms;
+                return Ok(ms);
+            }
+        } else {
+            // No timestamps, or this pass had none (a read-back was under way).
+            self.collect(gpu)?;
         }
-        // No timestamps, or this pass had none (a read-back was under way).
-        self.collect(gpu)?;
+        self.last_ms = wall_ms;
         Ok(wall_ms)
+    }
+
+    /// Whether the pass times come from GPU timestamps (else the wall clock).
+    pub fn uses_timestamps(&self) -> bool {
+        self.queries.is_some() && self.trusted
     }
 
     /// Milliseconds between the two timestamps in `bytes`.
