@@ -96,7 +96,7 @@ impl PassTimer {
     /// timestamps measure wall time, which needs the wait.
     pub fn submit_without_waiting(&mut self, gpu: &GpuContext, encoder: wgpu::CommandEncoder) -> Result<f64, GpuError> {
         self.unwaited += 1;
-        if !self.trusted || self.unwaited % CHECK_EVERY == 0 {
+        if !self.trusted || self.unwaited.is_multiple_of(CHECK_EVERY) {
             return self.submit_and_measure(gpu, encoder);
         }
         let Some((_, _, read)) = &self.queries else { return self.submit_and_measure(gpu, encoder) };
