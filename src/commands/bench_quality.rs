@@ -196,5 +196,6 @@ fn markdown(rows: &[QualityRow], sizes: &Sizes, adapter: &str) -> String {
         );
     }
     md += "\nThe level-of-detail knob (`--lod`) is not in this table: the SVO has no per-node aggregates yet (issue #11).\n";
+    md += "\nWhat these numbers say, scene by scene: [docs/rendering.md](../rendering.md#what-accuracy-costs).\n";
     md
 }
