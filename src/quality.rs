@@ -1,8 +1,16 @@
 //! How far an image is from a reference: NVIDIA's FLIP (perceptual, mean
 //! over the pixels, 0 = identical, 1 = as different as can be) and PSNR;
-//! and which of a set of (time, error) points no other beats on both.
+//! one frame drawn at a quality setting, timed; and which of a set of
+//! (time, error) points no other beats on both. `bench quality` and the
+//! window's quality presets use them.
 
 use image::RgbaImage;
+
+use crate::camera::Camera;
+use crate::gpu::Renderer;
+use crate::io::png::upscale;
+use crate::scene::Scene;
+use crate::settings::{PathSettings, RenderSettings, TraceMode, View, scaled_size};
 
 /// Mean FLIP error of `test` against `reference` (same size; RGB, the
 /// alpha ignored), at FLIP's default viewing distance (67 pixels per degree).
@@ -31,6 +39,55 @@ pub fn psnr(reference: &RgbaImage, test: &RgbaImage) -> Option<f64> {
     }
     let mse = sum / count.max(1) as f64;
     (mse > 0.0).then(|| 10.0 * (255.0 * 255.0 / mse).log10())
+}
+
+/// One way to draw a frame: the path tracer with its knobs, or the preview.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Setting {
+    Path { spp: u32, bounces: u32, shadow_samples: u32, render_scale: f32 },
+    Preview { mode: TraceMode, render_scale: f32 },
+}
+
+/// Draws one frame with `setting`; returns its wall-clock milliseconds
+/// (submit to finish of all its samples, which needs a renderer that waits
+/// for its frames; readback and upscaling excluded) and the image at `size`.
+/// Wall time rather than GPU timestamps: on lavapipe those of small frames
+/// cannot be trusted once the path kernel has run.
+pub fn render_setting(
+    renderer: &mut Renderer,
+    scene: &Scene,
+    camera: &Camera,
+    size: (u32, u32),
+    setting: Setting,
+) -> Result<(f64, RgbaImage), crate::gpu::GpuError> {
+    match setting {
+        Setting::Path { spp, bounces, shadow_samples, render_scale } => {
+            let settings = PathSettings { bounces, shadow_samples, ..PathSettings::default() };
+            let traced = scaled_size(size, render_scale);
+            renderer.compile_path_kernel(&scene.tree, &scene.palette, &settings)?;
+            let start = std::time::Instant::now();
+            for sample in 0..spp {
+                renderer.render_path(&scene.tree, &scene.palette, camera, traced, &settings, sample == 0)?;
+            }
+            let ms = start.elapsed().as_secs_f64() * 1e3;
+            Ok((ms, upscale(renderer.read_image()?, size)))
+        }
+        Setting::Preview { mode, render_scale } => {
+            let settings = RenderSettings { mode, view: View::Shaded, shadows: true, render_scale: 1.0 };
+            let traced = scaled_size(size, render_scale);
+            if mode == TraceMode::Grid {
+                let grid =
+                    crate::trace::grid::DenseGrid::from_octree(&scene.tree).map_err(crate::gpu::GpuError::TooLarge)?;
+                renderer.set_grid(&grid)?;
+            }
+            // The first frame compiles nothing but warms caches; time the second.
+            renderer.render(&scene.tree, camera, traced, &settings, None)?;
+            let start = std::time::Instant::now();
+            renderer.render(&scene.tree, camera, traced, &settings, None)?;
+            let ms = start.elapsed().as_secs_f64() * 1e3;
+            Ok((ms, upscale(renderer.read_image()?, size)))
+        }
+    }
 }
 
 /// For each (time, error) point, whether no other point is at least as good

@@ -57,6 +57,10 @@ pub enum Command {
     },
     Undo,
     Redo,
+    /// Set the quality knobs to preset `PRESETS[i]`.
+    ApplyPreset(usize),
+    /// Measure what each preset costs and how far it is from the reference.
+    MeasurePresets,
     SetTool(Tool),
     SetCamera(Camera),
     Orbit {

@@ -89,6 +89,7 @@ impl App {
                 loading: loading.as_ref().map(|(p, s)| (p.as_path(), *s)),
                 can_undo: self.history.can_undo(),
                 can_redo: self.history.can_redo(),
+                presets: self.presets_measured.as_deref(),
             };
             let (state, ui_state) = (&mut self.state, &mut self.ui);
             let pick = self.pick;

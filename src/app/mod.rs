@@ -19,6 +19,7 @@ mod files;
 mod frame;
 mod input;
 mod motion;
+mod presets;
 mod script;
 mod state;
 mod ui;
@@ -136,6 +137,8 @@ struct App {
     path_stale: bool,
     /// A palette control is held: its changes are one undo step.
     palette_stroke: bool,
+    /// What the last measurement of the quality presets found.
+    presets_measured: Option<Vec<presets::Measured>>,
     screenshot_requested: bool,
     ready: bool,
     last_frame: Option<Instant>,
@@ -172,6 +175,7 @@ impl App {
             grid_stale: true,
             path_stale: true,
             palette_stroke: false,
+            presets_measured: None,
             screenshot_requested: false,
             ready: false,
             last_frame: None,
@@ -357,6 +361,12 @@ impl App {
             | Command::Redo => {
                 self.ui.info("still loading…");
             }
+            Command::ApplyPreset(i) => {
+                if let Some(preset) = presets::PRESETS.get(i) {
+                    preset.apply(&mut self.state);
+                }
+            }
+            Command::MeasurePresets => self.measure_presets(),
             Command::SetTool(tool) => self.state.tool = tool,
             Command::SetCamera(camera) => self.state.camera = camera,
             Command::Orbit { dx, dy } => camera_control::orbit(&mut self.state.camera, dx, dy),
@@ -434,6 +444,27 @@ impl App {
         let py = ((y * f64::from(h) / f64::from(window_h)) as u32).min(h - 1);
         let hit = svo::pick(&self.scene.tree, &self.state.camera, (w, h), px, py)?;
         Ok(hit.map(|hit| Pick { voxel: hit.voxel, normal: hit.normal, value: hit.value }))
+    }
+
+    /// Measures the quality presets from the current camera (a second or
+    /// so on lavapipe; the window waits meanwhile) and prints the result.
+    fn measure_presets(&mut self) {
+        let window = self.gfx.as_ref().map_or(self.args.size, |g| (g.config.width, g.config.height));
+        let Some(gfx) = &mut self.gfx else { return };
+        match presets::measure(&mut gfx.renderer, &self.scene, &self.state.camera, window) {
+            Ok(measured) => {
+                let line: Vec<String> = presets::PRESETS
+                    .iter()
+                    .zip(&measured)
+                    .map(|(p, m)| format!("{} {:.1} ms FLIP {:.3}", p.name, m.ms, m.flip))
+                    .collect();
+                report!("presets: {}", line.join("; "));
+                self.presets_measured = Some(measured);
+            }
+            Err(err) => self.ui.error(format!("cannot measure the presets: {err}")),
+        }
+        self.path_stale = true;
+        self.request_redraw();
     }
 
     /// A palette change from the panel, recorded as `rgb`/`material` lines;

@@ -54,6 +54,8 @@ pub struct Info<'a> {
     pub loading: Option<(&'a Path, f64)>,
     pub can_undo: bool,
     pub can_redo: bool,
+    /// The last measurement of the quality presets, if any.
+    pub presets: Option<&'a [super::presets::Measured]>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -105,6 +107,7 @@ pub fn show(ui: &mut egui::Ui, state: &mut EditorState, ui_state: &mut UiState, 
             material_editor(ui, state.color, info.palette, &mut out);
             ui.separator();
             render(ui, state);
+            quality(ui, info.presets, &mut out);
             ui.separator();
             stats(ui, info);
         });
@@ -308,6 +311,35 @@ fn render(ui: &mut egui::Ui, state: &mut EditorState) {
     ui.add(egui::Slider::new(&mut state.frame_target_ms, 10.0..=100.0).text("ms target"))
         .on_hover_text("frame time to hold while the camera moves: the render scale drops as far as needed");
     path_tracing(ui, state);
+}
+
+/// Presets from draft to reference, with what each costs here and the error
+/// it buys once measured.
+fn quality(ui: &mut egui::Ui, measured: Option<&[super::presets::Measured]>, out: &mut Vec<Command>) {
+    ui.horizontal(|ui| {
+        ui.label("Quality");
+        if ui.button("Measure").on_hover_text("time and error (FLIP) of each preset from this camera").clicked() {
+            out.push(Command::MeasurePresets);
+        }
+    });
+    egui::Grid::new("presets").num_columns(3).show(ui, |ui| {
+        for (i, preset) in super::presets::PRESETS.iter().enumerate() {
+            if ui.small_button(preset.name).clicked() {
+                out.push(Command::ApplyPreset(i));
+            }
+            match measured.and_then(|m| m.get(i)) {
+                Some(m) => {
+                    ui.label(format!("{:.0} ms", m.ms));
+                    ui.label(format!("FLIP {:.3}", m.flip));
+                }
+                None => {
+                    ui.label("");
+                    ui.label("");
+                }
+            }
+            ui.end_row();
+        }
+    });
 }
 
 fn path_tracing(ui: &mut egui::Ui, state: &mut EditorState) {

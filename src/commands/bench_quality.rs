@@ -8,25 +8,16 @@
 use std::path::Path;
 
 use glam::DVec3;
-use image::RgbaImage;
 use serde::Serialize;
 
 use octovox::camera::Camera;
 use octovox::gpu::Renderer;
-use octovox::io::png::upscale;
-use octovox::quality::{flip, pareto_front, psnr};
+use octovox::quality::{Setting, flip, pareto_front, psnr, render_setting};
 use octovox::scene::Scene;
 use octovox::scene::demo::BuiltIn;
-use octovox::settings::{PathSettings, RenderSettings, TraceMode, View, scaled_size};
+use octovox::settings::TraceMode;
 
 use super::bench::header;
-
-/// One way to draw a frame: the path tracer with its knobs, or the preview.
-#[derive(Clone, Copy, Debug)]
-enum Setting {
-    Path { spp: u32, bounces: u32, shadow_samples: u32, render_scale: f32 },
-    Preview { mode: TraceMode },
-}
 
 #[derive(Serialize)]
 struct QualityRow {
@@ -63,8 +54,8 @@ fn knobs(sizes: &Sizes) -> Vec<(&'static str, String, Setting)> {
     for r in [0.25, 0.5] {
         out.push(("--render-scale", r.to_string(), base(spp, 3, 1, r)));
     }
-    out.push(("--mode", "svo (preview)".into(), Setting::Preview { mode: TraceMode::Svo }));
-    out.push(("--mode", "grid (preview)".into(), Setting::Preview { mode: TraceMode::Grid }));
+    out.push(("--mode", "svo (preview)".into(), Setting::Preview { mode: TraceMode::Svo, render_scale: 1.0 }));
+    out.push(("--mode", "grid (preview)".into(), Setting::Preview { mode: TraceMode::Grid, render_scale: 1.0 }));
     out
 }
 
@@ -89,40 +80,6 @@ fn scenes(quick: bool) -> anyhow::Result<Vec<(&'static str, Scene, Camera)>> {
     Ok(out)
 }
 
-/// Draws one frame with `setting`; returns its milliseconds (the sum over
-/// its samples) and the image at `size`.
-fn frame(
-    renderer: &mut Renderer,
-    scene: &Scene,
-    camera: &Camera,
-    size: (u32, u32),
-    setting: Setting,
-) -> anyhow::Result<(f64, RgbaImage)> {
-    match setting {
-        Setting::Path { spp, bounces, shadow_samples, render_scale } => {
-            let settings = PathSettings { bounces, shadow_samples, ..PathSettings::default() };
-            let traced = scaled_size(size, render_scale);
-            renderer.compile_path_kernel(&scene.tree, &scene.palette, &settings)?;
-            let mut ms = 0.0;
-            for sample in 0..spp {
-                ms += renderer.render_path(&scene.tree, &scene.palette, camera, traced, &settings, sample == 0)?.ms;
-            }
-            Ok((ms, upscale(renderer.read_image()?, size)))
-        }
-        Setting::Preview { mode } => {
-            let settings = RenderSettings { mode, view: View::Shaded, shadows: true, render_scale: 1.0 };
-            if mode == TraceMode::Grid {
-                let grid = octovox::trace::grid::DenseGrid::from_octree(&scene.tree).map_err(anyhow::Error::msg)?;
-                renderer.set_grid(&grid)?;
-            }
-            // The first frame compiles nothing but warms caches; time the second.
-            renderer.render(&scene.tree, camera, size, &settings, None)?;
-            let ms = renderer.render(&scene.tree, camera, size, &settings, None)?;
-            Ok((ms, renderer.read_image()?))
-        }
-    }
-}
-
 pub fn bench_quality(quick: bool, out: &Path) -> anyhow::Result<(String, String)> {
     let sizes = if quick {
         Sizes { size: (64, 36), reference_spp: 8, base_spp: 2 }
@@ -134,10 +91,10 @@ pub fn bench_quality(quick: bool, out: &Path) -> anyhow::Result<(String, String)
     for (name, mut scene, camera) in scenes(quick)? {
         renderer.sync(&mut scene.tree, &scene.palette);
         let reference = Setting::Path { spp: sizes.reference_spp, bounces: 8, shadow_samples: 4, render_scale: 1.0 };
-        let (_, reference_image) = frame(&mut renderer, &scene, &camera, sizes.size, reference)?;
+        let (_, reference_image) = render_setting(&mut renderer, &scene, &camera, sizes.size, reference)?;
         let mut scene_rows = Vec::new();
         for (knob, value, setting) in knobs(&sizes) {
-            let (ms, image) = frame(&mut renderer, &scene, &camera, sizes.size, setting)?;
+            let (ms, image) = render_setting(&mut renderer, &scene, &camera, sizes.size, setting)?;
             let row = QualityRow {
                 scene: name,
                 knob,
@@ -177,7 +134,7 @@ fn markdown(rows: &[QualityRow], sizes: &Sizes, adapter: &str) -> String {
     md += &format!(
         "On {adapter}, {}×{} pixels. The reference per scene: the path tracer at {} samples, 8 bounces, 4 shadow samples, full scale. \
          The base: {} samples, 3 bounces, 1 shadow sample, full scale; each other row turns one knob from the base (by its CLI flag). \
-         `ms/frame` is the GPU time of all the frame's samples; FLIP is the mean of NVIDIA's FLIP error map (0 = identical; lower is better); \
+         `ms/frame` is the wall time from submitting the frame's first sample to the end of its last (the renderer waits for each); FLIP is the mean of NVIDIA's FLIP error map (0 = identical; lower is better); \
          PSNR over the 8-bit RGB. ★ marks the Pareto front: no other setting of that scene is both faster and closer. \
          Plot: [quality.png](quality.png).\n\n",
         sizes.size.0, sizes.size.1, sizes.reference_spp, sizes.base_spp

@@ -1,0 +1,160 @@
+//! Quality presets of the window, from draft to reference, and what each
+//! costs on this adapter: a short measurement (small image, the reference
+//! at many samples) that reports, per preset, the milliseconds a frame
+//! takes at the window's size and its error (mean FLIP) against the
+//! reference. Plain data: the panel shows it, `App` applies and measures.
+
+use octovox::camera::Camera;
+use octovox::gpu::{GpuError, Renderer};
+use octovox::quality::{Setting, flip, render_setting};
+use octovox::scene::Scene;
+use octovox::settings::{PathSettings, Shading, TraceMode};
+
+use super::state::EditorState;
+
+/// A named bundle of the quality knobs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Preset {
+    pub name: &'static str,
+    pub shading: Shading,
+    pub render_scale: f32,
+    pub bounces: u32,
+    pub shadow_samples: u32,
+    /// Samples accumulated at rest.
+    pub samples: u32,
+}
+
+pub const PRESETS: [Preset; 5] = [
+    Preset { name: "draft", shading: Shading::Preview, render_scale: 0.5, bounces: 0, shadow_samples: 1, samples: 1 },
+    Preset { name: "preview", shading: Shading::Preview, render_scale: 1.0, bounces: 0, shadow_samples: 1, samples: 1 },
+    Preset {
+        name: "path: quick",
+        shading: Shading::Rest,
+        render_scale: 1.0,
+        bounces: 1,
+        shadow_samples: 1,
+        samples: 16,
+    },
+    Preset {
+        name: "path: good",
+        shading: Shading::Rest,
+        render_scale: 1.0,
+        bounces: 3,
+        shadow_samples: 1,
+        samples: 64,
+    },
+    Preset {
+        name: "reference",
+        shading: Shading::Rest,
+        render_scale: 1.0,
+        bounces: 8,
+        shadow_samples: 4,
+        samples: 256,
+    },
+];
+
+/// Pixels of the measurement's images, and the reference's samples.
+pub const MEASURE_SIZE: (u32, u32) = (256, 144);
+pub const MEASURE_REFERENCE_SPP: u32 = 64;
+
+impl Preset {
+    pub fn apply(&self, state: &mut EditorState) {
+        state.shading = self.shading;
+        state.settings.render_scale = self.render_scale;
+        state.path_settings =
+            PathSettings { bounces: self.bounces, shadow_samples: self.shadow_samples, ..state.path_settings };
+        state.sample_target = self.samples;
+    }
+
+    /// How the measurement draws a frame of this preset.
+    pub fn setting(&self) -> Setting {
+        match self.shading {
+            Shading::Preview => Setting::Preview { mode: TraceMode::Svo, render_scale: self.render_scale },
+            _ => Setting::Path {
+                spp: self.samples,
+                bounces: self.bounces,
+                shadow_samples: self.shadow_samples,
+                render_scale: self.render_scale,
+            },
+        }
+    }
+
+    /// The reference the measurement compares against.
+    pub fn reference() -> Setting {
+        Setting::Path { spp: MEASURE_REFERENCE_SPP, bounces: 8, shadow_samples: 4, render_scale: 1.0 }
+    }
+}
+
+/// What a measurement found for one preset.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Measured {
+    /// Milliseconds of one frame at the window's size (the measured time
+    /// scaled by the pixel count; a preview frame, or all the samples of a
+    /// path-traced view).
+    pub ms: f64,
+    pub flip: f32,
+}
+
+/// Measures every preset on `renderer` from `camera`; the times are scaled
+/// to a frame of `window` pixels. Frames wait for the GPU meanwhile, and the
+/// path accumulation starts over afterwards.
+pub fn measure(
+    renderer: &mut Renderer,
+    scene: &Scene,
+    camera: &Camera,
+    window: (u32, u32),
+) -> Result<Vec<Measured>, GpuError> {
+    let (wait, target) = (renderer.wait_for_frames, renderer.sample_target);
+    (renderer.wait_for_frames, renderer.sample_target) = (true, u32::MAX);
+    let result = measure_all(renderer, scene, camera, window);
+    (renderer.wait_for_frames, renderer.sample_target) = (wait, target);
+    result
+}
+
+fn measure_all(
+    renderer: &mut Renderer,
+    scene: &Scene,
+    camera: &Camera,
+    window: (u32, u32),
+) -> Result<Vec<Measured>, GpuError> {
+    let ratio = f64::from(window.0) * f64::from(window.1) / f64::from(MEASURE_SIZE.0 * MEASURE_SIZE.1);
+    let (_, reference) = render_setting(renderer, scene, camera, MEASURE_SIZE, Preset::reference())?;
+    PRESETS
+        .iter()
+        .map(|preset| {
+            let (ms, image) = render_setting(renderer, scene, camera, MEASURE_SIZE, preset.setting())?;
+            Ok(Measured { ms: ms * ratio, flip: flip(&reference, &image) })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn presets_cost_more_time_for_less_error() {
+        let mut scene = octovox::scene::demo::BuiltIn::Terrain.scene();
+        let (lo, hi) = scene.tree.solid_bounds().unwrap_or_default();
+        let camera = Camera::framing(lo, hi, 50.0);
+        let Ok(mut renderer) = Renderer::headless() else { return };
+        renderer.sync(&mut scene.tree, &scene.palette);
+        let measured = measure(&mut renderer, &scene, &camera, (1280, 720)).unwrap_or_default();
+        assert_eq!(measured.len(), PRESETS.len());
+        let (draft, reference) = (measured[0], measured[PRESETS.len() - 1]);
+        assert!(draft.ms < reference.ms, "{measured:?}");
+        assert!(draft.flip > reference.flip, "{measured:?}");
+        assert!(measured.iter().all(|m| m.ms > 0.0 && (0.0..=1.0).contains(&m.flip)), "{measured:?}");
+        assert!(renderer.wait_for_frames && renderer.sample_target == u32::MAX, "settings restored");
+    }
+
+    #[test]
+    fn applying_a_preset_sets_every_knob() {
+        let mut state = EditorState::default();
+        PRESETS[4].apply(&mut state);
+        assert_eq!((state.shading, state.sample_target), (Shading::Rest, 256));
+        assert_eq!((state.path_settings.bounces, state.path_settings.shadow_samples), (8, 4));
+        PRESETS[0].apply(&mut state);
+        assert_eq!((state.shading, state.settings.render_scale), (Shading::Preview, 0.5));
+    }
+}
