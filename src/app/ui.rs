@@ -271,6 +271,10 @@ fn material_editor(ui: &mut egui::Ui, index: u8, palette: &Palette, out: &mut Ve
         let mut value = material_value(&material, key);
         if ui.add(egui::Slider::new(&mut value, range.clone()).text(*label)).changed() {
             material.params.insert((*key).to_string(), format!("{value:.3}"));
+            if *key == "_ri" {
+                // MagicaVoxel writes the index minus one as `_ior` beside `_ri`.
+                material.params.insert("_ior".to_string(), format!("{:.3}", value - 1.0));
+            }
             changed = true;
         }
     }
