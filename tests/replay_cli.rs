@@ -168,3 +168,17 @@ fn palette_edits_are_undoable_change_the_effects_and_are_saved() {
         assert!(text.contains(message) && text.contains("bad.ovr:2:"), "{line}: {text}");
     }
 }
+
+#[test]
+fn pick_takes_the_colour_of_a_voxel() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("pick.ovr");
+    std::fs::write(&path, "new\ncolor 9\nplace 0 0 0\ncolor 4\npick 0 0 0\nplace 1 0 0\nexpect voxel 1 0 0 9\n")
+        .unwrap();
+    for cpu in [false, true] {
+        replay_passes(&path, cpu, "1 passed, 0 failed");
+    }
+    let (out, text) = run_script("new\npick 5 5 5\n");
+    assert!(!out.status.success());
+    assert!(text.contains("no voxel at [5, 5, 5] to pick a colour from") && text.contains("bad.ovr:2"), "{text}");
+}

@@ -29,6 +29,7 @@ use std::time::{Duration, Instant};
 use common::window::*;
 use glam::IVec3;
 use octovox::camera::Camera;
+use octovox::scene::{Op, Shape};
 use octovox::trace::{Ray, svo};
 
 #[test]
@@ -254,4 +255,41 @@ fn the_window_path_traces_the_showroom_at_rest() {
     let shot = screenshot_x(&display, &dir.path().join("path.png"));
     let (mean, variance) = grey_stats(&shot, 300, 60, 470, 300);
     assert!(variance > 100.0 && mean > 20.0, "a flat or black path-traced view: mean {mean}, variance {variance}");
+}
+
+/// Alt+click is the eyedropper: the colour of the voxel under the cursor
+/// (found here by the CPU tracer) becomes the current colour, and the next
+/// attach uses it, as the saved file shows.
+#[test]
+fn alt_click_picks_the_colour_under_the_cursor() {
+    for tool in ["Xvfb", "xdotool"] {
+        require_tool(tool);
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("two.vox");
+    let mut scene = octovox::scene::Scene::default();
+    let box_of = |x0: i32, color: u8| {
+        (Shape::Box { min: IVec3::new(x0, 0, 0), max: IVec3::new(x0 + 7, 7, 7) }, Op::Place(color))
+    };
+    for (shape, op) in [box_of(0, 12), box_of(8, 77)] {
+        scene.tree.apply_brush(&shape, op).unwrap();
+    }
+    octovox::io::save_scene(&file, &scene, Default::default()).unwrap();
+    let camera =
+        Camera { eye: glam::DVec3::new(8.0, 14.0, 30.0), target: glam::DVec3::new(8.0, 4.0, 4.0), fov_y_deg: 50.0 };
+    let (x, y, voxel, normal) = stable_pixel(&scene.tree, &camera, |v, n| scene.tree.get(v) == 77 && n == IVec3::Z);
+    let args = [file.display().to_string(), "--size".into(), format!("{WIDTH}x{HEIGHT}"), camera_arg(&camera)];
+    let (_xvfb, display) = start_xvfb(4);
+    let (mut app, mut lines, stderr_path) =
+        spawn_app(&display, dir.path(), &[&args[..], &["--shading".into(), "preview".into()]].concat());
+    let window = find_window(&display, &mut app, &stderr_path);
+    lines.wait_for("octovox: ready", Duration::from_secs(90));
+    xdotool(&display, &["windowfocus", "--sync", &window]);
+    xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y.to_string()]);
+    xdotool(&display, &["keydown", "alt", "click", "1", "keyup", "alt"]);
+    assert_eq!(lines.wait_for("picked colour", Duration::from_secs(30)), "picked colour 77");
+    click(&display, &window, &mut lines, x, y);
+    save(&display, &mut lines, &file);
+    let saved = octovox::io::load_scene(&file, 0).unwrap();
+    assert_eq!(saved.tree.get(voxel + normal), 77, "the attached voxel has the picked colour");
 }

@@ -57,6 +57,12 @@ pub enum Command {
     },
     Undo,
     Redo,
+    /// The eyedropper: the colour of the voxel under window pixel (x, y)
+    /// becomes the current colour.
+    PickColor {
+        x: f64,
+        y: f64,
+    },
     /// Set the quality knobs to preset `PRESETS[i]`.
     ApplyPreset(usize),
     /// Measure what each preset costs and how far it is from the reference.

@@ -91,6 +91,12 @@ impl Input {
                 let pressed = *state == ElementState::Pressed;
                 let at = self.cursor;
                 match (button, pressed) {
+                    // Alt+click: the eyedropper.
+                    (MouseButton::Left, true) if !consumed && self.modifiers.alt_key() => {
+                        if let Some((x, y)) = at {
+                            out.push(Command::PickColor { x, y });
+                        }
+                    }
                     (MouseButton::Left, true) if !consumed && !self.left => {
                         if let Some((x, y)) = at {
                             self.left = true;

@@ -367,6 +367,14 @@ impl App {
                 }
             }
             Command::MeasurePresets => self.measure_presets(),
+            Command::PickColor { x, y } => match self.pick_at(x, y) {
+                Ok(Some(pick)) => {
+                    self.state.color = pick.value;
+                    report!("picked colour {}", pick.value);
+                }
+                Ok(None) => self.ui.info("no voxel there to pick a colour from"),
+                Err(gave_up) => self.ui.error(gave_up.to_string()),
+            },
             Command::SetTool(tool) => self.state.tool = tool,
             Command::SetCamera(camera) => self.state.camera = camera,
             Command::Orbit { dx, dy } => camera_control::orbit(&mut self.state.camera, dx, dy),

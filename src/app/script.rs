@@ -98,6 +98,13 @@ impl App {
                 self.with_player(|p| p.color = *c);
                 self.state.color = *c;
             }
+            Line::Pick(p) => match self.scene.tree.get(*p) {
+                0 => return Played::Failed(format!("no voxel at {p} to pick a colour from")),
+                value => {
+                    self.with_player(|player| player.color = value);
+                    self.state.color = value;
+                }
+            },
             Line::Rgb(..) | Line::Material(..) => {
                 if let Some(edit) = octovox::replay::palette_edit(line, &self.scene.palette) {
                     self.execute(Command::Edit(edit), event_loop);

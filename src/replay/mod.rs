@@ -51,6 +51,8 @@ pub enum Command {
     ExpectImage(PathBuf, f64),
     /// The path tracer's effect set for the scene, as names (any order).
     ExpectEffects(Vec<String>),
+    /// `pick X Y Z`: the eyedropper; the voxel's colour becomes the current one.
+    Pick(IVec3),
     /// `rgb INDEX R G B`: a palette entry's colour (an undoable edit).
     Rgb(u8, [u8; 3]),
     /// `material INDEX KIND [KEY VALUE]...`: a palette entry's material,
@@ -105,6 +107,7 @@ impl fmt::Display for Command {
             Command::ExpectCount(n) => write!(f, "expect count {n}"),
             Command::ExpectWritten(n) => write!(f, "expect written <= {n}"),
             Command::ExpectImage(path, tol) => write!(f, "expect image {} {tol}", quoted(path)),
+            Command::Pick(p) => write!(f, "pick {}", v(*p)),
             Command::Rgb(index, [r, g, b]) => write!(f, "rgb {index} {r} {g} {b}"),
             Command::Material(index, material) => {
                 write!(f, "material {index} {}", &material.kind.vox_name()[1..])?;

@@ -142,6 +142,10 @@ impl Runner {
             Command::Viewport(w, h) => self.viewport = (*w, *h),
             Command::Brush(brush) => self.brush = *brush,
             Command::Color(c) => self.color = *c,
+            Command::Pick(p) => match self.scene.tree.get(*p) {
+                0 => return Err(format!("no voxel at {p} to pick a colour from")),
+                value => self.color = value,
+            },
             Command::Rgb(..) | Command::Material(..) => {
                 if let Some(edit) = super::palette_edit(&line.command, &self.scene.palette) {
                     self.apply(edit)?;
