@@ -94,6 +94,40 @@ impl History {
         Ok(())
     }
 
+    /// Applies several edits as one undo step (a fill), or as part of the
+    /// open stroke. If one is refused, those before it are undone: the
+    /// scene is as it was and the error is returned.
+    pub fn apply_group(&mut self, scene: &mut Scene, edits: Vec<Edit>) -> Result<(), EditError> {
+        let mut step = Step::default();
+        for edit in edits {
+            match edit.apply(scene) {
+                Ok(inverse) => {
+                    step.edits.push(edit);
+                    step.inverses.push(inverse);
+                }
+                Err(err) => {
+                    for inverse in step.inverses.iter().rev() {
+                        // Undoing what was just done cannot need more room than doing it.
+                        let _ = inverse.apply(scene);
+                    }
+                    return Err(err);
+                }
+            }
+        }
+        if step.edits.is_empty() {
+            return Ok(());
+        }
+        self.undone.clear();
+        match &mut self.stroke {
+            Some(stroke) => {
+                stroke.edits.extend(step.edits);
+                stroke.inverses.extend(step.inverses);
+            }
+            None => self.push(step),
+        }
+        Ok(())
+    }
+
     /// Starts grouping edits into one undo step (a mouse drag).
     pub fn begin_stroke(&mut self) {
         self.end_stroke();

@@ -182,3 +182,41 @@ fn pick_takes_the_colour_of_a_voxel() {
     assert!(!out.status.success());
     assert!(text.contains("no voxel at [5, 5, 5] to pick a colour from") && text.contains("bad.ovr:2"), "{text}");
 }
+
+#[test]
+fn fill_recolours_the_connected_region_of_one_colour_in_one_step() {
+    use glam::IVec3;
+    use octovox::scene::{Op, Scene, Shape};
+    // Box A and box B touch and share colour 3; box C has colour 3 but is
+    // apart; box D touches A with colour 5.
+    let boxes = [
+        (IVec3::new(0, 0, 0), IVec3::new(3, 3, 3), 3u8),
+        (IVec3::new(4, 0, 0), IVec3::new(5, 1, 1), 3),
+        (IVec3::new(10, 0, 0), IVec3::new(11, 1, 1), 3),
+        (IVec3::new(0, 4, 0), IVec3::new(1, 5, 1), 5),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    let mut scene = Scene::default();
+    for (min, max, color) in boxes {
+        scene.tree.apply_brush(&Shape::Box { min, max }, Op::Place(color)).unwrap();
+    }
+    octovox::io::save_scene(&dir.path().join("boxes.vox"), &scene, Default::default()).unwrap();
+    let script = "load boxes.vox\ncolor 7\nfill 1 1 1\nexpect voxel 5 1 1 7\nexpect voxel 10 0 0 3\nexpect voxel 0 4 0 5\n\
+                  save filled.vox\nundo\nexpect voxel 5 1 1 3\nexpect voxel 0 0 0 3\n";
+    let path = dir.path().join("fill.ovr");
+    std::fs::write(&path, script).unwrap();
+    for cpu in [false, true] {
+        replay_passes(&path, cpu, "5 passed, 0 failed");
+        // Every voxel, against the boxes: A and B are 7, C and D unchanged.
+        let filled = octovox::io::load_scene(&dir.path().join("filled.vox"), 0).unwrap();
+        for (p, c) in filled.tree.voxels() {
+            let (_, _, original) =
+                boxes.iter().copied().find(|(lo, hi, _)| p.cmpge(*lo).all() && p.cmple(*hi).all()).unwrap();
+            let expected = if p.x <= 5 && original == 3 { 7 } else { original };
+            assert_eq!(c, expected, "voxel {p}");
+        }
+    }
+    let (out, text) = run_script("new\nfill 5 5 5\n");
+    assert!(!out.status.success());
+    assert!(text.contains("no voxel at [5, 5, 5] to fill from") && text.contains("bad.ovr:2"), "{text}");
+}

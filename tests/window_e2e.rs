@@ -261,7 +261,7 @@ fn the_window_path_traces_the_showroom_at_rest() {
 /// (found here by the CPU tracer) becomes the current colour, and the next
 /// attach uses it, as the saved file shows.
 #[test]
-fn alt_click_picks_the_colour_under_the_cursor() {
+fn alt_click_picks_a_colour_and_shift_click_paint_fills_with_it() {
     for tool in ["Xvfb", "xdotool"] {
         require_tool(tool);
     }
@@ -292,4 +292,19 @@ fn alt_click_picks_the_colour_under_the_cursor() {
     save(&display, &mut lines, &file);
     let saved = octovox::io::load_scene(&file, 0).unwrap();
     assert_eq!(saved.tree.get(voxel + normal), 77, "the attached voxel has the picked colour");
+
+    // Shift+click with Paint floods the 77 region (the attached voxel
+    // included) with the colour picked from the other box: all is 12 then.
+    let (x12, y12, _, _) = stable_pixel(&scene.tree, &camera, |v, n| scene.tree.get(v) == 12 && n == IVec3::Z);
+    xdotool(&display, &["mousemove", "--window", &window, &x12.to_string(), &y12.to_string()]);
+    xdotool(&display, &["keydown", "alt", "click", "1", "keyup", "alt"]);
+    assert_eq!(lines.wait_for("picked colour", Duration::from_secs(30)), "picked colour 12");
+    xdotool(&display, &["key", "g"]);
+    xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y.to_string()]);
+    xdotool(&display, &["keydown", "shift", "click", "1", "keyup", "shift"]);
+    lines.wait_for("fill:", Duration::from_secs(30));
+    save(&display, &mut lines, &file);
+    let filled = octovox::io::load_scene(&file, 0).unwrap();
+    assert_eq!(filled.tree.solid_voxels(), 1025);
+    assert!(filled.tree.voxels().iter().all(|(_, c)| *c == 12), "the 77 region was filled with 12");
 }

@@ -57,6 +57,12 @@ pub enum Command {
     },
     Undo,
     Redo,
+    /// Flood fill from the voxel under window pixel (x, y) with the current
+    /// colour (Shift+click with the Paint tool).
+    FillAt {
+        x: f64,
+        y: f64,
+    },
     /// The eyedropper: the colour of the voxel under window pixel (x, y)
     /// becomes the current colour.
     PickColor {

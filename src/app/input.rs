@@ -91,6 +91,12 @@ impl Input {
                 let pressed = *state == ElementState::Pressed;
                 let at = self.cursor;
                 match (button, pressed) {
+                    // Shift+click with Paint: flood fill.
+                    (MouseButton::Left, true) if !consumed && self.modifiers.shift_key() && tool == Tool::Paint => {
+                        if let Some((x, y)) = at {
+                            out.push(Command::FillAt { x, y });
+                        }
+                    }
                     // Alt+click: the eyedropper.
                     (MouseButton::Left, true) if !consumed && self.modifiers.alt_key() => {
                         if let Some((x, y)) = at {

@@ -367,6 +367,15 @@ impl App {
                 }
             }
             Command::MeasurePresets => self.measure_presets(),
+            Command::FillAt { x, y } => match self.pick_at(x, y) {
+                Ok(Some(pick)) => {
+                    if let Err(err) = self.fill(pick.voxel, self.state.color.max(1)) {
+                        self.ui.error(format!("fill refused: {err}"));
+                    }
+                }
+                Ok(None) => self.ui.info("no voxel there to fill"),
+                Err(gave_up) => self.ui.error(gave_up.to_string()),
+            },
             Command::PickColor { x, y } => match self.pick_at(x, y) {
                 Ok(Some(pick)) => {
                     self.state.color = pick.value;
@@ -452,6 +461,16 @@ impl App {
         let py = ((y * f64::from(h) / f64::from(window_h)) as u32).min(h - 1);
         let hit = svo::pick(&self.scene.tree, &self.state.camera, (w, h), px, py)?;
         Ok(hit.map(|hit| Pick { voxel: hit.voxel, normal: hit.normal, value: hit.value }))
+    }
+
+    /// Recolours the region of `start`'s colour with `color`, as one undo
+    /// step, through the edit path; recorded as a `fill` line.
+    pub(super) fn fill(&mut self, start: IVec3, color: u8) -> Result<(), octovox::scene::EditError> {
+        let edits = octovox::scene::fill::fill_edits(&self.scene.tree, start, color)?;
+        self.history.apply_group(&mut self.scene, edits)?;
+        self.record(|r| r.fill(color, start));
+        self.after_change("fill");
+        Ok(())
     }
 
     /// Measures the quality presets from the current camera (a second or

@@ -98,6 +98,11 @@ impl App {
                 self.with_player(|p| p.color = *c);
                 self.state.color = *c;
             }
+            Line::Fill(p) => {
+                if let Err(err) = self.fill(*p, color) {
+                    return Played::Failed(err.to_string());
+                }
+            }
             Line::Pick(p) => match self.scene.tree.get(*p) {
                 0 => return Played::Failed(format!("no voxel at {p} to pick a colour from")),
                 value => {

@@ -51,6 +51,9 @@ pub enum Command {
     ExpectImage(PathBuf, f64),
     /// The path tracer's effect set for the scene, as names (any order).
     ExpectEffects(Vec<String>),
+    /// `fill X Y Z`: the 6-connected region of the voxel's colour takes the
+    /// current colour (one undo step).
+    Fill(IVec3),
     /// `pick X Y Z`: the eyedropper; the voxel's colour becomes the current one.
     Pick(IVec3),
     /// `rgb INDEX R G B`: a palette entry's colour (an undoable edit).
@@ -107,6 +110,7 @@ impl fmt::Display for Command {
             Command::ExpectCount(n) => write!(f, "expect count {n}"),
             Command::ExpectWritten(n) => write!(f, "expect written <= {n}"),
             Command::ExpectImage(path, tol) => write!(f, "expect image {} {tol}", quoted(path)),
+            Command::Fill(p) => write!(f, "fill {}", v(*p)),
             Command::Pick(p) => write!(f, "pick {}", v(*p)),
             Command::Rgb(index, [r, g, b]) => write!(f, "rgb {index} {r} {g} {b}"),
             Command::Material(index, material) => {

@@ -96,6 +96,21 @@ impl Recorder {
         self.command(&edit_command(tool, center))
     }
 
+    /// A flood fill: the colour it used if that changed, then the `fill`
+    /// line, one undo step of its own.
+    pub fn fill(&mut self, color: u8, at: IVec3) -> std::io::Result<()> {
+        self.end_step();
+        if self.color != Some(color) {
+            self.color = Some(color);
+            self.command(&Command::Color(color))?;
+        }
+        self.undone.clear();
+        self.open_stroke += 1;
+        self.command(&Command::Fill(at))?;
+        self.end_step();
+        Ok(())
+    }
+
     /// A palette edit: an `rgb` line if the colour changed, a `material`
     /// line if the material did (each one edit of the open step).
     pub fn palette(

@@ -154,6 +154,12 @@ impl Runner {
             Command::Place(p) => self.brush_edit(*p, Op::Place(self.color))?,
             Command::Remove(p) => self.brush_edit(*p, Op::Remove)?,
             Command::Paint(p) => self.brush_edit(*p, Op::Paint(self.color))?,
+            Command::Fill(p) => {
+                let edits =
+                    crate::scene::fill::fill_edits(&self.scene.tree, *p, self.color).map_err(|e| e.to_string())?;
+                self.history.apply_group(&mut self.scene, edits).map_err(|e| e.to_string())?;
+                self.last_written = Some(self.flush());
+            }
             Command::Click { x, y, tool } => {
                 let expected = format!("pixel ({x}, {y}) to hit a voxel");
                 let (voxel, normal) = match self.pick(*x, *y) {

@@ -4,6 +4,7 @@ pub mod apply;
 pub mod build;
 pub mod counts;
 pub mod demo;
+pub mod fill;
 pub mod octree;
 pub mod palette;
 pub mod sculpture;
