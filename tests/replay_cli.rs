@@ -220,3 +220,26 @@ fn fill_recolours_the_connected_region_of_one_colour_in_one_step() {
     assert!(!out.status.success());
     assert!(text.contains("no voxel at [5, 5, 5] to fill from") && text.contains("bad.ovr:2"), "{text}");
 }
+
+#[test]
+fn mirrored_edits_land_on_both_sides_in_one_step() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("mirror.ovr");
+    // x = 0.5 is the centre of voxel 0: voxel x maps to -x; z = 0 maps z to -z - 1.
+    let script = "new\ncolor 5\nmirror x 0.5\nplace 3 0 0\nexpect voxel -3 0 0 5\nexpect count 2\nundo\nexpect count 0\n\
+                  mirror z 0\nplace 1 0 5\nexpect voxel -1 0 5 5\nexpect voxel 1 0 -6 5\nexpect voxel -1 0 -6 5\n\
+                  mirror off\nplace 2 2 2\nexpect voxel -2 2 2 0\nexpect count 5\n";
+    std::fs::write(&path, script).unwrap();
+    for cpu in [false, true] {
+        replay_passes(&path, cpu, "8 passed, 0 failed");
+    }
+    for (line, message) in [
+        ("mirror w 3", "expected x, y, z or off, found 'w'"),
+        ("mirror x 0.25", "plane '0.25' must be a whole or half number"),
+        ("mirror y", "missing the plane's coordinate"),
+    ] {
+        let (out, text) = run_script(&format!("new\n{line}\n"));
+        assert!(!out.status.success(), "{line}");
+        assert!(text.contains(message) && text.contains("bad.ovr:2:"), "{line}: {text}");
+    }
+}

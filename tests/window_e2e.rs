@@ -308,3 +308,50 @@ fn alt_click_picks_a_colour_and_shift_click_paint_fills_with_it() {
     assert_eq!(filled.tree.solid_voxels(), 1025);
     assert!(filled.tree.voxels().iter().all(|(_, c)| *c == 12), "the 77 region was filled with 12");
 }
+
+/// A mirrored click: with `mirror x 8` (the floor's middle) in force (set by a replayed script
+/// line), one real click attaches a voxel and its image across the plane,
+/// and one Ctrl+Z takes both away.
+#[test]
+fn a_mirrored_click_places_both_sides_and_undoes_in_one_step() {
+    for tool in ["Xvfb", "xdotool"] {
+        require_tool(tool);
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("floor.vox");
+    let mut scene = octovox::scene::Scene::default();
+    scene.tree.apply_brush(&Shape::Box { min: IVec3::ZERO, max: IVec3::new(15, 0, 15) }, Op::Place(20)).unwrap();
+    octovox::io::save_scene(&file, &scene, Default::default()).unwrap();
+    let script = dir.path().join("mirror.ovr");
+    std::fs::write(&script, "mirror x 8\n").unwrap();
+    let camera =
+        Camera { eye: glam::DVec3::new(8.0, 20.0, 24.0), target: glam::DVec3::new(8.0, 0.0, 8.0), fov_y_deg: 50.0 };
+    // A floor voxel left of the plane, hit from above.
+    let (x, y, voxel, normal) = stable_pixel(&scene.tree, &camera, |v, n| n == IVec3::Y && v.x < 6);
+    let placed = voxel + normal;
+    let image = IVec3::new(15 - placed.x, placed.y, placed.z);
+    let args = [
+        file.display().to_string(),
+        "--size".into(),
+        format!("{WIDTH}x{HEIGHT}"),
+        camera_arg(&camera),
+        "--shading".into(),
+        "preview".into(),
+        "--replay".into(),
+        script.display().to_string(),
+    ];
+    let (_xvfb, display) = start_xvfb(5);
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
+    let window = find_window(&display, &mut app, &stderr_path);
+    lines.wait_for("replay:", Duration::from_secs(90));
+    xdotool(&display, &["windowfocus", "--sync", &window]);
+    click(&display, &window, &mut lines, x, y);
+    save(&display, &mut lines, &file);
+    let saved = octovox::io::load_scene(&file, 0).unwrap();
+    assert_eq!((saved.tree.get(placed), saved.tree.get(image)), (20, 20), "{placed} and its image {image}");
+    assert_eq!(saved.tree.solid_voxels(), 258);
+    xdotool(&display, &["key", "ctrl+z"]);
+    lines.wait_for("undo:", Duration::from_secs(30));
+    save(&display, &mut lines, &file);
+    assert_eq!(octovox::io::load_scene(&file, 0).unwrap().tree.solid_voxels(), 256, "one undo took both away");
+}

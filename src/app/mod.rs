@@ -279,7 +279,8 @@ impl App {
     /// Applies an edit the way every edit is applied: `History::apply` on the
     /// octree, then the pool's dirty ranges go to the GPU.
     pub fn apply_edit(&mut self, edit: Edit) -> bool {
-        match self.history.apply(&mut self.scene, edit) {
+        // A brush edit and its mirror images are one step (or part of the stroke).
+        match self.history.apply_group(&mut self.scene, self.state.mirror.edits(edit)) {
             Ok(()) => {
                 self.after_change("edit");
                 true
@@ -583,7 +584,8 @@ impl App {
             stroke.plane.get_or_insert(layer);
             stroke.last_center = Some(center);
             let (camera, brush, color) = (self.state.camera, self.state.brush(), self.state.color.max(1));
-            self.record(|r| r.edit(&camera, brush, color, tool, center));
+            let mirror = self.state.mirror;
+            self.record(|r| r.edit(&camera, brush, color, (tool, &mirror), center));
         }
     }
 }

@@ -98,6 +98,10 @@ impl App {
                 self.with_player(|p| p.color = *c);
                 self.state.color = *c;
             }
+            Line::Mirror(plane) => match plane {
+                Some((axis, c)) => self.state.mirror.set(*axis, Some(*c)),
+                None => self.state.mirror = octovox::mirror::Mirror::default(),
+            },
             Line::Fill(p) => {
                 if let Err(err) = self.fill(*p, color) {
                     return Played::Failed(err.to_string());

@@ -52,6 +52,8 @@ pub struct EditorState {
     pub path_settings: PathSettings,
     /// Samples the path tracer accumulates at rest before it stops.
     pub sample_target: u32,
+    /// Mirror planes in force for brush edits.
+    pub mirror: octovox::mirror::Mirror,
 }
 
 impl Default for EditorState {
@@ -70,6 +72,7 @@ impl Default for EditorState {
             shading: Shading::default(),
             path_settings: PathSettings::default(),
             sample_target: octovox::settings::DEFAULT_SAMPLE_TARGET,
+            mirror: octovox::mirror::Mirror::default(),
         }
     }
 }

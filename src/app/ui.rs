@@ -102,6 +102,7 @@ pub fn show(ui: &mut egui::Ui, state: &mut EditorState, ui_state: &mut UiState, 
     egui::Panel::left("tools").resizable(false).exact_size(PANEL_WIDTH).show(ui, |ui| {
         egui::ScrollArea::vertical().show(ui, |ui| {
             tools(ui, state);
+            mirror(ui, state);
             ui.separator();
             palette(ui, state, info.palette);
             material_editor(ui, state.color, info.palette, &mut out);
@@ -162,6 +163,22 @@ fn menu_bar(ui: &mut egui::Ui, info: &Info, ui_state: &mut UiState, out: &mut Ve
             ui.label(format!("loading {} … {seconds:.1} s", path.display()));
         }
         message(ui, ui_state);
+    });
+}
+
+/// Mirror planes: a checkbox and the plane's coordinate per axis.
+fn mirror(ui: &mut egui::Ui, state: &mut EditorState) {
+    ui.horizontal(|ui| {
+        ui.label("Mirror");
+        for (axis, name) in ["x", "y", "z"].into_iter().enumerate() {
+            let mut on = state.mirror.planes[axis].is_some();
+            let mut c = state.mirror.plane(axis).unwrap_or(0.0);
+            ui.checkbox(&mut on, name);
+            if on {
+                ui.add(egui::DragValue::new(&mut c).speed(0.5).fixed_decimals(1));
+            }
+            state.mirror.set(axis, on.then_some(c));
+        }
     });
 }
 

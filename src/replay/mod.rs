@@ -51,6 +51,9 @@ pub enum Command {
     ExpectImage(PathBuf, f64),
     /// The path tracer's effect set for the scene, as names (any order).
     ExpectEffects(Vec<String>),
+    /// `mirror x|y|z C`: later brush edits are also applied mirrored across
+    /// the plane at C (a whole or half number); `mirror off` ends them all.
+    Mirror(Option<(usize, f64)>),
     /// `fill X Y Z`: the 6-connected region of the voxel's colour takes the
     /// current colour (one undo step).
     Fill(IVec3),
@@ -111,6 +114,8 @@ impl fmt::Display for Command {
             Command::ExpectWritten(n) => write!(f, "expect written <= {n}"),
             Command::ExpectImage(path, tol) => write!(f, "expect image {} {tol}", quoted(path)),
             Command::Fill(p) => write!(f, "fill {}", v(*p)),
+            Command::Mirror(None) => write!(f, "mirror off"),
+            Command::Mirror(Some((axis, c))) => write!(f, "mirror {} {c}", ["x", "y", "z"][*axis]),
             Command::Pick(p) => write!(f, "pick {}", v(*p)),
             Command::Rgb(index, [r, g, b]) => write!(f, "rgb {index} {r} {g} {b}"),
             Command::Material(index, material) => {

@@ -9,6 +9,7 @@ use glam::IVec3;
 
 use super::{Command, edit_command};
 use crate::camera::Camera;
+use crate::mirror::Mirror;
 use crate::scene::Material;
 use crate::tool::{Brush, Tool};
 
@@ -20,6 +21,8 @@ pub struct Recorder {
     camera: Option<Camera>,
     brush: Option<Brush>,
     color: Option<u8>,
+    /// Mirror planes the script has in force.
+    mirror: Mirror,
     /// Edits of each undo step still undoable / redoable (a stroke is one
     /// step in the window but one line per edit in the script).
     done: Vec<u32>,
@@ -36,6 +39,7 @@ impl Recorder {
             camera: None,
             brush: None,
             color: None,
+            mirror: Mirror::default(),
             done: Vec::new(),
             undone: Vec::new(),
             open_stroke: 0,
@@ -68,6 +72,8 @@ impl Recorder {
     /// A voxel the window places by itself (the seed of a new scene), not an
     /// undo step there: recorded so the replay starts from the same voxels.
     pub fn seed(&mut self, color: u8, at: IVec3) -> std::io::Result<()> {
+        // The seed is not mirrored.
+        self.set_mirror(&Mirror::default())?;
         self.brush = Some(Brush::Voxel);
         self.color = Some(color);
         self.command(&Command::Brush(Brush::Voxel))?;
@@ -77,7 +83,15 @@ impl Recorder {
 
     /// One edit made by a click: writes the state it depends on if it
     /// changed, then the edit line.
-    pub fn edit(&mut self, camera: &Camera, brush: Brush, color: u8, tool: Tool, center: IVec3) -> std::io::Result<()> {
+    pub fn edit(
+        &mut self,
+        camera: &Camera,
+        brush: Brush,
+        color: u8,
+        (tool, mirror): (Tool, &Mirror),
+        center: IVec3,
+    ) -> std::io::Result<()> {
+        self.set_mirror(mirror)?;
         if self.camera != Some(*camera) {
             self.camera = Some(*camera);
             let (eye, target) = (camera.eye, camera.target);
@@ -128,6 +142,21 @@ impl Recorder {
         if before.1 != after.1 {
             self.open_stroke += 1;
             self.command(&Command::Material(index, Box::new(after.1.clone())))?;
+        }
+        Ok(())
+    }
+
+    /// Writes `mirror` lines when the planes in force changed.
+    fn set_mirror(&mut self, mirror: &Mirror) -> std::io::Result<()> {
+        if self.mirror == *mirror {
+            return Ok(());
+        }
+        self.mirror = *mirror;
+        self.command(&Command::Mirror(None))?;
+        for axis in 0..3 {
+            if let Some(c) = mirror.plane(axis) {
+                self.command(&Command::Mirror(Some((axis, c))))?;
+            }
         }
         Ok(())
     }

@@ -56,6 +56,8 @@ pub struct Runner {
     pub viewport: (u32, u32),
     pub brush: Brush,
     pub color: u8,
+    /// Mirror planes in force for brush edits.
+    pub mirror: crate::mirror::Mirror,
     pub settings: RenderSettings,
     /// Bytes the pool flush after the last edit line wrote.
     pub last_written: Option<u64>,
@@ -88,6 +90,7 @@ impl Runner {
             viewport: (640, 480),
             brush: Brush::Voxel,
             color: 1,
+            mirror: crate::mirror::Mirror::default(),
             settings: RenderSettings::default(),
             last_written: None,
             last_render: None,
@@ -142,6 +145,10 @@ impl Runner {
             Command::Viewport(w, h) => self.viewport = (*w, *h),
             Command::Brush(brush) => self.brush = *brush,
             Command::Color(c) => self.color = *c,
+            Command::Mirror(plane) => match plane {
+                Some((axis, c)) => self.mirror.set(*axis, Some(*c)),
+                None => self.mirror = crate::mirror::Mirror::default(),
+            },
             Command::Pick(p) => match self.scene.tree.get(*p) {
                 0 => return Err(format!("no voxel at {p} to pick a colour from")),
                 value => self.color = value,
@@ -235,7 +242,8 @@ impl Runner {
 
     /// The one edit path: history → octree → pool flush (→ GPU).
     pub fn apply(&mut self, edit: Edit) -> Result<(), String> {
-        self.history.apply(&mut self.scene, edit).map_err(|e| e.to_string())?;
+        // A brush edit and its mirror images are one step.
+        self.history.apply_group(&mut self.scene, self.mirror.edits(edit)).map_err(|e| e.to_string())?;
         self.last_written = Some(self.flush());
         Ok(())
     }
