@@ -88,3 +88,42 @@ pub fn click_edit(tool: Tool, brush: &Brush, color: u8, voxel: IVec3, normal: IV
     let center = click_target(tool, voxel, normal);
     (center, Edit::Brush { shape: brush.shape_at(center), op: tool_op(tool, color) })
 }
+
+/// The cells of a 3D line from `a` to `b`, both ends included: one per step
+/// along the longest axis (max(|Δx|, |Δy|, |Δz|) + 1 cells), the others
+/// rounded to the nearest cell (halves up).
+pub fn line_points(a: IVec3, b: IVec3) -> Vec<IVec3> {
+    let d = (b - a).as_i64vec3();
+    let n = d.abs().max_element();
+    if n == 0 {
+        return vec![a];
+    }
+    (0..=n)
+        .map(|i| {
+            let offset = (d * 2 * i + glam::I64Vec3::splat(n)).div_euclid(glam::I64Vec3::splat(2 * n));
+            a + offset.as_ivec3()
+        })
+        .collect()
+}
+
+/// The edits of a line: the brush placed with `color` at every cell of it.
+pub fn line_edits(brush: &Brush, color: u8, a: IVec3, b: IVec3) -> Vec<Edit> {
+    line_points(a, b).into_iter().map(|p| Edit::Brush { shape: brush.shape_at(p), op: Op::Place(color) }).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_line_has_one_cell_per_step_of_its_longest_axis() {
+        assert_eq!(line_points(IVec3::ZERO, IVec3::new(3, 0, 0)).len(), 4);
+        let diagonal = line_points(IVec3::new(1, 1, 1), IVec3::new(-2, -2, -2));
+        assert_eq!(diagonal, (0..4).map(|i| IVec3::splat(1 - i)).collect::<Vec<_>>());
+        let general = line_points(IVec3::ZERO, IVec3::new(7, -3, 2));
+        assert_eq!(general.len(), 8);
+        assert_eq!((general[0], general[7]), (IVec3::ZERO, IVec3::new(7, -3, 2)));
+        // 26-connected: each cell touches the next.
+        assert!(general.windows(2).all(|w| (w[1] - w[0]).abs().max_element() == 1));
+    }
+}

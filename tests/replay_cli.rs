@@ -243,3 +243,17 @@ fn mirrored_edits_land_on_both_sides_in_one_step() {
         assert!(text.contains(message) && text.contains("bad.ovr:2:"), "{line}: {text}");
     }
 }
+
+#[test]
+fn a_line_places_one_brush_per_step_in_one_undo_step() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("line.ovr");
+    // Along x: 5 cells. The diagonal: (i, i, i). Mirrored across x = 0.5: -x.
+    let script = "new\ncolor 6\nline 0 0 0 4 0 0\nexpect count 5\nexpect voxel 4 0 0 6\nundo\nexpect count 0\n\
+                  line 0 0 0 3 3 3\nexpect count 4\nexpect voxel 2 2 2 6\nexpect voxel 1 1 1 6\n\
+                  mirror x 0.5\nline 2 5 0 2 7 0\nexpect voxel -2 6 0 6\nexpect count 10\n";
+    std::fs::write(&path, script).unwrap();
+    for cpu in [false, true] {
+        replay_passes(&path, cpu, "8 passed, 0 failed");
+    }
+}

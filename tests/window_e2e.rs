@@ -355,3 +355,52 @@ fn a_mirrored_click_places_both_sides_and_undoes_in_one_step() {
     save(&display, &mut lines, &file);
     assert_eq!(octovox::io::load_scene(&file, 0).unwrap().tree.solid_voxels(), 256, "one undo took both away");
 }
+
+/// Line mode (L): a real press-drag-release across the floor places one
+/// voxel per step of the longest axis, both ends included, touching each
+/// other; one Ctrl+Z takes the line away.
+#[test]
+fn a_dragged_line_in_line_mode() {
+    for tool in ["Xvfb", "xdotool"] {
+        require_tool(tool);
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("floor.vox");
+    let mut scene = octovox::scene::Scene::default();
+    scene.tree.apply_brush(&Shape::Box { min: IVec3::ZERO, max: IVec3::new(15, 0, 15) }, Op::Place(20)).unwrap();
+    octovox::io::save_scene(&file, &scene, Default::default()).unwrap();
+    let camera =
+        Camera { eye: glam::DVec3::new(8.0, 20.0, 24.0), target: glam::DVec3::new(8.0, 0.0, 8.0), fov_y_deg: 50.0 };
+    let (xa, ya, va, na) = stable_pixel(&scene.tree, &camera, |v, n| n == IVec3::Y && v.x < 4);
+    let (xb, yb, vb, nb) = stable_pixel(&scene.tree, &camera, |v, n| n == IVec3::Y && v.x > 11);
+    let (a, b) = (va + na, vb + nb);
+    let args = [file.display().to_string(), "--size".into(), format!("{WIDTH}x{HEIGHT}"), camera_arg(&camera)];
+    let (_xvfb, display) = start_xvfb(6);
+    let (mut app, mut lines, stderr_path) =
+        spawn_app(&display, dir.path(), &[&args[..], &["--shading".into(), "preview".into()]].concat());
+    let window = find_window(&display, &mut app, &stderr_path);
+    lines.wait_for("octovox: ready", Duration::from_secs(90));
+    xdotool(&display, &["windowfocus", "--sync", &window]);
+    xdotool(&display, &["key", "l"]);
+    xdotool(&display, &["mousemove", "--window", &window, &xa.to_string(), &ya.to_string()]);
+    xdotool(&display, &["mousedown", "1"]);
+    for i in 1..=4 {
+        let (x, y) = (xa as i32 + (xb as i32 - xa as i32) * i / 4, ya as i32 + (yb as i32 - ya as i32) * i / 4);
+        xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y.to_string()]);
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    xdotool(&display, &["mouseup", "1"]);
+    lines.wait_for("line:", Duration::from_secs(30));
+    save(&display, &mut lines, &file);
+    let saved = octovox::io::load_scene(&file, 0).unwrap();
+    let added: Vec<IVec3> = saved.tree.voxels().into_iter().map(|(p, _)| p).filter(|p| p.y == 1).collect();
+    let steps = (b - a).abs().max_element();
+    assert_eq!(added.len() as i32, steps + 1, "{a} to {b}: {added:?}");
+    assert!(added.contains(&a) && added.contains(&b), "both ends: {added:?}");
+    let touching = added.iter().all(|p| added.iter().any(|q| q != p && (*q - *p).abs().max_element() == 1));
+    assert!(touching, "the cells touch: {added:?}");
+    xdotool(&display, &["key", "ctrl+z"]);
+    lines.wait_for("undo:", Duration::from_secs(30));
+    save(&display, &mut lines, &file);
+    assert_eq!(octovox::io::load_scene(&file, 0).unwrap().tree.solid_voxels(), 256, "one undo took the line away");
+}

@@ -69,6 +69,8 @@ pub enum Command {
         x: f64,
         y: f64,
     },
+    /// Line mode on or off (L).
+    ToggleLine,
     /// Set the quality knobs to preset `PRESETS[i]`.
     ApplyPreset(usize),
     /// Measure what each preset costs and how far it is from the reference.

@@ -189,6 +189,7 @@ impl Input {
             KeyCode::KeyT => Some(Command::SetTool(Tool::Attach)),
             KeyCode::KeyR => Some(Command::SetTool(Tool::Erase)),
             KeyCode::KeyG => Some(Command::SetTool(Tool::Paint)),
+            KeyCode::KeyL => Some(Command::ToggleLine),
             KeyCode::KeyF if self.right.is_none() => Some(Command::FrameModel),
             KeyCode::F12 => Some(Command::Screenshot),
             _ => None,

@@ -279,10 +279,16 @@ impl App {
     /// Applies an edit the way every edit is applied: `History::apply` on the
     /// octree, then the pool's dirty ranges go to the GPU.
     pub fn apply_edit(&mut self, edit: Edit) -> bool {
-        // A brush edit and its mirror images are one step (or part of the stroke).
-        match self.history.apply_group(&mut self.scene, self.state.mirror.edits(edit)) {
+        self.apply_edits(vec![edit], "edit")
+    }
+
+    /// Several edits (a line) and their mirror images as one undo step (or
+    /// part of the open stroke); `what` names it in the printed line.
+    pub fn apply_edits(&mut self, edits: Vec<Edit>, what: &str) -> bool {
+        let edits = edits.into_iter().flat_map(|e| self.state.mirror.edits(e)).collect();
+        match self.history.apply_group(&mut self.scene, edits) {
             Ok(()) => {
-                self.after_change("edit");
+                self.after_change(what);
                 true
             }
             Err(err) => {
@@ -368,6 +374,10 @@ impl App {
                 }
             }
             Command::MeasurePresets => self.measure_presets(),
+            Command::ToggleLine => {
+                self.state.line_mode = !self.state.line_mode;
+                self.state.line_start = None;
+            }
             Command::FillAt { x, y } => match self.pick_at(x, y) {
                 Ok(Some(pick)) => {
                     if let Err(err) = self.fill(pick.voxel, self.state.color.max(1)) {
@@ -464,6 +474,34 @@ impl App {
         Ok(hit.map(|hit| Pick { voxel: hit.voxel, normal: hit.normal, value: hit.value }))
     }
 
+    /// Line mode: the press picks the start (in front of the face), the
+    /// release the end; the brush is placed along the line as one step.
+    fn line_edit(&mut self, phase: StrokePhase, x: f64, y: f64) {
+        let target = match self.pick_at(x, y) {
+            Ok(Some(pick)) => Some(pick.voxel + pick.normal),
+            Ok(None) => None,
+            Err(gave_up) => {
+                self.ui.error(gave_up.to_string());
+                None
+            }
+        };
+        match phase {
+            StrokePhase::Begin => self.state.line_start = target,
+            StrokePhase::Move => {}
+            StrokePhase::End | StrokePhase::Click => {
+                let start = self.state.line_start.take().or(target);
+                if let (Some(a), Some(b)) = (start, target) {
+                    let (brush, color) = (self.state.brush(), self.state.color.max(1));
+                    let edits = octovox::tool::line_edits(&brush, color, a, b);
+                    if self.apply_edits(edits, "line") {
+                        let (camera, mirror) = (self.state.camera, self.state.mirror);
+                        self.record(|r| r.line_drawn(&camera, brush, color, &mirror, (a, b)));
+                    }
+                }
+            }
+        }
+    }
+
     /// Recolours the region of `start`'s colour with `color`, as one undo
     /// step, through the edit path; recorded as a `fill` line.
     pub(super) fn fill(&mut self, start: IVec3, color: u8) -> Result<(), octovox::scene::EditError> {
@@ -526,6 +564,9 @@ impl App {
     }
 
     fn pointer_edit(&mut self, phase: StrokePhase, tool: Tool, x: f64, y: f64) {
+        if self.state.line_mode {
+            return self.line_edit(phase, x, y);
+        }
         match phase {
             StrokePhase::Begin => {
                 self.history.begin_stroke();

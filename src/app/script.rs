@@ -98,6 +98,9 @@ impl App {
                 self.with_player(|p| p.color = *c);
                 self.state.color = *c;
             }
+            Line::Line(a, b) => {
+                self.apply_edits(octovox::tool::line_edits(&brush, color, *a, *b), "line");
+            }
             Line::Mirror(plane) => match plane {
                 Some((axis, c)) => self.state.mirror.set(*axis, Some(*c)),
                 None => self.state.mirror = octovox::mirror::Mirror::default(),

@@ -54,6 +54,10 @@ pub struct EditorState {
     pub sample_target: u32,
     /// Mirror planes in force for brush edits.
     pub mirror: octovox::mirror::Mirror,
+    /// Line mode (L): a press-drag-release places the brush along a line.
+    pub line_mode: bool,
+    /// Where the line being dragged starts (the cell in front of the face).
+    pub line_start: Option<IVec3>,
 }
 
 impl Default for EditorState {
@@ -73,6 +77,8 @@ impl Default for EditorState {
             path_settings: PathSettings::default(),
             sample_target: octovox::settings::DEFAULT_SAMPLE_TARGET,
             mirror: octovox::mirror::Mirror::default(),
+            line_mode: false,
+            line_start: None,
         }
     }
 }
@@ -94,6 +100,12 @@ impl EditorState {
 
     /// Inclusive world box of the cells the brush would touch at `pick`.
     pub fn preview_box(&self, pick: &Pick) -> (IVec3, IVec3) {
+        if let Some(start) = self.line_start {
+            // While a line is dragged: the box from its start to here.
+            let end = pick.voxel + pick.normal;
+            let ((a, b), (c, d)) = (self.brush().shape_at(start).bounds(), self.brush().shape_at(end).bounds());
+            return (a.min(c), b.max(d));
+        }
         let (center, _) = self.edit_at(self.tool, pick);
         self.brush().shape_at(center).bounds()
     }

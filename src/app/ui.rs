@@ -189,6 +189,13 @@ fn tools(ui: &mut egui::Ui, state: &mut EditorState) {
             ui.selectable_value(&mut state.tool, tool, tool_label(tool));
         }
     });
+    if ui
+        .toggle_value(&mut state.line_mode, "Line (L)")
+        .on_hover_text("press, drag and release: the brush along a line")
+        .changed()
+    {
+        state.line_start = None;
+    }
     ui.label("Brush");
     ui.horizontal(|ui| {
         ui.selectable_value(&mut state.brush_kind, BrushKind::Voxel, "Voxel");

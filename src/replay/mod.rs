@@ -51,6 +51,9 @@ pub enum Command {
     ExpectImage(PathBuf, f64),
     /// The path tracer's effect set for the scene, as names (any order).
     ExpectEffects(Vec<String>),
+    /// `line X1 Y1 Z1 X2 Y2 Z2`: the brush placed with the current colour at
+    /// every cell of the line, ends included (one undo step).
+    Line(IVec3, IVec3),
     /// `mirror x|y|z C`: later brush edits are also applied mirrored across
     /// the plane at C (a whole or half number); `mirror off` ends them all.
     Mirror(Option<(usize, f64)>),
@@ -114,6 +117,7 @@ impl fmt::Display for Command {
             Command::ExpectWritten(n) => write!(f, "expect written <= {n}"),
             Command::ExpectImage(path, tol) => write!(f, "expect image {} {tol}", quoted(path)),
             Command::Fill(p) => write!(f, "fill {}", v(*p)),
+            Command::Line(a, b) => write!(f, "line {} {}", v(*a), v(*b)),
             Command::Mirror(None) => write!(f, "mirror off"),
             Command::Mirror(Some((axis, c))) => write!(f, "mirror {} {c}", ["x", "y", "z"][*axis]),
             Command::Pick(p) => write!(f, "pick {}", v(*p)),

@@ -91,20 +91,7 @@ impl Recorder {
         (tool, mirror): (Tool, &Mirror),
         center: IVec3,
     ) -> std::io::Result<()> {
-        self.set_mirror(mirror)?;
-        if self.camera != Some(*camera) {
-            self.camera = Some(*camera);
-            let (eye, target) = (camera.eye, camera.target);
-            self.command(&Command::Camera { eye, target, fov: Some(camera.fov_y_deg) })?;
-        }
-        if self.brush != Some(brush) {
-            self.brush = Some(brush);
-            self.command(&Command::Brush(brush))?;
-        }
-        if tool != Tool::Erase && self.color != Some(color) {
-            self.color = Some(color);
-            self.command(&Command::Color(color))?;
-        }
+        self.edit_state(camera, brush, (tool != Tool::Erase).then_some(color), mirror)?;
         self.undone.clear();
         self.open_stroke += 1;
         self.command(&edit_command(tool, center))
@@ -142,6 +129,47 @@ impl Recorder {
         if before.1 != after.1 {
             self.open_stroke += 1;
             self.command(&Command::Material(index, Box::new(after.1.clone())))?;
+        }
+        Ok(())
+    }
+
+    /// A line drawn in line mode: the state it depends on, then the `line`
+    /// command, one undo step.
+    pub fn line_drawn(
+        &mut self,
+        camera: &Camera,
+        brush: Brush,
+        color: u8,
+        mirror: &Mirror,
+        (a, b): (IVec3, IVec3),
+    ) -> std::io::Result<()> {
+        self.end_step();
+        self.edit_state(camera, brush, Some(color), mirror)?;
+        self.undone.clear();
+        self.open_stroke += 1;
+        self.command(&Command::Line(a, b))?;
+        self.end_step();
+        Ok(())
+    }
+
+    /// Writes the camera, brush, colour (when the edit uses one) and mirror
+    /// planes an edit depends on, where they changed.
+    fn edit_state(&mut self, camera: &Camera, brush: Brush, color: Option<u8>, mirror: &Mirror) -> std::io::Result<()> {
+        self.set_mirror(mirror)?;
+        if self.camera != Some(*camera) {
+            self.camera = Some(*camera);
+            let (eye, target) = (camera.eye, camera.target);
+            self.command(&Command::Camera { eye, target, fov: Some(camera.fov_y_deg) })?;
+        }
+        if self.brush != Some(brush) {
+            self.brush = Some(brush);
+            self.command(&Command::Brush(brush))?;
+        }
+        if let Some(color) = color
+            && self.color != Some(color)
+        {
+            self.color = Some(color);
+            self.command(&Command::Color(color))?;
         }
         Ok(())
     }

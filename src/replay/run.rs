@@ -145,6 +145,10 @@ impl Runner {
             Command::Viewport(w, h) => self.viewport = (*w, *h),
             Command::Brush(brush) => self.brush = *brush,
             Command::Color(c) => self.color = *c,
+            Command::Line(a, b) => {
+                let edits = crate::tool::line_edits(&self.brush, self.color, *a, *b);
+                self.apply_all(edits)?;
+            }
             Command::Mirror(plane) => match plane {
                 Some((axis, c)) => self.mirror.set(*axis, Some(*c)),
                 None => self.mirror = crate::mirror::Mirror::default(),
@@ -242,8 +246,13 @@ impl Runner {
 
     /// The one edit path: history → octree → pool flush (→ GPU).
     pub fn apply(&mut self, edit: Edit) -> Result<(), String> {
-        // A brush edit and its mirror images are one step.
-        self.history.apply_group(&mut self.scene, self.mirror.edits(edit)).map_err(|e| e.to_string())?;
+        self.apply_all(vec![edit])
+    }
+
+    /// Several edits (a line) and their mirror images as one step.
+    fn apply_all(&mut self, edits: Vec<Edit>) -> Result<(), String> {
+        let edits = edits.into_iter().flat_map(|e| self.mirror.edits(e)).collect();
+        self.history.apply_group(&mut self.scene, edits).map_err(|e| e.to_string())?;
         self.last_written = Some(self.flush());
         Ok(())
     }
