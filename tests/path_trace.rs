@@ -12,7 +12,7 @@ use octovox::camera::Camera;
 use octovox::gpu::Renderer;
 use octovox::scene::{Material, MaterialKind, Octree, Op, Palette, Shape};
 use octovox::settings::{PathSettings, Sky};
-use octovox::trace::path::render_cpu;
+use octovox::trace::path::{CpuRender, render_cpu};
 
 const WHITE: u8 = 1;
 const RED: u8 = 2;
@@ -75,7 +75,7 @@ fn white_furnace_converges_to_the_sky_on_the_cpu() {
     // The second camera sees the faces on the root cube's own faces.
     for camera in furnace_cameras() {
         let size = (48, 36);
-        let (pixels, effects) = render_cpu(&tree, &palette(), &camera, size, &furnace(), 16);
+        let CpuRender { pixels, effects, .. } = render_cpu(&tree, &palette(), &camera, size, &furnace(), 16);
         assert_eq!(effects.names(), ["sky"]);
         assert_furnace(&tree, &camera, size, &pixels);
     }
@@ -116,14 +116,14 @@ fn a_closed_room_is_lit_by_its_emitter_and_dark_without() {
     let settings = PathSettings { bounces: 4, ..PathSettings::default() };
     let emit = material(MaterialKind::Emit, &[("_emit", "1")]);
     let (tree, palette, camera) = lamp_room(emit);
-    let (lit, effects) = render_cpu(&tree, &palette, &camera, (32, 24), &settings, 8);
+    let CpuRender { pixels: lit, effects, .. } = render_cpu(&tree, &palette, &camera, (32, 24), &settings, 8);
     assert_eq!(effects.names(), ["sun", "sky", "emit"]);
     let m = mean(&lit);
     assert!(m.min_element() > 0.05, "the lit room's mean {m}");
     // The red wall shows red.
     assert!(m.x > m.y, "{m}");
     let (tree, palette, camera) = lamp_room(Material::new(MaterialKind::Diffuse));
-    let (dark, effects) = render_cpu(&tree, &palette, &camera, (32, 24), &settings, 8);
+    let CpuRender { pixels: dark, effects, .. } = render_cpu(&tree, &palette, &camera, (32, 24), &settings, 8);
     assert_eq!(effects.names(), ["sun", "sky"]);
     assert!(dark.iter().all(|p| *p == Vec3::ZERO), "sun and sky cannot reach into a closed box");
 }
@@ -147,8 +147,9 @@ fn clear_glass_of_index_one_shows_what_is_behind_it_unchanged() {
     let mut palette = palette();
     palette.materials[usize::from(SPECIAL)] = material(MaterialKind::Glass, &[("_ri", "1"), ("_trans", "1")]);
     let size = (32, 32);
-    let (without, _) = render_cpu(&stripes_with(None), &palette, &camera, size, &settings, 64);
-    let (with, effects) = render_cpu(&stripes_with(Some(SPECIAL)), &palette, &camera, size, &settings, 64);
+    let CpuRender { pixels: without, .. } = render_cpu(&stripes_with(None), &palette, &camera, size, &settings, 64);
+    let CpuRender { pixels: with, effects, .. } =
+        render_cpu(&stripes_with(Some(SPECIAL)), &palette, &camera, size, &settings, 64);
     assert_eq!(effects.names(), ["sky", "glass"]);
     // The pane covers the middle of the view: compare there.
     let centre = |v: &[Vec3]| -> Vec<Vec3> {
@@ -177,7 +178,7 @@ fn a_mirror_shows_the_reflected_colour() {
     let settings = PathSettings { bounces: 3, sun: false, ..PathSettings::default() };
     let camera = look(DVec3::new(0.5, 10.0, 6.0), DVec3::new(0.5, -1.0, -3.0));
     let size = (16, 16);
-    let (pixels, effects) = render_cpu(&tree, &palette, &camera, size, &settings, 16);
+    let CpuRender { pixels, effects, .. } = render_cpu(&tree, &palette, &camera, size, &settings, 16);
     assert_eq!(effects.names(), ["sky", "metal"]);
     let basis = camera.basis(size.0, size.1, tree.origin());
     let (horizon, zenith) = Sky::Gradient.colors();
@@ -252,7 +253,8 @@ fn gpu_and_cpu_path_tracers_agree() {
     let settings = PathSettings { bounces: 3, ..PathSettings::default() };
     let size = (40, 30);
     let spp = 8;
-    let (cpu, cpu_effects) = render_cpu(&tree, &palette, &camera, size, &settings, spp);
+    let CpuRender { pixels: cpu, effects: cpu_effects, .. } =
+        render_cpu(&tree, &palette, &camera, size, &settings, spp);
     let (gpu, gpu_effects) = render_gpu(&mut tree, &palette, &camera, size, &settings, spp);
     assert_eq!(cpu_effects, gpu_effects);
     assert_eq!(gpu_effects.names(), ["sun", "sky", "emit", "metal", "glass"]);
@@ -284,7 +286,7 @@ fn no_nan_or_infinity_from_the_hard_case_cameras() {
     let mut renderer = Renderer::headless().expect("a GPU adapter (lavapipe on CI)");
     renderer.sync(&mut tree, &palette);
     for (i, camera) in cameras.iter().enumerate() {
-        let (cpu, _) = render_cpu(&tree, &palette, camera, (24, 18), &settings, 2);
+        let CpuRender { pixels: cpu, .. } = render_cpu(&tree, &palette, camera, (24, 18), &settings, 2);
         assert!(all_finite(&cpu), "camera {i}: the CPU's accumulation holds NaN, infinity or a negative");
         for sample in 0..2 {
             renderer.render_path(&tree, &palette, camera, (24, 18), &settings, sample == 0).unwrap();

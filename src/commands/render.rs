@@ -15,7 +15,7 @@ use octovox::scene::Scene;
 use octovox::scene::demo::BuiltIn;
 use octovox::settings::{RenderSettings, TraceMode, View};
 use octovox::trace::grid::DenseGrid;
-use octovox::trace::path::{lights, render_cpu, to_image};
+use octovox::trace::path::{render_cpu, to_image};
 use octovox::trace::render::render_scene_cpu;
 
 /// Peak bytes per pixel of a CPU render: a hit record, a shadow flag, the
@@ -119,11 +119,11 @@ fn path_traced(
     let settings = args.path.settings();
     if args.cpu {
         let start = Instant::now();
-        let (pixels, effects) = render_cpu(&scene.tree, &scene.palette, camera, size, &settings, spp);
+        let frame = render_cpu(&scene.tree, &scene.palette, camera, size, &settings, spp);
         let ms = start.elapsed().as_secs_f64() * 1e3 / f64::from(spp);
-        let lights = if effects.emit { lights::emitters(&scene.tree, &scene.palette).len() } else { 0 };
-        let image = to_image(&pixels, size.0, size.1);
-        return Ok((image, Stats { effects: effects.names(), spp, ms_per_sample: ms, adapter: "cpu".into(), lights }));
+        let image = to_image(&frame.pixels, size.0, size.1);
+        let (effects, lights) = (frame.effects.names(), frame.lights);
+        return Ok((image, Stats { effects, spp, ms_per_sample: ms, adapter: "cpu".into(), lights }));
     }
     let mut renderer = Renderer::headless().context("no GPU for rendering (try --cpu)")?;
     log::info!("path tracing on {}", renderer.gpu.adapter_name);

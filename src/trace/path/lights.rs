@@ -29,16 +29,24 @@ pub struct Emitter {
 /// The lights of a scene: empty when it has no emitters or more than
 /// [`MAX_EMITTERS`] emissive cells.
 pub fn emitters(tree: &Octree, palette: &Palette) -> Vec<Emitter> {
-    let emissive: Vec<u8> =
-        tree.counts().present().filter(|i| gpu_material(palette, *i).kind == MATERIAL_EMIT).collect();
-    if emissive.is_empty() {
+    // Mean radiance of each emissive index present, worked out once.
+    let mut radiance = [None; 256];
+    for index in tree.counts().present() {
+        let material = gpu_material(palette, index);
+        if material.kind == MATERIAL_EMIT {
+            radiance[usize::from(index)] =
+                Some(albedo(palette, index).dot(glam::Vec3::splat(1.0 / 3.0)) * material.emission);
+        }
+    }
+    if radiance.iter().all(Option::is_none) {
         return Vec::new();
     }
     let mut out = Vec::new();
     let mut total = 0.0f32;
     let mut overflow = false;
     tree.for_each_solid_cell(|min, size, value| {
-        if overflow || !emissive.contains(&value) {
+        let Some(radiance) = radiance[usize::from(value)] else { return };
+        if overflow {
             return;
         }
         if out.len() == MAX_EMITTERS {
@@ -46,7 +54,6 @@ pub fn emitters(tree: &Octree, palette: &Palette) -> Vec<Emitter> {
             return;
         }
         // Power: radiance times surface area.
-        let radiance = albedo(palette, value).dot(glam::Vec3::splat(1.0 / 3.0)) * gpu_material(palette, value).emission;
         total += radiance.max(1e-6) * (size * size) as f32;
         let min = min - tree.origin();
         out.push(Emitter { min: min.into(), size: size as u32, cdf: total, index: u32::from(value), _pad: [0; 2] });

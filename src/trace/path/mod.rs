@@ -444,8 +444,17 @@ fn metal_lobe(d: Vec3, n: Vec3, albedo: Vec3, material: &GpuMaterial, rng: &mut 
     Some((dir, fresnel * (g * cos_vh / (cos_v * cos_h).max(1e-6))))
 }
 
-/// The mean radiance of `spp` samples of every pixel, row-major: the CPU
-/// reference for path-traced frames (`render --cpu --spp N`).
+/// What the CPU reference rendered.
+pub struct CpuRender {
+    /// The mean radiance of every pixel, row-major.
+    pub pixels: Vec<Vec3>,
+    pub effects: Effects,
+    /// Emissive cells sampled as lights.
+    pub lights: usize,
+}
+
+/// The mean radiance of `spp` samples of every pixel: the CPU reference for
+/// path-traced frames (`render --cpu --spp N`).
 pub fn render_cpu(
     tree: &Octree,
     palette: &Palette,
@@ -453,7 +462,7 @@ pub fn render_cpu(
     size: (u32, u32),
     settings: &PathSettings,
     spp: u32,
-) -> (Vec<Vec3>, Effects) {
+) -> CpuRender {
     let scene = PathScene::new(tree, palette, settings);
     let basis = camera.basis(size.0, size.1, tree.origin());
     let pixels = (0..basis.height)
@@ -466,7 +475,7 @@ pub fn render_cpu(
             })
         })
         .collect();
-    (pixels, scene.effects)
+    CpuRender { pixels, effects: scene.effects, lights: scene.lights.len() }
 }
 
 /// Radiance to display bytes: clamped to 0..=1, as the preview's colours.
