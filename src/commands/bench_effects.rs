@@ -6,6 +6,7 @@
 //! nothing to the picture.
 
 use glam::{DVec3, Vec3};
+use octovox::trace::render::display_rgba;
 use serde::Serialize;
 
 use octovox::camera::Camera;
@@ -91,11 +92,9 @@ pub fn bench_effects(quick: bool) -> anyhow::Result<(String, String)> {
             all_times.extend(times);
             all_image = image;
         }
-        let to_byte = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
-        let bytes = |p: &Vec3| [to_byte(p.x), to_byte(p.y), to_byte(p.z)];
         let pairs = auto_image.iter().zip(&all_image);
         let max_difference = pairs.clone().map(|(a, b)| (*a - *b).abs().max_element()).fold(0.0, f32::max);
-        let pixels_differing = pairs.filter(|(a, b)| bytes(a) != bytes(b)).count();
+        let pixels_differing = pairs.filter(|(a, b)| display_rgba(**a) != display_rgba(**b)).count();
         let effects = octovox::trace::path::effects_for(&scene.tree, &scene.palette, &auto);
         rows.push(EffectsRow {
             scene: name,

@@ -15,7 +15,7 @@ use glam::Vec3;
 
 use super::context::validated_on;
 use super::prelude::with_prelude;
-use super::readback::{read_buffer, read_texture_rgba8, staging_buffer};
+use super::readback::{read_storage, read_texture_rgba8};
 use super::trace_pass::{FrameUniforms, buffer_entry, output_entry, output_texture, uniform_entry};
 use super::{GpuContext, GpuError, SceneBuffers};
 use crate::trace::path::lights::Emitter;
@@ -361,13 +361,7 @@ impl PathPass {
 
     /// The mean radiance of every pixel so far, row-major.
     pub fn read_radiance(&self, gpu: &GpuContext) -> Result<Vec<Vec3>, GpuError> {
-        let size = self.target.accum.size();
-        let staging = staging_buffer(&gpu.device, "accumulation readback", size);
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("accum") });
-        encoder.copy_buffer_to_buffer(&self.target.accum, 0, &staging, 0, size);
-        gpu.queue.submit([encoder.finish()]);
-        let bytes = read_buffer(gpu, &staging)?;
-        let sums: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
+        let sums: Vec<[f32; 4]> = read_storage(gpu, &self.target.accum, "accumulation readback")?;
         let pixels = (self.target.width * self.target.height) as usize;
         Ok(sums.iter().take(pixels).map(|s| Vec3::new(s[0], s[1], s[2]) / s[3].max(1.0)).collect())
     }

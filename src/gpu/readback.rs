@@ -27,6 +27,21 @@ pub fn staging_buffer(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Bu
     })
 }
 
+/// Copies a storage buffer into a mapped staging buffer and returns it as
+/// `T`s (copied out, so the bytes' alignment does not matter).
+pub fn read_storage<T: bytemuck::Pod>(
+    gpu: &GpuContext,
+    buffer: &wgpu::Buffer,
+    label: &str,
+) -> Result<Vec<T>, GpuError> {
+    let size = buffer.size();
+    let staging = staging_buffer(&gpu.device, label, size);
+    let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+    encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+    gpu.queue.submit([encoder.finish()]);
+    Ok(bytemuck::pod_collect_to_vec(&read_buffer(gpu, &staging)?))
+}
+
 /// Bytes per row of a texture copy: `width * 4` rounded up to wgpu's 256.
 pub fn padded_row_bytes(width: u32) -> u32 {
     (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT

@@ -5,7 +5,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::IVec3;
 
 use super::prelude::with_prelude;
-use super::readback::{read_buffer, read_texture_rgba8, staging_buffer};
+use super::readback::{read_storage, read_texture_rgba8};
 use super::{GpuContext, GpuError, SceneBuffers};
 use crate::camera::RayBasis;
 use crate::scene::Octree;
@@ -382,14 +382,8 @@ impl TracePass {
 
     /// Reads back the hit record of every pixel.
     pub fn read_hits(&self, gpu: &GpuContext) -> Result<Vec<Hit>, GpuError> {
-        let size = self.target.hits_buf.size();
-        let staging = staging_buffer(&gpu.device, "hit readback", size);
-        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("hits") });
-        encoder.copy_buffer_to_buffer(&self.target.hits_buf, 0, &staging, 0, size);
-        gpu.queue.submit([encoder.finish()]);
-        let bytes = read_buffer(gpu, &staging)?;
-        let words: &[[u32; 4]] = bytemuck::cast_slice(&bytes);
-        Ok(words.iter().map(|r| Hit::from_record(*r)).collect())
+        let records: Vec<[u32; 4]> = read_storage(gpu, &self.target.hits_buf, "hit readback")?;
+        Ok(records.into_iter().map(Hit::from_record).collect())
     }
 
     /// Reads back the colour output as tightly packed RGBA8 rows.

@@ -88,6 +88,12 @@ pub fn shade(hit: &Hit, dir: Vec3, palette: &Palette, view: View, in_shadow: boo
         View::Normals if hit.is_hit() => hit.normal.as_vec3() * 0.5 + Vec3::splat(0.5),
         View::Normals => Vec3::ZERO,
     };
+    display_rgba(rgb)
+}
+
+/// A colour as the display shows it: each channel clamped to 0..=1 and
+/// rounded to a byte (no tone mapping; the path tracer's radiance too).
+pub fn display_rgba(rgb: Vec3) -> [u8; 4] {
     let to_byte = |v: f32| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
     [to_byte(rgb.x), to_byte(rgb.y), to_byte(rgb.z), 255]
 }

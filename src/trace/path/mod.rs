@@ -480,7 +480,6 @@ pub fn render_cpu(
 
 /// Radiance to display bytes: clamped to 0..=1, as the preview's colours.
 pub fn to_image(pixels: &[Vec3], width: u32, height: u32) -> image::RgbaImage {
-    let to_byte = |v: f32| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
-    let bytes = pixels.iter().flat_map(|p| [to_byte(p.x), to_byte(p.y), to_byte(p.z), 255]).collect();
+    let bytes = pixels.iter().flat_map(|p| super::render::display_rgba(*p)).collect();
     image::RgbaImage::from_raw(width, height, bytes).unwrap_or_default()
 }
