@@ -25,6 +25,14 @@ impl Mirror {
         self.planes[axis] = c.map(|c| (c * 2.0).round() as i32);
     }
 
+    /// Carries out a `mirror` script line: one plane on, or (`None`) all off.
+    pub fn apply_line(&mut self, plane: Option<(usize, f64)>) {
+        match plane {
+            Some((axis, c)) => self.set(axis, Some(c)),
+            None => *self = Mirror::default(),
+        }
+    }
+
     /// `edit` and its mirror images across every plane in force (2^planes
     /// edits, the same one once); other edits as they are.
     pub fn edits(&self, edit: Edit) -> Vec<Edit> {

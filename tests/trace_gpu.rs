@@ -255,7 +255,7 @@ fn frames_that_do_not_wait_report_their_times_later() {
 #[test]
 fn frame_times_stay_plausible_after_path_traced_frames() {
     let mut scene = octovox::scene::demo::BuiltIn::Interior.scene();
-    let camera = Camera { eye: DVec3::new(36.0, 18.0, 36.0), target: DVec3::new(10.0, 4.0, 10.0), fov_y_deg: 60.0 };
+    let camera = octovox::scene::showroom::interior_camera();
     let mut renderer = Renderer::headless().unwrap();
     renderer.sync(&mut scene.tree, &scene.palette);
     renderer.set_grid(&DenseGrid::from_octree(&scene.tree).unwrap()).unwrap();

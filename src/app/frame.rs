@@ -263,10 +263,12 @@ impl App {
 /// Whether this frame is path traced: by the user's choice, and at rest
 /// only in the default mode (the preview keeps a moving camera fluid).
 fn path_traced(state: &super::state::EditorState, moving: bool) -> bool {
+    // The path tracer walks the SVO and shades; the grid and the debug views are the preview's.
+    let shaded_svo = state.settings.mode == TraceMode::Svo && state.settings.view == View::Shaded;
     match state.shading {
         Shading::Preview => false,
-        Shading::Rest => !moving && state.settings.mode == TraceMode::Svo && state.settings.view == View::Shaded,
-        Shading::Path => state.settings.mode == TraceMode::Svo && state.settings.view == View::Shaded,
+        Shading::Rest => shaded_svo && !moving,
+        Shading::Path => shaded_svo,
     }
 }
 

@@ -286,11 +286,8 @@ impl App {
     /// part of the open stroke); `what` names it in the printed line.
     pub fn apply_edits(&mut self, edits: Vec<Edit>, what: &str) -> bool {
         let edits = edits.into_iter().flat_map(|e| self.state.mirror.edits(e)).collect();
-        match self.history.apply_group(&mut self.scene, edits) {
-            Ok(()) => {
-                self.after_change(what);
-                true
-            }
+        match self.commit(edits, what) {
+            Ok(()) => true,
             Err(err) => {
                 self.ui.error(format!("edit refused: {err}"));
                 false
@@ -378,23 +375,19 @@ impl App {
                 self.state.line_mode = !self.state.line_mode;
                 self.state.line_start = None;
             }
-            Command::FillAt { x, y } => match self.pick_at(x, y) {
-                Ok(Some(pick)) => {
-                    if let Err(err) = self.fill(pick.voxel, self.state.color.max(1)) {
-                        self.ui.error(format!("fill refused: {err}"));
-                    }
+            Command::FillAt { x, y } => {
+                if let Some(pick) = self.pick_or_say(x, y, "no voxel there to fill")
+                    && let Err(err) = self.fill(pick.voxel, self.state.color.max(1))
+                {
+                    self.ui.error(format!("fill refused: {err}"));
                 }
-                Ok(None) => self.ui.info("no voxel there to fill"),
-                Err(gave_up) => self.ui.error(gave_up.to_string()),
-            },
-            Command::PickColor { x, y } => match self.pick_at(x, y) {
-                Ok(Some(pick)) => {
+            }
+            Command::PickColor { x, y } => {
+                if let Some(pick) = self.pick_or_say(x, y, "no voxel there to pick a colour from") {
                     self.state.color = pick.value;
                     report!("picked colour {}", pick.value);
                 }
-                Ok(None) => self.ui.info("no voxel there to pick a colour from"),
-                Err(gave_up) => self.ui.error(gave_up.to_string()),
-            },
+            }
             Command::SetTool(tool) => self.state.tool = tool,
             Command::SetCamera(camera) => self.state.camera = camera,
             Command::Orbit { dx, dy } => camera_control::orbit(&mut self.state.camera, dx, dy),
@@ -474,6 +467,22 @@ impl App {
         Ok(hit.map(|hit| Pick { voxel: hit.voxel, normal: hit.normal, value: hit.value }))
     }
 
+    /// The voxel under window pixel (x, y) for a click; when there is none,
+    /// `nothing` (or why the ray gave up) goes to the message line.
+    fn pick_or_say(&mut self, x: f64, y: f64, nothing: &str) -> Option<Pick> {
+        match self.pick_at(x, y) {
+            Ok(Some(pick)) => Some(pick),
+            Ok(None) => {
+                self.ui.info(nothing);
+                None
+            }
+            Err(gave_up) => {
+                self.ui.error(gave_up.to_string());
+                None
+            }
+        }
+    }
+
     /// Line mode: the press picks the start (in front of the face), the
     /// release the end; the brush is placed along the line as one step.
     fn line_edit(&mut self, phase: StrokePhase, x: f64, y: f64) {
@@ -505,10 +514,18 @@ impl App {
     /// Recolours the region of `start`'s colour with `color`, as one undo
     /// step, through the edit path; recorded as a `fill` line.
     pub(super) fn fill(&mut self, start: IVec3, color: u8) -> Result<(), octovox::scene::EditError> {
+        // Not mirrored: the region follows the colour, not the brush.
         let edits = octovox::scene::fill::fill_edits(&self.scene.tree, start, color)?;
-        self.history.apply_group(&mut self.scene, edits)?;
+        self.commit(edits, "fill")?;
         self.record(|r| r.fill(color, start));
-        self.after_change("fill");
+        Ok(())
+    }
+
+    /// Edits as one undo step (or part of the open stroke), then what
+    /// depends on the voxels; `what` names it in the printed line.
+    fn commit(&mut self, edits: Vec<Edit>, what: &str) -> Result<(), octovox::scene::EditError> {
+        self.history.apply_group(&mut self.scene, edits)?;
+        self.after_change(what);
         Ok(())
     }
 

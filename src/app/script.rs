@@ -101,21 +101,18 @@ impl App {
             Line::Line(a, b) => {
                 self.apply_edits(octovox::tool::line_edits(&brush, color, *a, *b), "line");
             }
-            Line::Mirror(plane) => match plane {
-                Some((axis, c)) => self.state.mirror.set(*axis, Some(*c)),
-                None => self.state.mirror = octovox::mirror::Mirror::default(),
-            },
+            Line::Mirror(plane) => self.state.mirror.apply_line(*plane),
             Line::Fill(p) => {
                 if let Err(err) = self.fill(*p, color) {
                     return Played::Failed(err.to_string());
                 }
             }
-            Line::Pick(p) => match self.scene.tree.get(*p) {
-                0 => return Played::Failed(format!("no voxel at {p} to pick a colour from")),
-                value => {
+            Line::Pick(p) => match octovox::replay::picked_color(&self.scene, *p) {
+                Ok(value) => {
                     self.with_player(|player| player.color = value);
                     self.state.color = value;
                 }
+                Err(message) => return Played::Failed(message),
             },
             Line::Rgb(..) | Line::Material(..) => {
                 if let Some(edit) = octovox::replay::palette_edit(line, &self.scene.palette) {

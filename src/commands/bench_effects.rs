@@ -5,7 +5,7 @@
 //! images compared: they must match, since an effect the scene lacks adds
 //! nothing to the picture.
 
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 use octovox::trace::render::display_rgba;
 use serde::Serialize;
 
@@ -34,11 +34,10 @@ struct EffectsRow {
 }
 
 fn scenes() -> [(&'static str, Scene, Option<Camera>); 3] {
-    let inside = Camera { eye: DVec3::new(36.0, 18.0, 36.0), target: DVec3::new(10.0, 4.0, 10.0), fov_y_deg: 60.0 };
     [
         ("terrain (diffuse only)", BuiltIn::Terrain.scene(), None),
         ("showroom (mixed)", BuiltIn::Showroom.scene(), None),
-        ("interior (emissive, closed)", BuiltIn::Interior.scene(), Some(inside)),
+        ("interior (emissive, closed)", BuiltIn::Interior.scene(), Some(octovox::scene::showroom::interior_camera())),
     ]
 }
 
@@ -69,10 +68,7 @@ pub fn bench_effects(quick: bool) -> anyhow::Result<(String, String)> {
     let (width, height, samples, rounds) = if quick { (160, 90, 3, 1) } else { (640, 360, 16, 2) };
     let mut rows = Vec::new();
     for (name, mut scene, camera) in scenes() {
-        let camera = camera.unwrap_or_else(|| {
-            let (lo, hi) = scene.tree.solid_bounds().unwrap_or_default();
-            Camera::framing(lo, hi, 50.0)
-        });
+        let camera = camera.unwrap_or_else(|| crate::cli::camera_or_framing(None, 50.0, &scene));
         renderer.sync(&mut scene.tree, &scene.palette);
         let auto = PathSettings::default();
         let all = PathSettings { effects: EffectsChoice::All, ..auto };

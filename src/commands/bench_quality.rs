@@ -61,11 +61,7 @@ fn knobs(sizes: &Sizes) -> Vec<(&'static str, String, Setting)> {
 
 fn scenes(quick: bool) -> anyhow::Result<Vec<(&'static str, Scene, Camera)>> {
     let teapot = octovox::io::load_scene(&super::bench::assets().join("vox/seed/teapot256.vox"), 0)?;
-    let framing = |scene: &Scene, fov| {
-        let (lo, hi) = scene.tree.solid_bounds().unwrap_or_default();
-        Camera::framing(lo, hi, fov)
-    };
-    let teapot_camera = framing(&teapot, 50.0);
+    let teapot_camera = crate::cli::camera_or_framing(None, 50.0, &teapot);
     let mut out = vec![("teapot256 (small)", teapot, teapot_camera)];
     if !quick {
         let sculpture = super::bench::sculpture_scene()?;
@@ -75,8 +71,7 @@ fn scenes(quick: bool) -> anyhow::Result<Vec<(&'static str, Scene, Camera)>> {
         let far = Camera { eye: centre + DVec3::new(1.0, 0.5, 1.4) * 2400.0, target: centre, fov_y_deg: 20.0 };
         out.push(("sculpture10M (far)", sculpture, far));
     }
-    let inside = Camera { eye: DVec3::new(36.0, 18.0, 36.0), target: DVec3::new(10.0, 4.0, 10.0), fov_y_deg: 60.0 };
-    out.push(("interior (path traced)", BuiltIn::Interior.scene(), inside));
+    out.push(("interior (path traced)", BuiltIn::Interior.scene(), octovox::scene::showroom::interior_camera()));
     Ok(out)
 }
 

@@ -139,7 +139,7 @@ impl Renderer {
     /// # Errors
     /// As [`Renderer::render`].
     pub fn render_floor(&mut self, tree: &Octree, camera: &Camera, size: (u32, u32)) -> Result<f64, GpuError> {
-        self.frame(tree, camera, size, crate::settings::View::Shaded, None, Kernel::Floor)
+        self.frame(tree, camera, size, View::Shaded, None, Kernel::Floor)
     }
 
     /// The one encode path of a frame: outputs sized, uniforms written, the
@@ -149,7 +149,7 @@ impl Renderer {
         tree: &Octree,
         camera: &Camera,
         size: (u32, u32),
-        view: crate::settings::View,
+        view: View,
         highlight: Option<(IVec3, IVec3)>,
         kernel: Kernel,
     ) -> Result<f64, GpuError> {

@@ -69,7 +69,7 @@ impl PassTimer {
     /// Timestamp writes for a compute pass descriptor (None without support,
     /// or while the last ones are still being read back).
     pub fn pass_writes(&self) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
-        if self.state.load(Ordering::Acquire) != FREE || !self.trusted {
+        if !self.recording() {
             return None;
         }
         self.queries.as_ref().map(|(set, _, _)| wgpu::ComputePassTimestampWrites {
@@ -82,8 +82,7 @@ impl PassTimer {
     /// Call after the pass, in the same encoder.
     pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
         if let Some((set, resolve, read)) = &self.queries
-            && self.trusted
-            && self.state.load(Ordering::Acquire) == FREE
+            && self.recording()
         {
             encoder.resolve_query_set(set, 0..2, resolve, 0);
             encoder.copy_buffer_to_buffer(resolve, 0, read, 0, None);
@@ -153,6 +152,12 @@ impl PassTimer {
         }
         self.last_ms = wall_ms;
         Ok(wall_ms)
+    }
+
+    /// Whether this pass records timestamps: they are trusted and the
+    /// read-back buffer is free.
+    fn recording(&self) -> bool {
+        self.trusted && self.state.load(Ordering::Acquire) == FREE
     }
 
     /// Whether the pass times come from GPU timestamps (else the wall clock).

@@ -186,3 +186,11 @@ pub fn palette_edit(command: &Command, palette: &crate::scene::Palette) -> Optio
     };
     Some(crate::edit::Edit::Palette { index, color, material: Box::new(material) })
 }
+
+/// `pick X Y Z`: the colour of the voxel there, or why there is none.
+pub fn picked_color(scene: &crate::scene::Scene, at: IVec3) -> Result<u8, String> {
+    match scene.tree.get(at) {
+        0 => Err(format!("no voxel at {at} to pick a colour from")),
+        value => Ok(value),
+    }
+}

@@ -149,14 +149,8 @@ impl Runner {
                 let edits = crate::tool::line_edits(&self.brush, self.color, *a, *b);
                 self.apply_all(edits)?;
             }
-            Command::Mirror(plane) => match plane {
-                Some((axis, c)) => self.mirror.set(*axis, Some(*c)),
-                None => self.mirror = crate::mirror::Mirror::default(),
-            },
-            Command::Pick(p) => match self.scene.tree.get(*p) {
-                0 => return Err(format!("no voxel at {p} to pick a colour from")),
-                value => self.color = value,
-            },
+            Command::Mirror(plane) => self.mirror.apply_line(*plane),
+            Command::Pick(p) => self.color = super::picked_color(&self.scene, *p)?,
             Command::Rgb(..) | Command::Material(..) => {
                 if let Some(edit) = super::palette_edit(&line.command, &self.scene.palette) {
                     self.apply(edit)?;
@@ -166,10 +160,10 @@ impl Runner {
             Command::Remove(p) => self.brush_edit(*p, Op::Remove)?,
             Command::Paint(p) => self.brush_edit(*p, Op::Paint(self.color))?,
             Command::Fill(p) => {
+                // Not mirrored: the region follows the colour, not the brush.
                 let edits =
                     crate::scene::fill::fill_edits(&self.scene.tree, *p, self.color).map_err(|e| e.to_string())?;
-                self.history.apply_group(&mut self.scene, edits).map_err(|e| e.to_string())?;
-                self.last_written = Some(self.flush());
+                self.commit(edits)?;
             }
             Command::Click { x, y, tool } => {
                 let expected = format!("pixel ({x}, {y}) to hit a voxel");
@@ -252,6 +246,11 @@ impl Runner {
     /// Several edits (a line) and their mirror images as one step.
     fn apply_all(&mut self, edits: Vec<Edit>) -> Result<(), String> {
         let edits = edits.into_iter().flat_map(|e| self.mirror.edits(e)).collect();
+        self.commit(edits)
+    }
+
+    /// Edits as one undo step, then the pool flush.
+    fn commit(&mut self, edits: Vec<Edit>) -> Result<(), String> {
         self.history.apply_group(&mut self.scene, edits).map_err(|e| e.to_string())?;
         self.last_written = Some(self.flush());
         Ok(())

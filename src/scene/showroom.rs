@@ -66,6 +66,12 @@ pub fn showroom_scene() -> Scene {
     Scene { palette: showroom_palette(), tree }
 }
 
+/// A camera inside the interior, looking at the table from a corner.
+pub fn interior_camera() -> crate::camera::Camera {
+    use glam::DVec3;
+    crate::camera::Camera { eye: DVec3::new(36.0, 18.0, 36.0), target: DVec3::new(10.0, 4.0, 10.0), fov_y_deg: 60.0 }
+}
+
 /// A closed room lit only by three lamps: a wooden floor, white walls, a
 /// table and a stool. No sunlight or sky reaches inside.
 pub fn interior_scene() -> Scene {
