@@ -318,14 +318,9 @@ fn a_mirrored_click_places_both_sides_and_undoes_in_one_step() {
         require_tool(tool);
     }
     let dir = tempfile::tempdir().unwrap();
-    let file = dir.path().join("floor.vox");
-    let mut scene = octovox::scene::Scene::default();
-    scene.tree.apply_brush(&Shape::Box { min: IVec3::ZERO, max: IVec3::new(15, 0, 15) }, Op::Place(20)).unwrap();
-    octovox::io::save_scene(&file, &scene, Default::default()).unwrap();
+    let (file, scene, camera) = floor_scene(dir.path());
     let script = dir.path().join("mirror.ovr");
     std::fs::write(&script, "mirror x 8\n").unwrap();
-    let camera =
-        Camera { eye: glam::DVec3::new(8.0, 20.0, 24.0), target: glam::DVec3::new(8.0, 0.0, 8.0), fov_y_deg: 50.0 };
     // A floor voxel left of the plane, hit from above.
     let (x, y, voxel, normal) = stable_pixel(&scene.tree, &camera, |v, n| n == IVec3::Y && v.x < 6);
     let placed = voxel + normal;
@@ -365,12 +360,7 @@ fn a_dragged_line_in_line_mode() {
         require_tool(tool);
     }
     let dir = tempfile::tempdir().unwrap();
-    let file = dir.path().join("floor.vox");
-    let mut scene = octovox::scene::Scene::default();
-    scene.tree.apply_brush(&Shape::Box { min: IVec3::ZERO, max: IVec3::new(15, 0, 15) }, Op::Place(20)).unwrap();
-    octovox::io::save_scene(&file, &scene, Default::default()).unwrap();
-    let camera =
-        Camera { eye: glam::DVec3::new(8.0, 20.0, 24.0), target: glam::DVec3::new(8.0, 0.0, 8.0), fov_y_deg: 50.0 };
+    let (file, scene, camera) = floor_scene(dir.path());
     let (xa, ya, va, na) = stable_pixel(&scene.tree, &camera, |v, n| n == IVec3::Y && v.x < 4);
     let (xb, yb, vb, nb) = stable_pixel(&scene.tree, &camera, |v, n| n == IVec3::Y && v.x > 11);
     let (a, b) = (va + na, vb + nb);
@@ -403,4 +393,16 @@ fn a_dragged_line_in_line_mode() {
     lines.wait_for("undo:", Duration::from_secs(30));
     save(&display, &mut lines, &file);
     assert_eq!(octovox::io::load_scene(&file, 0).unwrap().tree.solid_voxels(), 256, "one undo took the line away");
+}
+
+/// A 16×16 floor of colour 20 saved as `floor.vox` in `dir`, and a camera
+/// looking down at it from the front.
+fn floor_scene(dir: &std::path::Path) -> (PathBuf, octovox::scene::Scene, Camera) {
+    let file = dir.join("floor.vox");
+    let mut scene = octovox::scene::Scene::default();
+    scene.tree.apply_brush(&Shape::Box { min: IVec3::ZERO, max: IVec3::new(15, 0, 15) }, Op::Place(20)).unwrap();
+    octovox::io::save_scene(&file, &scene, Default::default()).unwrap();
+    let camera =
+        Camera { eye: glam::DVec3::new(8.0, 20.0, 24.0), target: glam::DVec3::new(8.0, 0.0, 8.0), fov_y_deg: 50.0 };
+    (file, scene, camera)
 }
