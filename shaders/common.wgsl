@@ -26,10 +26,14 @@ struct FrameUniforms {
     // No valid ray takes this many iterations (src/trace/mod.rs,
     // `iteration_bound`); one that does is reported as a give-up.
     max_iterations: u32,
+    // Level of detail: a camera ray stops at a node whose cell is at most
+    // this many voxels wide per unit of t (the `--lod` pixels' footprint);
+    // 0 = exact. See `Footprint` in src/trace/mod.rs.
+    lod_per_t: f32,
 }
 
 @group(0) @binding(0) var<uniform> u: FrameUniforms;
-// Nodes (8 words each) and then bricks (2 words each) of the node pool.
+// Nodes (NODE_WORDS words each) and then bricks (2 words each) of the node pool.
 @group(0) @binding(1) var<storage, read> pool: array<u32>;
 @group(0) @binding(3) var<storage, read> palette: array<u32>;
 @group(0) @binding(4) var<storage, read> grid: array<u32>;

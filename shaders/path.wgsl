@@ -148,7 +148,7 @@ fn root_exit(r: Ray, iterations: u32) -> Hit {
 }
 
 fn cross_medium(r: Ray, medium: u32) -> Hit {
-    let hit = trace_svo(r, 0.0, medium);
+    let hit = trace_svo(r, 0.0, medium, vec2<f32>(0.0));
     if (hit.found || medium == 0u || hit.iterations >= u.max_iterations) {
         return hit;
     }

@@ -30,7 +30,7 @@ fn octant_offset(o: u32) -> vec3<i32> {
 fn child_word(word: u32, level: u32, octant: u32) -> u32 {
     let slot = word & ~POINTER_BIT;
     let brick = level == 1u;
-    let loaded = pool[select(slot * 8u + octant, u.brick_base + slot * 2u + (octant >> 2u), brick)];
+    let loaded = pool[select(slot * NODE_WORDS + octant, u.brick_base + slot * 2u + (octant >> 2u), brick)];
     return select(loaded, (loaded >> (8u * (octant & 3u))) & 0xffu, brick);
 }
 
@@ -58,10 +58,19 @@ fn argmin3_select(t: vec3<f32>) -> u32 {
     return select(select(2u, 1u, t.y <= t.z), 0u, t.x <= t.y && t.x <= t.z);
 }
 
+// Whether a node cell `size` voxels wide, entered at t, is below the
+// footprint `lod` (voxels at t = 0, voxels per unit of t): twin of
+// `Footprint::covers` in src/trace/mod.rs.
+fn below_footprint(lod: vec2<f32>, size: u32, t: f32) -> bool {
+    return f32(size) <= lod.x + lod.y * t;
+}
+
 // The first voxel along `r`, at or after `t_min`, whose value is not
 // `medium`: the first solid voxel for rays in empty space (medium 0), the
-// way out for rays inside glass. Twin of `trace_through` in src/trace/svo.rs.
-fn trace_svo(r: Ray, t_min: f32, medium: u32) -> Hit {
+// way out for rays inside glass. With a footprint `lod` (zero: exact), a
+// node cell below it is hit as a solid cell of its summary's palette index.
+// Twin of `walk` in src/trace/svo.rs.
+fn trace_svo(r: Ray, t_min: f32, medium: u32, lod: vec2<f32>) -> Hit {
     var miss: Hit;
     let depth = u.depth;
     let size = f32(1u << depth);
@@ -103,6 +112,8 @@ fn trace_svo(r: Ray, t_min: f32, medium: u32) -> Hit {
     var iterations = 0u;
     var value = 0u;
     var found = false;
+    // The node word a footprint stopped at (0: none).
+    var summarized = 0u;
     loop {
         if (iterations >= u.max_iterations) {
             break;
@@ -110,8 +121,12 @@ fn trace_svo(r: Ray, t_min: f32, medium: u32) -> Hit {
         iterations += 1u;
         let word = child_word(node, level, octant_of(cell, level));
         let push = (word & POINTER_BIT) != 0u;
-        if (!push && word != medium) {
+        // Only a node cell the ray newly enters (not an ancestor walked down
+        // again after a restart) may stop it; bricks never do.
+        let stop = push && level >= 3u && level - 1u < known && below_footprint(lod, 1u << (level - 1u), t);
+        if ((!push && word != medium) || stop) {
             value = word;
+            summarized = select(0u, word, stop);
             found = true;
             break;
         }
@@ -152,6 +167,9 @@ fn trace_svo(r: Ray, t_min: f32, medium: u32) -> Hit {
     if (!found) {
         miss.iterations = iterations;
         return miss;
+    }
+    if (summarized != 0u) {
+        value = pool[(summarized & ~POINTER_BIT) * NODE_WORDS + LOD_WORD] & 0xffu;
     }
     return hit_cell(r, value, cell, level - 1u, t, axis, iterations);
 }
@@ -232,7 +250,7 @@ fn beam(@builtin(global_invocation_id) gid: vec3<u32>) {
             mn = mn & vec3<i32>(~((1 << level) - 1));
             node = u.root;
             for (var l = depth; l > level; l--) {
-                node = pool[(node & ~POINTER_BIT) * 8u + octant_of(mn, l)];
+                node = pool[(node & ~POINTER_BIT) * NODE_WORDS + octant_of(mn, l)];
             }
             continue;
         }
@@ -240,7 +258,7 @@ fn beam(@builtin(global_invocation_id) gid: vec3<u32>) {
         let near_side = u.eye >= vec3<f32>(mn + vec3<i32>(half));
         let near = select(0u, 1u, near_side.x) | select(0u, 2u, near_side.y) | select(0u, 4u, near_side.z);
         let o = near ^ next;
-        let child = pool[(node & ~POINTER_BIT) * 8u + o];
+        let child = pool[(node & ~POINTER_BIT) * NODE_WORDS + o];
         let child_min = mn + octant_offset(o) * half;
         next += 1u;
         if (child == 0u) {
@@ -253,7 +271,12 @@ fn beam(@builtin(global_invocation_id) gid: vec3<u32>) {
         if (beyond(n0, lo, hi) || beyond(n1, lo, hi) || beyond(n2, lo, hi) || beyond(n3, lo, hi) || distance >= best) {
             continue;
         }
-        if ((child & POINTER_BIT) == 0u || level - 1u <= BEAM_LEVEL) {
+        // A node cell that some ray of the tile may stop at under the level
+        // of detail counts as solid: no ray's t there exceeds the distance to
+        // the box's farthest corner (|d| >= 1).
+        let far_corner = length(max(abs(lo - u.eye), abs(hi - u.eye)));
+        let summarized = below_footprint(vec2<f32>(0.0, u.lod_per_t), u32(half), far_corner);
+        if ((child & POINTER_BIT) == 0u || level - 1u <= BEAM_LEVEL || summarized) {
             best = distance;
             continue;
         }
@@ -292,11 +315,14 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     var hit: Hit;
     let t_start = beam_start(gid.xy, r);
     if (t_start < BEAM_NONE) {
-        hit = trace_svo(r, t_start, 0u);
+        hit = trace_svo(r, t_start, 0u, vec2<f32>(0.0, u.lod_per_t));
     }
     var in_shadow = false;
     if (SHADOWS && u.view == VIEW_SHADED && hit.value != 0u && hit.normal_code != 0u) {
-        in_shadow = trace_svo(shadow_ray(hit), 0.0, 0u).value != 0u;
+        // The shadow ray keeps the footprint the camera ray had at the hit
+        // voxel's depth (`hit_depth` in src/trace/render.rs).
+        let depth = dot(vec3<f32>(hit.voxel) + vec3<f32>(0.5) - u.eye, u.forward);
+        in_shadow = trace_svo(shadow_ray(hit), 0.0, 0u, vec2<f32>(u.lod_per_t * depth, 0.0)).value != 0u;
     }
     write_pixel(gid.xy, hit, r.d, in_shadow);
 }

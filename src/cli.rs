@@ -44,6 +44,9 @@ pub struct WindowArgs {
     /// Start with sun shadows off (the UI can turn them on).
     #[arg(long)]
     pub no_shadows: bool,
+    /// Level of detail of the preview in pixels (0 = exact; the UI can change it).
+    #[arg(long, default_value_t = 0.0, value_parser = parse_lod, value_name = "PIXELS")]
+    pub lod: f32,
     /// Which built-in scene to open when there is no FILE.
     #[arg(long, value_enum, conflicts_with = "file")]
     pub demo: Option<octovox::scene::demo::BuiltIn>,
@@ -185,6 +188,10 @@ pub struct RenderArgs {
     /// Trace S × the image's pixels per axis (0.25..=1) and scale up.
     #[arg(long, default_value_t = 1.0, value_parser = parse_render_scale)]
     pub render_scale: f32,
+    /// Level of detail: stop at octree cells narrower than PIXELS traced
+    /// pixels and shade them by their summary (0 = exact; SVO preview only).
+    #[arg(long, default_value_t = 0.0, value_parser = parse_lod, value_name = "PIXELS")]
+    pub lod: f32,
     #[command(flatten)]
     pub path: PathArgs,
     /// Print one JSON object on stdout: effects, spp, ms_per_sample, adapter.
@@ -238,6 +245,10 @@ pub struct BenchArgs {
     /// Fewer repetitions and smaller images (a smoke run).
     #[arg(long)]
     pub quick: bool,
+    /// `bench render` only: the SVO column at this level of detail
+    /// (pixels, 0 = exact); `bench quality` measures several itself.
+    #[arg(long, default_value_t = 0.0, value_parser = parse_lod, value_name = "PIXELS")]
+    pub lod: f32,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -285,6 +296,15 @@ pub fn parse_render_scale(s: &str) -> Result<f32, String> {
     match s.trim().parse::<f32>() {
         Ok(v) if range.contains(&v) => Ok(v),
         _ => Err(format!("render scale '{s}' is not a number in {}..=1", range.start())),
+    }
+}
+
+/// Parses a level-of-detail footprint in pixels (0..=MAX_LOD).
+pub fn parse_lod(s: &str) -> Result<f32, String> {
+    let max = octovox::settings::MAX_LOD;
+    match s.trim().parse::<f32>() {
+        Ok(v) if (0.0..=max).contains(&v) => Ok(v),
+        _ => Err(format!("level of detail '{s}' is not a number of pixels in 0..={max}")),
     }
 }
 

@@ -6,10 +6,13 @@
 //! renderer hands them to `queue.write_buffer`. The layout is described in
 //! `docs/node-format.md`.
 
-/// Words in an interior node: one child word per octant.
-pub const NODE_WORDS: usize = 8;
+/// Words in an interior node slot: one child word per octant, then the
+/// node's level-of-detail summary (see [`NodeSlot`]).
+pub const NODE_WORDS: usize = 9;
+/// Word of a node slot that holds its level-of-detail summary.
+pub const LOD_WORD: usize = 8;
 /// Bytes of one interior node slot on the GPU.
-pub const NODE_BYTES: u64 = 32;
+pub const NODE_BYTES: u64 = 4 * NODE_WORDS as u64;
 /// Bytes of one brick slot (2×2×2 palette indices) on the GPU.
 pub const BRICK_BYTES: u64 = 8;
 
@@ -17,8 +20,22 @@ pub const BRICK_BYTES: u64 = 8;
 /// Without it, the word is a uniform palette index (0 = empty).
 pub const POINTER_BIT: u32 = 0x8000_0000;
 
-/// An interior node: eight child words, octant `x | y << 1 | z << 2`.
-pub type Node = [u32; NODE_WORDS];
+/// An interior node's children: eight child words, octant `x | y << 1 | z << 2`.
+pub type Node = [u32; 8];
+
+/// A node slot as the GPU reads it: the children, then the subtree's
+/// summary for level of detail (`crate::scene::lod`): its representative
+/// palette index in the low byte, its coverage (solid fraction × 255,
+/// rounded up) in the next. A traversal that stops early at this node shades
+/// it as a solid cell of that index.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct NodeSlot {
+    pub children: Node,
+    pub lod: u32,
+}
+
+const _: () = assert!(std::mem::size_of::<NodeSlot>() == NODE_BYTES as usize);
 /// A leaf brick: eight palette indices, octant `x | y << 1 | z << 2`.
 pub type Brick = [u8; 8];
 
@@ -220,7 +237,7 @@ pub struct PoolStats {
 /// Interior nodes and leaf bricks, each in its own arena (and GPU buffer).
 #[derive(Clone, Debug, Default)]
 pub struct NodePool {
-    pub nodes: SlotArena<Node>,
+    pub nodes: SlotArena<NodeSlot>,
     pub bricks: SlotArena<Brick>,
     pub stats: PoolStats,
 }

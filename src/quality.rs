@@ -45,7 +45,8 @@ pub fn psnr(reference: &RgbaImage, test: &RgbaImage) -> Option<f64> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Setting {
     Path { spp: u32, bounces: u32, shadow_samples: u32, render_scale: f32 },
-    Preview { mode: TraceMode, render_scale: f32 },
+    /// The preview; `lod` is the level-of-detail footprint in pixels (0 exact).
+    Preview { mode: TraceMode, render_scale: f32, lod: f32 },
 }
 
 /// Draws one frame with `setting`; returns its wall-clock milliseconds
@@ -72,8 +73,8 @@ pub fn render_setting(
             let ms = start.elapsed().as_secs_f64() * 1e3;
             Ok((ms, upscale(renderer.read_image()?, size)))
         }
-        Setting::Preview { mode, render_scale } => {
-            let settings = RenderSettings { mode, view: View::Shaded, shadows: true, render_scale: 1.0 };
+        Setting::Preview { mode, render_scale, lod } => {
+            let settings = RenderSettings { mode, view: View::Shaded, shadows: true, render_scale: 1.0, lod };
             let traced = scaled_size(size, render_scale);
             if mode == TraceMode::Grid {
                 let grid =

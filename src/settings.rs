@@ -67,13 +67,19 @@ pub struct RenderSettings {
     pub shadows: bool,
     /// Fraction of the window's pixels traced per axis (0.25..=1).
     pub render_scale: f32,
+    /// Level of detail: camera rays stop at octree cells narrower than this
+    /// many pixels (0 = exact; the SVO preview only).
+    pub lod: f32,
 }
 
 impl Default for RenderSettings {
     fn default() -> RenderSettings {
-        RenderSettings { mode: TraceMode::Svo, view: View::Shaded, shadows: true, render_scale: 1.0 }
+        RenderSettings { mode: TraceMode::Svo, view: View::Shaded, shadows: true, render_scale: 1.0, lod: 0.0 }
     }
 }
+
+/// Largest `--lod` accepted, in pixels.
+pub const MAX_LOD: f32 = 64.0;
 
 /// Direction toward the sun (normalised), shared with the shaders.
 pub const SUN_DIR: [f32; 3] = [0.454_858_8, 0.796_002_9, 0.398_001_5];

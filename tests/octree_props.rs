@@ -231,3 +231,22 @@ fn teapot_edits_write_only_what_they_touch() {
         }
     }
 }
+
+/// Level-of-detail summaries follow edits: the root's representative index
+/// is the one covering most, repainting the model changes it, and undo
+/// restores it.
+#[test]
+fn summaries_follow_edits_and_undo() {
+    let mut tree = Octree::default();
+    tree.apply_brush(&Shape::Box { min: IVec3::ZERO, max: IVec3::new(15, 7, 15) }, Op::Place(3)).unwrap();
+    tree.apply_brush(&Shape::Voxel(IVec3::new(0, 12, 0)), Op::Place(9)).unwrap();
+    let root = |tree: &Octree| tree.summary(tree.root_word(), tree.depth());
+    assert_eq!(root(&tree).index, 3);
+    assert_eq!(root(&tree).coverage, 128, "half the 16³ root is solid (rounded up)");
+    let patch = tree.apply_brush(&Shape::Box { min: IVec3::ZERO, max: IVec3::new(15, 7, 15) }, Op::Paint(7)).unwrap();
+    assert_eq!(root(&tree).index, 7);
+    tree.check_invariants().unwrap();
+    tree.apply_patch(&patch).unwrap();
+    assert_eq!(root(&tree).index, 3);
+    tree.check_invariants().unwrap();
+}

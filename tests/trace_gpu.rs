@@ -11,6 +11,7 @@ use octovox::gpu::Renderer;
 use octovox::io::mesh::{MESH_COLOR, UpAxis, voxelize_obj};
 use octovox::scene::{Octree, Op, Palette, Scene, Shape};
 use octovox::settings::{RenderSettings, TraceMode, View};
+use octovox::trace::Footprint;
 use octovox::trace::grid::DenseGrid;
 use octovox::trace::render::{Tracer, trace_image};
 
@@ -31,7 +32,7 @@ fn gpu_hits(
     size: (u32, u32),
     mode: TraceMode,
 ) -> Vec<octovox::trace::Hit> {
-    let settings = RenderSettings { mode, view: View::Shaded, shadows: true, render_scale: 1.0 };
+    let settings = RenderSettings { mode, view: View::Shaded, shadows: true, render_scale: 1.0, lod: 0.0 };
     renderer.render(tree, camera, size, &settings, None).unwrap();
     renderer.read_hits().unwrap()
 }
@@ -48,8 +49,8 @@ fn check_scene(tree: &mut Octree, cameras: &[Camera], size: (u32, u32)) {
         let gpu_svo = gpu_hits(&mut renderer, tree, camera, size, TraceMode::Svo);
         let gpu_grid = gpu_hits(&mut renderer, tree, camera, size, TraceMode::Grid);
         assert!(gpu_svo.iter().chain(&gpu_grid).all(|h| !h.gave_up()));
-        vs_cpu_svo.add(&gpu_svo, &trace_image(Tracer::Svo(tree), &basis));
-        vs_cpu_grid.add(&gpu_svo, &trace_image(Tracer::Grid(&grid), &basis));
+        vs_cpu_svo.add(&gpu_svo, &trace_image(Tracer::Svo(tree), &basis, Footprint::EXACT));
+        vs_cpu_grid.add(&gpu_svo, &trace_image(Tracer::Grid(&grid), &basis, Footprint::EXACT));
         gpu_grid_vs_svo.add(&gpu_grid, &gpu_svo);
     }
     vs_cpu_svo.assert_good("GPU SVO vs CPU SVO");
@@ -162,7 +163,7 @@ fn gpu_pool_growth_keeps_the_picture() {
         eprintln!("edit {i}: {} nodes, {} bricks, {stats:?}", tree.node_count(), tree.brick_count());
         growths += u32::from(stats.grew);
         let gpu = gpu_hits(&mut renderer, &tree, &camera, size, TraceMode::Svo);
-        let cpu = trace_image(Tracer::Svo(&tree), &camera.basis(size.0, size.1, tree.origin()));
+        let cpu = trace_image(Tracer::Svo(&tree), &camera.basis(size.0, size.1, tree.origin()), Footprint::EXACT);
         let mut agreement = Agreement::default();
         agreement.add(&gpu, &cpu);
         agreement.assert_good(&format!("after edit {i}"));
@@ -203,7 +204,7 @@ fn teapot_picture_and_iteration_counts() {
     let mut renderer = renderer_for(&mut scene.tree);
     let (lo, hi) = scene.tree.solid_bounds().unwrap();
     let camera = Camera::framing(lo, hi, 50.0);
-    let settings = RenderSettings { mode: TraceMode::Svo, view: View::Shaded, shadows: true, render_scale: 1.0 };
+    let settings = RenderSettings { mode: TraceMode::Svo, view: View::Shaded, shadows: true, render_scale: 1.0, lod: 0.0 };
     renderer.render(&scene.tree, &camera, (200, 150), &settings, None).unwrap();
     let image = renderer.read_image().unwrap();
     let distinct: std::collections::HashSet<[u8; 4]> = image.pixels().map(|p| p.0).collect();
@@ -272,5 +273,45 @@ fn frame_times_stay_plausible_after_path_traced_frames() {
         if wall > 10.0 {
             assert!(ms > wall * 0.05, "a {wall:.1} ms frame timed as {ms:.3} ms");
         }
+    }
+}
+
+/// With a level-of-detail footprint the GPU stops at the same summarized
+/// cells as the CPU reference, shadows included, and it does stop: fewer
+/// steps than the exact walk, and some pixels change.
+#[test]
+fn gpu_level_of_detail_matches_cpu() {
+    let path = common::assets().join("meshes/nefertiti.obj");
+    let dense = voxelize_obj(&path, 96, UpAxis::Z, MESH_COLOR).unwrap();
+    let mut scene = Scene::from_dense(&dense).unwrap();
+    scene.tree.apply_brush(&Shape::Sphere { center: IVec3::new(40, 60, 40), radius: 12 }, Op::Paint(9)).unwrap();
+    let (lo, hi) = scene.tree.solid_bounds().unwrap();
+    let size = (96, 72);
+    let mut renderer = renderer_for(&mut scene.tree);
+    renderer.sync(&mut scene.tree, &scene.palette);
+    for lod in [4.0, 8.0] {
+        let settings = RenderSettings { lod, ..RenderSettings::default() };
+        let (mut vs_cpu, mut vs_exact) = (Agreement::default(), Agreement::default());
+        let (mut steps, mut exact_steps) = (0u64, 0u64);
+        for camera in cameras_for(lo, hi) {
+            let basis = camera.basis(size.0, size.1, scene.tree.origin());
+            renderer.render(&scene.tree, &camera, size, &settings, None).unwrap();
+            let gpu = renderer.read_hits().unwrap();
+            let cpu = trace_image(Tracer::Svo(&scene.tree), &basis, Footprint::of_pixels(&basis, lod));
+            let exact = trace_image(Tracer::Svo(&scene.tree), &basis, Footprint::EXACT);
+            vs_cpu.add(&gpu, &cpu);
+            vs_exact.add(&gpu, &exact);
+            steps += gpu.iter().map(|h| u64::from(h.iterations)).sum::<u64>();
+            exact_steps += exact.iter().map(|h| u64::from(h.iterations)).sum::<u64>();
+            // The shaded image, shadow rays included, as the CPU draws it.
+            let image = renderer.read_image().unwrap();
+            let reference = octovox::trace::render::render_scene_cpu(&scene, None, &camera, size, &settings);
+            let differing = image.pixels().zip(reference.pixels()).filter(|(a, b)| a != b).count();
+            assert!(differing <= 2, "lod {lod}: {differing} pixels differ from the CPU's");
+        }
+        vs_cpu.assert_good(&format!("GPU vs CPU at lod {lod}"));
+        eprintln!("lod {lod}: {} of {} pixels as exact, steps {steps} vs {exact_steps}", vs_exact.exact, vs_exact.pixels);
+        assert!(vs_exact.exact_fraction() < 0.99, "lod {lod} changed nothing: {vs_exact:?}");
+        assert!(steps * 10 < exact_steps * 9, "lod {lod}: {steps} steps, exact {exact_steps}");
     }
 }

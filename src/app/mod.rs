@@ -191,6 +191,7 @@ impl App {
         app.open_script_files();
         app.state.settings.render_scale = app.args.render_scale;
         app.state.settings.shadows = !app.args.no_shadows;
+        app.state.settings.lod = app.args.lod;
         app.state.shading = app.args.shading;
         app.state.sample_target = app.args.samples;
         if let Some((eye, target)) = app.args.camera {

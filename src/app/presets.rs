@@ -18,6 +18,8 @@ pub struct Preset {
     pub name: &'static str,
     pub shading: Shading,
     pub render_scale: f32,
+    /// Level of detail of the preview, in pixels (0 exact).
+    pub lod: f32,
     pub bounces: u32,
     pub shadow_samples: u32,
     /// Samples accumulated at rest.
@@ -25,12 +27,29 @@ pub struct Preset {
 }
 
 pub const PRESETS: [Preset; 5] = [
-    Preset { name: "draft", shading: Shading::Preview, render_scale: 0.5, bounces: 0, shadow_samples: 1, samples: 1 },
-    Preset { name: "preview", shading: Shading::Preview, render_scale: 1.0, bounces: 0, shadow_samples: 1, samples: 1 },
+    Preset {
+        name: "draft",
+        shading: Shading::Preview,
+        render_scale: 0.5,
+        lod: 1.0,
+        bounces: 0,
+        shadow_samples: 1,
+        samples: 1,
+    },
+    Preset {
+        name: "preview",
+        shading: Shading::Preview,
+        render_scale: 1.0,
+        lod: 0.0,
+        bounces: 0,
+        shadow_samples: 1,
+        samples: 1,
+    },
     Preset {
         name: "path: quick",
         shading: Shading::Rest,
         render_scale: 1.0,
+        lod: 0.0,
         bounces: 1,
         shadow_samples: 1,
         samples: 16,
@@ -39,6 +58,7 @@ pub const PRESETS: [Preset; 5] = [
         name: "path: good",
         shading: Shading::Rest,
         render_scale: 1.0,
+        lod: 0.0,
         bounces: 3,
         shadow_samples: 1,
         samples: 64,
@@ -47,6 +67,7 @@ pub const PRESETS: [Preset; 5] = [
         name: "reference",
         shading: Shading::Rest,
         render_scale: 1.0,
+        lod: 0.0,
         bounces: 8,
         shadow_samples: 4,
         samples: 256,
@@ -61,6 +82,7 @@ impl Preset {
     pub fn apply(&self, state: &mut EditorState) {
         state.shading = self.shading;
         state.settings.render_scale = self.render_scale;
+        state.settings.lod = self.lod;
         state.path_settings =
             PathSettings { bounces: self.bounces, shadow_samples: self.shadow_samples, ..state.path_settings };
         state.sample_target = self.samples;
@@ -69,7 +91,7 @@ impl Preset {
     /// How the measurement draws a frame of this preset.
     pub fn setting(&self) -> Setting {
         match self.shading {
-            Shading::Preview => Setting::Preview { mode: TraceMode::Svo, render_scale: self.render_scale },
+            Shading::Preview => Setting::Preview { mode: TraceMode::Svo, render_scale: self.render_scale, lod: self.lod },
             _ => Setting::Path {
                 spp: self.samples,
                 bounces: self.bounces,
@@ -155,6 +177,6 @@ mod tests {
         assert_eq!((state.shading, state.sample_target), (Shading::Rest, 256));
         assert_eq!((state.path_settings.bounces, state.path_settings.shadow_samples), (8, 4));
         PRESETS[0].apply(&mut state);
-        assert_eq!((state.shading, state.settings.render_scale), (Shading::Preview, 0.5));
+        assert_eq!((state.shading, state.settings.render_scale, state.settings.lod), (Shading::Preview, 0.5, 1.0));
     }
 }

@@ -336,6 +336,10 @@ fn render(ui: &mut egui::Ui, state: &mut EditorState) {
     });
     ui.checkbox(&mut settings.shadows, "Sun shadows");
     ui.add(egui::Slider::new(&mut settings.render_scale, 0.25..=1.0).text("scale"));
+    ui.add(egui::Slider::new(&mut settings.lod, 0.0..=16.0).step_by(0.5).text("detail px")).on_hover_text(
+        "level of detail: the preview stops at octree cells narrower than this many pixels \
+         and draws them as one solid cell (0 = exact; the path tracer is always exact)",
+    );
     ui.add(egui::Slider::new(&mut state.frame_target_ms, 10.0..=100.0).text("ms target"))
         .on_hover_text("frame time to hold while the camera moves: the render scale drops as far as needed");
     path_tracing(ui, state);

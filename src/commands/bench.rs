@@ -79,15 +79,22 @@ pub(super) fn median(mut samples: Vec<f64>) -> f64 {
 }
 
 pub fn run(args: &BenchArgs) -> anyhow::Result<ExitCode> {
+    if args.lod > 0.0 && args.what != BenchKind::Render {
+        anyhow::bail!("--lod is for `bench render`; `bench quality` measures several levels of detail itself");
+    }
     let (markdown, json) = match args.what {
         BenchKind::Build => bench_build(args.quick)?,
         BenchKind::Edit => bench_edit(args.quick)?,
-        BenchKind::Render => bench_render(args.quick)?,
+        BenchKind::Render => bench_render(args.quick, args.lod)?,
         BenchKind::Effects => super::bench_effects::bench_effects(args.quick)?,
         BenchKind::Quality => super::bench_quality::bench_quality(args.quick, &args.out)?,
     };
     say!("{markdown}")?;
-    let name = format!("{:?}", args.what).to_lowercase();
+    let mut name = format!("{:?}", args.what).to_lowercase();
+    if args.lod > 0.0 {
+        // Beside the exact table, not over it.
+        name += &format!("-lod{}", args.lod);
+    }
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
     for (ext, text) in [("md", markdown), ("json", json)] {
         let path = args.out.join(format!("{name}.{ext}"));
@@ -255,7 +262,7 @@ struct RenderRow {
     report_grid_over_svo: f64,
 }
 
-fn bench_render(quick: bool) -> anyhow::Result<(String, String)> {
+fn bench_render(quick: bool, lod: f32) -> anyhow::Result<(String, String)> {
     let (width, height) = if quick { (425, 225) } else { (1700, 900) };
     let mut renderer = Renderer::headless().context("bench render needs a GPU (lavapipe works)")?;
     let mut rows = Vec::new();
@@ -268,7 +275,14 @@ fn bench_render(quick: bool) -> anyhow::Result<(String, String)> {
         let camera = Camera::framing(lo, hi, 50.0);
         // Shared machines are noisy: enough frames for a steady median.
         let frames = if quick { 2 } else { 9 };
-        let settings = |mode| RenderSettings { mode, view: View::Shaded, shadows: false, render_scale: 1.0 };
+        // The level of detail applies to the SVO only: the grid is exact.
+        let settings = |mode| RenderSettings {
+            mode,
+            view: View::Shaded,
+            shadows: false,
+            render_scale: 1.0,
+            lod: if mode == TraceMode::Svo { lod } else { 0.0 },
+        };
         let modes = [TraceMode::Grid, TraceMode::Svo];
         // Warm up all three, then alternate frames so machine noise hits them alike.
         for mode in modes {
@@ -312,7 +326,8 @@ fn bench_render(quick: bool) -> anyhow::Result<(String, String)> {
             report_grid_over_svo: model.report.1 / model.report.2,
         });
     }
-    let mut md = header(&format!("Grid DDA vs SVO, {width}×{height}"));
+    let lod_note = if lod > 0.0 { format!(", SVO at level of detail {lod} px") } else { String::new() };
+    let mut md = header(&format!("Grid DDA vs SVO, {width}×{height}{lod_note}"));
     md += &format!(
         "Adapter: **{}**; GPU time from timestamp queries where available, else wall time of submit + wait; median of the frames after one warm-up. Shadows off (the report's shading had none). Camera frames each whole model. The SVO time covers both of its dispatches: the beam prepass (one thread per 16×16-pixel tile) and the per-pixel traversal; its mean steps count the traversal's loop iterations per pixel. The report's 10 M-voxel scene is the Pietà, which is not public: `nefertiti512` is DESIGN.md's stand-in for it (the solid voxelization of meshes/nefertiti.obj, 512 voxels tall, 12.8 M voxels) and `sculpture10M` a smooth procedural shape with the Pietà's extent (11.6 M voxels); both rows compare with the report's Pietà. *Floor*: a kernel that does everything the per-pixel pass does except the traversal (the pixel's ray, shading, one store per pixel, the same dispatch shape): no traversal on this adapter can be faster, and *SVO / floor* says how far above it the SVO is.\n\n",
         renderer.gpu.adapter_name

@@ -38,6 +38,9 @@ struct Sizes {
     base_spp: u32,
 }
 
+/// The level-of-detail footprints measured, in pixels.
+const LOD_PIXELS: [f32; 3] = [1.0, 2.0, 4.0];
+
 /// The base setting and the knobs turned from it, by CLI flag.
 fn knobs(sizes: &Sizes) -> Vec<(&'static str, String, Setting)> {
     let base =
@@ -54,8 +57,12 @@ fn knobs(sizes: &Sizes) -> Vec<(&'static str, String, Setting)> {
     for r in [0.25, 0.5] {
         out.push(("--render-scale", r.to_string(), base(spp, 3, 1, r)));
     }
-    out.push(("--mode", "svo (preview)".into(), Setting::Preview { mode: TraceMode::Svo, render_scale: 1.0 }));
-    out.push(("--mode", "grid (preview)".into(), Setting::Preview { mode: TraceMode::Grid, render_scale: 1.0 }));
+    let preview = |mode, lod| Setting::Preview { mode, render_scale: 1.0, lod };
+    out.push(("--mode", "svo (preview)".into(), preview(TraceMode::Svo, 0.0)));
+    out.push(("--mode", "grid (preview)".into(), preview(TraceMode::Grid, 0.0)));
+    for lod in LOD_PIXELS {
+        out.push(("--lod", format!("{lod} (preview)"), preview(TraceMode::Svo, lod)));
+    }
     out
 }
 

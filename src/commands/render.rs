@@ -43,6 +43,9 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<ExitCode> {
     if args.path.spp.is_some() && (args.mode != TraceMode::Svo || args.view != View::Shaded) {
         anyhow::bail!("the path tracer (--spp) walks the SVO and shades: it takes neither --mode grid nor --view");
     }
+    if args.lod > 0.0 && (args.path.spp.is_some() || args.mode != TraceMode::Svo) {
+        anyhow::bail!("--lod applies to the SVO preview: the path tracer (--spp) and --mode grid trace exactly");
+    }
     let pixels = u64::from(args.size.0) * u64::from(args.size.1);
     let per_pixel = match (args.cpu, args.path.spp.is_some()) {
         (true, true) => CPU_PATH_BYTES_PER_PIXEL,
@@ -86,7 +89,8 @@ fn preview(
     args: &RenderArgs,
     size: (u32, u32),
 ) -> anyhow::Result<(image::RgbaImage, Stats)> {
-    let settings = RenderSettings { mode: args.mode, view: args.view, shadows: !args.no_shadows, render_scale: 1.0 };
+    let settings =
+        RenderSettings { mode: args.mode, view: args.view, shadows: !args.no_shadows, render_scale: 1.0, lod: args.lod };
     let grid = match args.mode {
         TraceMode::Grid => Some(DenseGrid::from_octree(&scene.tree).map_err(anyhow::Error::msg)?),
         TraceMode::Svo => None,

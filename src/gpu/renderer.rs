@@ -10,7 +10,7 @@ use super::{FrameUniforms, GpuContext, GpuError, Kernel, PathPass, PathUniforms,
 use crate::camera::{Camera, RayBasis};
 use crate::scene::{Octree, Palette};
 use crate::settings::{PathSettings, RenderSettings, View};
-use crate::trace::Hit;
+use crate::trace::{Footprint, Hit};
 use crate::trace::grid::DenseGrid;
 use crate::trace::path::materials::{Effects, material_table};
 use crate::trace::path::{effects_for, lights};
@@ -130,7 +130,7 @@ impl Renderer {
         settings: &RenderSettings,
         highlight: Option<(IVec3, IVec3)>,
     ) -> Result<f64, GpuError> {
-        self.frame(tree, camera, size, settings.view, highlight, Kernel::from(settings))
+        self.frame(tree, camera, size, (settings.view, settings.lod), highlight, Kernel::from(settings))
     }
 
     /// A frame of the floor kernel (everything but the traversal, see
@@ -139,7 +139,7 @@ impl Renderer {
     /// # Errors
     /// As [`Renderer::render`].
     pub fn render_floor(&mut self, tree: &Octree, camera: &Camera, size: (u32, u32)) -> Result<f64, GpuError> {
-        self.frame(tree, camera, size, View::Shaded, None, Kernel::Floor)
+        self.frame(tree, camera, size, (View::Shaded, 0.0), None, Kernel::Floor)
     }
 
     /// The one encode path of a frame: outputs sized, uniforms written, the
@@ -149,7 +149,7 @@ impl Renderer {
         tree: &Octree,
         camera: &Camera,
         size: (u32, u32),
-        view: View,
+        (view, lod): (View, f32),
         highlight: Option<(IVec3, IVec3)>,
         kernel: Kernel,
     ) -> Result<f64, GpuError> {
@@ -160,7 +160,7 @@ impl Renderer {
             let local = highlight.map(|(lo, hi)| (lo - tree.origin(), hi - tree.origin()));
             let uniforms = FrameUniforms {
                 hit_records: u32::from(self.hit_records),
-                ..FrameUniforms::new(&basis, tree, &self.buffers, view, local)
+                ..FrameUniforms::new(&basis, tree, &self.buffers, view, local, Footprint::of_pixels(&basis, lod))
             };
             self.records_written = self.hit_records;
             self.shown = Shown::Trace;
@@ -221,7 +221,7 @@ impl Renderer {
                 emitter_count: self.path_lights as u32,
                 _pad: [0; 2],
             };
-            let frame = FrameUniforms::new(&basis, tree, &self.buffers, View::Shaded, None);
+            let frame = FrameUniforms::new(&basis, tree, &self.buffers, View::Shaded, None, Footprint::EXACT);
             self.path.prepare(gpu, &self.buffers, &frame, &path);
             let mut encoder =
                 gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("path frame") });

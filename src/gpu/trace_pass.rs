@@ -10,7 +10,7 @@ use super::{GpuContext, GpuError, SceneBuffers};
 use crate::camera::RayBasis;
 use crate::scene::Octree;
 use crate::settings::{RenderSettings, TraceMode, View};
-use crate::trace::Hit;
+use crate::trace::{Footprint, Hit};
 
 const COMMON_WGSL: &str = include_str!("../../shaders/common.wgsl");
 const SVO_WGSL: &str = include_str!("../../shaders/trace_svo.wgsl");
@@ -56,7 +56,9 @@ pub struct FrameUniforms {
     pub brick_base: u32,
     /// `crate::trace::iteration_bound` of the tree: no valid ray reaches it.
     pub max_iterations: u32,
-    pub _pad: [u32; 3],
+    /// Level of detail: [`crate::trace::Footprint::per_t`] of camera rays.
+    pub lod_per_t: f32,
+    pub _pad: [u32; 2],
 }
 
 impl FrameUniforms {
@@ -68,6 +70,7 @@ impl FrameUniforms {
         buffers: &SceneBuffers,
         view: View,
         highlight: Option<(IVec3, IVec3)>,
+        lod: Footprint,
     ) -> FrameUniforms {
         let (lo, hi) = highlight.unwrap_or((IVec3::ZERO, IVec3::NEG_ONE));
         FrameUniforms {
@@ -88,7 +91,8 @@ impl FrameUniforms {
             highlight_max: hi.into(),
             brick_base: buffers.brick_base(),
             max_iterations: crate::trace::iteration_bound(tree.depth()),
-            _pad: [0; 3],
+            lod_per_t: lod.per_t,
+            _pad: [0; 2],
         }
     }
 }

@@ -9,7 +9,7 @@ use glam::IVec3;
 
 use super::octree::{MAX_DEPTH, Octree, WORLD_LIMIT, octant_offset};
 use super::shape::{Op, Overlap, Shape};
-use crate::gpu_pool::{Brick, Node, is_pointer, pointer_to};
+use crate::gpu_pool::{Brick, Node, is_pointer};
 
 /// Why an edit was refused. The tree is unchanged when one is returned.
 #[derive(Debug, thiserror::Error, Clone, PartialEq, Eq)]
@@ -116,7 +116,7 @@ impl Octree {
                 return self.replace_with(word, min, level, new, patch);
             }
             // Partly covered uniform cell: split it, then edit the parts.
-            let split = pointer_to(self.pool.nodes.alloc([word; 8]));
+            let split = self.split(word, level);
             return self.brush_children(split, min, level, shape, op, patch);
         }
         match op {
@@ -132,7 +132,7 @@ impl Octree {
         for (octant, child) in children.iter_mut().enumerate() {
             *child = self.brush_word(*child, min + octant_offset(octant) * half, level - 1, shape, op, patch);
         }
-        self.make_node(children, Some(node))
+        self.make_node(children, level, Some(node))
     }
 
     fn brush_brick(&mut self, word: u32, min: IVec3, shape: &Shape, op: Op, patch: &mut Patch) -> u32 {
@@ -193,7 +193,7 @@ impl Octree {
                 for child in &mut children {
                     *child = self.deserialize(words, level - 1);
                 }
-                self.make_node(children, None)
+                self.make_node(children, level, None)
             }
             BRICK_TAG if level == 1 => {
                 let lo = words.next().unwrap_or(0).to_le_bytes();
@@ -223,7 +223,7 @@ impl Octree {
             self.release(word, level);
             return new;
         }
-        let node = if is_pointer(word) { word } else { pointer_to(self.pool.nodes.alloc([word; 8])) };
+        let node = if is_pointer(word) { word } else { self.split(word, level) };
         let half = 1 << (level - 1);
         let rel = (target.0 - min) / half;
         let octant = (rel.x | rel.y << 1 | rel.z << 2) as usize;
@@ -236,7 +236,7 @@ impl Octree {
             subtree,
             inverse,
         );
-        self.make_node(children, Some(node))
+        self.make_node(children, level, Some(node))
     }
 
     /// Makes the root cube hold `lo..=hi`: adds root levels toward it, or,
@@ -289,7 +289,7 @@ impl Octree {
             let octant = usize::from(below.x) | usize::from(below.y) << 1 | usize::from(below.z) << 2;
             let mut children: Node = [0; 8];
             children[octant] = self.root;
-            self.root = if self.root == 0 { 0 } else { self.make_node(children, None) };
+            self.root = if self.root == 0 { 0 } else { self.make_node(children, self.depth + 1, None) };
             self.origin -= octant_offset(octant) * size;
             self.depth += 1;
         }

@@ -6,7 +6,8 @@ use rayon::prelude::*;
 
 use super::counts::VoxelCounts;
 use super::octree::{MAX_DEPTH, MIN_DEPTH, Octree, octant_offset};
-use crate::gpu_pool::{Brick, Node, POINTER_BIT, is_pointer, pointer_to, slot_of};
+use super::lod::{self, Summary};
+use crate::gpu_pool::{Brick, Node, NodeSlot, POINTER_BIT, is_pointer, pointer_to, slot_of};
 
 /// Why a tree could not be built.
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]
@@ -64,15 +65,15 @@ impl Octree {
             values.iter().for_each(|v| tree.counts.add(*v, 1));
             level.push((parent, tree.make_brick(values, None)));
         }
-        for _ in 2..=tree.depth {
-            level = tree.build_level(&level);
+        for node_level in 2..=tree.depth {
+            level = tree.build_level(&level, node_level);
         }
         tree.root = level.first().map_or(0, |l| l.1);
         Ok(tree)
     }
 
-    /// Groups sorted (code, word) children by parent code into nodes.
-    fn build_level(&mut self, children: &[(u64, u32)]) -> Vec<(u64, u32)> {
+    /// Groups sorted (code, word) children by parent code into nodes of `level`.
+    fn build_level(&mut self, children: &[(u64, u32)], level: u32) -> Vec<(u64, u32)> {
         let mut parents = Vec::with_capacity(children.len() / 4 + 1);
         let mut i = 0;
         while i < children.len() {
@@ -82,7 +83,7 @@ impl Octree {
                 node[(children[i].0 & 7) as usize] = children[i].1;
                 i += 1;
             }
-            parents.push((parent, self.make_node(node, None)));
+            parents.push((parent, self.make_node(node, level, None)));
         }
         parents
     }
@@ -112,7 +113,7 @@ impl Octree {
             tree.counts.add_counts(&part.counts);
             children[octant] = tree.adopt(part);
         }
-        tree.root = tree.make_node(children, None);
+        tree.root = tree.make_node(children, depth, None);
         Ok(tree)
     }
 
@@ -133,7 +134,7 @@ impl Octree {
             self.pool.bricks.alloc(brick);
         }
         for node in part.nodes {
-            self.pool.nodes.alloc(node.map(relocate));
+            self.pool.nodes.alloc(NodeSlot { children: node.children.map(relocate), ..node });
         }
         relocate(part.root)
     }
@@ -155,7 +156,7 @@ impl Dense<'_> {
 
 #[derive(Default)]
 struct LocalArena {
-    nodes: Vec<Node>,
+    nodes: Vec<NodeSlot>,
     bricks: Vec<Brick>,
     root: u32,
     counts: VoxelCounts,
@@ -180,7 +181,19 @@ impl LocalArena {
         if !is_pointer(children[0]) && children.iter().all(|c| *c == children[0]) {
             return children[0];
         }
-        self.nodes.push(children);
+        let summary = lod::combine(children.map(|c| self.summary(c, level - 1)));
+        self.nodes.push(NodeSlot { children, lod: summary.word() });
         pointer_to(self.nodes.len() as u32 - 1)
+    }
+
+    /// `Octree::summary` for this arena's local words.
+    fn summary(&self, word: u32, level: u32) -> Summary {
+        if !is_pointer(word) {
+            Summary::uniform(word as u8)
+        } else if level == 1 {
+            Summary::of_brick(&self.bricks[(word & !(POINTER_BIT | LOCAL_BRICK)) as usize])
+        } else {
+            Summary::from_word(self.nodes[slot_of(word) as usize].lod)
+        }
     }
 }

@@ -65,7 +65,7 @@ fn tally(pool: &NodePool, word: u32, level: u32, f: &mut impl FnMut(u8, u64)) {
     } else if level == 1 {
         pool.bricks.get(slot_of(word)).iter().for_each(|v| f(*v, 1));
     } else {
-        for &child in pool.nodes.get(slot_of(word)) {
+        for &child in &pool.nodes.get(slot_of(word)).children {
             tally(pool, child, level - 1, f);
         }
     }

@@ -5,6 +5,7 @@ pub mod build;
 pub mod counts;
 pub mod demo;
 pub mod fill;
+pub mod lod;
 pub mod octree;
 pub mod palette;
 pub mod sculpture;

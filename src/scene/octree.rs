@@ -11,7 +11,8 @@
 use glam::IVec3;
 
 use super::counts::VoxelCounts;
-use crate::gpu_pool::{self, Brick, Node, NodePool, is_pointer, pointer_to, slot_of};
+use super::lod::{self, Summary};
+use crate::gpu_pool::{self, Brick, Node, NodePool, NodeSlot, is_pointer, pointer_to, slot_of};
 
 /// Smallest root: a 4³ cube (the root is then a node of bricks).
 pub const MIN_DEPTH: u32 = 2;
@@ -106,7 +107,24 @@ impl Octree {
     }
 
     pub(crate) fn node(&self, word: u32) -> &Node {
-        self.pool.nodes.get(slot_of(word))
+        &self.pool.nodes.get(slot_of(word)).children
+    }
+
+    /// What the cell of child word `word` at `level` looks like from far away.
+    pub fn summary(&self, word: u32, level: u32) -> Summary {
+        if !is_pointer(word) {
+            Summary::uniform(word as u8)
+        } else if level == 1 {
+            Summary::of_brick(self.brick(word))
+        } else {
+            Summary::from_word(self.pool.nodes.get(slot_of(word)).lod)
+        }
+    }
+
+    /// A node slot for children of a `level` node, with their summary.
+    fn node_slot(&self, children: Node, level: u32) -> NodeSlot {
+        let summary = lod::combine(children.map(|c| self.summary(c, level - 1)));
+        NodeSlot { children, lod: summary.word() }
     }
 
     pub(crate) fn brick(&self, word: u32) -> &Brick {
@@ -274,24 +292,33 @@ impl Octree {
         }
     }
 
-    /// Word for eight child words: collapsed if all are the same uniform value.
-    /// `reuse` is an existing node word to overwrite in place.
-    pub(crate) fn make_node(&mut self, children: Node, reuse: Option<u32>) -> u32 {
+    /// Word for the eight child words of a `level` node: collapsed if all are
+    /// the same uniform value. `reuse` is an existing node word to overwrite
+    /// in place; it is written (and uploaded) only if the slot changes, its
+    /// summary included.
+    pub(crate) fn make_node(&mut self, children: Node, level: u32, reuse: Option<u32>) -> u32 {
         if !is_pointer(children[0]) && children.iter().all(|c| *c == children[0]) {
             if let Some(old) = reuse {
                 self.pool.nodes.free(slot_of(old));
             }
             return children[0];
         }
+        let slot = self.node_slot(children, level);
         match reuse {
             Some(old) => {
-                if self.node(old) != &children {
-                    self.pool.nodes.set(slot_of(old), children);
+                if self.pool.nodes.get(slot_of(old)) != &slot {
+                    self.pool.nodes.set(slot_of(old), slot);
                 }
                 old
             }
-            None => pointer_to(self.pool.nodes.alloc(children)),
+            None => pointer_to(self.pool.nodes.alloc(slot)),
         }
+    }
+
+    /// A node slot of `word` repeated: a uniform cell split so its parts can
+    /// be edited (a brush or undo then rewrites it through `make_node`).
+    pub(crate) fn split(&mut self, word: u32, level: u32) -> u32 {
+        pointer_to(self.pool.nodes.alloc(self.node_slot([word; 8], level)))
     }
 
     /// Checks the structural invariants: collapse, no dangling or leaked
@@ -334,6 +361,10 @@ impl Octree {
         }
         reached.0 += 1;
         let node = *self.node(word);
+        let stored = self.pool.nodes.get(slot_of(word)).lod;
+        if stored != self.node_slot(node, level).lod {
+            return Err(format!("stale summary {:?} of node {} at level {level}", Summary::from_word(stored), slot_of(word)));
+        }
         if !is_pointer(node[0]) && node.iter().all(|c| *c == node[0]) {
             return Err(format!("uncollapsed node {node:?} at level {level}"));
         }

@@ -27,6 +27,38 @@ pub fn iteration_bound(depth: u32) -> u32 {
     u32::try_from(bound).unwrap_or(u32::MAX)
 }
 
+/// The width in voxels below which a traversal stops at a node and shades
+/// it by its level-of-detail summary (`crate::scene::lod`): `at_start +
+/// per_t · t` at the ray's t. Zero is exact: every cell is at least one voxel.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Footprint {
+    pub at_start: f32,
+    pub per_t: f32,
+}
+
+impl Footprint {
+    pub const EXACT: Footprint = Footprint { at_start: 0.0, per_t: 0.0 };
+
+    /// The footprint of `pixels` image pixels for the camera rays of
+    /// `basis`: their t is the depth along the view axis, where one pixel is
+    /// `2·|up| / height` voxels wide per unit of depth.
+    pub fn of_pixels(basis: &crate::camera::RayBasis, pixels: f32) -> Footprint {
+        let per_t = pixels.max(0.0) * 2.0 * basis.up.length() / basis.height.max(1) as f32;
+        Footprint { at_start: 0.0, per_t }
+    }
+
+    /// The footprint a shadow ray from a hit at camera-ray `t` keeps.
+    pub fn at(self, t: f32) -> Footprint {
+        Footprint { at_start: self.at_start + self.per_t * t, per_t: 0.0 }
+    }
+
+    /// Whether a cell `size` voxels wide, entered at `t`, is below the
+    /// footprint. Twin of `below_footprint` in `shaders/trace_svo.wgsl`.
+    pub fn covers(self, size: u32, t: f32) -> bool {
+        size as f32 <= self.at_start + self.per_t * t
+    }
+}
+
 /// Entry axis of a ray that starts inside a cell (no face entered).
 pub const NO_AXIS: usize = 3;
 

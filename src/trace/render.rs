@@ -5,7 +5,7 @@ use glam::{IVec3, Vec3};
 use rayon::prelude::*;
 
 use super::grid::{self, DenseGrid};
-use super::{Hit, Ray, svo};
+use super::{Footprint, Hit, Ray, svo};
 use crate::camera::{Camera, RayBasis};
 use crate::scene::{Octree, Palette, Scene};
 use crate::settings::{RenderSettings, SUN_DIR, View};
@@ -18,22 +18,23 @@ pub enum Tracer<'a> {
 }
 
 impl Tracer<'_> {
-    pub fn trace(&self, ray: &Ray) -> Hit {
+    /// The first hit along `ray`; the grid is always exact.
+    pub fn trace(&self, ray: &Ray, footprint: Footprint) -> Hit {
         match self {
-            Tracer::Svo(tree) => svo::trace(tree, ray),
+            Tracer::Svo(tree) => svo::trace_lod(tree, ray, footprint),
             Tracer::Grid(grid) => grid::trace(grid, ray),
         }
     }
 }
 
 /// Hit records of every pixel, row-major from the top-left.
-pub fn trace_image(tracer: Tracer, basis: &RayBasis) -> Vec<Hit> {
+pub fn trace_image(tracer: Tracer, basis: &RayBasis, footprint: Footprint) -> Vec<Hit> {
     (0..basis.height)
         .into_par_iter()
         .flat_map_iter(|y| {
             (0..basis.width).map(move |x| {
                 let (origin, dir) = basis.ray(x, y);
-                tracer.trace(&Ray::new(origin, dir))
+                tracer.trace(&Ray::new(origin, dir), footprint)
             })
         })
         .collect()
@@ -62,6 +63,12 @@ pub fn shadow_ray(hit: &Hit) -> Option<Ray> {
     }
     let origin = (hit.voxel + hit.normal).as_vec3() + Vec3::splat(0.5);
     Some(Ray::new(origin, Vec3::from(SUN_DIR)))
+}
+
+/// The hit voxel's depth along the view axis: the camera ray's t there, near
+/// enough, from integers alone so the GPU (`hit_depth` in WGSL) agrees.
+pub fn hit_depth(hit: &Hit, basis: &RayBasis) -> f32 {
+    (hit.voxel.as_vec3() + Vec3::splat(0.5) - basis.eye).dot(basis.forward)
 }
 
 /// Colour of a ray that ran out of iterations before it hit or left the
@@ -132,7 +139,8 @@ pub fn render_scene_cpu(
         None => Tracer::Svo(&scene.tree),
     };
     let basis = camera.basis(size.0, size.1, scene.tree.origin());
-    let hits = trace_image(tracer, &basis);
+    let footprint = Footprint::of_pixels(&basis, settings.lod);
+    let hits = trace_image(tracer, &basis, footprint);
     let gave_up = hits.iter().filter(|hit| hit.gave_up()).count();
     if gave_up > 0 {
         log::warn!(
@@ -142,7 +150,10 @@ pub fn render_scene_cpu(
         );
     }
     let shadows: Vec<bool> = if settings.shadows {
-        hits.par_iter().map(|hit| shadow_ray(hit).is_some_and(|ray| tracer.trace(&ray).is_hit())).collect()
+        // A shadow ray keeps the footprint its camera ray had at the hit.
+        hits.par_iter()
+            .map(|hit| shadow_ray(hit).is_some_and(|ray| tracer.trace(&ray, footprint.at(hit_depth(hit, &basis))).is_hit()))
+            .collect()
     } else {
         Vec::new()
     };

@@ -13,7 +13,7 @@
 
 use glam::{IVec3, Vec3};
 
-use super::{Hit, NO_AXIS, Ray, argmin, iteration_bound};
+use super::{Footprint, Hit, NO_AXIS, Ray, argmin, iteration_bound};
 use crate::camera::Camera;
 use crate::gpu_pool::{is_pointer, slot_of};
 use crate::scene::octree::{MAX_DEPTH, Octree};
@@ -44,7 +44,14 @@ pub struct GaveUp {
 
 /// The first solid voxel along `ray` (tree-local coordinates).
 pub fn trace(tree: &Octree, ray: &Ray) -> Hit {
-    trace_through(tree, ray, 0).hit
+    walk(tree, ray, 0, Footprint::EXACT).hit
+}
+
+/// The first solid cell along `ray` under a level-of-detail footprint: a
+/// node cell below it is hit as a solid cell of its summary's palette index
+/// (`cell_level` then says how big). With [`Footprint::EXACT`], [`trace`].
+pub fn trace_lod(tree: &Octree, ray: &Ray, footprint: Footprint) -> Hit {
+    walk(tree, ray, 0, footprint).hit
 }
 
 /// Where a ray leaves its medium: the first voxel whose value differs from
@@ -60,8 +67,13 @@ pub struct Crossing {
 
 /// The first voxel along `ray` whose value is not `medium` (0 for rays in
 /// empty space): the traversal of [`trace`] with "solid" read as "not the
-/// medium". Twin of `trace_svo` in `shaders/trace_svo.wgsl`.
+/// medium".
 pub fn trace_through(tree: &Octree, ray: &Ray, medium: u8) -> Crossing {
+    walk(tree, ray, medium, Footprint::EXACT)
+}
+
+/// The traversal itself. Twin of `trace_svo` in `shaders/trace_svo.wgsl`.
+fn walk(tree: &Octree, ray: &Ray, medium: u8, footprint: Footprint) -> Crossing {
     let depth = tree.depth();
     let size = (1u32 << depth) as f32;
     let (t_enter, t_exit, entry_axis) = ray.slab(Vec3::ZERO, Vec3::splat(size));
@@ -92,6 +104,11 @@ pub fn trace_through(tree: &Octree, ray: &Ray, medium: u8) -> Crossing {
         iterations += 1;
         let word = child_word(tree, nodes[level as usize], level, octant_of(cell, level));
         if is_pointer(word) {
+            // A node cell (bricks never stop) below the footprint.
+            if level >= 3 && footprint.covers(1 << (level - 1), t) {
+                let index = tree.summary(word, level - 1).index;
+                return hit_cell(ray, index, cell, level - 1, t, axis, iterations);
+            }
             level -= 1;
             nodes[level as usize] = word;
             cell = child_cell(ray, cell, level, t, axis);
@@ -134,7 +151,7 @@ fn child_word(tree: &Octree, word: u32, level: u32, octant: usize) -> u32 {
     if level == 1 {
         u32::from(tree.pool().bricks.get(slot_of(word))[octant])
     } else {
-        tree.pool().nodes.get(slot_of(word))[octant]
+        tree.pool().nodes.get(slot_of(word)).children[octant]
     }
 }
 
