@@ -80,6 +80,19 @@ impl<T> Default for SlotArena<T> {
 }
 
 impl<T: bytemuck::Pod> SlotArena<T> {
+    /// An arena holding `items` in slots 0.., all in use and all dirty (the
+    /// first flush uploads them).
+    pub fn from_items(items: Vec<T>) -> SlotArena<T> {
+        let n = items.len();
+        SlotArena {
+            items,
+            state: vec![SlotState::Dirty; n],
+            free: Vec::new(),
+            dirty: (0..n as u32).collect(),
+            gpu_capacity: None,
+        }
+    }
+
     /// Stores `item` in a free slot (reusing freed ones first) and marks it dirty.
     pub fn alloc(&mut self, item: T) -> u32 {
         if let Some(slot) = self.free.pop() {

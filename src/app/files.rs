@@ -155,7 +155,7 @@ impl App {
         }
     }
 
-    /// Reads a .vox (or voxelizes an .obj) on a background thread; the
+    /// Reads a .vox or .ovx (or voxelizes an .obj) on a background thread; the
     /// window keeps drawing.
     pub(super) fn start_loading(&mut self, path: PathBuf) {
         let (tx, rx) = mpsc::channel();

@@ -451,8 +451,8 @@ fn message(ui: &mut egui::Ui, ui_state: &mut UiState) {
     }
 }
 
-/// Files in the current folder and in `saves/` for a path dialog: .vox and
-/// .obj to open, .vox to save over.
+/// Files in the current folder and in `saves/` for a path dialog: .vox,
+/// .ovx and .obj to open, .vox or .ovx to save over.
 fn nearby_files(kind: DialogKind) -> Vec<PathBuf> {
     let mut files: Vec<PathBuf> = [Path::new("."), Path::new("saves")]
         .iter()
@@ -461,10 +461,10 @@ fn nearby_files(kind: DialogKind) -> Vec<PathBuf> {
         .filter_map(Result::ok)
         .map(|e| e.path())
         .filter(|p| {
-            let vox = p.extension().is_some_and(|e| e.eq_ignore_ascii_case("vox"));
+            let scene = p.extension().is_some_and(|e| e.eq_ignore_ascii_case("vox")) || octovox::io::is_ovx_path(p);
             match kind {
-                DialogKind::Open => vox || octovox::io::is_mesh_path(p),
-                DialogKind::SaveAs => vox,
+                DialogKind::Open => scene || octovox::io::is_mesh_path(p),
+                DialogKind::SaveAs => scene,
                 DialogKind::Export => octovox::io::export::MeshFormat::of(p).is_some(),
             }
         })
@@ -476,8 +476,8 @@ fn nearby_files(kind: DialogKind) -> Vec<PathBuf> {
 fn dialog(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
     let Some((kind, path)) = &mut ui_state.dialog else { return };
     let title = match kind {
-        DialogKind::Open => "Open .vox or .obj",
-        DialogKind::SaveAs => "Save as .vox",
+        DialogKind::Open => "Open .vox, .ovx or .obj",
+        DialogKind::SaveAs => "Save as .vox or .ovx",
         DialogKind::Export => "Export a mesh (.obj or .ply)",
     };
     let mut close = false;

@@ -1,4 +1,4 @@
-//! `octovox info FILE [--json] [--frame N]`: what a .vox file holds.
+//! `octovox info FILE [--json] [--frame N]`: what a .vox or .ovx file holds.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -6,12 +6,25 @@ use std::process::ExitCode;
 
 use anyhow::Context;
 use octovox::io::vox::load_vox_file;
-use octovox::scene::{MaterialKind, VoxelModel};
+use octovox::scene::{MaterialKind, Scene, VoxelModel};
+
+/// Widest world MagicaVoxel opens, in voxels per axis.
+const MAGICAVOXEL_WORLD: i64 = 2048;
 
 /// Loads `file` and prints its summary, as JSON when `json` is set.
 pub fn run(file: &Path, json: bool, frame: usize) -> anyhow::Result<ExitCode> {
-    let model = load_vox_file(file, frame).with_context(|| format!("loading {}", file.display()))?;
-    let summary = Summary::of(&model);
+    let loading = || format!("loading {}", file.display());
+    let mut summary = if octovox::io::is_ovx_path(file) {
+        Summary::of_scene(&octovox::io::ovx::load_ovx(file).with_context(loading)?)
+    } else {
+        Summary::of(&load_vox_file(file, frame).with_context(loading)?)
+    };
+    if summary.extent().iter().any(|e| *e > MAGICAVOXEL_WORLD) {
+        let [x, y, z] = summary.extent();
+        summary.warnings.push(format!(
+            "the world is {x} x {y} x {z} voxels: MagicaVoxel opens worlds up to {MAGICAVOXEL_WORLD} across"
+        ));
+    }
     if json {
         say!("{}", serde_json::to_string_pretty(&summary.to_json(file))?)?;
     } else {
@@ -46,6 +59,24 @@ impl Summary {
             warnings: model.warnings.clone(),
             voxels: model.voxels.len(),
             bounds: model.bounds().map(|(lo, hi)| (lo.to_array(), hi.to_array())),
+            palette_entries: used.len(),
+            materials,
+        }
+    }
+
+    /// An octree read back from an .ovx file: one model, stored as a pool.
+    fn of_scene(scene: &Scene) -> Summary {
+        let used: Vec<u8> = scene.tree.counts().present().collect();
+        let mut materials = BTreeMap::new();
+        for &index in &used {
+            *materials.entry(scene.palette.material(index).kind).or_insert(0) += 1;
+        }
+        Summary {
+            models: 1,
+            stored_models: 1,
+            warnings: Vec::new(),
+            voxels: scene.tree.solid_voxels() as usize,
+            bounds: scene.tree.solid_bounds().map(|(lo, hi)| (lo.to_array(), hi.to_array())),
             palette_entries: used.len(),
             materials,
         }

@@ -1,4 +1,5 @@
-//! File formats: MagicaVoxel .vox in and out, .obj meshes in (voxelized).
+//! File formats: MagicaVoxel .vox and the native .ovx in and out, .obj
+//! meshes in (voxelized).
 
 pub mod atomic;
 pub mod export;
@@ -6,6 +7,7 @@ mod guard;
 pub mod input;
 pub mod mesh;
 pub mod output;
+pub mod ovx;
 pub mod png;
 pub mod vox;
 
@@ -21,13 +23,19 @@ pub enum LoadError {
     #[error(transparent)]
     Mesh(#[from] mesh::MeshError),
     #[error("{}: {source}", path.display())]
+    Ovx { path: std::path::PathBuf, source: ovx::OvxError },
+    #[error("{}: {source}", path.display())]
     Build { path: std::path::PathBuf, source: BuildError },
 }
 
 /// Loads a .vox file, or an .obj mesh (voxelized solid, [`mesh::DEFAULT_MESH_SIZE`]
-/// voxels on its longest side, y up), and builds its octree.
+/// voxels on its longest side, y up), and builds its octree; or reads an
+/// .ovx file's octree back.
 pub fn load_scene(path: &Path, frame: usize) -> Result<Scene, LoadError> {
     let build_error = |source| LoadError::Build { path: path.to_path_buf(), source };
+    if is_ovx_path(path) {
+        return ovx::load_ovx(path).map_err(|source| LoadError::Ovx { path: path.to_path_buf(), source });
+    }
     if is_mesh_path(path) {
         let dense = mesh::voxelize_obj(path, mesh::DEFAULT_MESH_SIZE, mesh::UpAxis::Y, mesh::MESH_COLOR)?;
         return Scene::from_dense(&dense).map_err(build_error);
@@ -44,13 +52,31 @@ pub fn is_mesh_path(path: &Path) -> bool {
     path.extension().is_some_and(|e| e.eq_ignore_ascii_case("obj"))
 }
 
-/// Saves a scene as .vox, one model at a time, atomically (the old file
-/// survives a failed write; see [`atomic`]). A name that is not .vox is
-/// refused, so an imported mesh is never overwritten with .vox bytes.
-pub fn save_scene(path: &Path, scene: &Scene, options: atomic::WriteOptions) -> Result<(), vox::VoxError> {
-    if !path.extension().is_some_and(|e| e.eq_ignore_ascii_case("vox")) {
-        let reason = std::io::Error::new(std::io::ErrorKind::InvalidInput, "scenes are saved as .vox files");
-        return Err(vox::VoxError::Write { path: path.to_path_buf(), source: reason });
+/// Whether `path` names a native octree file (.ovx).
+pub fn is_ovx_path(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("ovx"))
+}
+
+/// Why a scene could not be saved.
+#[derive(Debug, thiserror::Error)]
+pub enum SaveError {
+    #[error(transparent)]
+    Vox(#[from] vox::VoxError),
+    #[error(transparent)]
+    Ovx(#[from] ovx::OvxError),
+}
+
+/// Saves a scene as .ovx (the pool as it is) or as .vox (one model at a
+/// time), atomically: the old file survives a failed write (see
+/// [`atomic`]). Any other name is refused, so an imported mesh is never
+/// overwritten with scene bytes.
+pub fn save_scene(path: &Path, scene: &Scene, options: atomic::WriteOptions) -> Result<(), SaveError> {
+    if is_ovx_path(path) {
+        return Ok(ovx::save_ovx(path, scene, options)?);
     }
-    vox::save_tree(path, &scene.palette, &scene.tree, options)
+    if !path.extension().is_some_and(|e| e.eq_ignore_ascii_case("vox")) {
+        let reason = std::io::Error::new(std::io::ErrorKind::InvalidInput, "scenes are saved as .vox or .ovx files");
+        return Err(vox::VoxError::Write { path: path.to_path_buf(), source: reason }.into());
+    }
+    Ok(vox::save_tree(path, &scene.palette, &scene.tree, options)?)
 }

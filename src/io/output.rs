@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 pub enum OutputKind {
     /// A rendered image: `.png`.
     Image,
-    /// A scene: `.vox`.
+    /// A scene: `.vox` or `.ovx`.
     Scene,
     /// A replay script (`--record`): any name, `.ovr` by convention.
     Script,
@@ -24,7 +24,7 @@ impl OutputKind {
     fn extensions(self) -> &'static [&'static str] {
         match self {
             OutputKind::Image => &["png"],
-            OutputKind::Scene => &["vox"],
+            OutputKind::Scene => &["vox", "ovx"],
             OutputKind::Script => &[],
             OutputKind::Mesh => &["obj", "ply"],
             OutputKind::Materials => &["mtl"],
@@ -35,7 +35,7 @@ impl OutputKind {
 /// Extensions of the files users make by hand or with other tools (meshes
 /// and their materials included); an existing one is only replaced with
 /// `--force`.
-const DOCUMENT_EXTENSIONS: [&str; 5] = ["vox", "obj", "ovr", "ply", "mtl"];
+const DOCUMENT_EXTENSIONS: [&str; 6] = ["vox", "ovx", "obj", "ovr", "ply", "mtl"];
 
 /// Why an output was refused.
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]

@@ -321,6 +321,33 @@ impl Octree {
         pointer_to(self.pool.nodes.alloc(self.node_slot([word; 8], level)))
     }
 
+    /// A tree from a stored pool (the native file): slots `0..` of `nodes` and
+    /// `bricks`, each slot used exactly once. Checked before it is used, so a crafted pool gives
+    /// an error, not a cycle or a shared subtree; then the invariants
+    /// (collapse, summaries) are checked and the counts recomputed.
+    ///
+    /// # Errors
+    /// What is wrong with the pool, in words.
+    pub fn from_parts(
+        origin: IVec3,
+        depth: u32,
+        root: u32,
+        nodes: Vec<NodeSlot>,
+        bricks: Vec<Brick>,
+    ) -> Result<Octree, String> {
+        check_tree_shape(root, depth, &nodes, bricks.len())?;
+        let mut tree = Octree::empty(origin, depth);
+        if tree.depth != depth {
+            return Err(format!("root depth {depth} is outside {MIN_DEPTH}..={MAX_DEPTH}"));
+        }
+        tree.pool.nodes = gpu_pool::SlotArena::from_items(nodes);
+        tree.pool.bricks = gpu_pool::SlotArena::from_items(bricks);
+        tree.root = root;
+        tree.counts.add_word(&tree.pool, root, depth);
+        tree.check_invariants()?;
+        Ok(tree)
+    }
+
     /// Checks the structural invariants: collapse, no dangling or leaked
     /// slots, and the cached voxel count. Returns a description of the first
     /// violation. Used by tests after every edit.
@@ -370,6 +397,38 @@ impl Octree {
         }
         node.iter().try_for_each(|&c| self.check_word(c, level - 1, reached))
     }
+}
+
+/// Checks that the pointers under `root` form a tree over exactly the given
+/// slots: in range, each used once (so no cycle and no shared subtree), and
+/// uniform words that are palette indices.
+fn check_tree_shape(root: u32, depth: u32, nodes: &[NodeSlot], bricks: usize) -> Result<(), String> {
+    let mut used = (vec![false; nodes.len()], vec![false; bricks]);
+    let mut stack = vec![(root, depth)];
+    while let Some((word, level)) = stack.pop() {
+        if !is_pointer(word) {
+            if word > 255 {
+                return Err(format!("bad cell word {word:#x}"));
+            }
+            continue;
+        }
+        let slot = slot_of(word);
+        let (seen, what) = if level == 1 { (&mut used.1, "brick") } else { (&mut used.0, "node") };
+        match seen.get_mut(slot as usize) {
+            None => return Err(format!("{what} {slot} is past the {} stored", seen.len())),
+            Some(true) => return Err(format!("{what} {slot} is used twice")),
+            Some(flag) => *flag = true,
+        }
+        if level == 1 {
+            continue;
+        }
+        stack.extend(nodes[slot as usize].children.map(|child| (child, level - 1)));
+    }
+    let unused = used.0.iter().chain(&used.1).filter(|u| !**u).count();
+    if unused > 0 {
+        return Err(format!("{unused} stored nodes or bricks are not in the tree"));
+    }
+    Ok(())
 }
 
 /// Reads voxels back from raw GPU-layout bytes exactly as the shader walks

@@ -1,0 +1,410 @@
+//! The native octree file, `.ovx`: the node pool as the GPU reads it, the
+//! palette and the materials, zstd-compressed, with a version and a checksum.
+//! Loading reads the pool back (no rebuild), checks that it is a tree, and
+//! hands it to the renderer as it is. `docs/ovx.md` describes the layout.
+//!
+//! A file is a 32-byte header, a zstd frame, and a CRC-32 of everything
+//! before it. The header holds the file's own length, so a cut file is told
+//! from a corrupted one; the counts in the payload are checked against the
+//! header's payload length and the memory budget before anything is
+//! allocated.
+
+use std::io::{self, Read, Write};
+use std::path::{Path, PathBuf};
+
+use glam::IVec3;
+
+use super::atomic::{WriteOptions, write_atomically};
+use crate::gpu_pool::{Brick, NODE_BYTES, NodeSlot, is_pointer, pointer_to, slot_of};
+use crate::scene::octree::{MAX_DEPTH, MIN_DEPTH, Octree};
+use crate::scene::{Material, MaterialKind, Palette, Scene};
+
+/// The first eight bytes of every .ovx file.
+pub const MAGIC: [u8; 8] = *b"OCTOVOX\x1a";
+/// The version this build writes and reads.
+pub const VERSION: u32 = 1;
+/// Magic, version, flags, file length, payload length.
+const HEADER_BYTES: u64 = 32;
+/// The CRC-32 at the end.
+const FOOTER_BYTES: u64 = 4;
+/// Largest .ovx file read (the memory budget usually says no first).
+pub const MAX_FILE_BYTES: u64 = 1 << 36;
+/// Payload bytes before the node and brick arrays: origin, depth, root,
+/// node and brick counts, the palette.
+const FIXED_PAYLOAD_BYTES: u64 = 12 + 4 + 4 + 8 + 8 + 256 * 4;
+/// zstd level: fast (about the speed of writing the file) and within a
+/// few percent of level 9 on pools.
+const ZSTD_LEVEL: i32 = 3;
+
+/// Why an .ovx file could not be read or written.
+#[derive(Debug, thiserror::Error)]
+pub enum OvxError {
+    #[error("cannot read {}: {source}", path.display())]
+    Read { path: PathBuf, source: io::Error },
+    #[error("cannot write {}: {source}", path.display())]
+    Write { path: PathBuf, source: io::Error },
+    #[error("not an .ovx file (it does not start with octovox's magic bytes)")]
+    NotOvx,
+    #[error("unsupported .ovx version {0} (this octovox reads version {VERSION})")]
+    UnsupportedVersion(u32),
+    #[error("the file is truncated: {found} of its {expected} bytes are there")]
+    Truncated { found: u64, expected: u64 },
+    #[error("checksum mismatch (stored {stored:#010x}, computed {computed:#010x}): the file is corrupted")]
+    BadChecksum { stored: u32, computed: u32 },
+    #[error("the file is corrupted: {0}")]
+    Corrupt(String),
+    #[error(transparent)]
+    OverBudget(#[from] crate::budget::OverBudget),
+}
+
+fn corrupt(what: impl Into<String>) -> OvxError {
+    OvxError::Corrupt(what.into())
+}
+
+/// Writes `scene` to `path` atomically (the old file survives a failure).
+///
+/// # Errors
+/// [`OvxError::Write`] with the cause; `path` is then unchanged.
+pub fn save_ovx(path: &Path, scene: &Scene, options: WriteOptions) -> Result<(), OvxError> {
+    let write_error = |source| OvxError::Write { path: path.to_path_buf(), source };
+    let compact = Compact::of(&scene.tree);
+    let materials = encode_materials(&scene.palette);
+    let payload_len = FIXED_PAYLOAD_BYTES
+        + compact.nodes.len() as u64 * NODE_BYTES
+        + compact.bricks.len() as u64 * 8
+        + materials.len() as u64;
+    write_atomically(path, options, |file| {
+        let mut out = Counting::new(io::BufWriter::new(file));
+        // The file length goes in once the frame is written (a seek back).
+        out.write_all(&header(0, payload_len))?;
+        let mut encoder = zstd::Encoder::new(&mut out, ZSTD_LEVEL)?;
+        encoder.include_checksum(true)?;
+        write_payload(&mut encoder, &scene.tree, &scene.palette, &compact, &materials)?;
+        encoder.finish()?;
+        let file_len = out.written + FOOTER_BYTES;
+        let file = out.into_inner()?;
+        use std::io::Seek;
+        file.seek(io::SeekFrom::Start(0))?;
+        // The checksum covers the final header: recompute it over the file.
+        file.write_all(&header(file_len, payload_len))?;
+        file.seek(io::SeekFrom::Start(0))?;
+        let crc = crc_of(&mut *file, file_len - FOOTER_BYTES)?;
+        file.seek(io::SeekFrom::End(0))?;
+        file.write_all(&crc.to_le_bytes())?;
+        Ok(())
+    })
+    .map_err(write_error)
+}
+
+fn header(file_len: u64, payload_len: u64) -> [u8; HEADER_BYTES as usize] {
+    let mut h = [0u8; HEADER_BYTES as usize];
+    h[..8].copy_from_slice(&MAGIC);
+    h[8..12].copy_from_slice(&VERSION.to_le_bytes());
+    // 12..16: flags, none yet.
+    h[16..24].copy_from_slice(&file_len.to_le_bytes());
+    h[24..32].copy_from_slice(&payload_len.to_le_bytes());
+    h
+}
+
+fn write_payload(
+    out: &mut impl Write,
+    tree: &Octree,
+    palette: &Palette,
+    compact: &Compact,
+    materials: &[u8],
+) -> io::Result<()> {
+    for v in tree.origin().to_array() {
+        out.write_all(&v.to_le_bytes())?;
+    }
+    out.write_all(&tree.depth().to_le_bytes())?;
+    out.write_all(&compact.root.to_le_bytes())?;
+    out.write_all(&(compact.nodes.len() as u64).to_le_bytes())?;
+    out.write_all(&(compact.bricks.len() as u64).to_le_bytes())?;
+    out.write_all(bytemuck::cast_slice(&palette.colors))?;
+    out.write_all(bytemuck::cast_slice(&compact.nodes))?;
+    out.write_all(bytemuck::cast_slice(&compact.bricks))?;
+    out.write_all(materials)
+}
+
+/// The live part of a pool renumbered in depth-first order: no free slots.
+struct Compact {
+    root: u32,
+    nodes: Vec<NodeSlot>,
+    bricks: Vec<Brick>,
+}
+
+impl Compact {
+    fn of(tree: &Octree) -> Compact {
+        let mut compact = Compact { root: 0, nodes: Vec::new(), bricks: Vec::new() };
+        compact.root = compact.copy(tree, tree.root_word(), tree.depth());
+        compact
+    }
+
+    fn copy(&mut self, tree: &Octree, word: u32, level: u32) -> u32 {
+        if !is_pointer(word) {
+            return word;
+        }
+        if level == 1 {
+            self.bricks.push(*tree.pool().bricks.get(slot_of(word)));
+            return pointer_to(self.bricks.len() as u32 - 1);
+        }
+        let slot = *tree.pool().nodes.get(slot_of(word));
+        let index = self.nodes.len();
+        self.nodes.push(slot);
+        let children = slot.children.map(|child| self.copy(tree, child, level - 1));
+        self.nodes[index].children = children;
+        pointer_to(index as u32)
+    }
+}
+
+/// Kind byte, then the parameter count and each key and value, all
+/// length-prefixed, for each of the 256 entries.
+fn encode_materials(palette: &Palette) -> Vec<u8> {
+    let mut out = Vec::new();
+    for material in &palette.materials {
+        let kind = MaterialKind::ALL.iter().position(|k| *k == material.kind).unwrap_or(0);
+        out.push(kind as u8);
+        out.extend((material.params.len() as u32).to_le_bytes());
+        for (key, value) in &material.params {
+            for text in [key, value] {
+                out.extend((text.len() as u32).to_le_bytes());
+                out.extend(text.as_bytes());
+            }
+        }
+    }
+    out
+}
+
+/// Reads an .ovx file.
+///
+/// # Errors
+/// A distinct [`OvxError`] for a missing file, a wrong magic or version, a
+/// cut file, a bad checksum, a pool that is not a tree, or one past the
+/// memory budget; nothing is built then.
+pub fn load_ovx(path: &Path) -> Result<Scene, OvxError> {
+    let read_error = |source| OvxError::Read { path: path.to_path_buf(), source };
+    let bytes = super::input::read_limited(path, MAX_FILE_BYTES).map_err(|e| match e {
+        super::input::InputError::Io(source) => read_error(source),
+        other => read_error(io::Error::new(io::ErrorKind::InvalidInput, other.to_string())),
+    })?;
+    decode_ovx(&bytes)
+}
+
+/// Decodes the bytes of an .ovx file (see [`load_ovx`]).
+///
+/// # Errors
+/// As [`load_ovx`].
+pub fn decode_ovx(bytes: &[u8]) -> Result<Scene, OvxError> {
+    let found = bytes.len() as u64;
+    if found < 12 || bytes[..8] != MAGIC {
+        return Err(if found < 8 && MAGIC.starts_with(bytes) {
+            OvxError::Truncated { found, expected: HEADER_BYTES + FOOTER_BYTES }
+        } else {
+            OvxError::NotOvx
+        });
+    }
+    let word = |at: usize| u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]);
+    if word(8) != VERSION {
+        return Err(OvxError::UnsupportedVersion(word(8)));
+    }
+    if found < HEADER_BYTES + FOOTER_BYTES {
+        return Err(OvxError::Truncated { found, expected: HEADER_BYTES + FOOTER_BYTES });
+    }
+    let long = |at: usize| u64::from(word(at)) | u64::from(word(at + 4)) << 32;
+    let (expected, payload_len) = (long(16), long(24));
+    if found < expected {
+        return Err(OvxError::Truncated { found, expected });
+    }
+    if found > expected {
+        return Err(corrupt(format!("{found} bytes where the header says {expected}")));
+    }
+    let body = &bytes[..bytes.len() - FOOTER_BYTES as usize];
+    let stored = word(body.len());
+    let computed = crc32fast::hash(body);
+    if stored != computed {
+        return Err(OvxError::BadChecksum { stored, computed });
+    }
+    crate::budget::check(|| format!("an .ovx pool of {payload_len} bytes"), payload_len)?;
+    let mut decoder = zstd::Decoder::new(&body[HEADER_BYTES as usize..])
+        .map_err(|e| corrupt(format!("zstd: {e}")))?
+        .take(payload_len);
+    let scene = read_payload(&mut decoder, payload_len)?;
+    if decoder.limit() != 0 {
+        return Err(corrupt(format!("{} payload bytes left unread", decoder.limit())));
+    }
+    Ok(scene)
+}
+
+fn read_payload(input: &mut impl Read, payload_len: u64) -> Result<Scene, OvxError> {
+    let mut read = |n: usize| -> Result<Vec<u8>, OvxError> {
+        let mut buf = vec![0u8; n];
+        input.read_exact(&mut buf).map_err(|e| corrupt(format!("the payload ends early ({e})")))?;
+        Ok(buf)
+    };
+    let fixed = read(FIXED_PAYLOAD_BYTES as usize)?;
+    let word = |at: usize| u32::from_le_bytes([fixed[at], fixed[at + 1], fixed[at + 2], fixed[at + 3]]);
+    let long = |at: usize| u64::from(word(at)) | u64::from(word(at + 4)) << 32;
+    let origin = IVec3::new(word(0) as i32, word(4) as i32, word(8) as i32);
+    let (depth, root, node_count, brick_count) = (word(12), word(16), long(20), long(28));
+    if !(MIN_DEPTH..=MAX_DEPTH).contains(&depth) {
+        return Err(corrupt(format!("root depth {depth} is outside {MIN_DEPTH}..={MAX_DEPTH}")));
+    }
+    let arrays = node_count.checked_mul(NODE_BYTES).zip(brick_count.checked_mul(8));
+    let Some(materials_len) =
+        arrays.and_then(|(n, b)| payload_len.checked_sub(FIXED_PAYLOAD_BYTES)?.checked_sub(n)?.checked_sub(b))
+    else {
+        return Err(corrupt(format!("{node_count} nodes and {brick_count} bricks do not fit its {payload_len} bytes")));
+    };
+    let mut palette = Palette::default();
+    palette.colors = bytemuck::pod_read_unaligned(&fixed[36..36 + 256 * 4]);
+    let nodes: Vec<NodeSlot> = read(node_count as usize * NODE_BYTES as usize)?
+        .chunks_exact(NODE_BYTES as usize)
+        .map(bytemuck::pod_read_unaligned)
+        .collect();
+    let bricks: Vec<Brick> =
+        read(brick_count as usize * 8)?.chunks_exact(8).map(bytemuck::pod_read_unaligned).collect();
+    palette.materials = decode_materials(&read(materials_len as usize)?)?;
+    let tree = Octree::from_parts(origin, depth, root, nodes, bricks).map_err(corrupt)?;
+    Ok(Scene { palette, tree })
+}
+
+fn decode_materials(bytes: &[u8]) -> Result<Vec<Material>, OvxError> {
+    let mut at = 0usize;
+    let mut take = |n: usize| -> Result<&[u8], OvxError> {
+        let part = bytes.get(at..at.saturating_add(n)).ok_or_else(|| corrupt("the materials end early"))?;
+        at += n;
+        Ok(part)
+    };
+    let mut materials = Vec::with_capacity(256);
+    for index in 0..256 {
+        let kind = take(1)?[0];
+        let kind = *MaterialKind::ALL.get(usize::from(kind)).ok_or_else(|| corrupt(format!("material {index} has kind {kind}")))?;
+        let mut material = Material::new(kind);
+        let count = u32::from_le_bytes(take(4)?.try_into().unwrap_or_default());
+        for _ in 0..count {
+            let mut text = || -> Result<String, OvxError> {
+                let len = u32::from_le_bytes(take(4)?.try_into().unwrap_or_default()) as usize;
+                String::from_utf8(take(len)?.to_vec()).map_err(|_| corrupt(format!("material {index}: text is not UTF-8")))
+            };
+            let key = text()?;
+            material.params.insert(key, text()?);
+        }
+        materials.push(material);
+    }
+    Ok(materials)
+}
+
+/// CRC-32 of the first `len` bytes read from `input`.
+fn crc_of(input: &mut impl Read, len: u64) -> io::Result<u32> {
+    let mut hasher = crc32fast::Hasher::new();
+    let mut limited = input.take(len);
+    let mut buf = vec![0u8; 1 << 16];
+    loop {
+        let n = limited.read(&mut buf)?;
+        if n == 0 {
+            return Ok(hasher.finalize());
+        }
+        hasher.update(&buf[..n]);
+    }
+}
+
+/// A writer that counts the bytes that pass through it.
+struct Counting<W: Write> {
+    inner: W,
+    written: u64,
+}
+
+impl<W: Write> Counting<W> {
+    fn new(inner: W) -> Self {
+        Counting { inner, written: 0 }
+    }
+}
+
+impl<'a> Counting<io::BufWriter<&'a mut std::fs::File>> {
+    fn into_inner(self) -> io::Result<&'a mut std::fs::File> {
+        self.inner.into_inner().map_err(|e| e.into_error())
+    }
+}
+
+impl<W: Write> Write for Counting<W> {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        let n = self.inner.write(buf)?;
+        self.written += n as u64;
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.inner.flush()
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use crate::scene::{Op, Shape};
+
+    /// The showroom (materials of every kind) with an edit and its undo
+    /// behind it, so the pool has free slots to compact away.
+    fn scene() -> Scene {
+        let mut scene = crate::scene::demo::BuiltIn::Showroom.scene();
+        let patch = scene.tree.apply_brush(&Shape::Sphere { center: IVec3::new(3, 9, 4), radius: 6 }, Op::Remove).unwrap();
+        scene.tree.apply_patch(&patch).unwrap();
+        scene
+    }
+
+    fn saved(scene: &Scene) -> Vec<u8> {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("scene.ovx");
+        save_ovx(&path, scene, WriteOptions::default()).unwrap();
+        std::fs::read(path).unwrap()
+    }
+
+    #[test]
+    fn a_scene_comes_back_as_it_was() {
+        let scene = scene();
+        let loaded = decode_ovx(&saved(&scene)).unwrap();
+        assert_eq!(loaded.tree.voxels(), scene.tree.voxels());
+        assert_eq!(loaded.palette, scene.palette);
+        assert_eq!((loaded.tree.origin(), loaded.tree.depth()), (scene.tree.origin(), scene.tree.depth()));
+        assert_eq!(loaded.tree.counts(), scene.tree.counts());
+        assert_eq!(loaded.tree.node_count(), scene.tree.node_count());
+        assert_eq!(loaded.tree.pool().nodes.len(), scene.tree.node_count(), "no free slots stored");
+        loaded.tree.check_invariants().unwrap();
+        let empty = decode_ovx(&saved(&Scene::default())).unwrap();
+        assert_eq!(empty.tree.solid_voxels(), 0);
+    }
+
+    #[test]
+    fn each_kind_of_damage_has_its_own_message() {
+        let bytes = saved(&scene());
+        let message = |b: &[u8]| decode_ovx(b).err().unwrap().to_string();
+        assert!(message(&bytes[..bytes.len() - 10]).contains("truncated"), "{}", message(&bytes[..bytes.len() - 10]));
+        assert!(message(&bytes[..20]).contains("truncated"));
+        assert!(message(&bytes[..5]).contains("truncated"));
+        let mut version = bytes.clone();
+        version[8] = 9;
+        assert!(message(&version).contains("unsupported .ovx version 9"));
+        let mut flipped = bytes.clone();
+        let middle = bytes.len() / 2;
+        flipped[middle] ^= 0x40;
+        assert!(message(&flipped).contains("checksum mismatch"));
+        assert!(message(b"VOX \x96\0\0\0 and so on").contains("not an .ovx file"));
+        let mut longer = bytes.clone();
+        longer.push(0);
+        assert!(message(&longer).contains("corrupted"));
+    }
+
+    #[test]
+    fn a_pool_that_is_not_a_tree_is_refused() {
+        let slot = |children: [u32; 8]| NodeSlot { children, lod: 0 };
+        let shared = vec![slot([pointer_to(1), pointer_to(1), 0, 0, 0, 0, 0, 0]), slot([1, 2, 0, 0, 0, 0, 0, 0])];
+        assert!(Octree::from_parts(IVec3::ZERO, 3, pointer_to(0), shared, Vec::new()).unwrap_err().contains("twice"));
+        let cycle = vec![slot([pointer_to(0), 1, 0, 0, 0, 0, 0, 0])];
+        assert!(Octree::from_parts(IVec3::ZERO, 4, pointer_to(0), cycle, Vec::new()).unwrap_err().contains("twice"));
+        let past = vec![slot([pointer_to(7), 1, 0, 0, 0, 0, 0, 0])];
+        assert!(Octree::from_parts(IVec3::ZERO, 3, pointer_to(0), past, Vec::new()).unwrap_err().contains("past"));
+        let stale = vec![slot([1, 2, 0, 0, 0, 0, 0, 0])];
+        assert!(Octree::from_parts(IVec3::ZERO, 3, pointer_to(0), stale, Vec::new()).unwrap_err().contains("summary"));
+    }
+}
