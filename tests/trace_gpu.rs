@@ -68,8 +68,8 @@ fn gpu_matches_cpu_on_sculpture() {
 #[test]
 fn gpu_matches_cpu_on_a_voxelized_scan() {
     let path = common::assets().join("meshes/nefertiti.obj");
-    let dense = voxelize_obj(&path, 96, UpAxis::Z, MESH_COLOR).unwrap();
-    let mut scene = Scene::from_dense(&dense).unwrap();
+    let tree = voxelize_obj(&path, 96, UpAxis::Z, MESH_COLOR).unwrap();
+    let mut scene = Scene { palette: Palette::default(), tree };
     let (lo, hi) = scene.tree.solid_bounds().unwrap();
     check_scene(&mut scene.tree, &cameras_for(lo, hi), (96, 72));
 }
@@ -282,8 +282,8 @@ fn frame_times_stay_plausible_after_path_traced_frames() {
 #[test]
 fn gpu_level_of_detail_matches_cpu() {
     let path = common::assets().join("meshes/nefertiti.obj");
-    let dense = voxelize_obj(&path, 96, UpAxis::Z, MESH_COLOR).unwrap();
-    let mut scene = Scene::from_dense(&dense).unwrap();
+    let tree = voxelize_obj(&path, 96, UpAxis::Z, MESH_COLOR).unwrap();
+    let mut scene = Scene { palette: Palette::default(), tree };
     scene.tree.apply_brush(&Shape::Sphere { center: IVec3::new(40, 60, 40), radius: 12 }, Op::Paint(9)).unwrap();
     let (lo, hi) = scene.tree.solid_bounds().unwrap();
     let size = (96, 72);

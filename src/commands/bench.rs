@@ -12,7 +12,7 @@ use serde::Serialize;
 use crate::cli::{BenchArgs, BenchKind};
 use octovox::camera::Camera;
 use octovox::gpu::Renderer;
-use octovox::io::mesh::{DenseVoxels, MESH_COLOR, UpAxis, voxelize_obj};
+use octovox::io::mesh::{DenseVoxels, MESH_COLOR, UpAxis, load_obj_triangles, voxelize_dense};
 use octovox::scene::{Octree, Op, Palette, Scene, Shape, sculpture};
 use octovox::settings::{RenderSettings, TraceMode, View};
 use octovox::trace::grid::DenseGrid;
@@ -49,7 +49,8 @@ fn source(model: &Model) -> anyhow::Result<Source> {
         "sculpture10M" => Source::Dense(DenseVoxels { dims: sculpture::DIMS, data: sculpture::sculpture_dense() }),
         "nefertiti512" => {
             let path = assets().join("meshes/nefertiti.obj");
-            Source::Dense(voxelize_obj(&path, 512, UpAxis::Z, MESH_COLOR)?)
+            // The dense block, so that the build row times `from_dense` as before.
+            Source::Dense(voxelize_dense(&load_obj_triangles(&path, UpAxis::Z)?, 512, MESH_COLOR))
         }
         name => {
             let path = assets().join(format!("vox/seed/{name}.vox"));

@@ -1,5 +1,5 @@
 //! `octovox import MESH.obj -o OUT.vox [--size N] [--up y|z] [--color I]`:
-//! voxelize a closed mesh, solid inside, and save it as .vox.
+//! voxelize a closed mesh, solid inside, and save it as .vox or .ovx.
 
 use std::process::ExitCode;
 use std::time::Instant;
@@ -8,20 +8,22 @@ use anyhow::Context;
 use octovox::io::atomic::WriteOptions;
 use octovox::io::mesh::voxelize_obj;
 use octovox::io::output::{OutputKind, check_output};
-use octovox::scene::Scene;
+use glam::IVec3;
+use octovox::scene::{Palette, Scene};
 
 use crate::cli::ImportArgs;
 
 pub fn run(args: &ImportArgs) -> anyhow::Result<ExitCode> {
     check_output(&args.output, OutputKind::Scene, &[&args.mesh], args.force)?;
     let start = Instant::now();
-    let dense = voxelize_obj(&args.mesh, args.size, args.up, args.color)?;
+    let tree = voxelize_obj(&args.mesh, args.size, args.up, args.color)?;
     let voxelized = start.elapsed();
-    let scene = Scene::from_dense(&dense).with_context(|| format!("building {}", args.mesh.display()))?;
+    let (lo, hi) = tree.solid_bounds().unwrap_or_default();
+    let d = hi - lo + IVec3::ONE;
+    let scene = Scene { palette: Palette::default(), tree };
     let options = WriteOptions { overwrite_read_only: args.force };
     octovox::io::save_scene(&args.output, &scene, options)
         .with_context(|| format!("saving {}", args.output.display()))?;
-    let d = dense.dims;
     say!(
         "{}: {} solid voxels in {}×{}×{} (voxelized in {:.2} s), wrote {}",
         args.mesh.display(),

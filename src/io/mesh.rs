@@ -11,13 +11,17 @@
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
-use glam::{UVec3, Vec2, Vec3};
+use glam::{IVec3, UVec3, Vec2, Vec3};
 use rayon::prelude::*;
+
+use crate::scene::build::{BLOCK_LEVEL, Block, BlockBuilder, VoxelSource};
+use crate::scene::{BuildError, Octree};
 
 /// Longest side of an imported mesh when no size is asked for.
 pub const DEFAULT_MESH_SIZE: u32 = 256;
-/// Largest `size`: at most 1024³ bytes of dense voxels.
-pub const MAX_MESH_SIZE: u32 = 1024;
+/// Largest `size`. The voxelizer streams tiles of columns, so memory
+/// follows the surface; the memory budget has the last word.
+pub const MAX_MESH_SIZE: u32 = 8192;
 /// Palette index of imported meshes (white in the default palette).
 pub const MESH_COLOR: u8 = 1;
 /// Largest .obj file read.
@@ -51,6 +55,8 @@ pub enum MeshError {
     NothingInside { path: PathBuf, size: u32 },
     #[error("voxel size {0} is outside 1..={MAX_MESH_SIZE}")]
     Size(u32),
+    #[error("{}: {source}", path.display())]
+    Build { path: PathBuf, source: BuildError },
 }
 
 /// A dense block of voxels, indexed `x + dims.x * (y + dims.y * z)` (the
@@ -174,9 +180,9 @@ fn largest_vertex(bytes: &[u8]) -> (usize, String) {
     (line, reason)
 }
 
-/// Loads and voxelizes an .obj file: the longest side becomes `size` voxels,
-/// all of palette index `color`.
-pub fn voxelize_obj(path: &Path, size: u32, up: UpAxis, color: u8) -> Result<DenseVoxels, MeshError> {
+/// Loads and voxelizes an .obj file into an octree, streaming: the longest
+/// side becomes `size` voxels, all of palette index `color`.
+pub fn voxelize_obj(path: &Path, size: u32, up: UpAxis, color: u8) -> Result<Octree, MeshError> {
     if !(1..=MAX_MESH_SIZE).contains(&size) {
         return Err(MeshError::Size(size));
     }
@@ -186,11 +192,11 @@ pub fn voxelize_obj(path: &Path, size: u32, up: UpAxis, color: u8) -> Result<Den
         voxelize_bytes(&triangles, size),
     )
     .map_err(|source| MeshError::OverBudget { path: path.to_path_buf(), source })?;
-    let dense = voxelize(&triangles, size, color);
-    if dense.solid_count() == 0 {
+    let tree = voxelize(&triangles, size, color).map_err(|e| MeshError::Build { path: path.to_path_buf(), source: e })?;
+    if tree.solid_voxels() == 0 {
         return Err(MeshError::NothingInside { path: path.to_path_buf(), size });
     }
-    Ok(dense)
+    Ok(tree)
 }
 
 /// The min and max corners of the triangles' vertices.
@@ -200,89 +206,272 @@ fn bounds(triangles: &[[Vec3; 3]]) -> (Vec3, Vec3) {
     (lo, hi)
 }
 
-/// The scale and the block size in voxels of `triangles` at `size`.
-fn placement(triangles: &[[Vec3; 3]], size: u32) -> (Vec3, f32, UVec3) {
+/// Where the voxels go: the mesh's min corner, voxels per mesh unit, and
+/// the block size in voxels.
+#[derive(Clone, Copy)]
+struct Placement {
+    lo: Vec3,
+    scale: f32,
+    dims: UVec3,
+}
+
+fn placement(triangles: &[[Vec3; 3]], size: u32) -> Placement {
     let (lo, hi) = bounds(triangles);
     let scale = size as f32 / (hi - lo).max_element().max(f32::MIN_POSITIVE);
     let dims = ((hi - lo) * scale).ceil().as_uvec3().clamp(UVec3::ONE, UVec3::splat(size));
-    (lo, scale, dims)
+    Placement { lo, scale, dims }
 }
 
-/// Peak memory of [`voxelize`]: the dense block (twice, for the octree
-/// built from it), the column lists, and at most one crossing per column
-/// under each triangle's footprint.
+/// Peak memory of [`voxelize`] beyond the pool it builds: the triangles'
+/// tile lists, and per thread one tile of columns (its dense bytes and its
+/// crossings, at most one per column under each triangle's footprint), plus
+/// the pool itself, estimated from the crossings (each a surface voxel, at
+/// most 24 bytes of bricks and nodes apiece).
 pub fn voxelize_bytes(triangles: &[[Vec3; 3]], size: u32) -> u64 {
-    let (lo, scale, dims) = placement(triangles, size);
-    let columns = u64::from(dims.x) * u64::from(dims.z);
+    let place = placement(triangles, size);
     let crossings: u64 = triangles
         .iter()
         .map(|t| {
-            let [a, b, c] = t.map(|p| (p - lo) * scale);
+            let [a, b, c] = t.map(|p| (p - place.lo) * place.scale);
             let span = |u: f32, v: f32, w: f32| (u.max(v).max(w).ceil() - u.min(v).min(w).floor()) as u64 + 1;
             span(a.x, b.x, c.x) * span(a.z, b.z, c.z)
         })
         .sum();
-    2 * u64::from(dims.x) * u64::from(dims.y) * u64::from(dims.z)
-        + columns * std::mem::size_of::<Vec<f32>>() as u64
-        // A list that grows by doubling may hold twice what it uses.
-        + crossings * 8
+    let tile = u64::from(TILE) * u64::from(TILE) * u64::from(place.dims.y);
+    let threads = rayon::current_num_threads() as u64;
+    triangles.len() as u64 * 16 + threads * (tile + tile / 8) + crossings * 24
 }
 
-/// Fills the inside of `triangles` (see the module comment). `size` must be
+/// Columns per side of a tile: the cubes of one tile share its columns.
+const TILE: u32 = 1 << BLOCK_LEVEL;
+
+/// Fills the inside of `triangles` (see the module comment) into an octree,
+/// one tile of TILE × TILE columns at a time (both cores), so that memory
+/// follows the surface and the pool rather than the volume. `size` must be
 /// at least 1; `triangles` must not be empty.
-pub fn voxelize(triangles: &[[Vec3; 3]], size: u32, color: u8) -> DenseVoxels {
-    let (lo, scale, dims) = placement(triangles, size);
-    let mut columns = crossings(triangles, lo, scale, dims);
-    columns.par_iter_mut().for_each(|ys| ys.sort_by(f32::total_cmp));
-    let mut data = vec![0u8; dims.x as usize * dims.y as usize * dims.z as usize];
-    let plane = dims.x as usize * dims.y as usize;
-    // One z slice per task: each owns its part of `data`.
-    data.par_chunks_mut(plane).enumerate().for_each(|(z, slice)| {
-        for x in 0..dims.x as usize {
-            for pair in columns[z * dims.x as usize + x].chunks_exact(2) {
-                // Voxels whose centre y + 0.5 lies in [pair[0], pair[1]).
-                let first = (pair[0] - 0.5).ceil().max(0.0) as usize;
-                let end = ((pair[1] - 0.5).ceil().max(0.0) as usize).min(dims.y as usize);
-                for y in first..end {
-                    slice[x + dims.x as usize * y] = color;
-                }
-            }
+///
+/// # Errors
+/// A mesh wider than the largest octree.
+pub fn voxelize(triangles: &[[Vec3; 3]], size: u32, color: u8) -> Result<Octree, BuildError> {
+    let place = placement(triangles, size);
+    let mut builder = BlockBuilder::new(IVec3::ZERO, place.dims)?;
+    let block_level = builder.block_level;
+    let tiles = (place.dims - UVec3::ONE) / (1 << block_level) + UVec3::ONE;
+    let bins = bin_triangles(triangles, place, block_level, tiles);
+    // A few tiles per thread at a time: their cubes go into the tree before
+    // the next ones are filled.
+    let batch = 4 * rayon::current_num_threads();
+    let all: Vec<(u32, u32)> = (0..tiles.z).flat_map(|z| (0..tiles.x).map(move |x| (x, z))).collect();
+    for chunk in all.chunks(batch) {
+        let built: Vec<Vec<(UVec3, Block)>> = chunk
+            .par_iter()
+            .map(|&(tx, tz)| {
+                let which = &bins[(tz * tiles.x + tx) as usize];
+                Columns::of_tile(triangles, which, place, (tx, tz), block_level, color).blocks(tiles.y, block_level)
+            })
+            .collect();
+        for (coord, block) in built.into_iter().flatten() {
+            builder.add(coord, block);
         }
-    });
-    DenseVoxels { dims, data }
+    }
+    Ok(builder.finish())
 }
 
-/// For every column (x, z) of voxel centres, the heights (in voxels) at
-/// which it crosses a triangle.
-fn crossings(triangles: &[[Vec3; 3]], lo: Vec3, scale: f32, dims: UVec3) -> Vec<Vec<f32>> {
-    let mut columns = vec![Vec::new(); dims.x as usize * dims.z as usize];
-    // Sample slightly off the centre so that no sample lies exactly on a
-    // shared edge or vertex, where it would count for two triangles or none.
-    let jitter = Vec2::new(0.5 + 1.37e-3, 0.5 + 2.91e-3);
-    for triangle in triangles {
-        let [a, b, c] = triangle.map(|p| (p - lo) * scale);
-        let (a2, b2, c2) = (Vec2::new(a.x, a.z), Vec2::new(b.x, b.z), Vec2::new(c.x, c.z));
-        let area = cross(b2 - a2, c2 - a2);
-        if area == 0.0 {
-            continue; // edge-on: no column crosses it
-        }
-        let min = a2.min(b2).min(c2) - jitter;
-        let max = a2.max(b2).max(c2) - jitter;
-        let x_range = (min.x.ceil().max(0.0) as u32)..=(max.x.floor().min(dims.x as f32 - 1.0) as u32);
-        let z_range = (min.y.ceil().max(0.0) as u32)..=(max.y.floor().min(dims.z as f32 - 1.0) as u32);
-        for z in z_range {
-            for x in x_range.clone() {
-                let p = Vec2::new(x as f32, z as f32) + jitter;
-                // Barycentric weights; all of one sign when p is inside.
-                let (wa, wb, wc) =
-                    (cross(b2 - p, c2 - p) / area, cross(c2 - p, a2 - p) / area, cross(a2 - p, b2 - p) / area);
-                if wa >= 0.0 && wb >= 0.0 && wc >= 0.0 {
-                    columns[z as usize * dims.x as usize + x as usize].push(wa * a.y + wb * b.y + wc * c.y);
-                }
+/// The dense reference of [`voxelize`]: the same columns over the whole
+/// block at once (tests compare the two).
+pub fn voxelize_dense(triangles: &[[Vec3; 3]], size: u32, color: u8) -> DenseVoxels {
+    let place = placement(triangles, size);
+    let all: Vec<u32> = (0..triangles.len() as u32).collect();
+    let columns = Columns::of(triangles, &all, place, ((0, 0), (place.dims.x, place.dims.z)), color);
+    DenseVoxels { dims: place.dims, data: columns.fill() }
+}
+
+/// For each tile of columns, the triangles whose footprint reaches it, in
+/// mesh order (so each column sees its crossings in the same order as a
+/// whole-block pass would).
+fn bin_triangles(triangles: &[[Vec3; 3]], place: Placement, block_level: u32, tiles: UVec3) -> Vec<Vec<u32>> {
+    let mut bins = vec![Vec::new(); (tiles.x * tiles.z) as usize];
+    for (i, triangle) in triangles.iter().enumerate() {
+        let Some((xs, zs)) = column_ranges(triangle, place) else { continue };
+        for tz in (zs.start() >> block_level)..=(zs.end() >> block_level) {
+            for tx in (xs.start() >> block_level)..=(xs.end() >> block_level) {
+                bins[(tz * tiles.x + tx) as usize].push(i as u32);
             }
         }
     }
-    columns
+    bins
+}
+
+/// Sample slightly off the column centre so that no sample lies exactly on
+/// a shared edge or vertex, where it would count for two triangles or none.
+const JITTER: Vec2 = Vec2::new(0.5 + 1.37e-3, 0.5 + 2.91e-3);
+
+/// The triangle in voxel units, and its 2D (x, z) area; `None` edge-on.
+fn projected(triangle: &[Vec3; 3], place: Placement) -> Option<([Vec3; 3], f32)> {
+    let [a, b, c] = triangle.map(|p| (p - place.lo) * place.scale);
+    let area = cross(Vec2::new(b.x - a.x, b.z - a.z), Vec2::new(c.x - a.x, c.z - a.z));
+    (area != 0.0).then_some(([a, b, c], area))
+}
+
+/// The columns (x and z ranges) under a triangle's footprint, or `None`
+/// when no column centre can cross it.
+fn column_ranges(
+    triangle: &[Vec3; 3],
+    place: Placement,
+) -> Option<(std::ops::RangeInclusive<u32>, std::ops::RangeInclusive<u32>)> {
+    let ([a, b, c], _) = projected(triangle, place)?;
+    let min = Vec2::new(a.x.min(b.x).min(c.x), a.z.min(b.z).min(c.z)) - JITTER;
+    let max = Vec2::new(a.x.max(b.x).max(c.x), a.z.max(b.z).max(c.z)) - JITTER;
+    let (x0, x1) = (min.x.ceil().max(0.0), max.x.floor().min(place.dims.x as f32 - 1.0));
+    let (z0, z1) = (min.y.ceil().max(0.0), max.y.floor().min(place.dims.z as f32 - 1.0));
+    (x0 <= x1 && z0 <= z1).then(|| ((x0 as u32)..=(x1 as u32), (z0 as u32)..=(z1 as u32)))
+}
+
+/// A rectangle of columns as solid runs: for each column (x, z), the y
+/// ranges of voxels inside, in order. Both voxelizers fill from these.
+struct Columns {
+    /// First column (x, z) and the rectangle's size in columns.
+    min: (u32, u32),
+    size: (u32, u32),
+    height: u32,
+    color: u8,
+    runs: Vec<Vec<std::ops::Range<u32>>>,
+}
+
+impl Columns {
+    /// The columns of tile (tx, tz).
+    fn of_tile(triangles: &[[Vec3; 3]], which: &[u32], place: Placement, tile: (u32, u32), level: u32, color: u8) -> Columns {
+        let min = (tile.0 << level, tile.1 << level);
+        let size = ((place.dims.x - min.0).min(1 << level), (place.dims.z - min.1).min(1 << level));
+        Columns::of(triangles, which, place, (min, size), color)
+    }
+
+    /// For every column (x, z) of voxel centres in the rectangle, the
+    /// heights (in voxels) at which it crosses one of the `which` triangles,
+    /// sorted; the voxels whose centre y + 0.5 lies between the 1st and 2nd,
+    /// 3rd and 4th, … are inside (even-odd).
+    fn of(
+        triangles: &[[Vec3; 3]],
+        which: &[u32],
+        place: Placement,
+        (min, size): ((u32, u32), (u32, u32)),
+        color: u8,
+    ) -> Columns {
+        let mut heights = vec![Vec::new(); size.0 as usize * size.1 as usize];
+        for &i in which {
+            let triangle = &triangles[i as usize];
+            let (Some(([a, b, c], area)), Some((xs, zs))) = (projected(triangle, place), column_ranges(triangle, place))
+            else {
+                continue;
+            };
+            let (a2, b2, c2) = (Vec2::new(a.x, a.z), Vec2::new(b.x, b.z), Vec2::new(c.x, c.z));
+            let (x0, x1) = ((*xs.start()).max(min.0), (*xs.end()).min(min.0 + size.0 - 1));
+            let (z0, z1) = ((*zs.start()).max(min.1), (*zs.end()).min(min.1 + size.1 - 1));
+            for z in z0..=z1 {
+                for x in x0..=x1 {
+                    let p = Vec2::new(x as f32, z as f32) + JITTER;
+                    // Barycentric weights; all of one sign when p is inside.
+                    let (wa, wb, wc) =
+                        (cross(b2 - p, c2 - p) / area, cross(c2 - p, a2 - p) / area, cross(a2 - p, b2 - p) / area);
+                    if wa >= 0.0 && wb >= 0.0 && wc >= 0.0 {
+                        let column = (z - min.1) as usize * size.0 as usize + (x - min.0) as usize;
+                        heights[column].push(wa * a.y + wb * b.y + wc * c.y);
+                    }
+                }
+            }
+        }
+        let height = place.dims.y;
+        let runs = heights
+            .into_par_iter()
+            .map(|mut ys| {
+                ys.sort_by(f32::total_cmp);
+                let mut runs: Vec<std::ops::Range<u32>> = Vec::new();
+                for pair in ys.chunks_exact(2) {
+                    let first = ((pair[0] - 0.5).ceil().max(0.0) as u32).min(height);
+                    let end = ((pair[1] - 0.5).ceil().max(0.0) as u32).min(height);
+                    match runs.last_mut() {
+                        // Touching runs are one (a run's cover test needs it).
+                        Some(last) if last.end >= first => last.end = last.end.max(end),
+                        _ if first < end => runs.push(first..end),
+                        _ => {}
+                    }
+                }
+                runs
+            })
+            .collect();
+        Columns { min, size, height, color, runs }
+    }
+
+    fn column(&self, x: i32, z: i32) -> Option<&[std::ops::Range<u32>]> {
+        let inside = x >= 0 && z >= 0 && (x as u32) < self.size.0 && (z as u32) < self.size.1;
+        inside.then(|| self.runs[z as usize * self.size.0 as usize + x as usize].as_slice())
+    }
+
+    /// The rectangle as dense voxels, indexed `x + w * (y + height * z)`.
+    fn fill(&self) -> Vec<u8> {
+        let (w, d) = (self.size.0 as usize, self.size.1 as usize);
+        let plane = w * self.height as usize;
+        let mut data = vec![0u8; plane * d];
+        data.par_chunks_mut(plane).enumerate().for_each(|(z, slice)| {
+            for x in 0..w {
+                for run in &self.runs[z * w + x] {
+                    for y in run.clone() {
+                        slice[x + w * y as usize] = self.color;
+                    }
+                }
+            }
+        });
+        data
+    }
+
+    /// The tile's column of cubes, each with its cube coordinate.
+    fn blocks(&self, cubes: u32, level: u32) -> Vec<(UVec3, Block)> {
+        let tile = UVec3::new(self.min.0 >> level, 0, self.min.1 >> level);
+        (0..cubes).map(|y| (tile + UVec3::Y * y, BlockBuilder::build_block(self, UVec3::Y * y, level))).collect()
+    }
+}
+
+/// How a column meets the heights `lo..hi`.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Cover {
+    Empty,
+    Full,
+    Part,
+}
+
+fn cover(runs: &[std::ops::Range<u32>], lo: u32, hi: u32) -> Cover {
+    // The first run that ends above lo.
+    let i = runs.partition_point(|r| r.end <= lo);
+    match runs.get(i) {
+        Some(r) if r.start <= lo && r.end >= hi => Cover::Full,
+        Some(r) if r.start < hi => Cover::Part,
+        _ => Cover::Empty,
+    }
+}
+
+impl VoxelSource for Columns {
+    fn at(&self, p: IVec3) -> u8 {
+        let Some(runs) = self.column(p.x, p.z) else { return 0 };
+        let y = p.y as u32;
+        if p.y >= 0 && cover(runs, y, y + 1) == Cover::Full { self.color } else { 0 }
+    }
+
+    /// Uniform when every column of the cube is wholly inside or wholly
+    /// outside it: a look at each column's runs, no voxel visited.
+    fn uniform(&self, min: IVec3, size: i32) -> Option<u8> {
+        let (lo, hi) = (min.y.max(0) as u32, (min.y + size).max(0) as u32);
+        let mut seen: Option<Cover> = None;
+        for z in min.z..min.z + size {
+            for x in min.x..min.x + size {
+                let here = self.column(x, z).map_or(Cover::Empty, |runs| cover(runs, lo, hi));
+                if here == Cover::Part || seen.is_some_and(|s| s != here) {
+                    return None;
+                }
+                seen = Some(here);
+            }
+        }
+        Some(if seen == Some(Cover::Full) { self.color } else { 0 })
+    }
 }
 
 fn cross(u: Vec2, v: Vec2) -> f32 {

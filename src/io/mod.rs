@@ -37,8 +37,8 @@ pub fn load_scene(path: &Path, frame: usize) -> Result<Scene, LoadError> {
         return ovx::load_ovx(path).map_err(|source| LoadError::Ovx { path: path.to_path_buf(), source });
     }
     if is_mesh_path(path) {
-        let dense = mesh::voxelize_obj(path, mesh::DEFAULT_MESH_SIZE, mesh::UpAxis::Y, mesh::MESH_COLOR)?;
-        return Scene::from_dense(&dense).map_err(build_error);
+        let tree = mesh::voxelize_obj(path, mesh::DEFAULT_MESH_SIZE, mesh::UpAxis::Y, mesh::MESH_COLOR)?;
+        return Ok(Scene { palette: crate::scene::Palette::default(), tree });
     }
     let model = vox::load_vox_file(path, frame)?;
     for warning in &model.warnings {

@@ -1,5 +1,5 @@
 //! Building an octree in one pass: from a voxel list (Morton sort, then
-//! bottom-up) or from a dense array (octants built in parallel, then merged).
+//! bottom-up) or from dense data (cubes built in parallel, then assembled).
 
 use glam::{IVec3, UVec3};
 use rayon::prelude::*;
@@ -89,32 +89,22 @@ impl Octree {
     }
 
     /// Builds from a dense array indexed `x + dims.x * (y + dims.y * z)`
-    /// whose cell (0, 0, 0) sits at world `origin`. The root's eight octants
-    /// are built in parallel into local arenas, then merged.
+    /// whose cell (0, 0, 0) sits at world `origin`: cubes of
+    /// [`BLOCK_LEVEL`] built in parallel, then assembled.
     pub fn from_dense(dims: UVec3, origin: IVec3, data: &[u8]) -> Result<Octree, BuildError> {
         let needed = u64::from(dims.x) * u64::from(dims.y) * u64::from(dims.z);
         if data.len() as u64 != needed {
             return Err(BuildError::DenseSize { len: data.len(), dims, needed });
         }
-        let depth = depth_for(i64::from(dims.max_element()))?;
-        let mut tree = Octree::empty(origin, depth);
+        let mut builder = BlockBuilder::new(origin, dims)?;
         let grid = Dense { dims: dims.as_ivec3(), data };
-        let half = 1 << (depth - 1);
-        let parts: Vec<LocalArena> = (0..8)
-            .into_par_iter()
-            .map(|octant| {
-                let mut local = LocalArena::default();
-                local.root = local.build(&grid, octant_offset(octant) * half, depth - 1);
-                local
-            })
-            .collect();
-        let mut children: Node = [0; 8];
-        for (octant, part) in parts.into_iter().enumerate() {
-            tree.counts.add_counts(&part.counts);
-            children[octant] = tree.adopt(part);
+        let blocks = builder.blocks_in(dims);
+        let built: Vec<(UVec3, Block)> =
+            blocks.into_par_iter().map(|b| (b, BlockBuilder::build_block(&grid, b, builder.block_level))).collect();
+        for (coord, block) in built {
+            builder.add(coord, block);
         }
-        tree.root = tree.make_node(children, depth, None);
-        Ok(tree)
+        Ok(builder.finish())
     }
 
     /// Moves a local arena's slots into the pool, rewriting its pointers.
@@ -140,17 +130,94 @@ impl Octree {
     }
 }
 
+/// Level of the cubes a block build makes: 64³ voxels, 256 KiB of dense
+/// bytes per cube, small enough for a thread each and large enough that
+/// assembling them is a small part of the work.
+pub const BLOCK_LEVEL: u32 = 6;
+
+/// An octree assembled from cubes of 2^`block_level` voxels built
+/// separately (in parallel, in any order) from dense data: `from_dense`,
+/// and the streaming voxelizer, which fills one column of cubes at a time.
+pub struct BlockBuilder {
+    tree: Octree,
+    pub block_level: u32,
+    /// (Morton code of the cube, its word), non-empty cubes only.
+    words: Vec<(u64, u32)>,
+}
+
+/// One cube's subtree, not yet in the tree.
+pub struct Block(LocalArena);
+
+impl BlockBuilder {
+    /// A builder for a block of `dims` voxels with its min corner at `origin`.
+    ///
+    /// # Errors
+    /// [`BuildError::TooWide`] past the largest root.
+    pub fn new(origin: IVec3, dims: UVec3) -> Result<BlockBuilder, BuildError> {
+        let depth = depth_for(i64::from(dims.max_element()))?;
+        let tree = Octree::empty(origin, depth);
+        Ok(BlockBuilder { tree, block_level: BLOCK_LEVEL.min(depth), words: Vec::new() })
+    }
+
+    /// The cube coordinates covering `dims` voxels.
+    pub fn blocks_in(&self, dims: UVec3) -> Vec<UVec3> {
+        let n = (dims - UVec3::ONE) / (1 << self.block_level) + UVec3::ONE;
+        (0..n.z).flat_map(|z| (0..n.y).flat_map(move |y| (0..n.x).map(move |x| UVec3::new(x, y, z)))).collect()
+    }
+
+    /// Builds cube `coord` of `grid`, whose cell (0, 0, 0) is the cube
+    /// grid's origin.
+    pub fn build_block(grid: &impl VoxelSource, coord: UVec3, block_level: u32) -> Block {
+        let mut local = LocalArena::default();
+        local.root = local.build(grid, (coord << block_level).as_ivec3(), block_level);
+        Block(local)
+    }
+
+    /// Puts a built cube into the tree (each cube once).
+    pub fn add(&mut self, coord: UVec3, block: Block) {
+        self.tree.counts.add_counts(&block.0.counts);
+        let word = self.tree.adopt(block.0);
+        if word != 0 {
+            self.words.push((morton(coord), word));
+        }
+    }
+
+    /// Assembles the levels above the cubes.
+    pub fn finish(mut self) -> Octree {
+        self.words.sort_unstable_by_key(|w| w.0);
+        let mut level = std::mem::take(&mut self.words);
+        for node_level in self.block_level + 1..=self.tree.depth {
+            level = self.tree.build_level(&level, node_level);
+        }
+        self.tree.root = level.first().map_or(0, |l| l.1);
+        self.tree
+    }
+}
+
 /// Local-arena tag on brick pointers, so `adopt` can tell them from node pointers.
 const LOCAL_BRICK: u32 = 0x4000_0000;
+
+/// Voxels a block build reads: block coordinates from 0, empty past the data.
+pub trait VoxelSource: Sync {
+    /// The palette index at `p` (0 empty).
+    fn at(&self, p: IVec3) -> u8;
+    /// The value of the whole cube at `min`, `size` wide, when it is uniform
+    /// and cheap to tell; `None` to look inside.
+    fn uniform(&self, min: IVec3, size: i32) -> Option<u8>;
+}
 
 struct Dense<'a> {
     dims: IVec3,
     data: &'a [u8],
 }
 
-impl Dense<'_> {
+impl VoxelSource for Dense<'_> {
     fn at(&self, p: IVec3) -> u8 {
         if p.cmplt(self.dims).all() { self.data[(p.x + self.dims.x * (p.y + self.dims.y * p.z)) as usize] } else { 0 }
+    }
+
+    fn uniform(&self, min: IVec3, _size: i32) -> Option<u8> {
+        min.cmpge(self.dims).any().then_some(0)
     }
 }
 
@@ -163,9 +230,10 @@ struct LocalArena {
 }
 
 impl LocalArena {
-    fn build(&mut self, grid: &Dense, min: IVec3, level: u32) -> u32 {
-        if min.cmpge(grid.dims).any() {
-            return 0;
+    fn build(&mut self, grid: &impl VoxelSource, min: IVec3, level: u32) -> u32 {
+        if let Some(value) = grid.uniform(min, 1 << level) {
+            self.counts.add(value, 1 << (3 * level));
+            return u32::from(value);
         }
         if level == 1 {
             let values: Brick = std::array::from_fn(|o| grid.at(min + octant_offset(o)));
