@@ -13,6 +13,9 @@
 // Side of the square tile of pixels that shares one beam: set from
 // `BEAM_TILE` in src/gpu/trace_pass.rs, which also sizes the beam buffer.
 override BEAM_TILE: u32;
+// Level of detail compiled in (`--lod` above 0): without it the walk has no
+// footprint test at all, so an exact frame costs what it did before.
+override LOD: bool = false;
 // The beam stops at nodes this small (4³ voxels): finer levels cost more
 // prepass steps than they save.
 const BEAM_LEVEL: u32 = 2u;
@@ -123,7 +126,7 @@ fn trace_svo(r: Ray, t_min: f32, medium: u32, lod: vec2<f32>) -> Hit {
         let push = (word & POINTER_BIT) != 0u;
         // Only a node cell the ray newly enters (not an ancestor walked down
         // again after a restart) may stop it; bricks never do.
-        let stop = push && level >= 3u && level - 1u < known && below_footprint(lod, 1u << (level - 1u), t);
+        let stop = LOD && push && level >= 3u && level - 1u < known && below_footprint(lod, 1u << (level - 1u), t);
         if ((!push && word != medium) || stop) {
             value = word;
             summarized = select(0u, word, stop);
@@ -168,7 +171,7 @@ fn trace_svo(r: Ray, t_min: f32, medium: u32, lod: vec2<f32>) -> Hit {
         miss.iterations = iterations;
         return miss;
     }
-    if (summarized != 0u) {
+    if (LOD && summarized != 0u) {
         value = pool[(summarized & ~POINTER_BIT) * NODE_WORDS + LOD_WORD] & 0xffu;
     }
     return hit_cell(r, value, cell, level - 1u, t, axis, iterations);
@@ -275,7 +278,7 @@ fn beam(@builtin(global_invocation_id) gid: vec3<u32>) {
         // of detail counts as solid: no ray's t there exceeds the distance to
         // the box's farthest corner (|d| >= 1).
         let far_corner = length(max(abs(lo - u.eye), abs(hi - u.eye)));
-        let summarized = below_footprint(vec2<f32>(0.0, u.lod_per_t), u32(half), far_corner);
+        let summarized = LOD && below_footprint(vec2<f32>(0.0, u.lod_per_t), u32(half), far_corner);
         if ((child & POINTER_BIT) == 0u || level - 1u <= BEAM_LEVEL || summarized) {
             best = distance;
             continue;

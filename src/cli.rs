@@ -151,6 +151,9 @@ pub struct ImportArgs {
     /// Replace OUTPUT even if it exists or is the mesh.
     #[arg(long)]
     pub force: bool,
+    /// Print one JSON object: solid voxels, seconds, peak resident bytes.
+    #[arg(long)]
+    pub stats: bool,
 }
 
 #[derive(Args, Debug)]
@@ -263,6 +266,8 @@ pub enum BenchKind {
     Effects,
     /// Error (FLIP, PSNR) against time for each quality knob, and the plot.
     Quality,
+    /// Nefertiti at 512 to 4096 voxels tall: import, memory, .ovx, frame, edit.
+    Scale,
 }
 
 /// Parses "WxH".

@@ -183,6 +183,12 @@ impl History {
         !self.undone.is_empty()
     }
 
+    /// Undo steps kept and the memory their undo data holds (what the
+    /// budget `memory_limit_bytes` is checked against).
+    pub fn usage(&self) -> (usize, usize) {
+        (self.done.len(), self.done_bytes)
+    }
+
     /// Forgets everything (a new scene was loaded).
     pub fn clear(&mut self) {
         self.done.clear();

@@ -157,9 +157,19 @@ impl<T: bytemuck::Pod> SlotArena<T> {
         bytemuck::cast_slice(&self.items)
     }
 
-    /// Takes the dirty slots, coalesced into runs of consecutive slots, and
-    /// decides whether the GPU buffer must grow.
-    fn take_dirty(&mut self) -> Region {
+    /// The slots the GPU buffer should be re-created with, when it cannot
+    /// hold the arena: half again as many as are in use, so a long session
+    /// does not grow on every edit.
+    fn wanted_capacity(&self) -> Option<usize> {
+        match self.gpu_capacity {
+            Some(cap) if cap >= self.items.len() => None,
+            _ => Some((self.items.len() + self.items.len() / 2).max(1024)),
+        }
+    }
+
+    /// Takes the dirty slots, coalesced into runs of consecutive slots; the
+    /// GPU buffer is re-created with `capacity` slots when one is given.
+    fn take_dirty(&mut self, capacity: Option<usize>) -> Region {
         let mut slots = std::mem::take(&mut self.dirty);
         slots.sort_unstable();
         let mut runs: Vec<(u32, u32)> = Vec::new();
@@ -173,16 +183,10 @@ impl<T: bytemuck::Pod> SlotArena<T> {
                 _ => runs.push((slot, slot + 1)),
             }
         }
-        let grow_to = match self.gpu_capacity {
-            Some(cap) if cap >= self.items.len() => None,
-            _ => {
-                // Grow by half again so a long session does not grow on every edit.
-                let cap = (self.items.len() + self.items.len() / 2).max(1024);
-                self.gpu_capacity = Some(cap);
-                Some(cap)
-            }
-        };
-        Region { slot_bytes: std::mem::size_of::<T>() as u64, grow_to_slots: grow_to, runs }
+        if capacity.is_some() {
+            self.gpu_capacity = capacity;
+        }
+        Region { slot_bytes: std::mem::size_of::<T>() as u64, grow_to_slots: capacity, runs }
     }
 }
 
@@ -255,11 +259,56 @@ pub struct NodePool {
     pub stats: PoolStats,
 }
 
+/// A pool too large for one GPU buffer binding.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("the scene's node pool needs {needed} bytes; this GPU binds at most {limit} bytes in one buffer")]
+pub struct PoolTooLarge {
+    pub needed: u64,
+    pub limit: u64,
+}
+
 impl NodePool {
     /// Takes every change since the last flush. The caller writes each range
     /// (after re-creating a buffer that must grow) and nothing else.
     pub fn flush(&mut self) -> Upload {
-        let upload = Upload { nodes: self.nodes.take_dirty(), bricks: self.bricks.take_dirty() };
+        let capacities = (self.nodes.wanted_capacity(), self.bricks.wanted_capacity());
+        self.take(capacities)
+    }
+
+    /// [`NodePool::flush`] for a GPU whose one buffer holds at most
+    /// `max_bytes` (nodes and bricks share it): the headroom shrinks to fit,
+    /// and a pool whose live slots alone do not fit is refused, its changes
+    /// kept for a later flush.
+    ///
+    /// # Errors
+    /// [`PoolTooLarge`] when the slots in use exceed `max_bytes`.
+    pub fn flush_within(&mut self, max_bytes: u64) -> Result<Upload, PoolTooLarge> {
+        let (nodes, bricks) = (self.nodes.wanted_capacity(), self.bricks.wanted_capacity());
+        if nodes.is_none() && bricks.is_none() {
+            return Ok(self.take((None, None)));
+        }
+        let bytes = |n: usize, b: usize| n as u64 * NODE_BYTES + b as u64 * BRICK_BYTES;
+        let current = |arena: Option<usize>| arena.unwrap_or(0);
+        let planned = (
+            nodes.unwrap_or(current(self.nodes.gpu_capacity)),
+            bricks.unwrap_or(current(self.bricks.gpu_capacity)),
+        );
+        if bytes(planned.0, planned.1) <= max_bytes {
+            return Ok(self.take((nodes, bricks)));
+        }
+        let used = (self.nodes.len(), self.bricks.len());
+        let needed = bytes(used.0, used.1);
+        if needed > max_bytes {
+            return Err(PoolTooLarge { needed, limit: max_bytes });
+        }
+        // Both re-created, what is in use plus half each of what is left.
+        let spare = max_bytes - needed;
+        let fitted = (used.0 + (spare / 2 / NODE_BYTES) as usize, used.1 + (spare / 2 / BRICK_BYTES) as usize);
+        Ok(self.take((Some(fitted.0), Some(fitted.1))))
+    }
+
+    fn take(&mut self, (nodes, bricks): (Option<usize>, Option<usize>)) -> Upload {
+        let upload = Upload { nodes: self.nodes.take_dirty(nodes), bricks: self.bricks.take_dirty(bricks) };
         let bytes = upload.byte_count();
         self.stats.last_flush_bytes = bytes;
         self.stats.total_bytes += bytes;

@@ -12,6 +12,7 @@ fn every_bench_runs_and_writes_its_tables() {
         ("build", &["torus64", "teapot256", "nefertiti512", "sculpture10M"][..]),
         ("edit", &["one voxel", "sphere r = 8", "sphere r = 32"][..]),
         ("render", &["torus64", "teapot256", "nefertiti512", "sculpture10M"][..]),
+        ("scale", &["64", "128"][..]),
     ] {
         let run = Command::new(env!("CARGO_BIN_EXE_octovox"))
             .args(["bench", kind, "--quick", "--out"])
@@ -62,11 +63,22 @@ fn the_quality_bench_measures_every_knob_and_plots_them() {
         .unwrap();
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
     let md = std::fs::read_to_string(out.path().join("quality.md")).unwrap();
-    for knob in ["| base |", "| --spp |", "| --bounces |", "| --shadow-samples |", "| --render-scale |", "| --mode |"] {
+    for knob in
+        ["| base |", "| --spp |", "| --bounces |", "| --shadow-samples |", "| --render-scale |", "| --mode |", "| --lod |"]
+    {
         assert!(md.contains(knob), "no row {knob}\n{md}");
     }
-    let rows: Vec<serde_json::Value> =
+    let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.path().join("quality.json")).unwrap()).unwrap();
+    let rows = json["knobs"].as_array().unwrap();
+    // The level of detail alone: exact at 0, and it changes the picture no
+    // more as the footprint shrinks.
+    let lod = json["level_of_detail"].as_array().unwrap();
+    assert_eq!(lod.len(), 5);
+    assert_eq!((lod[0]["lod"].as_f64(), lod[0]["flip"].as_f64()), (Some(0.0), Some(0.0)));
+    let changed: Vec<f64> = lod.iter().map(|r| r["changed_pixels"].as_f64().unwrap()).collect();
+    assert!(changed.windows(2).all(|w| w[0] <= w[1]), "{changed:?}");
+    assert!(changed[4] > 0.0, "lod 8 changed nothing: {changed:?}");
     assert!(rows.iter().all(|r| r["flip"].as_f64().is_some_and(|f| (0.0..=1.0).contains(&f))), "{rows:?}");
     assert!(rows.iter().any(|r| r["pareto"] == true));
     // Fewer bounces cannot be closer to an 8-bounce reference on average than more.

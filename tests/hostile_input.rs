@@ -206,7 +206,7 @@ fn imports_are_checked_against_the_budget_and_what_can_be_read_back() {
     std::fs::write(&cube, format!("{vertices}{faces}")).unwrap();
     let out = dir.path().join("cube.vox");
     assert_refused(
-        &octovox(&["--memory-budget", "256M", "import", s(&cube), "-o", s(&out), "--size", "1024"]),
+        &octovox(&["--memory-budget", "256M", "import", s(&cube), "-o", s(&out), "--size", "4096"]),
         "--memory-budget raises it",
     );
     // 416³ = 72 M voxels fits the budget but not a file octovox reads back.

@@ -160,13 +160,15 @@ impl App {
     pub(super) fn start_loading(&mut self, path: PathBuf) {
         let (tx, rx) = mpsc::channel();
         let thread_path = path.clone();
+        let progress = octovox::io::progress::Progress::default();
+        let reporter = progress.clone();
         let spawned = std::thread::Builder::new().name("vox loader".into()).spawn(move || {
-            let result = octovox::io::load_scene(&thread_path, 0).map_err(|e| e.to_string());
+            let result = octovox::io::load_scene_with(&thread_path, 0, &reporter).map_err(|e| e.to_string());
             // The window may have closed meanwhile; then nobody wants the scene.
             let _ = tx.send(result);
         });
         match spawned {
-            Ok(_) => self.loading = Some(Loading { path, started: Instant::now(), result: rx }),
+            Ok(_) => self.loading = Some(Loading { path, started: Instant::now(), progress, result: rx }),
             Err(err) => self.ui.error(format!("cannot start loading: {err}")),
         }
         self.request_redraw();

@@ -77,7 +77,8 @@ impl App {
         let gfx = self.gfx.as_mut()?;
         let raw_input = gfx.egui_state.take_egui_input(&gfx.window);
         let ctx = gfx.egui_state.egui_ctx().clone();
-        let loading = self.loading.as_ref().map(|l| (l.path.clone(), l.started.elapsed().as_secs_f64()));
+        let loading =
+            self.loading.as_ref().map(|l| (l.path.clone(), l.started.elapsed().as_secs_f64(), l.progress.fraction()));
         let mut commands = Vec::new();
         let mut full = {
             let info = ui::Info {
@@ -86,9 +87,13 @@ impl App {
                 stats: &self.stats,
                 adapter: &gfx.renderer.gpu.adapter_name,
                 timestamps: gfx.renderer.timed_by_gpu(),
-                loading: loading.as_ref().map(|(p, s)| (p.as_path(), *s)),
+                loading: loading.as_ref().map(|(p, s, f)| (p.as_path(), *s, *f)),
                 can_undo: self.history.can_undo(),
                 can_redo: self.history.can_redo(),
+                history: {
+                    let (steps, bytes) = self.history.usage();
+                    (steps, bytes, self.history.memory_limit_bytes)
+                },
                 presets: self.presets_measured.as_deref(),
             };
             let (state, ui_state) = (&mut self.state, &mut self.ui);

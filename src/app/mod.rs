@@ -95,6 +95,7 @@ struct Gfx {
 struct Loading {
     path: PathBuf,
     started: Instant,
+    progress: octovox::io::progress::Progress,
     result: Receiver<Result<Scene, String>>,
 }
 

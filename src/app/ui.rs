@@ -50,10 +50,13 @@ pub struct Info<'a> {
     pub stats: &'a Stats,
     pub adapter: &'a str,
     pub timestamps: bool,
-    /// File being loaded and seconds since it started.
-    pub loading: Option<(&'a Path, f64)>,
+    /// File being loaded, seconds since it started, and the fraction done
+    /// where the loader reports one (.obj tiles, .ovx bytes).
+    pub loading: Option<(&'a Path, f64, Option<f32>)>,
     pub can_undo: bool,
     pub can_redo: bool,
+    /// Undo steps, their bytes, and the history's budget.
+    pub history: (usize, usize, usize),
     /// The last measurement of the quality presets, if any.
     pub presets: Option<&'a [super::presets::Measured]>,
 }
@@ -158,8 +161,15 @@ fn menu_bar(ui: &mut egui::Ui, info: &Info, ui_state: &mut UiState, out: &mut Ve
                 out.push(Command::FrameModel);
             }
         });
-        if let Some((path, seconds)) = info.loading {
-            ui.spinner();
+        if let Some((path, seconds, fraction)) = info.loading {
+            match fraction {
+                Some(f) => {
+                    ui.add(egui::ProgressBar::new(f).desired_width(120.0).show_percentage());
+                }
+                None => {
+                    ui.spinner();
+                }
+            }
             ui.label(format!("loading {} … {seconds:.1} s", path.display()));
         }
         message(ui, ui_state);
@@ -433,6 +443,9 @@ fn stats(ui: &mut egui::Ui, info: &Info) {
         row("pool", format!("{} bytes", pool.live_bytes()));
         row("last edit", format!("{} bytes, {} ranges", s.last_edit_bytes, s.last_edit_ranges));
         row("uploaded", format!("{} bytes total", pool.stats.total_bytes));
+        let (steps, bytes, limit) = info.history;
+        let human = |b: usize| octovox::budget::human(b as u64);
+        row("undo", format!("{steps} steps, {} of {} (oldest dropped past it)", human(bytes), human(limit)));
         row("adapter", info.adapter.to_string());
     });
 }

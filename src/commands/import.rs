@@ -6,7 +6,7 @@ use std::time::Instant;
 
 use anyhow::Context;
 use octovox::io::atomic::WriteOptions;
-use octovox::io::mesh::voxelize_obj;
+use octovox::io::mesh::voxelize_obj_with;
 use octovox::io::output::{OutputKind, check_output};
 use glam::IVec3;
 use octovox::scene::{Palette, Scene};
@@ -16,7 +16,9 @@ use crate::cli::ImportArgs;
 pub fn run(args: &ImportArgs) -> anyhow::Result<ExitCode> {
     check_output(&args.output, OutputKind::Scene, &[&args.mesh], args.force)?;
     let start = Instant::now();
-    let tree = voxelize_obj(&args.mesh, args.size, args.up, args.color)?;
+    let tree = super::progress_bar::with_bar("voxelizing", |progress| {
+        voxelize_obj_with(&args.mesh, args.size, args.up, args.color, progress)
+    })?;
     let voxelized = start.elapsed();
     let (lo, hi) = tree.solid_bounds().unwrap_or_default();
     let d = hi - lo + IVec3::ONE;
@@ -24,6 +26,15 @@ pub fn run(args: &ImportArgs) -> anyhow::Result<ExitCode> {
     let options = WriteOptions { overwrite_read_only: args.force };
     octovox::io::save_scene(&args.output, &scene, options)
         .with_context(|| format!("saving {}", args.output.display()))?;
+    if args.stats {
+        let stats = super::bench_scale::ImportStats {
+            voxels: scene.tree.solid_voxels(),
+            seconds: start.elapsed().as_secs_f64(),
+            peak_bytes: super::bench_scale::peak_resident_bytes(),
+        };
+        say!("{}", serde_json::to_string(&stats)?)?;
+        return Ok(ExitCode::SUCCESS);
+    }
     say!(
         "{}: {} solid voxels in {}×{}×{} (voxelized in {:.2} s), wrote {}",
         args.mesh.display(),

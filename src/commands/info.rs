@@ -1,12 +1,12 @@
 //! `octovox info FILE [--json] [--frame N]`: what a .vox or .ovx file holds.
 
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::ExitCode;
 
 use anyhow::Context;
-use octovox::io::vox::load_vox_file;
-use octovox::scene::{MaterialKind, Scene, VoxelModel};
+use octovox::io::vox::{VoxMeta, load_vox_scene_file};
+use octovox::scene::{MaterialKind, Scene};
 
 /// Widest world MagicaVoxel opens, in voxels per axis.
 const MAGICAVOXEL_WORLD: i64 = 2048;
@@ -14,11 +14,13 @@ const MAGICAVOXEL_WORLD: i64 = 2048;
 /// Loads `file` and prints its summary, as JSON when `json` is set.
 pub fn run(file: &Path, json: bool, frame: usize) -> anyhow::Result<ExitCode> {
     let loading = || format!("loading {}", file.display());
-    let mut summary = if octovox::io::is_ovx_path(file) {
-        Summary::of_scene(&octovox::io::ovx::load_ovx(file).with_context(loading)?)
+    let (scene, meta) = if octovox::io::is_ovx_path(file) {
+        let scene = octovox::io::ovx::load_ovx(file, &Default::default()).with_context(loading)?;
+        (scene, VoxMeta { models: 1, stored_models: 1, warnings: Vec::new() })
     } else {
-        Summary::of(&load_vox_file(file, frame).with_context(loading)?)
+        load_vox_scene_file(file, frame).with_context(loading)?
     };
+    let mut summary = Summary::of(&scene, meta);
     if summary.extent().iter().any(|e| *e > MAGICAVOXEL_WORLD) {
         let [x, y, z] = summary.extent();
         summary.warnings.push(format!(
@@ -38,7 +40,7 @@ struct Summary {
     models: usize,
     stored_models: usize,
     warnings: Vec<String>,
-    voxels: usize,
+    voxels: u64,
     /// Inclusive corners in world axes (y up); `None` for an empty scene.
     bounds: Option<([i32; 3], [i32; 3])>,
     palette_entries: usize,
@@ -47,35 +49,18 @@ struct Summary {
 }
 
 impl Summary {
-    fn of(model: &VoxelModel) -> Summary {
-        let used: BTreeSet<u8> = model.voxels.iter().map(|&(_, index)| index).collect();
-        let mut materials = BTreeMap::new();
-        for &index in &used {
-            *materials.entry(model.palette.material(index).kind).or_insert(0) += 1;
-        }
-        Summary {
-            models: model.models,
-            stored_models: model.stored_models,
-            warnings: model.warnings.clone(),
-            voxels: model.voxels.len(),
-            bounds: model.bounds().map(|(lo, hi)| (lo.to_array(), hi.to_array())),
-            palette_entries: used.len(),
-            materials,
-        }
-    }
-
-    /// An octree read back from an .ovx file: one model, stored as a pool.
-    fn of_scene(scene: &Scene) -> Summary {
+    /// A scene as loaded (streamed from a .vox, or an .ovx's pool).
+    fn of(scene: &Scene, meta: VoxMeta) -> Summary {
         let used: Vec<u8> = scene.tree.counts().present().collect();
         let mut materials = BTreeMap::new();
         for &index in &used {
             *materials.entry(scene.palette.material(index).kind).or_insert(0) += 1;
         }
         Summary {
-            models: 1,
-            stored_models: 1,
-            warnings: Vec::new(),
-            voxels: scene.tree.solid_voxels() as usize,
+            models: meta.models,
+            stored_models: meta.stored_models,
+            warnings: meta.warnings,
+            voxels: scene.tree.solid_voxels(),
             bounds: scene.tree.solid_bounds().map(|(lo, hi)| (lo.to_array(), hi.to_array())),
             palette_entries: used.len(),
             materials,

@@ -12,10 +12,12 @@ macro_rules! say {
 mod bench;
 mod bench_effects;
 mod bench_quality;
+mod bench_scale;
 mod convert;
 mod export;
 mod import;
 mod info;
+mod progress_bar;
 mod quality_plot;
 pub mod render;
 mod replay;

@@ -70,6 +70,9 @@ pub struct Renderer {
     pub hit_records: bool,
     /// Whether the last frame wrote them.
     records_written: bool,
+    /// Why the last sync could not upload the pool; frames fail with it
+    /// until a sync succeeds.
+    pool_error: Option<String>,
 }
 
 impl Renderer {
@@ -92,6 +95,7 @@ impl Renderer {
             wait_for_frames: true,
             hit_records: false,
             records_written: false,
+            pool_error: None,
         })
     }
 
@@ -100,10 +104,27 @@ impl Renderer {
         Renderer::new(GpuContext::headless()?)
     }
 
-    /// Sends the pool's changes since the last call and the palette.
+    /// Sends the pool's changes since the last call and the palette. A pool
+    /// too large for one buffer binding is not sent: frames then fail with
+    /// [`GpuError::TooLarge`] saying so, until a sync succeeds.
     pub fn sync(&mut self, tree: &mut Octree, palette: &Palette) -> UploadStats {
         self.buffers.upload_palette(&self.gpu.queue, palette);
-        self.buffers.upload_pool(&self.gpu.device, &self.gpu.queue, tree)
+        let limit = self.gpu.device.limits().max_storage_buffer_binding_size;
+        match self.buffers.upload_pool(&self.gpu.device, &self.gpu.queue, tree, limit) {
+            Ok(stats) => {
+                self.pool_error = None;
+                stats
+            }
+            Err(err) => {
+                self.pool_error = Some(format!("{err} ({})", self.gpu.adapter_name));
+                UploadStats::default()
+            }
+        }
+    }
+
+    /// The pool's upload error, as a frame's error.
+    fn check_pool(&self) -> Result<(), GpuError> {
+        self.pool_error.clone().map_or(Ok(()), |message| Err(GpuError::TooLarge(message)))
     }
 
     /// Uploads the dense grid the grid tracer walks.
@@ -153,9 +174,11 @@ impl Renderer {
         highlight: Option<(IVec3, IVec3)>,
         kernel: Kernel,
     ) -> Result<f64, GpuError> {
+        self.check_pool()?;
         let gpu = &self.gpu;
         gpu.checked(|| {
             self.pass.resize(gpu, &self.buffers, size, self.hit_records)?;
+            self.pass.ensure_kernel(gpu, kernel)?;
             let basis = camera.basis(size.0.max(1), size.1.max(1), tree.origin());
             let local = highlight.map(|(lo, hi)| (lo - tree.origin(), hi - tree.origin()));
             let uniforms = FrameUniforms {
@@ -190,6 +213,7 @@ impl Renderer {
         settings: &PathSettings,
         scene_changed: bool,
     ) -> Result<PathFrame, GpuError> {
+        self.check_pool()?;
         let gpu = &self.gpu;
         gpu.checked(|| {
             let resized = self.path.resize(gpu, &self.buffers, size)?;

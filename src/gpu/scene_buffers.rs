@@ -6,7 +6,7 @@
 //! and on CPU-emulated GPUs every load site in the loop is a scalar loop
 //! over the SIMD lanes.
 
-use crate::gpu_pool::{Region, SlotArena};
+use crate::gpu_pool::{PoolTooLarge, Region, SlotArena};
 use crate::scene::{Octree, Palette};
 use crate::trace::grid::DenseGrid;
 
@@ -61,11 +61,22 @@ impl SceneBuffers {
 
     /// Flushes the pool's dirty ranges to the GPU: only changed slots are
     /// written; a pool that outgrew its buffer gets a bigger one, filled by a
-    /// GPU-side copy of the old contents.
-    pub fn upload_pool(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, tree: &mut Octree) -> UploadStats {
-        let upload = tree.pool_mut().flush();
-        let node_capacity = upload.nodes.grow_to_bytes().map_or(self.node_capacity, |b| b.max(self.node_capacity));
-        let brick_capacity = upload.bricks.grow_to_bytes().map_or(self.brick_capacity, |b| b.max(self.brick_capacity));
+    /// GPU-side copy of the old contents, its headroom cut to what one
+    /// binding of `max_bytes` allows.
+    ///
+    /// # Errors
+    /// [`PoolTooLarge`] when the pool does not fit one buffer binding of
+    /// `max_bytes`; nothing is written then.
+    pub fn upload_pool(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        tree: &mut Octree,
+        max_bytes: u64,
+    ) -> Result<UploadStats, PoolTooLarge> {
+        let upload = tree.pool_mut().flush_within(max_bytes)?;
+        let node_capacity = upload.nodes.grow_to_bytes().unwrap_or(self.node_capacity);
+        let brick_capacity = upload.bricks.grow_to_bytes().unwrap_or(self.brick_capacity);
         let grew = (node_capacity, brick_capacity) != (self.node_capacity, self.brick_capacity);
         if grew {
             self.grow(device, queue, node_capacity, brick_capacity);
@@ -73,11 +84,11 @@ impl SceneBuffers {
         let pool = tree.pool();
         write_region(queue, &self.pool_buf, 0, &upload.nodes, &pool.nodes);
         write_region(queue, &self.pool_buf, self.node_capacity, &upload.bricks, &pool.bricks);
-        UploadStats {
+        Ok(UploadStats {
             bytes: upload.byte_count(),
             ranges: upload.nodes.range_count() + upload.bricks.range_count(),
             grew,
-        }
+        })
     }
 
     /// Where the bricks start in the pool buffer, in 32-bit words.
@@ -90,17 +101,14 @@ impl SceneBuffers {
     fn grow(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, node_capacity: u64, brick_capacity: u64) {
         let bigger = storage_buffer(device, "node pool", node_capacity + brick_capacity);
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pool grow") });
-        if self.node_capacity > 0 {
-            encoder.copy_buffer_to_buffer(&self.pool_buf, 0, &bigger, 0, self.node_capacity);
+        // A region may also shrink (its headroom given up to fit the binding
+        // limit): the slots past its new size are free, so only what fits is copied.
+        let (nodes_kept, bricks_kept) = (self.node_capacity.min(node_capacity), self.brick_capacity.min(brick_capacity));
+        if nodes_kept > 0 {
+            encoder.copy_buffer_to_buffer(&self.pool_buf, 0, &bigger, 0, nodes_kept);
         }
-        if self.brick_capacity > 0 {
-            encoder.copy_buffer_to_buffer(
-                &self.pool_buf,
-                self.node_capacity,
-                &bigger,
-                node_capacity,
-                self.brick_capacity,
-            );
+        if bricks_kept > 0 {
+            encoder.copy_buffer_to_buffer(&self.pool_buf, self.node_capacity, &bigger, node_capacity, bricks_kept);
         }
         // Submitted now: queued writes run at the start of the *next*
         // submit, so they land after this copy, not under it.

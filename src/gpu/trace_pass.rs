@@ -20,15 +20,17 @@ const FLOOR_WGSL: &str = include_str!("../../shaders/floor.wgsl");
 /// What a frame dispatches.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kernel {
-    /// The scene, traced (the SVO with its beam prepass, or the grid).
-    Trace { mode: TraceMode, shadows: bool },
+    /// The scene, traced (the SVO with its beam prepass, or the grid);
+    /// `lod`: the SVO kernels with the level-of-detail test compiled in.
+    Trace { mode: TraceMode, shadows: bool, lod: bool },
     /// Everything but the traversal: the floor a frame cannot go below.
     Floor,
 }
 
 impl From<&RenderSettings> for Kernel {
     fn from(settings: &RenderSettings) -> Kernel {
-        Kernel::Trace { mode: settings.mode, shadows: settings.shadows }
+        let lod = settings.mode == TraceMode::Svo && settings.lod > 0.0;
+        Kernel::Trace { mode: settings.mode, shadows: settings.shadows, lod }
     }
 }
 
@@ -120,9 +122,13 @@ const BEAM_TILE: u32 = 16;
 /// of pixels) and the per-pixel trace, which starts where the beam allows.
 pub struct TracePass {
     layout: wgpu::BindGroupLayout,
+    pipeline_layout: wgpu::PipelineLayout,
     /// [svo without shadows, svo with, grid without, grid with].
     pipelines: [wgpu::ComputePipeline; 4],
     beam: wgpu::ComputePipeline,
+    /// The SVO kernels with level of detail, compiled on first use:
+    /// [without shadows, with shadows, beam].
+    lod_pipelines: Option<[wgpu::ComputePipeline; 3]>,
     floor: wgpu::ComputePipeline,
     uniform_buf: wgpu::Buffer,
     target: Target,
@@ -142,6 +148,28 @@ pub(super) fn uniform_entry(binding: u32, size: usize) -> wgpu::BindGroupLayoutE
         },
         count: None,
     }
+}
+
+/// A compute pipeline of `module`'s `entry` with override `constants`,
+/// inside a validation scope.
+fn compute_pipeline(
+    gpu: &GpuContext,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    entry: &str,
+    constants: &[(&str, f64)],
+    label: &str,
+) -> Result<wgpu::ComputePipeline, GpuError> {
+    gpu.validated(label, |device| {
+        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(label),
+            layout: Some(layout),
+            module,
+            entry_point: Some(entry),
+            compilation_options: wgpu::PipelineCompilationOptions { constants, zero_initialize_workgroup_memory: false },
+            cache: None,
+        })
+    })
 }
 
 /// The binding of the RGBA8 output texture a kernel writes.
@@ -217,20 +245,8 @@ impl TracePass {
         });
         let svo = gpu.shader("trace_svo.wgsl", &with_prelude(&[COMMON_WGSL, SVO_WGSL]))?;
         let grid = gpu.shader("trace_grid.wgsl", &with_prelude(&[COMMON_WGSL, GRID_WGSL]))?;
-        let pipeline = |module: &wgpu::ShaderModule, entry: &str, constants: &[(&str, f64)], label: &str| {
-            gpu.validated(label, |device| {
-                device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(label),
-                    layout: Some(&pipeline_layout),
-                    module,
-                    entry_point: Some(entry),
-                    compilation_options: wgpu::PipelineCompilationOptions {
-                        constants,
-                        zero_initialize_workgroup_memory: false,
-                    },
-                    cache: None,
-                })
-            })
+        let pipeline = |module, entry, constants: &[(&str, f64)], label| {
+            compute_pipeline(gpu, &pipeline_layout, module, entry, constants, label)
         };
         let tile = ("BEAM_TILE", f64::from(BEAM_TILE));
         let pipelines = [
@@ -251,7 +267,40 @@ impl TracePass {
         let target = Self::make_target(device, 1, 1, false);
         let bind_group = Self::make_bind_group(device, &layout, &uniform_buf, buffers, &target);
         let bound_generation = buffers.generation;
-        Ok(TracePass { layout, pipelines, beam, floor, uniform_buf, target, bind_group, bound_generation })
+        Ok(TracePass {
+            layout,
+            pipeline_layout,
+            pipelines,
+            beam,
+            lod_pipelines: None,
+            floor,
+            uniform_buf,
+            target,
+            bind_group,
+            bound_generation,
+        })
+    }
+
+    /// Compiles the level-of-detail kernels if `kernel` needs them and they
+    /// are not compiled yet (a frame with `--lod` above 0).
+    ///
+    /// # Errors
+    /// A kernel that does not compile.
+    pub fn ensure_kernel(&mut self, gpu: &GpuContext, kernel: Kernel) -> Result<(), GpuError> {
+        if !matches!(kernel, Kernel::Trace { lod: true, .. }) || self.lod_pipelines.is_some() {
+            return Ok(());
+        }
+        let svo = gpu.shader("trace_svo.wgsl", &with_prelude(&[COMMON_WGSL, SVO_WGSL]))?;
+        let pipeline = |entry, constants: &[(&str, f64)], label| {
+            compute_pipeline(gpu, &self.pipeline_layout, &svo, entry, constants, label)
+        };
+        let (tile, lod) = (("BEAM_TILE", f64::from(BEAM_TILE)), ("LOD", 1.0));
+        self.lod_pipelines = Some([
+            pipeline("main", &[("SHADOWS", 0.0), tile, lod], "trace svo, lod")?,
+            pipeline("main", &[("SHADOWS", 1.0), tile, lod], "trace svo + shadows, lod")?,
+            pipeline("beam", &[tile, lod], "beam prepass, lod")?,
+        ]);
+        Ok(())
     }
 
     /// The outputs; the hit records (16 bytes a pixel) only when asked for,
@@ -363,8 +412,8 @@ impl TracePass {
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("trace"), timestamp_writes: timestamps });
         pass.set_bind_group(0, &self.bind_group, &[]);
-        let (mode, shadows) = match kernel {
-            Kernel::Trace { mode, shadows } => (mode, shadows),
+        let (mode, shadows, lod) = match kernel {
+            Kernel::Trace { mode, shadows, lod } => (mode, shadows, lod),
             Kernel::Floor => {
                 pass.set_pipeline(&self.floor);
                 pass.dispatch_workgroups(self.target.width.div_ceil(8), self.target.height.div_ceil(8), 1);
@@ -375,12 +424,14 @@ impl TracePass {
             TraceMode::Svo => 0,
             TraceMode::Grid => 2,
         } + usize::from(shadows);
+        // `ensure_kernel` compiled these; without them the exact kernels run.
+        let lod_pipelines = self.lod_pipelines.as_ref().filter(|_| lod);
         if mode == TraceMode::Svo {
             let (tiles_x, tiles_y) = (self.target.width.div_ceil(BEAM_TILE), self.target.height.div_ceil(BEAM_TILE));
-            pass.set_pipeline(&self.beam);
+            pass.set_pipeline(lod_pipelines.map_or(&self.beam, |p| &p[2]));
             pass.dispatch_workgroups(tiles_x.div_ceil(8), tiles_y.div_ceil(8), 1);
         }
-        pass.set_pipeline(&self.pipelines[index]);
+        pass.set_pipeline(lod_pipelines.map_or(&self.pipelines[index], |p| &p[usize::from(shadows)]));
         pass.dispatch_workgroups(self.target.width.div_ceil(8), self.target.height.div_ceil(8), 1);
     }
 

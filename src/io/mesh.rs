@@ -15,6 +15,7 @@ use glam::{IVec3, UVec3, Vec2, Vec3};
 use rayon::prelude::*;
 
 use crate::scene::build::{BLOCK_LEVEL, Block, BlockBuilder, VoxelSource};
+use crate::io::progress::Progress;
 use crate::scene::{BuildError, Octree};
 
 /// Longest side of an imported mesh when no size is asked for.
@@ -183,6 +184,17 @@ fn largest_vertex(bytes: &[u8]) -> (usize, String) {
 /// Loads and voxelizes an .obj file into an octree, streaming: the longest
 /// side becomes `size` voxels, all of palette index `color`.
 pub fn voxelize_obj(path: &Path, size: u32, up: UpAxis, color: u8) -> Result<Octree, MeshError> {
+    voxelize_obj_with(path, size, up, color, &Progress::default())
+}
+
+/// [`voxelize_obj`], counting the tiles of columns done in `progress`.
+pub fn voxelize_obj_with(
+    path: &Path,
+    size: u32,
+    up: UpAxis,
+    color: u8,
+    progress: &Progress,
+) -> Result<Octree, MeshError> {
     if !(1..=MAX_MESH_SIZE).contains(&size) {
         return Err(MeshError::Size(size));
     }
@@ -192,7 +204,8 @@ pub fn voxelize_obj(path: &Path, size: u32, up: UpAxis, color: u8) -> Result<Oct
         voxelize_bytes(&triangles, size),
     )
     .map_err(|source| MeshError::OverBudget { path: path.to_path_buf(), source })?;
-    let tree = voxelize(&triangles, size, color).map_err(|e| MeshError::Build { path: path.to_path_buf(), source: e })?;
+    let tree = voxelize(&triangles, size, color, progress)
+        .map_err(|e| MeshError::Build { path: path.to_path_buf(), source: e })?;
     if tree.solid_voxels() == 0 {
         return Err(MeshError::NothingInside { path: path.to_path_buf(), size });
     }
@@ -222,11 +235,11 @@ fn placement(triangles: &[[Vec3; 3]], size: u32) -> Placement {
     Placement { lo, scale, dims }
 }
 
-/// Peak memory of [`voxelize`] beyond the pool it builds: the triangles'
-/// tile lists, and per thread one tile of columns (its dense bytes and its
-/// crossings, at most one per column under each triangle's footprint), plus
-/// the pool itself, estimated from the crossings (each a surface voxel, at
-/// most 24 bytes of bricks and nodes apiece).
+/// Peak memory of [`voxelize`]: the triangles' tile lists, per thread a few
+/// tiles of columns (a list of crossings and one of runs per column), and
+/// the pool, estimated from the crossings (at most one per column under each
+/// triangle's footprint; each a surface voxel, at most 24 bytes of bricks,
+/// nodes and run apiece).
 pub fn voxelize_bytes(triangles: &[[Vec3; 3]], size: u32) -> u64 {
     let place = placement(triangles, size);
     let crossings: u64 = triangles
@@ -237,9 +250,9 @@ pub fn voxelize_bytes(triangles: &[[Vec3; 3]], size: u32) -> u64 {
             span(a.x, b.x, c.x) * span(a.z, b.z, c.z)
         })
         .sum();
-    let tile = u64::from(TILE) * u64::from(TILE) * u64::from(place.dims.y);
+    let tile = u64::from(TILE) * u64::from(TILE) * 2 * std::mem::size_of::<Vec<f32>>() as u64;
     let threads = rayon::current_num_threads() as u64;
-    triangles.len() as u64 * 16 + threads * (tile + tile / 8) + crossings * 24
+    triangles.len() as u64 * 16 + 4 * threads * tile + crossings * 24
 }
 
 /// Columns per side of a tile: the cubes of one tile share its columns.
@@ -252,7 +265,7 @@ const TILE: u32 = 1 << BLOCK_LEVEL;
 ///
 /// # Errors
 /// A mesh wider than the largest octree.
-pub fn voxelize(triangles: &[[Vec3; 3]], size: u32, color: u8) -> Result<Octree, BuildError> {
+pub fn voxelize(triangles: &[[Vec3; 3]], size: u32, color: u8, progress: &Progress) -> Result<Octree, BuildError> {
     let place = placement(triangles, size);
     let mut builder = BlockBuilder::new(IVec3::ZERO, place.dims)?;
     let block_level = builder.block_level;
@@ -262,6 +275,7 @@ pub fn voxelize(triangles: &[[Vec3; 3]], size: u32, color: u8) -> Result<Octree,
     // the next ones are filled.
     let batch = 4 * rayon::current_num_threads();
     let all: Vec<(u32, u32)> = (0..tiles.z).flat_map(|z| (0..tiles.x).map(move |x| (x, z))).collect();
+    progress.start(all.len() as u64);
     for chunk in all.chunks(batch) {
         let built: Vec<Vec<(UVec3, Block)>> = chunk
             .par_iter()
@@ -273,6 +287,7 @@ pub fn voxelize(triangles: &[[Vec3; 3]], size: u32, color: u8) -> Result<Octree,
         for (coord, block) in built.into_iter().flatten() {
             builder.add(coord, block);
         }
+        progress.advance(chunk.len() as u64);
     }
     Ok(builder.finish())
 }

@@ -8,12 +8,13 @@ pub mod input;
 pub mod mesh;
 pub mod output;
 pub mod ovx;
+pub mod progress;
 pub mod png;
 pub mod vox;
 
 use std::path::Path;
 
-use crate::scene::{BuildError, Scene};
+use crate::scene::Scene;
 
 /// Why a scene could not be opened.
 #[derive(Debug, thiserror::Error)]
@@ -24,27 +25,30 @@ pub enum LoadError {
     Mesh(#[from] mesh::MeshError),
     #[error("{}: {source}", path.display())]
     Ovx { path: std::path::PathBuf, source: ovx::OvxError },
-    #[error("{}: {source}", path.display())]
-    Build { path: std::path::PathBuf, source: BuildError },
 }
 
 /// Loads a .vox file, or an .obj mesh (voxelized solid, [`mesh::DEFAULT_MESH_SIZE`]
 /// voxels on its longest side, y up), and builds its octree; or reads an
 /// .ovx file's octree back.
 pub fn load_scene(path: &Path, frame: usize) -> Result<Scene, LoadError> {
-    let build_error = |source| LoadError::Build { path: path.to_path_buf(), source };
+    load_scene_with(path, frame, &progress::Progress::default())
+}
+
+/// [`load_scene`], reporting to `progress` as it goes (the tiles of an
+/// .obj, the bytes of an .ovx; a .vox reports nothing).
+pub fn load_scene_with(path: &Path, frame: usize, progress: &progress::Progress) -> Result<Scene, LoadError> {
     if is_ovx_path(path) {
-        return ovx::load_ovx(path).map_err(|source| LoadError::Ovx { path: path.to_path_buf(), source });
+        return ovx::load_ovx(path, progress).map_err(|source| LoadError::Ovx { path: path.to_path_buf(), source });
     }
     if is_mesh_path(path) {
-        let tree = mesh::voxelize_obj(path, mesh::DEFAULT_MESH_SIZE, mesh::UpAxis::Y, mesh::MESH_COLOR)?;
+        let tree = mesh::voxelize_obj_with(path, mesh::DEFAULT_MESH_SIZE, mesh::UpAxis::Y, mesh::MESH_COLOR, progress)?;
         return Ok(Scene { palette: crate::scene::Palette::default(), tree });
     }
-    let model = vox::load_vox_file(path, frame)?;
-    for warning in &model.warnings {
+    let (scene, meta) = vox::load_vox_scene_file(path, frame)?;
+    for warning in &meta.warnings {
         log::warn!("{}: {warning}", path.display());
     }
-    Scene::from_model(&model).map_err(build_error)
+    Ok(scene)
 }
 
 /// Whether `path` names a mesh (.obj) rather than a .vox.

@@ -15,6 +15,7 @@ use std::path::{Path, PathBuf};
 use glam::IVec3;
 
 use super::atomic::{WriteOptions, write_atomically};
+use super::progress::Progress;
 use crate::gpu_pool::{Brick, NODE_BYTES, NodeSlot, is_pointer, pointer_to, slot_of};
 use crate::scene::octree::{MAX_DEPTH, MIN_DEPTH, Octree};
 use crate::scene::{Material, MaterialKind, Palette, Scene};
@@ -181,20 +182,20 @@ fn encode_materials(palette: &Palette) -> Vec<u8> {
 /// A distinct [`OvxError`] for a missing file, a wrong magic or version, a
 /// cut file, a bad checksum, a pool that is not a tree, or one past the
 /// memory budget; nothing is built then.
-pub fn load_ovx(path: &Path) -> Result<Scene, OvxError> {
+pub fn load_ovx(path: &Path, progress: &Progress) -> Result<Scene, OvxError> {
     let read_error = |source| OvxError::Read { path: path.to_path_buf(), source };
     let bytes = super::input::read_limited(path, MAX_FILE_BYTES).map_err(|e| match e {
         super::input::InputError::Io(source) => read_error(source),
         other => read_error(io::Error::new(io::ErrorKind::InvalidInput, other.to_string())),
     })?;
-    decode_ovx(&bytes)
+    decode_ovx(&bytes, progress)
 }
 
 /// Decodes the bytes of an .ovx file (see [`load_ovx`]).
 ///
 /// # Errors
 /// As [`load_ovx`].
-pub fn decode_ovx(bytes: &[u8]) -> Result<Scene, OvxError> {
+pub fn decode_ovx(bytes: &[u8], progress: &Progress) -> Result<Scene, OvxError> {
     let found = bytes.len() as u64;
     if found < 12 || bytes[..8] != MAGIC {
         return Err(if found < 8 && MAGIC.starts_with(bytes) {
@@ -225,9 +226,9 @@ pub fn decode_ovx(bytes: &[u8]) -> Result<Scene, OvxError> {
         return Err(OvxError::BadChecksum { stored, computed });
     }
     crate::budget::check(|| format!("an .ovx pool of {payload_len} bytes"), payload_len)?;
-    let mut decoder = zstd::Decoder::new(&body[HEADER_BYTES as usize..])
-        .map_err(|e| corrupt(format!("zstd: {e}")))?
-        .take(payload_len);
+    progress.start(payload_len);
+    let decoder = zstd::Decoder::new(&body[HEADER_BYTES as usize..]).map_err(|e| corrupt(format!("zstd: {e}")))?;
+    let mut decoder = Reporting { inner: decoder, progress }.take(payload_len);
     let scene = read_payload(&mut decoder, payload_len)?;
     if decoder.limit() != 0 {
         return Err(corrupt(format!("{} payload bytes left unread", decoder.limit())));
@@ -308,6 +309,20 @@ fn crc_of(input: &mut impl Read, len: u64) -> io::Result<u32> {
     }
 }
 
+/// A reader that reports the bytes it hands out.
+struct Reporting<'a, R: Read> {
+    inner: R,
+    progress: &'a Progress,
+}
+
+impl<R: Read> Read for Reporting<'_, R> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.progress.advance(n as u64);
+        Ok(n)
+    }
+}
+
 /// A writer that counts the bytes that pass through it.
 struct Counting<W: Write> {
     inner: W,
@@ -363,7 +378,7 @@ mod tests {
     #[test]
     fn a_scene_comes_back_as_it_was() {
         let scene = scene();
-        let loaded = decode_ovx(&saved(&scene)).unwrap();
+        let loaded = decode_ovx(&saved(&scene), &Progress::default()).unwrap();
         assert_eq!(loaded.tree.voxels(), scene.tree.voxels());
         assert_eq!(loaded.palette, scene.palette);
         assert_eq!((loaded.tree.origin(), loaded.tree.depth()), (scene.tree.origin(), scene.tree.depth()));
@@ -371,14 +386,14 @@ mod tests {
         assert_eq!(loaded.tree.node_count(), scene.tree.node_count());
         assert_eq!(loaded.tree.pool().nodes.len(), scene.tree.node_count(), "no free slots stored");
         loaded.tree.check_invariants().unwrap();
-        let empty = decode_ovx(&saved(&Scene::default())).unwrap();
+        let empty = decode_ovx(&saved(&Scene::default()), &Progress::default()).unwrap();
         assert_eq!(empty.tree.solid_voxels(), 0);
     }
 
     #[test]
     fn each_kind_of_damage_has_its_own_message() {
         let bytes = saved(&scene());
-        let message = |b: &[u8]| decode_ovx(b).err().unwrap().to_string();
+        let message = |b: &[u8]| decode_ovx(b, &Progress::default()).err().unwrap().to_string();
         assert!(message(&bytes[..bytes.len() - 10]).contains("truncated"), "{}", message(&bytes[..bytes.len() - 10]));
         assert!(message(&bytes[..20]).contains("truncated"));
         assert!(message(&bytes[..5]).contains("truncated"));

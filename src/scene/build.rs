@@ -72,6 +72,59 @@ impl Octree {
         Ok(tree)
     }
 
+    /// An empty tree whose root cube is placed as [`Octree::from_voxels`]
+    /// places it for voxels spanning `lo..=hi`.
+    ///
+    /// # Errors
+    /// [`BuildError::TooWide`] past the largest root.
+    pub fn empty_for(lo: IVec3, hi: IVec3) -> Result<Octree, BuildError> {
+        let extent = (hi.as_i64vec3() - lo.as_i64vec3()).max_element() + 1;
+        Ok(Octree::empty(lo, depth_for(extent)?))
+    }
+
+    /// Sets the given voxels (inside the root cube; others are skipped), a
+    /// position listed twice keeping its last value, in one pass down the
+    /// tree: a loader adds the models of a file one at a time this way. Only
+    /// the cells holding a voxel are visited; collapse and summaries are kept.
+    pub fn insert_voxels(&mut self, voxels: &[(IVec3, u8)]) {
+        let mut keyed: Vec<(u64, u8)> = voxels
+            .iter()
+            .filter(|(p, _)| self.contains(*p))
+            .map(|&(p, v)| (morton((p - self.origin).as_uvec3()), v))
+            .collect();
+        // Stable, so of two entries for one position the later stays later.
+        keyed.sort_by_key(|k| k.0);
+        self.root = self.insert_sorted(self.root, self.depth, &keyed);
+    }
+
+    /// [`Octree::insert_voxels`] under one cell: `keyed` holds its voxels
+    /// in Morton order (codes relative to the root).
+    fn insert_sorted(&mut self, word: u32, level: u32, keyed: &[(u64, u8)]) -> u32 {
+        if keyed.is_empty() {
+            return word;
+        }
+        if level == 1 {
+            let old: Brick = if is_pointer(word) { *self.brick(word) } else { [word as u8; 8] };
+            let mut new = old;
+            for &(code, value) in keyed {
+                new[(code & 7) as usize] = value;
+            }
+            old.iter().for_each(|v| self.counts.remove(*v, 1));
+            new.iter().for_each(|v| self.counts.add(*v, 1));
+            return self.make_brick(new, is_pointer(word).then_some(word));
+        }
+        let node = if is_pointer(word) { word } else { self.split(word, level) };
+        let mut children: Node = *self.node(node);
+        let shift = 3 * (level - 1);
+        let mut rest = keyed;
+        for (octant, child) in children.iter_mut().enumerate() {
+            let n = rest.partition_point(|k| (k.0 >> shift) & 7 == octant as u64);
+            *child = self.insert_sorted(*child, level - 1, &rest[..n]);
+            rest = &rest[n..];
+        }
+        self.make_node(children, level, Some(node))
+    }
+
     /// Groups sorted (code, word) children by parent code into nodes of `level`.
     fn build_level(&mut self, children: &[(u64, u32)], level: u32) -> Vec<(u64, u32)> {
         let mut parents = Vec::with_capacity(children.len() / 4 + 1);

@@ -30,14 +30,17 @@ pub fn vox(data: &[u8]) {
     assert_eq!(again.voxels, expected, "the voxels changed in a save and load");
 }
 
-/// An .obj file: parsing never panics; what parses voxelizes.
+/// An .obj file: parsing never panics; what parses voxelizes, streamed,
+/// into the dense reference's voxel count.
 pub fn obj(data: &[u8]) {
     let path = Path::new("fuzz.obj");
     let Ok(triangles) = octovox::io::mesh::parse_obj(data, path, octovox::io::mesh::UpAxis::Y) else { return };
-    let dense = octovox::io::mesh::voxelize(&triangles, OBJ_VOXELS, 1);
+    let dense = octovox::io::mesh::voxelize_dense(&triangles, OBJ_VOXELS, 1);
     let dims = dense.dims;
     assert!(dims.max_element() <= OBJ_VOXELS && dims.min_element() >= 1, "block {dims}");
     assert_eq!(dense.data.len() as u64, dims.as_u64vec3().element_product());
+    let tree = octovox::io::mesh::voxelize(&triangles, OBJ_VOXELS, 1, &Default::default()).expect("a small block builds");
+    assert_eq!(tree.solid_voxels(), dense.solid_count() as u64, "streamed and dense voxel counts differ");
 }
 
 /// A script: parsing never panics, and every parsed line prints as text

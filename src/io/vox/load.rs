@@ -12,7 +12,7 @@ use super::validate::{self, Layout};
 use super::{MAX_FILE_BYTES, VoxError};
 use crate::io::guard::catch_quietly;
 use crate::io::input::{InputError, read_limited};
-use crate::scene::{Material, MaterialKind, Palette, Voxel, VoxelModel};
+use crate::scene::{Material, MaterialKind, Octree, Palette, Scene, Voxel, VoxelModel};
 
 /// Reads and loads the `.vox` file at `path`; see [`load_vox`].
 ///
@@ -20,12 +20,23 @@ use crate::scene::{Material, MaterialKind, Palette, Voxel, VoxelModel};
 /// [`VoxError::Read`] (naming the path) when the file cannot be read,
 /// [`VoxError::FileTooLarge`] beyond [`MAX_FILE_BYTES`], else as [`load_vox`].
 pub fn load_vox_file(path: &Path, frame: usize) -> Result<VoxelModel, VoxError> {
-    let bytes = read_limited(path, MAX_FILE_BYTES).map_err(|e| match e {
+    load_vox(&read_file(path)?, frame)
+}
+
+/// Reads the `.vox` file at `path` into an octree; see [`load_vox_scene`].
+///
+/// # Errors
+/// As [`load_vox_file`].
+pub fn load_vox_scene_file(path: &Path, frame: usize) -> Result<(Scene, VoxMeta), VoxError> {
+    load_vox_scene(&read_file(path)?, frame)
+}
+
+fn read_file(path: &Path) -> Result<Vec<u8>, VoxError> {
+    read_limited(path, MAX_FILE_BYTES).map_err(|e| match e {
         InputError::Io(source) => VoxError::Read { path: path.to_owned(), source },
         InputError::NotRegular => VoxError::NotRegular { path: path.to_owned() },
         InputError::TooLarge { .. } => VoxError::FileTooLarge { path: path.to_owned() },
-    })?;
-    load_vox(&bytes, frame)
+    })
 }
 
 /// Loads a MagicaVoxel `.vox` file held in memory.
@@ -44,6 +55,66 @@ pub fn load_vox_file(path: &Path, frame: usize) -> Result<VoxelModel, VoxError> 
 /// nothing in the file can make this panic or allocate much more than the
 /// scene it describes (at most [`super::MAX_VOXELS`] voxels).
 pub fn load_vox(bytes: &[u8], frame: usize) -> Result<VoxelModel, VoxError> {
+    let parsed = parse(bytes, frame)?;
+    let voxels = place_voxels(&parsed)?;
+    let (palette, meta) = parsed.palette_and_meta();
+    Ok(VoxelModel { palette, voxels, models: meta.models, stored_models: meta.stored_models, warnings: meta.warnings })
+}
+
+/// What a load says beside the voxels.
+#[derive(Clone, Debug, Default)]
+pub struct VoxMeta {
+    /// Models placed, and models stored in the file.
+    pub models: usize,
+    pub stored_models: usize,
+    /// What the loader accepted but the user should know, one sentence each.
+    pub warnings: Vec<String>,
+}
+
+/// Loads a `.vox` file held in memory straight into an octree, one placed
+/// model at a time: the same voxels as [`load_vox`] then
+/// `Scene::from_model`, without ever holding the list of every voxel.
+///
+/// # Errors
+/// As [`load_vox`].
+pub fn load_vox_scene(bytes: &[u8], frame: usize) -> Result<(Scene, VoxMeta), VoxError> {
+    let parsed = parse(bytes, frame)?;
+    let largest = parsed.placements.iter().map(|p| parsed.layout.model_voxels[p.model]).max().unwrap_or(0);
+    let total: usize = parsed.placements.iter().map(|p| parsed.layout.model_voxels[p.model]).sum();
+    crate::budget::check(
+        || format!("loading {total} voxels"),
+        largest as u64 * BYTES_PER_STREAMED_VOXEL + total as u64 * POOL_BYTES_PER_VOXEL,
+    )?;
+    // The bounds first, so the root is placed as a build from the whole list places it.
+    let mut bounds: Option<(IVec3, IVec3)> = None;
+    for placement in &parsed.placements {
+        for voxel in parsed.placed(placement) {
+            let p = voxel?.0;
+            bounds = Some(bounds.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p))));
+        }
+    }
+    let mut tree = match bounds {
+        Some((lo, hi)) => Octree::empty_for(lo, hi).map_err(|e| VoxError::BadSceneGraph(e.to_string()))?,
+        None => Octree::default(),
+    };
+    for placement in &parsed.placements {
+        let voxels: Vec<Voxel> = parsed.placed(placement).collect::<Result<_, _>>()?;
+        tree.insert_voxels(&voxels);
+    }
+    let (palette, meta) = parsed.palette_and_meta();
+    Ok((Scene { palette, tree }, meta))
+}
+
+/// A file parsed and checked, with its model placements.
+struct Parsed {
+    data: DotVoxData,
+    layout: Layout,
+    placements: Vec<Placement>,
+    /// (model, ordinal) of voxels with palette index 0, which are skipped.
+    empty: HashSet<(usize, usize)>,
+}
+
+fn parse(bytes: &[u8], frame: usize) -> Result<Parsed, VoxError> {
     let layout = validate::check(bytes)?;
     let data = parse_guarded(bytes)?;
     cross_check(&layout, &data)?;
@@ -52,10 +123,36 @@ pub fn load_vox(bytes: &[u8], frame: usize) -> Result<VoxelModel, VoxError> {
     } else {
         scene::placements(&data.scenes, &layout.node_ids, &layout.model_voxels, frame)?
     };
-    let voxels = place_voxels(&data, &layout, &placements)?;
-    let mut warnings = layout.warnings.clone();
-    let palette = palette_of(&data, &layout, &mut warnings);
-    Ok(VoxelModel { palette, voxels, models: placements.len(), stored_models: data.models.len(), warnings })
+    let empty = layout.zero_index_voxels.iter().copied().collect();
+    Ok(Parsed { data, layout, placements, empty })
+}
+
+impl Parsed {
+    /// The voxels of one placement in world axes, in file order.
+    fn placed<'a>(&'a self, placement: &'a Placement) -> impl Iterator<Item = Result<Voxel, VoxError>> + 'a {
+        let model = &self.data.models[placement.model];
+        let size = [model.size.x, model.size.y, model.size.z];
+        model.voxels.iter().enumerate().filter(move |(ordinal, _)| !self.empty.contains(&(placement.model, *ordinal))).map(
+            move |(_, v)| {
+                let [x, y, z] = placement.place([v.x, v.y, v.z], size);
+                let world = to_world([x, z, -y]).ok_or_else(|| {
+                    VoxError::BadSceneGraph(format!(
+                        "a voxel of model {} lands at ({x}, {y}, {z}), outside the 32-bit range",
+                        placement.model
+                    ))
+                })?;
+                // `dot_vox` stores the file's index minus one; 0 was skipped above.
+                Ok((world, v.i.saturating_add(1)))
+            },
+        )
+    }
+
+    fn palette_and_meta(&self) -> (Palette, VoxMeta) {
+        let mut warnings = self.layout.warnings.clone();
+        let palette = palette_of(&self.data, &self.layout, &mut warnings);
+        let meta = VoxMeta { models: self.placements.len(), stored_models: self.data.models.len(), warnings };
+        (palette, meta)
+    }
 }
 
 /// Runs `dot_vox::load_bytes`, turning a panic into [`VoxError::ParserPanic`].
@@ -107,29 +204,21 @@ fn frame_placement(models: usize, frame: usize) -> Result<Vec<Placement>, VoxErr
 /// Peak bytes per voxel of a load and the octree build after it: the list
 /// (16), its sort, and the build's Morton keys (16 each).
 const BYTES_PER_LOADED_VOXEL: u64 = 48;
+/// Of a streamed load, per voxel of the largest placed model: its list (16)
+/// and its Morton keys (16).
+const BYTES_PER_STREAMED_VOXEL: u64 = 32;
+/// The pool a streamed load builds, per placed voxel at most (bricks of one
+/// solid voxel and their nodes; solid regions cost far less).
+const POOL_BYTES_PER_VOXEL: u64 = 8;
 
 /// Every placed voxel in world axes, sorted by position, overlaps resolved.
-fn place_voxels(data: &DotVoxData, layout: &Layout, placements: &[Placement]) -> Result<Vec<Voxel>, VoxError> {
-    let empty: HashSet<(usize, usize)> = layout.zero_index_voxels.iter().copied().collect();
-    let total: usize = placements.iter().map(|p| layout.model_voxels[p.model]).sum();
+fn place_voxels(parsed: &Parsed) -> Result<Vec<Voxel>, VoxError> {
+    let total: usize = parsed.placements.iter().map(|p| parsed.layout.model_voxels[p.model]).sum();
     crate::budget::check(|| format!("loading {total} voxels"), total as u64 * BYTES_PER_LOADED_VOXEL)?;
     let mut voxels = Vec::with_capacity(total);
-    for placement in placements {
-        let model = &data.models[placement.model];
-        let size = [model.size.x, model.size.y, model.size.z];
-        for (ordinal, v) in model.voxels.iter().enumerate() {
-            if !empty.is_empty() && empty.contains(&(placement.model, ordinal)) {
-                continue;
-            }
-            let [x, y, z] = placement.place([v.x, v.y, v.z], size);
-            let world = to_world([x, z, -y]).ok_or_else(|| {
-                VoxError::BadSceneGraph(format!(
-                    "a voxel of model {} lands at ({x}, {y}, {z}), outside the 32-bit range",
-                    placement.model
-                ))
-            })?;
-            // `dot_vox` stores the file's index minus one; 0 was skipped above.
-            voxels.push((world, v.i.saturating_add(1)));
+    for placement in &parsed.placements {
+        for voxel in parsed.placed(placement) {
+            voxels.push(voxel?);
         }
     }
     sort_and_dedup(&mut voxels);

@@ -20,7 +20,7 @@ mod validate;
 
 use std::path::PathBuf;
 
-pub use load::{load_vox, load_vox_file};
+pub use load::{VoxMeta, load_vox, load_vox_file, load_vox_scene, load_vox_scene_file};
 pub use save::{encode_vox, save_tree, save_vox};
 
 /// Most voxels one load may produce (after scene-graph instancing).

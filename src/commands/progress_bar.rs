@@ -1,0 +1,30 @@
+//! A terminal progress bar (indicatif) over a long step: the step runs on
+//! a scoped thread and reports to an `octovox::io::progress::Progress`; this
+//! thread draws it. Nothing is drawn when stderr is not a terminal.
+
+use std::time::Duration;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use octovox::io::progress::Progress;
+
+/// Runs `work` with a progress it reports to, showing a bar named `what`.
+pub fn with_bar<T: Send>(what: &str, work: impl FnOnce(&Progress) -> T + Send) -> T {
+    let progress = Progress::default();
+    let bar = ProgressBar::new(0).with_message(what.to_string());
+    bar.set_style(
+        ProgressStyle::with_template("{msg} [{bar:30}] {percent}% {elapsed}").unwrap_or(ProgressStyle::default_bar()),
+    );
+    let result = std::thread::scope(|scope| {
+        let worker = scope.spawn(|| work(&progress));
+        while !worker.is_finished() {
+            let (done, total) = progress.get();
+            bar.set_length(total.max(1));
+            bar.set_position(done);
+            std::thread::sleep(Duration::from_millis(100));
+        }
+        worker.join()
+    });
+    bar.finish_and_clear();
+    // A panic in the worker is the worker's: pass it on as it was.
+    result.unwrap_or_else(|panic| std::panic::resume_unwind(panic))
+}
