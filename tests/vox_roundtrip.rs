@@ -264,3 +264,22 @@ fn saved_files_are_world_readable() {
     let mode = std::fs::metadata(&path).expect("stat").permissions().mode();
     assert_eq!(mode & 0o777, 0o644);
 }
+
+/// Loading model by model into the octree gives exactly the voxels, palette
+/// and materials of the whole-list load, on every shared model (scene
+/// graphs, instancing, overlapping placements, animation frames).
+#[test]
+fn a_streamed_load_equals_the_whole_list_load() {
+    for path in asset_files() {
+        let bytes = std::fs::read(&path).unwrap();
+        let Ok(model) = load_vox(&bytes, 0) else { continue };
+        let reference = octovox::scene::Scene::from_model(&model).unwrap();
+        let (streamed, meta) = octovox::io::vox::load_vox_scene(&bytes, 0).unwrap();
+        let name = path.display();
+        assert_eq!(streamed.tree.voxels(), reference.tree.voxels(), "{name}");
+        assert_eq!((streamed.tree.origin(), streamed.tree.depth()), (reference.tree.origin(), reference.tree.depth()));
+        assert_eq!(streamed.palette, reference.palette, "{name}");
+        assert_eq!((meta.models, meta.stored_models, &meta.warnings), (model.models, model.stored_models, &model.warnings));
+        streamed.tree.check_invariants().unwrap();
+    }
+}
