@@ -50,8 +50,9 @@ pub struct WindowArgs {
     /// Which built-in scene to open when there is no FILE.
     #[arg(long, value_enum, conflicts_with = "file")]
     pub demo: Option<octovox::scene::demo::BuiltIn>,
-    /// Samples the path tracer accumulates once the camera rests (the UI can change it).
-    #[arg(long, default_value_t = octovox::settings::DEFAULT_SAMPLE_TARGET, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    /// Samples per pixel the path tracer accumulates once the camera rests
+    /// (the UI can change it); `--samples` is the older name.
+    #[arg(long = "spp", visible_alias = "samples", value_name = "N", default_value_t = octovox::settings::DEFAULT_SAMPLE_TARGET, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub samples: u32,
     /// Preview shading only, the path tracer once the camera rests, or the
     /// path tracer always (the UI can change it).

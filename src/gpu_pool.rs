@@ -289,10 +289,8 @@ impl NodePool {
         }
         let bytes = |n: usize, b: usize| n as u64 * NODE_BYTES + b as u64 * BRICK_BYTES;
         let current = |arena: Option<usize>| arena.unwrap_or(0);
-        let planned = (
-            nodes.unwrap_or(current(self.nodes.gpu_capacity)),
-            bricks.unwrap_or(current(self.bricks.gpu_capacity)),
-        );
+        let planned =
+            (nodes.unwrap_or(current(self.nodes.gpu_capacity)), bricks.unwrap_or(current(self.bricks.gpu_capacity)));
         if bytes(planned.0, planned.1) <= max_bytes {
             return Ok(self.take((nodes, bricks)));
         }

@@ -44,9 +44,18 @@ pub fn psnr(reference: &RgbaImage, test: &RgbaImage) -> Option<f64> {
 /// One way to draw a frame: the path tracer with its knobs, or the preview.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Setting {
-    Path { spp: u32, bounces: u32, shadow_samples: u32, render_scale: f32 },
+    Path {
+        spp: u32,
+        bounces: u32,
+        shadow_samples: u32,
+        render_scale: f32,
+    },
     /// The preview; `lod` is the level-of-detail footprint in pixels (0 exact).
-    Preview { mode: TraceMode, render_scale: f32, lod: f32 },
+    Preview {
+        mode: TraceMode,
+        render_scale: f32,
+        lod: f32,
+    },
 }
 
 /// Draws one frame with `setting`; returns its wall-clock milliseconds

@@ -63,9 +63,15 @@ fn the_quality_bench_measures_every_knob_and_plots_them() {
         .unwrap();
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
     let md = std::fs::read_to_string(out.path().join("quality.md")).unwrap();
-    for knob in
-        ["| base |", "| --spp |", "| --bounces |", "| --shadow-samples |", "| --render-scale |", "| --mode |", "| --lod |"]
-    {
+    for knob in [
+        "| base |",
+        "| --spp |",
+        "| --bounces |",
+        "| --shadow-samples |",
+        "| --render-scale |",
+        "| --mode |",
+        "| --lod |",
+    ] {
         assert!(md.contains(knob), "no row {knob}\n{md}");
     }
     let json: serde_json::Value =

@@ -210,5 +210,8 @@ fn streaming_equals_dense_on_the_shared_meshes() {
         voxelized(&bunny, size, UpAxis::Y, 5);
     }
     let triangles = load_obj_triangles(&nefertiti, UpAxis::Z).unwrap();
-    assert_eq!(voxelize(&triangles, 1, 1, &Default::default()).unwrap().solid_voxels(), voxelize_dense(&triangles, 1, 1).solid_count() as u64);
+    assert_eq!(
+        voxelize(&triangles, 1, 1, &Default::default()).unwrap().solid_voxels(),
+        voxelize_dense(&triangles, 1, 1).solid_count() as u64
+    );
 }

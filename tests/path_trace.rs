@@ -59,7 +59,11 @@ fn look(eye: DVec3, target: DVec3) -> Camera {
 /// Pixels whose hit (by the CPU tracer) is a voxel.
 fn object_pixels(tree: &Octree, camera: &Camera, size: (u32, u32), pixels: &[Vec3]) -> Vec<Vec3> {
     let basis = camera.basis(size.0, size.1, tree.origin());
-    let hits = octovox::trace::render::trace_image(octovox::trace::render::Tracer::Svo(tree), &basis, octovox::trace::Footprint::EXACT);
+    let hits = octovox::trace::render::trace_image(
+        octovox::trace::render::Tracer::Svo(tree),
+        &basis,
+        octovox::trace::Footprint::EXACT,
+    );
     hits.iter().zip(pixels).filter(|(h, _)| h.is_hit()).map(|(_, p)| *p).collect()
 }
 

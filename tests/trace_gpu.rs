@@ -204,7 +204,8 @@ fn teapot_picture_and_iteration_counts() {
     let mut renderer = renderer_for(&mut scene.tree);
     let (lo, hi) = scene.tree.solid_bounds().unwrap();
     let camera = Camera::framing(lo, hi, 50.0);
-    let settings = RenderSettings { mode: TraceMode::Svo, view: View::Shaded, shadows: true, render_scale: 1.0, lod: 0.0 };
+    let settings =
+        RenderSettings { mode: TraceMode::Svo, view: View::Shaded, shadows: true, render_scale: 1.0, lod: 0.0 };
     renderer.render(&scene.tree, &camera, (200, 150), &settings, None).unwrap();
     let image = renderer.read_image().unwrap();
     let distinct: std::collections::HashSet<[u8; 4]> = image.pixels().map(|p| p.0).collect();
@@ -310,7 +311,10 @@ fn gpu_level_of_detail_matches_cpu() {
             assert!(differing <= 2, "lod {lod}: {differing} pixels differ from the CPU's");
         }
         vs_cpu.assert_good(&format!("GPU vs CPU at lod {lod}"));
-        eprintln!("lod {lod}: {} of {} pixels as exact, steps {steps} vs {exact_steps}", vs_exact.exact, vs_exact.pixels);
+        eprintln!(
+            "lod {lod}: {} of {} pixels as exact, steps {steps} vs {exact_steps}",
+            vs_exact.exact, vs_exact.pixels
+        );
         assert!(vs_exact.exact_fraction() < 0.99, "lod {lod} changed nothing: {vs_exact:?}");
         assert!(steps * 10 < exact_steps * 9, "lod {lod}: {steps} steps, exact {exact_steps}");
     }

@@ -279,7 +279,10 @@ fn a_streamed_load_equals_the_whole_list_load() {
         assert_eq!(streamed.tree.voxels(), reference.tree.voxels(), "{name}");
         assert_eq!((streamed.tree.origin(), streamed.tree.depth()), (reference.tree.origin(), reference.tree.depth()));
         assert_eq!(streamed.palette, reference.palette, "{name}");
-        assert_eq!((meta.models, meta.stored_models, &meta.warnings), (model.models, model.stored_models, &model.warnings));
+        assert_eq!(
+            (meta.models, meta.stored_models, &meta.warnings),
+            (model.models, model.stored_models, &model.warnings)
+        );
         streamed.tree.check_invariants().unwrap();
     }
 }

@@ -91,7 +91,9 @@ impl Preset {
     /// How the measurement draws a frame of this preset.
     pub fn setting(&self) -> Setting {
         match self.shading {
-            Shading::Preview => Setting::Preview { mode: TraceMode::Svo, render_scale: self.render_scale, lod: self.lod },
+            Shading::Preview => {
+                Setting::Preview { mode: TraceMode::Svo, render_scale: self.render_scale, lod: self.lod }
+            }
             _ => Setting::Path {
                 spp: self.samples,
                 bounces: self.bounces,

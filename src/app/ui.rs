@@ -341,12 +341,14 @@ fn render(ui: &mut egui::Ui, state: &mut EditorState) {
         }
     });
     ui.horizontal(|ui| {
-        ui.radio_value(&mut settings.mode, TraceMode::Svo, "SVO");
-        ui.radio_value(&mut settings.mode, TraceMode::Grid, "Grid (DDA)");
+        ui.label("--mode");
+        ui.radio_value(&mut settings.mode, TraceMode::Svo, "svo");
+        ui.radio_value(&mut settings.mode, TraceMode::Grid, "grid (DDA)");
     });
     ui.checkbox(&mut settings.shadows, "Sun shadows");
-    ui.add(egui::Slider::new(&mut settings.render_scale, 0.25..=1.0).text("scale"));
-    ui.add(egui::Slider::new(&mut settings.lod, 0.0..=16.0).step_by(0.5).text("detail px")).on_hover_text(
+    // The knobs carry their command-line names, as in `bench quality`.
+    ui.add(egui::Slider::new(&mut settings.render_scale, 0.25..=1.0).text("--render-scale"));
+    ui.add(egui::Slider::new(&mut settings.lod, 0.0..=16.0).step_by(0.5).text("--lod (px)")).on_hover_text(
         "level of detail: the preview stops at octree cells narrower than this many pixels \
          and draws them as one solid cell (0 = exact; the path tracer is always exact)",
     );
@@ -394,9 +396,9 @@ fn path_tracing(ui: &mut egui::Ui, state: &mut EditorState) {
         return;
     }
     let path = &mut state.path_settings;
-    ui.add(egui::Slider::new(&mut path.bounces, 0..=16).text("bounces"));
-    ui.add(egui::Slider::new(&mut path.shadow_samples, 1..=16).text("shadow samples"));
-    ui.add(egui::Slider::new(&mut state.sample_target, 1..=4096).logarithmic(true).text("samples"));
+    ui.add(egui::Slider::new(&mut path.bounces, 0..=16).text("--bounces"));
+    ui.add(egui::Slider::new(&mut path.shadow_samples, 1..=16).text("--shadow-samples"));
+    ui.add(egui::Slider::new(&mut state.sample_target, 1..=4096).logarithmic(true).text("--spp"));
     ui.horizontal(|ui| {
         ui.checkbox(&mut path.sun, "Sun");
         egui::ComboBox::from_id_salt("sky").selected_text(format!("sky: {:?}", path.sky)).show_ui(ui, |ui| {

@@ -12,8 +12,9 @@ use octovox::io::output::{OutputKind, check_output};
 /// atomically; an existing .vox or the input itself only with `force`.
 pub fn run(input: &Path, output: &Path, frame: usize, force: bool) -> anyhow::Result<ExitCode> {
     check_output(output, OutputKind::Scene, &[input], force)?;
-    let scene = super::progress_bar::with_bar("loading", |progress| octovox::io::load_scene_with(input, frame, progress))
-        .with_context(|| format!("loading {}", input.display()))?;
+    let scene =
+        super::progress_bar::with_bar("loading", |progress| octovox::io::load_scene_with(input, frame, progress))
+            .with_context(|| format!("loading {}", input.display()))?;
     let options = WriteOptions { overwrite_read_only: force };
     octovox::io::save_scene(output, &scene, options).with_context(|| format!("saving {}", output.display()))?;
     say!("wrote {} voxels to {}", scene.tree.solid_voxels(), output.display())?;

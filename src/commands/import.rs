@@ -5,10 +5,10 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::Context;
+use glam::IVec3;
 use octovox::io::atomic::WriteOptions;
 use octovox::io::mesh::voxelize_obj_with;
 use octovox::io::output::{OutputKind, check_output};
-use glam::IVec3;
 use octovox::scene::{Palette, Scene};
 
 use crate::cli::ImportArgs;

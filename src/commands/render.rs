@@ -89,8 +89,13 @@ fn preview(
     args: &RenderArgs,
     size: (u32, u32),
 ) -> anyhow::Result<(image::RgbaImage, Stats)> {
-    let settings =
-        RenderSettings { mode: args.mode, view: args.view, shadows: !args.no_shadows, render_scale: 1.0, lod: args.lod };
+    let settings = RenderSettings {
+        mode: args.mode,
+        view: args.view,
+        shadows: !args.no_shadows,
+        render_scale: 1.0,
+        lod: args.lod,
+    };
     let grid = match args.mode {
         TraceMode::Grid => Some(DenseGrid::from_octree(&scene.tree).map_err(anyhow::Error::msg)?),
         TraceMode::Svo => None,

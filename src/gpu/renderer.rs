@@ -10,10 +10,10 @@ use super::{FrameUniforms, GpuContext, GpuError, Kernel, PathPass, PathUniforms,
 use crate::camera::{Camera, RayBasis};
 use crate::scene::{Octree, Palette};
 use crate::settings::{PathSettings, RenderSettings, View};
-use crate::trace::{Footprint, Hit};
 use crate::trace::grid::DenseGrid;
 use crate::trace::path::materials::{Effects, material_table};
 use crate::trace::path::{effects_for, lights};
+use crate::trace::{Footprint, Hit};
 
 /// Which pass drew the last frame (the one the window shows).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

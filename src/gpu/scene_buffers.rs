@@ -103,7 +103,8 @@ impl SceneBuffers {
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pool grow") });
         // A region may also shrink (its headroom given up to fit the binding
         // limit): the slots past its new size are free, so only what fits is copied.
-        let (nodes_kept, bricks_kept) = (self.node_capacity.min(node_capacity), self.brick_capacity.min(brick_capacity));
+        let (nodes_kept, bricks_kept) =
+            (self.node_capacity.min(node_capacity), self.brick_capacity.min(brick_capacity));
         if nodes_kept > 0 {
             encoder.copy_buffer_to_buffer(&self.pool_buf, 0, &bigger, 0, nodes_kept);
         }

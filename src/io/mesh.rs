@@ -14,8 +14,8 @@ use std::path::{Path, PathBuf};
 use glam::{IVec3, UVec3, Vec2, Vec3};
 use rayon::prelude::*;
 
-use crate::scene::build::{BLOCK_LEVEL, Block, BlockBuilder, VoxelSource};
 use crate::io::progress::Progress;
+use crate::scene::build::{BLOCK_LEVEL, Block, BlockBuilder, VoxelSource};
 use crate::scene::{BuildError, Octree};
 
 /// Longest side of an imported mesh when no size is asked for.
@@ -339,7 +339,7 @@ fn column_ranges(
     let max = Vec2::new(a.x.max(b.x).max(c.x), a.z.max(b.z).max(c.z)) - JITTER;
     let (x0, x1) = (min.x.ceil().max(0.0), max.x.floor().min(place.dims.x as f32 - 1.0));
     let (z0, z1) = (min.y.ceil().max(0.0), max.y.floor().min(place.dims.z as f32 - 1.0));
-    (x0 <= x1 && z0 <= z1).then(|| ((x0 as u32)..=(x1 as u32), (z0 as u32)..=(z1 as u32)))
+    (x0 <= x1 && z0 <= z1).then_some(((x0 as u32)..=(x1 as u32), (z0 as u32)..=(z1 as u32)))
 }
 
 /// A rectangle of columns as solid runs: for each column (x, z), the y
@@ -355,7 +355,14 @@ struct Columns {
 
 impl Columns {
     /// The columns of tile (tx, tz).
-    fn of_tile(triangles: &[[Vec3; 3]], which: &[u32], place: Placement, tile: (u32, u32), level: u32, color: u8) -> Columns {
+    fn of_tile(
+        triangles: &[[Vec3; 3]],
+        which: &[u32],
+        place: Placement,
+        tile: (u32, u32),
+        level: u32,
+        color: u8,
+    ) -> Columns {
         let min = (tile.0 << level, tile.1 << level);
         let size = ((place.dims.x - min.0).min(1 << level), (place.dims.z - min.1).min(1 << level));
         Columns::of(triangles, which, place, (min, size), color)
@@ -375,7 +382,8 @@ impl Columns {
         let mut heights = vec![Vec::new(); size.0 as usize * size.1 as usize];
         for &i in which {
             let triangle = &triangles[i as usize];
-            let (Some(([a, b, c], area)), Some((xs, zs))) = (projected(triangle, place), column_ranges(triangle, place))
+            let (Some(([a, b, c], area)), Some((xs, zs))) =
+                (projected(triangle, place), column_ranges(triangle, place))
             else {
                 continue;
             };

@@ -8,8 +8,8 @@ pub mod input;
 pub mod mesh;
 pub mod output;
 pub mod ovx;
-pub mod progress;
 pub mod png;
+pub mod progress;
 pub mod vox;
 
 use std::path::Path;

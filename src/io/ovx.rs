@@ -256,8 +256,7 @@ fn read_payload(input: &mut impl Read, payload_len: u64) -> Result<Scene, OvxErr
     else {
         return Err(corrupt(format!("{node_count} nodes and {brick_count} bricks do not fit its {payload_len} bytes")));
     };
-    let mut palette = Palette::default();
-    palette.colors = bytemuck::pod_read_unaligned(&fixed[36..36 + 256 * 4]);
+    let mut palette = Palette { colors: bytemuck::pod_read_unaligned(&fixed[36..36 + 256 * 4]), ..Palette::default() };
     let nodes: Vec<NodeSlot> = read(node_count as usize * NODE_BYTES as usize)?
         .chunks_exact(NODE_BYTES as usize)
         .map(bytemuck::pod_read_unaligned)
@@ -279,13 +278,16 @@ fn decode_materials(bytes: &[u8]) -> Result<Vec<Material>, OvxError> {
     let mut materials = Vec::with_capacity(256);
     for index in 0..256 {
         let kind = take(1)?[0];
-        let kind = *MaterialKind::ALL.get(usize::from(kind)).ok_or_else(|| corrupt(format!("material {index} has kind {kind}")))?;
+        let kind = *MaterialKind::ALL
+            .get(usize::from(kind))
+            .ok_or_else(|| corrupt(format!("material {index} has kind {kind}")))?;
         let mut material = Material::new(kind);
         let count = u32::from_le_bytes(take(4)?.try_into().unwrap_or_default());
         for _ in 0..count {
             let mut text = || -> Result<String, OvxError> {
                 let len = u32::from_le_bytes(take(4)?.try_into().unwrap_or_default()) as usize;
-                String::from_utf8(take(len)?.to_vec()).map_err(|_| corrupt(format!("material {index}: text is not UTF-8")))
+                String::from_utf8(take(len)?.to_vec())
+                    .map_err(|_| corrupt(format!("material {index}: text is not UTF-8")))
             };
             let key = text()?;
             material.params.insert(key, text()?);
@@ -363,7 +365,8 @@ mod tests {
     /// behind it, so the pool has free slots to compact away.
     fn scene() -> Scene {
         let mut scene = crate::scene::demo::BuiltIn::Showroom.scene();
-        let patch = scene.tree.apply_brush(&Shape::Sphere { center: IVec3::new(3, 9, 4), radius: 6 }, Op::Remove).unwrap();
+        let patch =
+            scene.tree.apply_brush(&Shape::Sphere { center: IVec3::new(3, 9, 4), radius: 6 }, Op::Remove).unwrap();
         scene.tree.apply_patch(&patch).unwrap();
         scene
     }

@@ -5,8 +5,8 @@ use glam::{IVec3, UVec3};
 use rayon::prelude::*;
 
 use super::counts::VoxelCounts;
-use super::octree::{MAX_DEPTH, MIN_DEPTH, Octree, octant_offset};
 use super::lod::{self, Summary};
+use super::octree::{MAX_DEPTH, MIN_DEPTH, Octree, octant_offset};
 use crate::gpu_pool::{Brick, Node, NodeSlot, POINTER_BIT, is_pointer, pointer_to, slot_of};
 
 /// Why a tree could not be built.

@@ -390,7 +390,11 @@ impl Octree {
         let node = *self.node(word);
         let stored = self.pool.nodes.get(slot_of(word)).lod;
         if stored != self.node_slot(node, level).lod {
-            return Err(format!("stale summary {:?} of node {} at level {level}", Summary::from_word(stored), slot_of(word)));
+            return Err(format!(
+                "stale summary {:?} of node {} at level {level}",
+                Summary::from_word(stored),
+                slot_of(word)
+            ));
         }
         if !is_pointer(node[0]) && node.iter().all(|c| *c == node[0]) {
             return Err(format!("uncollapsed node {node:?} at level {level}"));

@@ -152,7 +152,9 @@ pub fn render_scene_cpu(
     let shadows: Vec<bool> = if settings.shadows {
         // A shadow ray keeps the footprint its camera ray had at the hit.
         hits.par_iter()
-            .map(|hit| shadow_ray(hit).is_some_and(|ray| tracer.trace(&ray, footprint.at(hit_depth(hit, &basis))).is_hit()))
+            .map(|hit| {
+                shadow_ray(hit).is_some_and(|ray| tracer.trace(&ray, footprint.at(hit_depth(hit, &basis))).is_hit())
+            })
             .collect()
     } else {
         Vec::new()

@@ -39,7 +39,8 @@ pub fn obj(data: &[u8]) {
     let dims = dense.dims;
     assert!(dims.max_element() <= OBJ_VOXELS && dims.min_element() >= 1, "block {dims}");
     assert_eq!(dense.data.len() as u64, dims.as_u64vec3().element_product());
-    let tree = octovox::io::mesh::voxelize(&triangles, OBJ_VOXELS, 1, &Default::default()).expect("a small block builds");
+    let tree =
+        octovox::io::mesh::voxelize(&triangles, OBJ_VOXELS, 1, &Default::default()).expect("a small block builds");
     assert_eq!(tree.solid_voxels(), dense.solid_count() as u64, "streamed and dense voxel counts differ");
 }
 

@@ -132,8 +132,12 @@ impl Parsed {
     fn placed<'a>(&'a self, placement: &'a Placement) -> impl Iterator<Item = Result<Voxel, VoxError>> + 'a {
         let model = &self.data.models[placement.model];
         let size = [model.size.x, model.size.y, model.size.z];
-        model.voxels.iter().enumerate().filter(move |(ordinal, _)| !self.empty.contains(&(placement.model, *ordinal))).map(
-            move |(_, v)| {
+        model
+            .voxels
+            .iter()
+            .enumerate()
+            .filter(move |(ordinal, _)| !self.empty.contains(&(placement.model, *ordinal)))
+            .map(move |(_, v)| {
                 let [x, y, z] = placement.place([v.x, v.y, v.z], size);
                 let world = to_world([x, z, -y]).ok_or_else(|| {
                     VoxError::BadSceneGraph(format!(
@@ -143,8 +147,7 @@ impl Parsed {
                 })?;
                 // `dot_vox` stores the file's index minus one; 0 was skipped above.
                 Ok((world, v.i.saturating_add(1)))
-            },
-        )
+            })
     }
 
     fn palette_and_meta(&self) -> (Palette, VoxMeta) {
