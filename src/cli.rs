@@ -99,6 +99,16 @@ pub enum Command {
     /// Voxelize a closed .obj mesh (solid inside) and save it as .vox.
     #[command(allow_negative_numbers = true)]
     Import(ImportArgs),
+    /// Apply the crash-recovery journal the window left beside FILE (its
+    /// unsaved edits) and save the result as OUT; FILE and the journal stay.
+    Recover {
+        file: PathBuf,
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Replace OUTPUT even if it exists or is FILE.
+        #[arg(long)]
+        force: bool,
+    },
     /// Export the visible faces as a mesh (.obj with .mtl, or .ply), greedy-meshed.
     #[command(allow_negative_numbers = true)]
     Export {

@@ -9,6 +9,7 @@ pub mod edit;
 pub mod gpu;
 pub mod gpu_pool;
 pub mod io;
+pub mod journal;
 pub mod mirror;
 pub mod quality;
 pub mod replay;

@@ -109,4 +109,8 @@ pub enum Command {
     Quit,
     /// Answer to the unsaved-changes prompt.
     Resolve(Choice),
+    /// Answers to the crash-recovery prompt: apply the open document's
+    /// journal, or delete it.
+    RecoverJournal,
+    DiscardJournal,
 }

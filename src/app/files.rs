@@ -27,7 +27,13 @@ impl App {
             }
             line => (None, line),
         };
-        self.record(|r| r.scene(line));
+        self.record(|r| r.scene(line.clone()));
+        // The old document's edits were saved or discarded before this.
+        self.close_journal();
+        self.journal_source = match &line {
+            octovox::replay::Command::Load(_) => Some(line),
+            _ => None,
+        };
         self.scene = scene;
         self.history.clear();
         self.stroke = None;
@@ -98,7 +104,36 @@ impl App {
                 camera_control::frame_model(&mut self.state.camera, Some((IVec3::splat(-4), IVec3::splat(4))));
             }
             Pending::Open(path) => self.start_loading(path),
-            Pending::Quit => event_loop.exit(),
+            Pending::Quit => {
+                // Saved or discarded: nothing is left to recover.
+                self.close_journal();
+                event_loop.exit();
+            }
+        }
+    }
+
+    /// Applies the open document's crash-recovery journal (what `octovox
+    /// recover` does), then goes on journaling at its end.
+    pub(super) fn recover_journal(&mut self) {
+        let Some(document) = self.state.path.clone() else { return };
+        match octovox::journal::recover(&document) {
+            Ok(scene) => {
+                self.scene = scene;
+                self.history.clear();
+                self.state.dirty = true;
+                self.grid_stale = true;
+                self.path_stale = true;
+                self.upload();
+                let journal = octovox::journal::journal_path(&document);
+                match octovox::replay::Recorder::append(&journal) {
+                    Ok(recorder) => self.journal = Some(recorder),
+                    Err(err) => self.ui.error(format!("cannot go on with the journal {}: {err}", journal.display())),
+                }
+                report!("recovered: {}", document.display());
+                self.ui.info(format!("recovered the unsaved edits of {}", document.display()));
+                self.update_title();
+            }
+            Err(err) => self.ui.error(format!("cannot recover: {err}")),
         }
     }
 
@@ -126,6 +161,10 @@ impl App {
             Ok(()) => {
                 report!("saved: {}", path.display());
                 self.state.dirty = false;
+                // The file now holds every edit: the journal starts again from it.
+                self.close_journal();
+                let absolute = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+                self.journal_source = Some(octovox::replay::Command::Load(absolute));
                 self.ui.info(format!("saved {}", path.display()));
                 self.update_title();
                 true
@@ -193,6 +232,10 @@ impl App {
                     self.frame_model();
                 }
                 self.ui.info(format!("opened {}", loading.path.display()));
+                if let Some(journal) = self.state.path.as_deref().and_then(octovox::journal::find) {
+                    report!("asking: recover {}", journal.display());
+                    self.ui.recover = Some(journal);
+                }
             }
             Err(err) => self.ui.error(format!("cannot open {}: {err}", loading.path.display())),
         }

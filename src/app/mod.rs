@@ -152,6 +152,10 @@ struct App {
     player: Option<script::Player>,
     /// `--record`: where the session is written as a script.
     recorder: Option<octovox::replay::Recorder>,
+    /// The crash-recovery journal of the open document (`octovox::journal`),
+    /// and the line that loads the document as saved, which starts it.
+    journal: Option<octovox::replay::Recorder>,
+    journal_source: Option<octovox::replay::Command>,
     /// Where the next screenshot goes (a script's `render PATH`), else `saves/`.
     screenshot_path: Option<PathBuf>,
 }
@@ -186,6 +190,8 @@ impl App {
             fatal: None,
             player: None,
             recorder: None,
+            journal: None,
+            journal_source: None,
             screenshot_path: None,
             args,
         };
@@ -425,6 +431,12 @@ impl App {
             Command::Export(path) => self.export(&path),
             Command::Screenshot => self.screenshot_requested = true,
             Command::Resolve(choice) => self.resolve(choice, event_loop),
+            Command::RecoverJournal => self.recover_journal(),
+            Command::DiscardJournal => {
+                if let Some(path) = &self.state.path {
+                    let _ = std::fs::remove_file(octovox::journal::journal_path(path));
+                }
+            }
         }
         self.request_redraw();
     }

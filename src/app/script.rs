@@ -170,13 +170,50 @@ impl App {
         Played::Done
     }
 
-    /// Runs `f` on the recorder; an I/O error stops recording with a message.
-    pub(super) fn record(&mut self, f: impl FnOnce(&mut octovox::replay::Recorder) -> std::io::Result<()>) {
+    /// Runs `f` on the recorder and on the document's journal (created at
+    /// the first unsaved edit); an I/O error stops that one with a message.
+    pub(super) fn record(&mut self, f: impl Fn(&mut octovox::replay::Recorder) -> std::io::Result<()>) {
         if let Some(recorder) = &mut self.recorder
             && let Err(err) = f(recorder)
         {
             self.ui.error(format!("recording to {} stopped: {err}", recorder.path().display()));
             self.recorder = None;
+        }
+        self.open_journal();
+        if let Some(journal) = &mut self.journal
+            && let Err(err) = f(journal)
+        {
+            self.ui.error(format!("the crash-recovery journal {} stopped: {err}", journal.path().display()));
+            self.journal = None;
+            self.journal_source = None;
+        }
+    }
+
+    /// Starts the journal of the open document once it has unsaved edits:
+    /// its first line loads the document as it is on disk.
+    fn open_journal(&mut self) {
+        if self.journal.is_some() || !self.state.dirty {
+            return;
+        }
+        let (Some(source), Some(document)) = (self.journal_source.clone(), self.state.path.clone()) else { return };
+        let path = octovox::journal::journal_path(&document);
+        let header = format!("crash-recovery journal of {}: `octovox recover` replays it", document.display());
+        match octovox::replay::Recorder::with_header(&path, &header).and_then(|mut journal| {
+            journal.scene(source)?;
+            Ok(journal)
+        }) {
+            Ok(journal) => self.journal = Some(journal),
+            Err(err) => {
+                self.ui.error(format!("cannot write the crash-recovery journal {}: {err}", path.display()));
+                self.journal_source = None;
+            }
+        }
+    }
+
+    /// Removes the journal: the document was saved, or its edits discarded.
+    pub(super) fn close_journal(&mut self) {
+        if let Some(journal) = self.journal.take() {
+            let _ = std::fs::remove_file(journal.path());
         }
     }
 }

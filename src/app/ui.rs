@@ -77,6 +77,8 @@ pub struct UiState {
     pub prompt_open: bool,
     /// A read-only file the user is asked about overwriting.
     pub read_only: Option<PathBuf>,
+    /// A crash-recovery journal found beside the document just opened.
+    pub recover: Option<PathBuf>,
     /// Last message for the user, and whether it is an error.
     pub message: Option<(String, bool)>,
 }
@@ -119,6 +121,7 @@ pub fn show(ui: &mut egui::Ui, state: &mut EditorState, ui_state: &mut UiState, 
     dialog(ui.ctx(), ui_state, &mut out);
     prompt(ui.ctx(), ui_state, &mut out);
     read_only_prompt(ui.ctx(), ui_state, &mut out);
+    recover_prompt(ui.ctx(), ui_state, &mut out);
     out
 }
 
@@ -557,6 +560,28 @@ fn prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
             }
             if ui.button("Cancel").clicked() {
                 out.push(Command::Resolve(Choice::Cancel));
+            }
+        });
+    });
+}
+
+/// Offers to apply a crash-recovery journal found beside the document.
+fn recover_prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
+    let Some(journal) = ui_state.recover.clone() else { return };
+    egui::Modal::new(egui::Id::unique("recover")).show(ctx, |ui| {
+        ui.heading("Recover unsaved edits?");
+        ui.label(format!(
+            "A session that ended without saving left its edits in {}. Apply them to the document?",
+            journal.display()
+        ));
+        ui.horizontal(|ui| {
+            if ui.button("Recover").clicked() {
+                ui_state.recover = None;
+                out.push(Command::RecoverJournal);
+            }
+            if ui.button("Discard").clicked() {
+                ui_state.recover = None;
+                out.push(Command::DiscardJournal);
             }
         });
     });

@@ -19,6 +19,7 @@ mod import;
 mod info;
 mod progress_bar;
 mod quality_plot;
+mod recover;
 pub mod render;
 mod replay;
 
@@ -38,6 +39,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Some(Command::Info { file, json, frame }) => info::run(&file, json, frame),
         Some(Command::Convert { input, output, frame, force }) => convert::run(&input, &output, frame, force),
         Some(Command::Import(args)) => import::run(&args),
+        Some(Command::Recover { file, output, force }) => recover::run(&file, &output, force),
         Some(Command::Export { file, output, scale, frame, force }) => export::run(&file, &output, scale, frame, force),
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),

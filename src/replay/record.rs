@@ -32,8 +32,28 @@ pub struct Recorder {
 
 impl Recorder {
     pub fn create(path: &Path) -> std::io::Result<Recorder> {
-        let file = std::fs::File::create(path)?;
-        let mut recorder = Recorder {
+        Recorder::with_header(path, "recorded by octovox --record")
+    }
+
+    /// A recorder whose file starts with the comment `# HEADER`.
+    pub fn with_header(path: &Path, header: &str) -> std::io::Result<Recorder> {
+        let mut recorder = Recorder::on(path, std::fs::File::create(path)?);
+        recorder.line(&format!("# {header}"))?;
+        Ok(recorder)
+    }
+
+    /// A recorder that goes on at the end of an existing script (a recovered
+    /// journal): the camera, brush and colour are written again before the
+    /// next edit, and undo does not reach before this point.
+    pub fn append(path: &Path) -> std::io::Result<Recorder> {
+        let mut recorder = Recorder::on(path, std::fs::OpenOptions::new().append(true).open(path)?);
+        // The script may end with mirror planes on; this recorder starts with none.
+        recorder.command(&Command::Mirror(None))?;
+        Ok(recorder)
+    }
+
+    fn on(path: &Path, file: std::fs::File) -> Recorder {
+        Recorder {
             out: std::io::BufWriter::new(file),
             path: path.to_path_buf(),
             camera: None,
@@ -43,9 +63,7 @@ impl Recorder {
             done: Vec::new(),
             undone: Vec::new(),
             open_stroke: 0,
-        };
-        recorder.line("# recorded by octovox --record")?;
-        Ok(recorder)
+        }
     }
 
     pub fn path(&self) -> &Path {

@@ -1,0 +1,144 @@
+//! Crash recovery: the real window is killed with SIGKILL after a few
+//! mouse edits; `octovox recover` then gives the document as it was after
+//! the last of them (computed independently by replaying the same clicks
+//! headless), and damaged or foreign journals are refused and left alone.
+//!
+//! Needs `Xvfb` and `xdotool`, like tests/window_e2e.rs.
+#![allow(clippy::unwrap_used)] // in tests a panic is the failure report
+
+mod common;
+
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Duration;
+
+use common::window::*;
+use glam::IVec3;
+use octovox::camera::Camera;
+
+fn octovox(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_octovox")).args(args).output().unwrap()
+}
+
+fn s(path: &Path) -> &str {
+    path.to_str().unwrap()
+}
+
+#[test]
+fn a_killed_window_loses_no_finished_edit() {
+    for tool in ["Xvfb", "xdotool"] {
+        require_tool(tool);
+    }
+    let source = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/vox/seed/torus64.vox");
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("torus.vox");
+    common::copy_writable(&source, &file);
+    let original = octovox::io::load_scene(&file, 0).unwrap();
+    let (lo, hi) = original.tree.solid_bounds().unwrap();
+    let camera = Camera::framing(lo, hi, 50.0);
+    // Three clicks on three different faces.
+    let mut pixels: Vec<(u32, u32)> = Vec::new();
+    let mut used: Vec<IVec3> = Vec::new();
+    for _ in 0..3 {
+        let (x, y, voxel, _) =
+            stable_pixel(&original.tree, &camera, |v, _| !used.iter().any(|u| (*u - v).abs().max_element() < 3));
+        used.push(voxel);
+        pixels.push((x, y));
+    }
+
+    let (_xvfb, display) = start_xvfb(7);
+    let args = [file.display().to_string(), "--size".into(), format!("{WIDTH}x{HEIGHT}"), camera_arg(&camera)];
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
+    let window = find_window(&display, &mut app, &stderr_path);
+    lines.wait_for("octovox: ready", Duration::from_secs(90));
+    let journal = octovox::journal::journal_path(&file);
+    assert!(!journal.exists(), "no journal before the first edit");
+    for &(x, y) in &pixels {
+        click(&display, &window, &mut lines, x, y);
+    }
+    assert!(journal.is_file(), "unsaved edits have a journal beside the document");
+    // A crash: no chance to clean up or save.
+    app.0.kill().unwrap();
+    app.0.wait().unwrap();
+    assert_eq!(
+        octovox::io::load_scene(&file, 0).unwrap().tree.voxels(),
+        original.tree.voxels(),
+        "the document is untouched"
+    );
+
+    // What the session held: the same clicks replayed headless.
+    let expected_file = dir.path().join("expected.vox");
+    let mut script = format!(
+        "load {}\nviewport {WIDTH} {HEIGHT}\ncamera {} {} {} {} {} {}\n",
+        s(&file),
+        camera.eye.x,
+        camera.eye.y,
+        camera.eye.z,
+        camera.target.x,
+        camera.target.y,
+        camera.target.z
+    );
+    for (x, y) in &pixels {
+        script += &format!("click {x} {y} attach\n");
+    }
+    script += &format!("save {}\n", s(&expected_file));
+    let script_path = dir.path().join("expected.ovr");
+    std::fs::write(&script_path, script).unwrap();
+    let run = octovox(&["replay", "--cpu", s(&script_path)]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stdout));
+
+    let recovered = dir.path().join("recovered.vox");
+    let run = octovox(&["recover", s(&file), "-o", s(&recovered)]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let voxels = |p: &Path| -> HashSet<(IVec3, u8)> {
+        octovox::io::load_scene(p, 0).unwrap().tree.voxels().into_iter().collect()
+    };
+    assert_eq!(voxels(&recovered), voxels(&expected_file), "recover gives the session's voxels");
+    assert_eq!(voxels(&recovered).len(), original.tree.voxels().len() + 3);
+    assert!(journal.is_file(), "recover leaves the journal in place");
+
+    // Opening the document again offers to recover; Recover applies it.
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
+    let window = find_window(&display, &mut app, &stderr_path);
+    let asked = lines.wait_for("asking: recover", Duration::from_secs(90));
+    assert!(asked.ends_with(&*journal.file_name().unwrap().to_string_lossy()), "{asked}");
+    xdotool(&display, &["windowfocus", "--sync", &window]);
+    // The modal's first button (Recover) has the keyboard focus after Tab.
+    xdotool(&display, &["key", "Tab", "Return"]);
+    lines.wait_for("recovered:", Duration::from_secs(30));
+    // Escape takes the keyboard focus back from the panel for Ctrl+S.
+    xdotool(&display, &["key", "Escape"]);
+    std::thread::sleep(Duration::from_millis(500));
+    save(&display, &mut lines, &file);
+    assert_eq!(voxels(&file), voxels(&expected_file), "Recover then Save writes the session's voxels");
+    assert!(!journal.exists(), "saving removes the journal");
+}
+
+#[test]
+fn damaged_and_foreign_journals_are_refused_and_left_in_place() {
+    let dir = tempfile::tempdir().unwrap();
+    let source = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/vox/seed/torus16.vox");
+    let file = dir.path().join("a.vox");
+    let other = dir.path().join("b.vox");
+    common::copy_writable(&source, &file);
+    common::copy_writable(&source, &other);
+    let out = dir.path().join("out.vox");
+    let journal = octovox::journal::journal_path(&file);
+
+    let message = String::from_utf8_lossy(&octovox(&["recover", s(&file), "-o", s(&out)]).stderr).into_owned();
+    assert!(message.contains("has no journal"), "{message}");
+    let cases = [
+        ("place 1 2\n".to_string(), "journal"),
+        (format!("load {}\nplace 0 40 0\n", s(&other)), "belongs to"),
+        (format!("load {}\nundo\n", s(&file)), "nothing was applied"),
+    ];
+    for (text, expected) in cases {
+        std::fs::write(&journal, &text).unwrap();
+        let run = octovox(&["recover", s(&file), "-o", s(&out)]);
+        let message = String::from_utf8_lossy(&run.stderr);
+        assert!(!run.status.success() && message.contains(expected), "{text}: {message}");
+        assert_eq!(std::fs::read_to_string(&journal).unwrap(), text, "the journal is left as it was");
+        assert!(!out.exists(), "nothing is written from a bad journal");
+    }
+}
