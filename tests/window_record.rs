@@ -5,12 +5,10 @@
 
 mod common;
 
-use std::path::PathBuf;
 use std::process::Command;
 use std::time::Duration;
 
 use common::window::*;
-use octovox::camera::Camera;
 
 fn wait_exit(app: &mut KillOnDrop) {
     let status = wait_for_exit(app, Duration::from_secs(30), "quit");
@@ -19,16 +17,7 @@ fn wait_exit(app: &mut KillOnDrop) {
 
 #[test]
 fn recorded_window_session_replays_to_the_same_voxels() {
-    for tool in ["Xvfb", "xdotool"] {
-        require_tool(tool);
-    }
-    let source = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/vox/seed/torus64.vox");
-    let dir = tempfile::tempdir().unwrap();
-    let file = dir.path().join("torus.vox");
-    common::copy_writable(&source, &file);
-    let original = octovox::io::load_scene(&file, 0).unwrap();
-    let (lo, hi) = original.tree.solid_bounds().unwrap();
-    let camera = Camera::framing(lo, hi, 50.0);
+    let (dir, file, original, camera) = torus_document();
     let (x, y, _, _) = stable_pixel(&original.tree, &camera, |_, _| true);
 
     let (_xvfb, display) = start_xvfb(0);

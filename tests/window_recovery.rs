@@ -15,7 +15,6 @@ use std::time::Duration;
 
 use common::window::*;
 use glam::IVec3;
-use octovox::camera::Camera;
 
 fn octovox(args: &[&str]) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_octovox")).args(args).output().unwrap()
@@ -27,16 +26,7 @@ fn s(path: &Path) -> &str {
 
 #[test]
 fn a_killed_window_loses_no_finished_edit() {
-    for tool in ["Xvfb", "xdotool"] {
-        require_tool(tool);
-    }
-    let source = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/vox/seed/torus64.vox");
-    let dir = tempfile::tempdir().unwrap();
-    let file = dir.path().join("torus.vox");
-    common::copy_writable(&source, &file);
-    let original = octovox::io::load_scene(&file, 0).unwrap();
-    let (lo, hi) = original.tree.solid_bounds().unwrap();
-    let camera = Camera::framing(lo, hi, 50.0);
+    let (dir, file, original, camera) = torus_document();
     // Three clicks on three different faces.
     let mut pixels: Vec<(u32, u32)> = Vec::new();
     let mut used: Vec<IVec3> = Vec::new();

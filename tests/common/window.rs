@@ -293,3 +293,19 @@ pub fn camera_arg(camera: &Camera) -> String {
     let (e, t) = (camera.eye, camera.target);
     format!("--camera={},{},{}:{},{},{}", e.x, e.y, e.z, t.x, t.y, t.z)
 }
+
+/// A writable copy of `torus64.vox` in a new folder, the scene it holds and
+/// a camera framing it: the document the window tests edit.
+pub fn torus_document() -> (tempfile::TempDir, PathBuf, octovox::scene::Scene, Camera) {
+    for tool in ["Xvfb", "xdotool"] {
+        require_tool(tool);
+    }
+    let source = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/vox/seed/torus64.vox");
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("torus.vox");
+    super::copy_writable(&source, &file);
+    let original = octovox::io::load_scene(&file, 0).unwrap();
+    let (lo, hi) = original.tree.solid_bounds().unwrap();
+    let camera = Camera::framing(lo, hi, 50.0);
+    (dir, file, original, camera)
+}
