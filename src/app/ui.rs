@@ -349,7 +349,9 @@ fn render(ui: &mut egui::Ui, state: &mut EditorState) {
         ui.radio_value(&mut settings.mode, TraceMode::Grid, "grid (DDA)");
     });
     ui.checkbox(&mut settings.shadows, "Sun shadows");
-    // The knobs carry their command-line names, as in `bench quality`.
+    // The knobs carry their command-line names, as in `bench quality`;
+    // shorter sliders leave the panel room for them.
+    ui.spacing_mut().slider_width = 64.0;
     ui.add(egui::Slider::new(&mut settings.render_scale, 0.25..=1.0).text("--render-scale"));
     ui.add(egui::Slider::new(&mut settings.lod, 0.0..=16.0).step_by(0.5).text("--lod (px)")).on_hover_text(
         "level of detail: the preview stops at octree cells narrower than this many pixels \
