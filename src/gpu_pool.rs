@@ -327,3 +327,47 @@ impl NodePool {
         self.nodes.len() as u64 * NODE_BYTES + self.bricks.len() as u64 * BRICK_BYTES
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pool(nodes: usize, bricks: usize) -> NodePool {
+        let mut pool = NodePool::default();
+        for _ in 0..nodes {
+            pool.nodes.alloc(NodeSlot { children: [1; 8], lod: 0 });
+        }
+        for _ in 0..bricks {
+            pool.bricks.alloc([1; 8]);
+        }
+        pool
+    }
+
+    fn bytes(upload: &Upload) -> u64 {
+        upload.nodes.grow_to_bytes().unwrap_or(0) + upload.bricks.grow_to_bytes().unwrap_or(0)
+    }
+
+    /// The 4096-tall statue's pool fitted lavapipe's binding but its
+    /// headroom did not, and every frame failed validation.
+    #[test]
+    fn the_headroom_shrinks_to_fit_one_binding() {
+        let mut roomy = pool(2000, 4000);
+        let upload = roomy.flush_within(u64::MAX).unwrap();
+        assert_eq!(upload.nodes.grow_to_slots, Some(3000), "half again as many slots when there is room");
+        let used = 2000 * NODE_BYTES + 4000 * BRICK_BYTES;
+        let mut tight = pool(2000, 4000);
+        let limit = used + used / 10;
+        let upload = tight.flush_within(limit).unwrap();
+        assert!(bytes(&upload) <= limit && bytes(&upload) >= used, "{} of {limit}", bytes(&upload));
+        assert_eq!(upload.byte_count(), used, "every slot is still written");
+    }
+
+    #[test]
+    fn a_pool_past_the_binding_is_refused_and_kept_for_later() {
+        let mut big = pool(100, 100);
+        let err = big.flush_within(100).unwrap_err();
+        assert_eq!(err, PoolTooLarge { needed: 100 * NODE_BYTES + 100 * BRICK_BYTES, limit: 100 });
+        let upload = big.flush_within(u64::MAX).unwrap();
+        assert_eq!(upload.byte_count(), 100 * NODE_BYTES + 100 * BRICK_BYTES, "nothing was lost");
+    }
+}
