@@ -93,6 +93,19 @@ impl RayBasis {
         self.ray_through(x as f32 + 0.5, y as f32 + 0.5)
     }
 
+    /// Where the (tree-local) point `p` lands on the image, in pixels; `None`
+    /// behind the eye. The inverse of [`RayBasis::ray_through`].
+    pub fn project(&self, p: Vec3) -> Option<(f32, f32)> {
+        let d = p - self.eye;
+        let depth = d.dot(self.forward);
+        if depth <= 0.0 {
+            return None;
+        }
+        let ndc_x = d.dot(self.right) / self.right.length_squared() / depth;
+        let ndc_y = d.dot(self.up) / self.up.length_squared() / depth;
+        Some(((ndc_x + 1.0) * 0.5 * self.width as f32, (1.0 - ndc_y) * 0.5 * self.height as f32))
+    }
+
     /// Origin and direction through a point of the image given in pixels
     /// (pixel (x, y) spans x..x + 1, y..y + 1).
     pub fn ray_through(&self, px: f32, py: f32) -> (Vec3, Vec3) {

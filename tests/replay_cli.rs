@@ -162,10 +162,33 @@ fn palette_edits_are_undoable_change_the_effects_and_are_saved() {
         ("material 9 metal _rough", "missing a number for _rough"),
         ("rgb 0 1 2 3", "palette index 0 is outside 1..=255"),
         ("rgb 9 1 2 300", "blue 300 is outside 0..=255"),
+        ("extrude 0 0 0 0 1 0 5000", "layers 5000 is outside -4096..=4096"),
     ] {
         let (out, text) = run_script(&format!("new\n{line}\n"));
         assert!(!out.status.success(), "{line}");
         assert!(text.contains(message) && text.contains("bad.ovr:2:"), "{line}: {text}");
+    }
+}
+
+/// An extrude without a face, with a slanted normal, or past the world's
+/// edge is refused and changes nothing.
+#[test]
+fn a_refused_extrude_changes_nothing() {
+    for (line, message) in [
+        ("extrude 0 5 0 0 1 0 1", "shows no face"),
+        ("extrude 0 0 0 1 1 0 1", "is not one of ±x, ±y, ±z"),
+        ("extrude 0 0 0 0 1 0 0", "extrude by 0 layers"),
+        ("extrude 16777210 0 0 1 0 0 4096", "outside the world"),
+    ] {
+        let start = if line.starts_with("extrude 1677") { "place 16777210 0 0" } else { "place 0 0 0" };
+        let (out, text) = run_script(&format!(
+            "new
+{start}
+{line}
+expect count 1
+"
+        ));
+        assert!(!out.status.success() && text.contains(message), "{line}: {text}");
     }
 }
 

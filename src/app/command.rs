@@ -69,6 +69,13 @@ pub enum Command {
         x: f64,
         y: f64,
     },
+    /// Ctrl+drag from a face: extrude its coplanar region by the layers
+    /// the drag covers along the face's normal on screen (Begin, then End).
+    ExtrudeDrag {
+        phase: StrokePhase,
+        x: f64,
+        y: f64,
+    },
     /// Line mode on or off (L).
     ToggleLine,
     /// Set the quality knobs to preset `PRESETS[i]`.

@@ -25,6 +25,8 @@ pub struct Input {
     right: Option<((f64, f64), bool)>,
     keys: HashSet<KeyCode>,
     modifiers: ModifiersState,
+    /// A Ctrl+drag extrude is under way.
+    extruding: bool,
 }
 
 impl Input {
@@ -96,6 +98,18 @@ impl Input {
                         if let Some((x, y)) = at {
                             out.push(Command::FillAt { x, y });
                         }
+                    }
+                    // Ctrl+drag from a face: extrude.
+                    (MouseButton::Left, true) if !consumed && self.modifiers.control_key() => {
+                        if let Some((x, y)) = at {
+                            self.extruding = true;
+                            out.push(Command::ExtrudeDrag { phase: StrokePhase::Begin, x, y });
+                        }
+                    }
+                    (MouseButton::Left, false) if self.extruding => {
+                        self.extruding = false;
+                        let (x, y) = at.unwrap_or_default();
+                        out.push(Command::ExtrudeDrag { phase: StrokePhase::End, x, y });
                     }
                     // Alt+click: the eyedropper.
                     (MouseButton::Left, true) if !consumed && self.modifiers.alt_key() => {

@@ -156,6 +156,8 @@ struct App {
     /// and the line that loads the document as saved, which starts it.
     journal: Option<octovox::replay::Recorder>,
     journal_source: Option<octovox::replay::Command>,
+    /// The face a Ctrl+drag extrude started on and where the drag began.
+    extrude_from: Option<(Pick, (f64, f64))>,
     /// Where the next screenshot goes (a script's `render PATH`), else `saves/`.
     screenshot_path: Option<PathBuf>,
 }
@@ -192,6 +194,7 @@ impl App {
             recorder: None,
             journal: None,
             journal_source: None,
+            extrude_from: None,
             screenshot_path: None,
             args,
         };
@@ -349,6 +352,7 @@ impl App {
                 self.apply_edit(edit);
             }
             Command::PointerEdit { phase, tool, x, y } if !busy_loading => self.pointer_edit(phase, tool, x, y),
+            Command::ExtrudeDrag { phase, x, y } if !busy_loading => self.extrude_drag(phase, x, y),
             Command::EditPalette { edit, dragging } if !busy_loading => self.palette_edit(edit, dragging),
             Command::Undo if !busy_loading => match self.history.undo(&mut self.scene) {
                 Ok(true) => {
@@ -368,6 +372,7 @@ impl App {
             },
             Command::Edit(_)
             | Command::PointerEdit { .. }
+            | Command::ExtrudeDrag { .. }
             | Command::EditPalette { .. }
             | Command::Undo
             | Command::Redo => {
@@ -532,6 +537,55 @@ impl App {
         let edits = octovox::scene::fill::fill_edits(&self.scene.tree, start, color)?;
         self.commit(edits, "fill")?;
         self.record(|r| r.fill(color, start));
+        Ok(())
+    }
+
+    /// A Ctrl+drag extrude: the face under the press, then at the release
+    /// the layers the drag covers along the face's normal as drawn on
+    /// screen (one layer = the on-screen length of one voxel step).
+    fn extrude_drag(&mut self, phase: StrokePhase, x: f64, y: f64) {
+        match phase {
+            StrokePhase::Begin => {
+                self.extrude_from = self
+                    .pick_or_say(x, y, "no face under the cursor to extrude")
+                    .filter(|p| p.normal != IVec3::ZERO)
+                    .map(|p| (p, (x, y)));
+            }
+            StrokePhase::End => {
+                let Some((pick, start)) = self.extrude_from.take() else { return };
+                let (w, h) = self.gfx.as_ref().map_or(self.args.size, |g| (g.config.width, g.config.height));
+                let basis = self.state.camera.basis(w, h, self.scene.tree.origin());
+                let face = (pick.voxel - self.scene.tree.origin()).as_vec3()
+                    + glam::Vec3::splat(0.5)
+                    + pick.normal.as_vec3() * 0.5;
+                let (Some(a), Some(b)) = (basis.project(face), basis.project(face + pick.normal.as_vec3())) else {
+                    return;
+                };
+                let step = glam::DVec2::new(f64::from(b.0 - a.0), f64::from(b.1 - a.1));
+                let drag = glam::DVec2::new(x - start.0, y - start.1);
+                let layers = (drag.dot(step) / step.length_squared().max(1e-6)).round() as i32;
+                if layers == 0 {
+                    return;
+                }
+                if let Err(err) = self.extrude(pick.voxel, pick.normal, layers) {
+                    self.ui.error(format!("extrude refused: {err}"));
+                }
+            }
+            StrokePhase::Move | StrokePhase::Click => {}
+        }
+    }
+
+    /// Extrudes the face region of `start` toward `normal` by `layers` (one
+    /// undo step, not mirrored: the region follows the faces).
+    pub(super) fn extrude(
+        &mut self,
+        start: IVec3,
+        normal: IVec3,
+        layers: i32,
+    ) -> Result<(), octovox::scene::EditError> {
+        let edits = octovox::scene::extrude::extrude_edits(&self.scene.tree, start, normal, layers)?;
+        self.commit(edits, "extrude")?;
+        self.record(|r| r.extrude(start, normal, layers));
         Ok(())
     }
 

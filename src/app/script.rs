@@ -107,6 +107,11 @@ impl App {
                     return Played::Failed(err.to_string());
                 }
             }
+            Line::Extrude(p, normal, layers) => {
+                if let Err(err) = self.extrude(*p, *normal, *layers) {
+                    return Played::Failed(err.to_string());
+                }
+            }
             Line::Pick(p) => match octovox::replay::picked_color(&self.scene, *p) {
                 Ok(value) => {
                     self.with_player(|player| player.color = value);

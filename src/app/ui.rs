@@ -224,7 +224,7 @@ fn tools(ui: &mut egui::Ui, state: &mut EditorState) {
             ui.add(egui::Slider::new(&mut state.box_size, 1..=64).text("size"));
         }
     }
-    ui.small("left: apply · right-drag: orbit · right-click: erase (Attach) · middle: pan · wheel: zoom · WASDQE + right: fly · F: frame");
+    ui.small("left: apply · Ctrl+drag a face: extrude · right-drag: orbit · right-click: erase (Attach) · middle: pan · wheel: zoom · WASDQE + right: fly · F: frame");
 }
 
 fn palette(ui: &mut egui::Ui, state: &mut EditorState, palette: &Palette) {

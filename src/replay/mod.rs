@@ -62,6 +62,9 @@ pub enum Command {
     Fill(IVec3),
     /// `pick X Y Z`: the eyedropper; the voxel's colour becomes the current one.
     Pick(IVec3),
+    /// `extrude X Y Z NX NY NZ N`: the connected coplanar faces facing
+    /// (NX, NY, NZ) around voxel (X, Y, Z)'s move out N layers (in, N < 0).
+    Extrude(IVec3, IVec3, i32),
     /// `rgb INDEX R G B`: a palette entry's colour (an undoable edit).
     Rgb(u8, [u8; 3]),
     /// `material INDEX KIND [KEY VALUE]...`: a palette entry's material,
@@ -117,6 +120,7 @@ impl fmt::Display for Command {
             Command::ExpectWritten(n) => write!(f, "expect written <= {n}"),
             Command::ExpectImage(path, tol) => write!(f, "expect image {} {tol}", quoted(path)),
             Command::Fill(p) => write!(f, "fill {}", v(*p)),
+            Command::Extrude(p, n, layers) => write!(f, "extrude {} {} {layers}", v(*p), v(*n)),
             Command::Line(a, b) => write!(f, "line {} {}", v(*a), v(*b)),
             Command::Mirror(None) => write!(f, "mirror off"),
             Command::Mirror(Some((axis, c))) => write!(f, "mirror {} {c}", ["x", "y", "z"][*axis]),

@@ -236,6 +236,11 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
         "paint" => Command::Paint(c.position()?),
         "pick" => Command::Pick(c.position()?),
         "fill" => Command::Fill(c.position()?),
+        "extrude" => {
+            let (at, normal) = (c.position()?, c.position()?);
+            let limit = i64::from(crate::scene::shape::MAX_BRUSH_EXTENT);
+            Command::Extrude(at, normal, c.int_in("layers", -limit..=limit)? as i32)
+        }
         "line" => Command::Line(c.position()?, c.position()?),
         "mirror" => {
             let axis = c.word("x, y, z or off")?;
@@ -421,7 +426,8 @@ mod tests {
                     color 7\nplace -1 2 3\nremove 1 2 3\npaint 1 2 -3\nclick 3 4 erase\nundo 2\nredo 1\nsave b.vox\n\
                     render c.png\nexpect voxel 1 2 3 0\nexpect count 5\nexpect written <= 512\nexpect image c.png 0.01\n\
                     demo showroom\nexpect effects sun glass\nexpect effects none\nrgb 4 1 2 3\n\
-                    material 4 glass _ri 1.45 _trans 0.5\nmaterial 5 diffuse\npick 1 -2 3\nfill 0 0 -1\nmirror x 4.5\nmirror z -2\nmirror off\nline 1 2 3 -4 5 6\n";
+                    material 4 glass _ri 1.45 _trans 0.5\nmaterial 5 diffuse\npick 1 -2 3\nfill 0 0 -1\nmirror x 4.5\nmirror z -2\nmirror off\nline 1 2 3 -4 5 6\n\
+                    extrude 1 2 3 0 -1 0 -2\n";
         let script = parse_script(Path::new("t.ovr"), text).unwrap();
         let printed: String = script.lines.iter().map(|l| format!("{}\n", l.command)).collect();
         let again = parse_script(Path::new("t.ovr"), &printed).unwrap();
@@ -429,7 +435,7 @@ mod tests {
             script.lines.iter().map(|l| &l.command).collect::<Vec<_>>(),
             again.lines.iter().map(|l| &l.command).collect::<Vec<_>>()
         );
-        assert_eq!(script.lines.len(), 33);
+        assert_eq!(script.lines.len(), 34);
     }
 
     #[test]

@@ -130,6 +130,16 @@ impl Recorder {
         Ok(())
     }
 
+    /// An extrude: the `extrude` line, one undo step of its own.
+    pub fn extrude(&mut self, at: IVec3, normal: IVec3, layers: i32) -> std::io::Result<()> {
+        self.end_step();
+        self.undone.clear();
+        self.open_stroke += 1;
+        self.command(&Command::Extrude(at, normal, layers))?;
+        self.end_step();
+        Ok(())
+    }
+
     /// A palette edit: an `rgb` line if the colour changed, a `material`
     /// line if the material did (each one edit of the open step).
     pub fn palette(

@@ -165,6 +165,12 @@ impl Runner {
                     crate::scene::fill::fill_edits(&self.scene.tree, *p, self.color).map_err(|e| e.to_string())?;
                 self.commit(edits)?;
             }
+            Command::Extrude(p, normal, layers) => {
+                // Not mirrored: the region follows the faces, not the brush.
+                let edits = crate::scene::extrude::extrude_edits(&self.scene.tree, *p, *normal, *layers)
+                    .map_err(|e| e.to_string())?;
+                self.commit(edits)?;
+            }
             Command::Click { x, y, tool } => {
                 let expected = format!("pixel ({x}, {y}) to hit a voxel");
                 let (voxel, normal) = match self.pick(*x, *y) {

@@ -4,6 +4,7 @@ pub mod apply;
 pub mod build;
 pub mod counts;
 pub mod demo;
+pub mod extrude;
 pub mod fill;
 pub mod lod;
 pub mod octree;
