@@ -174,7 +174,7 @@ fn bench_build(quick: bool) -> anyhow::Result<(String, String)> {
             r.report_build_ms / r.build_ms
         );
     }
-    md += "\nBuild: .vox models from their voxel list (parallel Morton sort, then bottom-up); the voxelized Nefertiti and the procedural sculpture from their dense arrays (octants in parallel). Times exclude file parsing, voxelization and the sculpture's generation. The report's times are from its own machine (see DESIGN.md), so the speed-up column compares machines too.\n";
+    md += "\nBuild: .vox models from their voxel list (parallel Morton sort, then bottom-up); the voxelized Nefertiti and the procedural sculpture from their dense arrays (64³ cubes in parallel, then assembled bottom-up; `import` builds the same cubes from column runs, with no dense array). Times exclude file parsing, voxelization and the sculpture's generation. The report's times are from its own machine (see DESIGN.md), so the speed-up column compares machines too.\n";
     Ok((md, serde_json::to_string_pretty(&rows)?))
 }
 
