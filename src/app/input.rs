@@ -88,6 +88,9 @@ impl Input {
                 if self.left {
                     out.push(Command::PointerEdit { phase: StrokePhase::Move, tool, x, y });
                 }
+                if self.extruding {
+                    out.push(Command::ExtrudeDrag { phase: StrokePhase::Move, x, y });
+                }
             }
             WindowEvent::MouseInput { state, button, .. } => {
                 let pressed = *state == ElementState::Pressed;

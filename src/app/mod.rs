@@ -551,28 +551,37 @@ impl App {
                     .filter(|p| p.normal != IVec3::ZERO)
                     .map(|p| (p, (x, y)));
             }
-            StrokePhase::End => {
-                let Some((pick, start)) = self.extrude_from.take() else { return };
-                let (w, h) = self.gfx.as_ref().map_or(self.args.size, |g| (g.config.width, g.config.height));
-                let basis = self.state.camera.basis(w, h, self.scene.tree.origin());
-                let face = (pick.voxel - self.scene.tree.origin()).as_vec3()
-                    + glam::Vec3::splat(0.5)
-                    + pick.normal.as_vec3() * 0.5;
-                let (Some(a), Some(b)) = (basis.project(face), basis.project(face + pick.normal.as_vec3())) else {
-                    return;
-                };
-                let step = glam::DVec2::new(f64::from(b.0 - a.0), f64::from(b.1 - a.1));
-                let drag = glam::DVec2::new(x - start.0, y - start.1);
-                let layers = (drag.dot(step) / step.length_squared().max(1e-6)).round() as i32;
-                if layers == 0 {
-                    return;
+            // While dragging, the message line says what the release will do.
+            StrokePhase::Move => {
+                if let Some(layers) = self.extrude_layers(x, y) {
+                    let how = if layers < 0 { "in" } else { "out" };
+                    self.ui.info(format!("extrude {how} {} layer(s)", layers.abs()));
                 }
+            }
+            StrokePhase::End => {
+                let layers = self.extrude_layers(x, y);
+                let Some((pick, _)) = self.extrude_from.take() else { return };
+                let Some(layers) = layers.filter(|l| *l != 0) else { return };
                 if let Err(err) = self.extrude(pick.voxel, pick.normal, layers) {
                     self.ui.error(format!("extrude refused: {err}"));
                 }
             }
-            StrokePhase::Move | StrokePhase::Click => {}
+            StrokePhase::Click => {}
         }
+    }
+
+    /// The layers a Ctrl+drag from its start to (x, y) covers: the drag
+    /// along the face normal's on-screen step, in whole steps.
+    fn extrude_layers(&self, x: f64, y: f64) -> Option<i32> {
+        let (pick, start) = self.extrude_from?;
+        let (w, h) = self.gfx.as_ref().map_or(self.args.size, |g| (g.config.width, g.config.height));
+        let basis = self.state.camera.basis(w, h, self.scene.tree.origin());
+        let normal = pick.normal.as_vec3();
+        let face = (pick.voxel - self.scene.tree.origin()).as_vec3() + glam::Vec3::splat(0.5) + normal * 0.5;
+        let (a, b) = (basis.project(face)?, basis.project(face + normal)?);
+        let step = glam::DVec2::new(f64::from(b.0 - a.0), f64::from(b.1 - a.1));
+        let drag = glam::DVec2::new(x - start.0, y - start.1);
+        Some((drag.dot(step) / step.length_squared().max(1e-6)).round() as i32)
     }
 
     /// Extrudes the face region of `start` toward `normal` by `layers` (one

@@ -68,10 +68,4 @@ impl Scene {
     pub fn from_model(model: &VoxelModel) -> Result<Scene, BuildError> {
         Ok(Scene { palette: model.palette.clone(), tree: Octree::from_voxels(&model.voxels)? })
     }
-
-    /// Builds the octree of a dense block (a voxelized mesh) with its min
-    /// corner at the origin, in the default palette.
-    pub fn from_dense(dense: &crate::io::mesh::DenseVoxels) -> Result<Scene, BuildError> {
-        Ok(Scene { palette: Palette::default(), tree: Octree::from_dense(dense.dims, IVec3::ZERO, &dense.data)? })
-    }
 }
