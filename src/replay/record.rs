@@ -123,19 +123,20 @@ impl Recorder {
             self.color = Some(color);
             self.command(&Command::Color(color))?;
         }
-        self.undone.clear();
-        self.open_stroke += 1;
-        self.command(&Command::Fill(at))?;
-        self.end_step();
-        Ok(())
+        self.one_step(&Command::Fill(at))
     }
 
     /// An extrude: the `extrude` line, one undo step of its own.
     pub fn extrude(&mut self, at: IVec3, normal: IVec3, layers: i32) -> std::io::Result<()> {
         self.end_step();
+        self.one_step(&Command::Extrude(at, normal, layers))
+    }
+
+    /// A line that is an undo step of its own (a fill, an extrude).
+    fn one_step(&mut self, command: &Command) -> std::io::Result<()> {
         self.undone.clear();
         self.open_stroke += 1;
-        self.command(&Command::Extrude(at, normal, layers))?;
+        self.command(command)?;
         self.end_step();
         Ok(())
     }

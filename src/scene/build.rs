@@ -309,12 +309,7 @@ impl LocalArena {
 
     /// `Octree::summary` for this arena's local words.
     fn summary(&self, word: u32, level: u32) -> Summary {
-        if !is_pointer(word) {
-            Summary::uniform(word as u8)
-        } else if level == 1 {
-            Summary::of_brick(&self.bricks[(word & !(POINTER_BIT | LOCAL_BRICK)) as usize])
-        } else {
-            Summary::from_word(self.nodes[slot_of(word) as usize].lod)
-        }
+        let brick = |w: u32| self.bricks[(w & !(POINTER_BIT | LOCAL_BRICK)) as usize];
+        lod::of_word(word, level, brick, |w| self.nodes[slot_of(w) as usize].lod)
     }
 }

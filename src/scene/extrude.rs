@@ -2,10 +2,9 @@
 //! faces facing one way, pushed out by whole layers or pulled in, as one
 //! undo step.
 
-use std::collections::{HashSet, VecDeque};
-
 use glam::IVec3;
 
+use super::fill::connected;
 use super::shape::MAX_BRUSH_EXTENT;
 use super::{EditError, Octree, Op, Shape};
 use crate::edit::Edit;
@@ -38,24 +37,12 @@ pub fn face_region(tree: &Octree, start: IVec3, normal: IVec3) -> Result<Vec<(IV
         .filter(|axis| axis.dot(normal) == 0)
         .flat_map(|axis| [axis, -axis])
         .collect();
-    let mut seen = HashSet::from([start]);
-    let mut queue = VecDeque::from([start]);
-    let mut region = Vec::new();
-    while let Some(p) = queue.pop_front() {
-        region.push((p, tree.get(p)));
-        if region.len() > MAX_EXTRUDE_FACES {
-            return Err(EditError::Brush(format!(
-                "the face at {start} has more than {MAX_EXTRUDE_FACES} voxels: extrude refused, nothing changed"
-            )));
-        }
-        for step in &in_plane {
-            let next = p + *step;
-            if shows_face(tree, next, normal) && seen.insert(next) {
-                queue.push_back(next);
-            }
-        }
-    }
-    Ok(region)
+    let region = connected(start, &in_plane, MAX_EXTRUDE_FACES, |p| shows_face(tree, p, normal)).ok_or_else(|| {
+        EditError::Brush(format!(
+            "the face at {start} has more than {MAX_EXTRUDE_FACES} voxels: extrude refused, nothing changed"
+        ))
+    })?;
+    Ok(region.into_iter().map(|p| (p, tree.get(p))).collect())
 }
 
 /// The edits of an extrude by `layers` (> 0 pushes out, each new voxel the

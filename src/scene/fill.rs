@@ -21,24 +21,39 @@ pub fn fill_region(tree: &Octree, start: IVec3) -> Result<Vec<IVec3>, EditError>
     if value == 0 {
         return Err(EditError::Brush(format!("no voxel at {start} to fill from")));
     }
+    let steps = [IVec3::X, IVec3::NEG_X, IVec3::Y, IVec3::NEG_Y, IVec3::Z, IVec3::NEG_Z];
+    connected(start, &steps, MAX_FILL_VOXELS, |p| tree.get(p) == value).ok_or_else(|| {
+        EditError::Brush(format!(
+            "the region at {start} has more than {MAX_FILL_VOXELS} voxels: fill refused, nothing changed"
+        ))
+    })
+}
+
+/// The cells reachable from `start` (itself included, breadth first) by
+/// `steps` through cells that `accept` holds for; `None` past `limit` cells.
+/// Flood fill and extrude's face region.
+pub(crate) fn connected(
+    start: IVec3,
+    steps: &[IVec3],
+    limit: usize,
+    accept: impl Fn(IVec3) -> bool,
+) -> Option<Vec<IVec3>> {
     let mut seen = HashSet::from([start]);
     let mut queue = VecDeque::from([start]);
     let mut region = Vec::new();
     while let Some(p) = queue.pop_front() {
         region.push(p);
-        if region.len() > MAX_FILL_VOXELS {
-            return Err(EditError::Brush(format!(
-                "the region at {start} has more than {MAX_FILL_VOXELS} voxels: fill refused, nothing changed"
-            )));
+        if region.len() > limit {
+            return None;
         }
-        for step in [IVec3::X, IVec3::NEG_X, IVec3::Y, IVec3::NEG_Y, IVec3::Z, IVec3::NEG_Z] {
-            let next = p + step;
-            if tree.get(next) == value && seen.insert(next) {
+        for step in steps {
+            let next = p + *step;
+            if accept(next) && seen.insert(next) {
                 queue.push_back(next);
             }
         }
     }
-    Ok(region)
+    Some(region)
 }
 
 /// The edits of a fill with `color`: one paint per voxel of the region,

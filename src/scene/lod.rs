@@ -15,7 +15,7 @@
 //! the nodes on its path and nothing else: builds, brushes and undo all make
 //! nodes through [`Octree::make_node`](super::Octree), which computes it.
 
-use crate::gpu_pool::Brick;
+use crate::gpu_pool::{Brick, is_pointer};
 
 /// What a cell looks like from far away.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -44,6 +44,20 @@ impl Summary {
     /// A brick's eight voxels.
     pub fn of_brick(brick: &Brick) -> Summary {
         combine(brick.map(Summary::uniform))
+    }
+}
+
+/// The summary of the cell of child word `word` at `level`: a uniform
+/// word's own, a brick's from its voxels (`brick` reads it), a node's as
+/// stored in its slot (`node_lod` reads the summary word). One rule for the
+/// octree's pool and a build's local arena.
+pub fn of_word(word: u32, level: u32, brick: impl FnOnce(u32) -> Brick, node_lod: impl FnOnce(u32) -> u32) -> Summary {
+    if !is_pointer(word) {
+        Summary::uniform(word as u8)
+    } else if level == 1 {
+        Summary::of_brick(&brick(word))
+    } else {
+        Summary::from_word(node_lod(word))
     }
 }
 

@@ -112,13 +112,7 @@ impl Octree {
 
     /// What the cell of child word `word` at `level` looks like from far away.
     pub fn summary(&self, word: u32, level: u32) -> Summary {
-        if !is_pointer(word) {
-            Summary::uniform(word as u8)
-        } else if level == 1 {
-            Summary::of_brick(self.brick(word))
-        } else {
-            Summary::from_word(self.pool.nodes.get(slot_of(word)).lod)
-        }
+        lod::of_word(word, level, |w| *self.brick(w), |w| self.pool.nodes.get(slot_of(w)).lod)
     }
 
     /// A node slot for children of a `level` node, with their summary.
