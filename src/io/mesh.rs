@@ -269,7 +269,7 @@ pub fn voxelize(triangles: &[[Vec3; 3]], size: u32, color: u8, progress: &Progre
     let place = placement(triangles, size);
     let mut builder = BlockBuilder::new(IVec3::ZERO, place.dims)?;
     let block_level = builder.block_level;
-    let tiles = (place.dims - UVec3::ONE) / (1 << block_level) + UVec3::ONE;
+    let tiles = builder.cubes_across(place.dims);
     let bins = bin_triangles(triangles, place, block_level, tiles);
     // A few tiles per thread at a time: their cubes go into the tree before
     // the next ones are filled.
@@ -307,7 +307,9 @@ pub fn voxelize_dense(triangles: &[[Vec3; 3]], size: u32, color: u8) -> DenseVox
 fn bin_triangles(triangles: &[[Vec3; 3]], place: Placement, block_level: u32, tiles: UVec3) -> Vec<Vec<u32>> {
     let mut bins = vec![Vec::new(); (tiles.x * tiles.z) as usize];
     for (i, triangle) in triangles.iter().enumerate() {
-        let Some((xs, zs)) = column_ranges(triangle, place) else { continue };
+        let Some((xs, zs)) = projected(triangle, place).and_then(|(v, _)| column_ranges(v, place.dims)) else {
+            continue;
+        };
         for tz in (zs.start() >> block_level)..=(zs.end() >> block_level) {
             for tx in (xs.start() >> block_level)..=(xs.end() >> block_level) {
                 bins[(tz * tiles.x + tx) as usize].push(i as u32);
@@ -328,17 +330,17 @@ fn projected(triangle: &[Vec3; 3], place: Placement) -> Option<([Vec3; 3], f32)>
     (area != 0.0).then_some(([a, b, c], area))
 }
 
-/// The columns (x and z ranges) under a triangle's footprint, or `None`
-/// when no column centre can cross it.
+/// The columns (x and z ranges) under a triangle's footprint (its vertices
+/// in voxel units, from [`projected`]), or `None` when no column centre can
+/// cross it.
 fn column_ranges(
-    triangle: &[Vec3; 3],
-    place: Placement,
+    [a, b, c]: [Vec3; 3],
+    dims: UVec3,
 ) -> Option<(std::ops::RangeInclusive<u32>, std::ops::RangeInclusive<u32>)> {
-    let ([a, b, c], _) = projected(triangle, place)?;
     let min = Vec2::new(a.x.min(b.x).min(c.x), a.z.min(b.z).min(c.z)) - JITTER;
     let max = Vec2::new(a.x.max(b.x).max(c.x), a.z.max(b.z).max(c.z)) - JITTER;
-    let (x0, x1) = (min.x.ceil().max(0.0), max.x.floor().min(place.dims.x as f32 - 1.0));
-    let (z0, z1) = (min.y.ceil().max(0.0), max.y.floor().min(place.dims.z as f32 - 1.0));
+    let (x0, x1) = (min.x.ceil().max(0.0), max.x.floor().min(dims.x as f32 - 1.0));
+    let (z0, z1) = (min.y.ceil().max(0.0), max.y.floor().min(dims.z as f32 - 1.0));
     (x0 <= x1 && z0 <= z1).then_some(((x0 as u32)..=(x1 as u32), (z0 as u32)..=(z1 as u32)))
 }
 
@@ -381,12 +383,8 @@ impl Columns {
     ) -> Columns {
         let mut heights = vec![Vec::new(); size.0 as usize * size.1 as usize];
         for &i in which {
-            let triangle = &triangles[i as usize];
-            let (Some(([a, b, c], area)), Some((xs, zs))) =
-                (projected(triangle, place), column_ranges(triangle, place))
-            else {
-                continue;
-            };
+            let Some(([a, b, c], area)) = projected(&triangles[i as usize], place) else { continue };
+            let Some((xs, zs)) = column_ranges([a, b, c], place.dims) else { continue };
             let (a2, b2, c2) = (Vec2::new(a.x, a.z), Vec2::new(b.x, b.z), Vec2::new(c.x, c.z));
             let (x0, x1) = ((*xs.start()).max(min.0), (*xs.end()).min(min.0 + size.0 - 1));
             let (z0, z1) = ((*zs.start()).max(min.1), (*zs.end()).min(min.1 + size.1 - 1));

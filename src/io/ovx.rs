@@ -16,7 +16,7 @@ use glam::IVec3;
 
 use super::atomic::{WriteOptions, write_atomically};
 use super::progress::Progress;
-use crate::gpu_pool::{Brick, NODE_BYTES, NodeSlot, is_pointer, pointer_to, slot_of};
+use crate::gpu_pool::{BRICK_BYTES, Brick, NODE_BYTES, NodeSlot, is_pointer, pointer_to, slot_of};
 use crate::scene::octree::{MAX_DEPTH, MIN_DEPTH, Octree};
 use crate::scene::{Material, MaterialKind, Palette, Scene};
 
@@ -72,7 +72,7 @@ pub fn save_ovx(path: &Path, scene: &Scene, options: WriteOptions) -> Result<(),
     let materials = encode_materials(&scene.palette);
     let payload_len = FIXED_PAYLOAD_BYTES
         + compact.nodes.len() as u64 * NODE_BYTES
-        + compact.bricks.len() as u64 * 8
+        + compact.bricks.len() as u64 * BRICK_BYTES
         + materials.len() as u64;
     write_atomically(path, options, |file| {
         let mut out = Counting::new(io::BufWriter::new(file));
@@ -204,15 +204,13 @@ pub fn decode_ovx(bytes: &[u8], progress: &Progress) -> Result<Scene, OvxError> 
             OvxError::NotOvx
         });
     }
-    let word = |at: usize| u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]]);
-    if word(8) != VERSION {
-        return Err(OvxError::UnsupportedVersion(word(8)));
+    if le_u32(bytes, 8) != VERSION {
+        return Err(OvxError::UnsupportedVersion(le_u32(bytes, 8)));
     }
     if found < HEADER_BYTES + FOOTER_BYTES {
         return Err(OvxError::Truncated { found, expected: HEADER_BYTES + FOOTER_BYTES });
     }
-    let long = |at: usize| u64::from(word(at)) | u64::from(word(at + 4)) << 32;
-    let (expected, payload_len) = (long(16), long(24));
+    let (expected, payload_len) = (le_u64(bytes, 16), le_u64(bytes, 24));
     if found < expected {
         return Err(OvxError::Truncated { found, expected });
     }
@@ -220,7 +218,7 @@ pub fn decode_ovx(bytes: &[u8], progress: &Progress) -> Result<Scene, OvxError> 
         return Err(corrupt(format!("{found} bytes where the header says {expected}")));
     }
     let body = &bytes[..bytes.len() - FOOTER_BYTES as usize];
-    let stored = word(body.len());
+    let stored = le_u32(bytes, body.len());
     let computed = crc32fast::hash(body);
     if stored != computed {
         return Err(OvxError::BadChecksum { stored, computed });
@@ -237,35 +235,43 @@ pub fn decode_ovx(bytes: &[u8], progress: &Progress) -> Result<Scene, OvxError> 
 }
 
 fn read_payload(input: &mut impl Read, payload_len: u64) -> Result<Scene, OvxError> {
-    let mut read = |n: usize| -> Result<Vec<u8>, OvxError> {
-        let mut buf = vec![0u8; n];
-        input.read_exact(&mut buf).map_err(|e| corrupt(format!("the payload ends early ({e})")))?;
-        Ok(buf)
-    };
-    let fixed = read(FIXED_PAYLOAD_BYTES as usize)?;
-    let word = |at: usize| u32::from_le_bytes([fixed[at], fixed[at + 1], fixed[at + 2], fixed[at + 3]]);
-    let long = |at: usize| u64::from(word(at)) | u64::from(word(at + 4)) << 32;
+    let fixed: Vec<u8> = read_items(input, FIXED_PAYLOAD_BYTES as usize)?;
+    let word = |at: usize| le_u32(&fixed, at);
     let origin = IVec3::new(word(0) as i32, word(4) as i32, word(8) as i32);
-    let (depth, root, node_count, brick_count) = (word(12), word(16), long(20), long(28));
+    let (depth, root, node_count, brick_count) = (word(12), word(16), le_u64(&fixed, 20), le_u64(&fixed, 28));
     if !(MIN_DEPTH..=MAX_DEPTH).contains(&depth) {
         return Err(corrupt(format!("root depth {depth} is outside {MIN_DEPTH}..={MAX_DEPTH}")));
     }
-    let arrays = node_count.checked_mul(NODE_BYTES).zip(brick_count.checked_mul(8));
+    let arrays = node_count.checked_mul(NODE_BYTES).zip(brick_count.checked_mul(BRICK_BYTES));
     let Some(materials_len) =
         arrays.and_then(|(n, b)| payload_len.checked_sub(FIXED_PAYLOAD_BYTES)?.checked_sub(n)?.checked_sub(b))
     else {
         return Err(corrupt(format!("{node_count} nodes and {brick_count} bricks do not fit its {payload_len} bytes")));
     };
     let mut palette = Palette { colors: bytemuck::pod_read_unaligned(&fixed[36..36 + 256 * 4]), ..Palette::default() };
-    let nodes: Vec<NodeSlot> = read(node_count as usize * NODE_BYTES as usize)?
-        .chunks_exact(NODE_BYTES as usize)
-        .map(bytemuck::pod_read_unaligned)
-        .collect();
-    let bricks: Vec<Brick> =
-        read(brick_count as usize * 8)?.chunks_exact(8).map(bytemuck::pod_read_unaligned).collect();
-    palette.materials = decode_materials(&read(materials_len as usize)?)?;
+    let nodes: Vec<NodeSlot> = read_items(input, node_count as usize)?;
+    let bricks: Vec<Brick> = read_items(input, brick_count as usize)?;
+    palette.materials = decode_materials(&read_items::<u8>(input, materials_len as usize)?)?;
     let tree = Octree::from_parts(origin, depth, root, nodes, bricks).map_err(corrupt)?;
     Ok(Scene { palette, tree })
+}
+
+/// `n` items read straight into their vector (the counts were checked
+/// against the payload's length, itself against the memory budget).
+fn read_items<T: bytemuck::Pod>(input: &mut impl Read, n: usize) -> Result<Vec<T>, OvxError> {
+    let mut items = vec![T::zeroed(); n];
+    input
+        .read_exact(bytemuck::cast_slice_mut(&mut items))
+        .map_err(|e| corrupt(format!("the payload ends early ({e})")))?;
+    Ok(items)
+}
+
+fn le_u32(bytes: &[u8], at: usize) -> u32 {
+    u32::from_le_bytes([bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]])
+}
+
+fn le_u64(bytes: &[u8], at: usize) -> u64 {
+    u64::from(le_u32(bytes, at)) | u64::from(le_u32(bytes, at + 4)) << 32
 }
 
 fn decode_materials(bytes: &[u8]) -> Result<Vec<Material>, OvxError> {
@@ -282,10 +288,10 @@ fn decode_materials(bytes: &[u8]) -> Result<Vec<Material>, OvxError> {
             .get(usize::from(kind))
             .ok_or_else(|| corrupt(format!("material {index} has kind {kind}")))?;
         let mut material = Material::new(kind);
-        let count = u32::from_le_bytes(take(4)?.try_into().unwrap_or_default());
+        let count = le_u32(take(4)?, 0);
         for _ in 0..count {
             let mut text = || -> Result<String, OvxError> {
-                let len = u32::from_le_bytes(take(4)?.try_into().unwrap_or_default()) as usize;
+                let len = le_u32(take(4)?, 0) as usize;
                 String::from_utf8(take(len)?.to_vec())
                     .map_err(|_| corrupt(format!("material {index}: text is not UTF-8")))
             };

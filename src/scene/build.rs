@@ -212,9 +212,14 @@ impl BlockBuilder {
         Ok(BlockBuilder { tree, block_level: BLOCK_LEVEL.min(depth), words: Vec::new() })
     }
 
+    /// How many cubes cover `dims` voxels along each axis.
+    pub fn cubes_across(&self, dims: UVec3) -> UVec3 {
+        (dims - UVec3::ONE) / (1 << self.block_level) + UVec3::ONE
+    }
+
     /// The cube coordinates covering `dims` voxels.
     pub fn blocks_in(&self, dims: UVec3) -> Vec<UVec3> {
-        let n = (dims - UVec3::ONE) / (1 << self.block_level) + UVec3::ONE;
+        let n = self.cubes_across(dims);
         (0..n.z).flat_map(|z| (0..n.y).flat_map(move |y| (0..n.x).map(move |x| UVec3::new(x, y, z)))).collect()
     }
 

@@ -50,10 +50,12 @@ impl VoxelModel {
 
 /// Inclusive bounding box of a set of positions, or `None` when empty.
 pub fn bounds_of(points: impl Iterator<Item = IVec3>) -> Option<(IVec3, IVec3)> {
-    points.fold(None, |acc, p| match acc {
-        None => Some((p, p)),
-        Some((lo, hi)) => Some((lo.min(p), hi.max(p))),
-    })
+    points.fold(None, |acc, p| Some(grow_bounds(acc, p)))
+}
+
+/// Bounds that also hold `p`.
+pub fn grow_bounds(bounds: Option<(IVec3, IVec3)>, p: IVec3) -> (IVec3, IVec3) {
+    bounds.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p)))
 }
 
 /// What the sandbox edits: a palette and an octree of palette indices.

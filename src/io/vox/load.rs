@@ -90,7 +90,7 @@ pub fn load_vox_scene(bytes: &[u8], frame: usize) -> Result<(Scene, VoxMeta), Vo
     for placement in &parsed.placements {
         for voxel in parsed.placed(placement) {
             let p = voxel?.0;
-            bounds = Some(bounds.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p))));
+            bounds = Some(crate::scene::grow_bounds(bounds, p));
         }
     }
     let mut tree = match bounds {
