@@ -118,12 +118,9 @@ impl App {
         let Some(document) = self.state.path.clone() else { return };
         match octovox::journal::recover(&document) {
             Ok(scene) => {
-                self.scene = scene;
-                self.history.clear();
+                self.replace_scene(scene, octovox::replay::Command::Load(document.clone()));
+                // What is shown is the document plus its journal, not yet saved.
                 self.state.dirty = true;
-                self.grid_stale = true;
-                self.path_stale = true;
-                self.upload();
                 let journal = octovox::journal::journal_path(&document);
                 match octovox::replay::Recorder::append(&journal) {
                     Ok(recorder) => self.journal = Some(recorder),

@@ -463,9 +463,14 @@ impl App {
         self.state.settings.render_scale.clamp(octovox::settings::MIN_RENDER_SCALE, 1.0) * self.motion.factor()
     }
 
+    /// The window's size in physical pixels (the requested one before it opens).
+    fn window_size(&self) -> (u32, u32) {
+        self.gfx.as_ref().map_or(self.args.size, |g| (g.config.width, g.config.height))
+    }
+
     /// The trace resolution for the current window size and render scale.
     fn trace_size(&self) -> (u32, u32) {
-        let (w, h) = self.gfx.as_ref().map_or(self.args.size, |g| (g.config.width, g.config.height));
+        let (w, h) = self.window_size();
         let scale = self.render_scale();
         (((w as f32 * scale).round() as u32).max(1), ((h as f32 * scale).round() as u32).max(1))
     }
@@ -475,7 +480,7 @@ impl App {
     /// pixels by the render scale; the panels sit over the image).
     /// A ray that gave up is an error, never "nothing under the cursor".
     fn pick_at(&self, x: f64, y: f64) -> Result<Option<Pick>, svo::GaveUp> {
-        let (window_w, window_h) = self.gfx.as_ref().map_or(self.args.size, |g| (g.config.width, g.config.height));
+        let (window_w, window_h) = self.window_size();
         let (w, h) = self.trace_size();
         if x < 0.0 || y < 0.0 || x >= f64::from(window_w) || y >= f64::from(window_h) {
             return Ok(None);
@@ -574,7 +579,7 @@ impl App {
     /// along the face normal's on-screen step, in whole steps.
     fn extrude_layers(&self, x: f64, y: f64) -> Option<i32> {
         let (pick, start) = self.extrude_from?;
-        let (w, h) = self.gfx.as_ref().map_or(self.args.size, |g| (g.config.width, g.config.height));
+        let (w, h) = self.window_size();
         let basis = self.state.camera.basis(w, h, self.scene.tree.origin());
         let normal = pick.normal.as_vec3();
         let face = (pick.voxel - self.scene.tree.origin()).as_vec3() + glam::Vec3::splat(0.5) + normal * 0.5;
@@ -609,7 +614,7 @@ impl App {
     /// Measures the quality presets from the current camera (a second or
     /// so on lavapipe; the window waits meanwhile) and prints the result.
     fn measure_presets(&mut self) {
-        let window = self.gfx.as_ref().map_or(self.args.size, |g| (g.config.width, g.config.height));
+        let window = self.window_size();
         let Some(gfx) = &mut self.gfx else { return };
         match presets::measure(&mut gfx.renderer, &self.scene, &self.state.camera, window) {
             Ok(measured) => {

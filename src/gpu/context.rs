@@ -161,3 +161,28 @@ pub fn validated_on<T>(
         None => Ok(created),
     }
 }
+
+/// A compute pipeline of `module`'s `entry` with override `constants`,
+/// inside a validation scope (on any thread): every pass's kernels.
+pub(super) fn compute_pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    entry: &str,
+    constants: &[(&str, f64)],
+    label: &str,
+) -> Result<wgpu::ComputePipeline, GpuError> {
+    validated_on(device, label, |device| {
+        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(label),
+            layout: Some(layout),
+            module,
+            entry_point: Some(entry),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants,
+                zero_initialize_workgroup_memory: false,
+            },
+            cache: None,
+        })
+    })
+}

@@ -13,7 +13,7 @@ use std::sync::mpsc;
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
-use super::context::validated_on;
+use super::context::compute_pipeline;
 use super::prelude::with_prelude;
 use super::readback::{read_storage, read_texture_rgba8};
 use super::trace_pass::{FrameUniforms, buffer_entry, output_entry, output_texture, uniform_entry};
@@ -55,20 +55,7 @@ fn compile(
     module: &wgpu::ShaderModule,
     effects: Effects,
 ) -> Result<wgpu::ComputePipeline, GpuError> {
-    let constants = effects.constants();
-    validated_on(device, "path tracer", |device| {
-        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("path tracer"),
-            layout: Some(layout),
-            module,
-            entry_point: Some("path"),
-            compilation_options: wgpu::PipelineCompilationOptions {
-                constants: &constants,
-                zero_initialize_workgroup_memory: false,
-            },
-            cache: None,
-        })
-    })
+    compute_pipeline(device, layout, module, "path", &effects.constants(), "path tracer")
 }
 
 const EMITTER_BYTES: u64 = std::mem::size_of::<Emitter>() as u64;

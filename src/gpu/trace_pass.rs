@@ -4,6 +4,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::IVec3;
 
+use super::context::compute_pipeline;
 use super::prelude::with_prelude;
 use super::readback::{read_storage, read_texture_rgba8};
 use super::{GpuContext, GpuError, SceneBuffers};
@@ -126,9 +127,10 @@ pub struct TracePass {
     /// [svo without shadows, svo with, grid without, grid with].
     pipelines: [wgpu::ComputePipeline; 4],
     beam: wgpu::ComputePipeline,
-    /// The SVO kernels with level of detail, compiled on first use:
-    /// [without shadows, with shadows, beam].
+    /// The SVO kernels with level of detail, compiled on first use from
+    /// `svo`: [without shadows, with shadows, beam].
     lod_pipelines: Option<[wgpu::ComputePipeline; 3]>,
+    svo: wgpu::ShaderModule,
     floor: wgpu::ComputePipeline,
     uniform_buf: wgpu::Buffer,
     target: Target,
@@ -148,31 +150,6 @@ pub(super) fn uniform_entry(binding: u32, size: usize) -> wgpu::BindGroupLayoutE
         },
         count: None,
     }
-}
-
-/// A compute pipeline of `module`'s `entry` with override `constants`,
-/// inside a validation scope.
-fn compute_pipeline(
-    gpu: &GpuContext,
-    layout: &wgpu::PipelineLayout,
-    module: &wgpu::ShaderModule,
-    entry: &str,
-    constants: &[(&str, f64)],
-    label: &str,
-) -> Result<wgpu::ComputePipeline, GpuError> {
-    gpu.validated(label, |device| {
-        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(label),
-            layout: Some(layout),
-            module,
-            entry_point: Some(entry),
-            compilation_options: wgpu::PipelineCompilationOptions {
-                constants,
-                zero_initialize_workgroup_memory: false,
-            },
-            cache: None,
-        })
-    })
 }
 
 /// The binding of the RGBA8 output texture a kernel writes.
@@ -249,7 +226,7 @@ impl TracePass {
         let svo = gpu.shader("trace_svo.wgsl", &with_prelude(&[COMMON_WGSL, SVO_WGSL]))?;
         let grid = gpu.shader("trace_grid.wgsl", &with_prelude(&[COMMON_WGSL, GRID_WGSL]))?;
         let pipeline = |module, entry, constants: &[(&str, f64)], label| {
-            compute_pipeline(gpu, &pipeline_layout, module, entry, constants, label)
+            compute_pipeline(&gpu.device, &pipeline_layout, module, entry, constants, label)
         };
         let tile = ("BEAM_TILE", f64::from(BEAM_TILE));
         let pipelines = [
@@ -276,6 +253,7 @@ impl TracePass {
             pipelines,
             beam,
             lod_pipelines: None,
+            svo,
             floor,
             uniform_buf,
             target,
@@ -293,9 +271,8 @@ impl TracePass {
         if !matches!(kernel, Kernel::Trace { lod: true, .. }) || self.lod_pipelines.is_some() {
             return Ok(());
         }
-        let svo = gpu.shader("trace_svo.wgsl", &with_prelude(&[COMMON_WGSL, SVO_WGSL]))?;
         let pipeline = |entry, constants: &[(&str, f64)], label| {
-            compute_pipeline(gpu, &self.pipeline_layout, &svo, entry, constants, label)
+            compute_pipeline(&gpu.device, &self.pipeline_layout, &self.svo, entry, constants, label)
         };
         let (tile, lod) = (("BEAM_TILE", f64::from(BEAM_TILE)), ("LOD", 1.0));
         self.lod_pipelines = Some([
