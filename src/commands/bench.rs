@@ -74,6 +74,11 @@ fn build(source: &Source) -> anyhow::Result<Octree> {
     })
 }
 
+/// Mean traversal steps per pixel of a frame's hit records.
+pub(super) fn mean_steps(hits: &[octovox::trace::Hit]) -> f64 {
+    hits.iter().map(|h| f64::from(h.iterations)).sum::<f64>() / hits.len().max(1) as f64
+}
+
 pub(super) fn median(mut samples: Vec<f64>) -> f64 {
     samples.sort_by(f64::total_cmp);
     samples[samples.len() / 2]
@@ -306,7 +311,7 @@ fn bench_render(quick: bool, lod: f32) -> anyhow::Result<(String, String)> {
         for (i, mode) in modes.into_iter().enumerate() {
             renderer.render(&scene.tree, &camera, (width, height), &settings(mode), None)?;
             let hits = renderer.read_hits()?;
-            mean_iterations[i] = hits.iter().map(|h| f64::from(h.iterations)).sum::<f64>() / hits.len().max(1) as f64;
+            mean_iterations[i] = mean_steps(&hits);
         }
         renderer.hit_records = false;
         let [grid_times, svo_times] = times;

@@ -66,9 +66,15 @@ fn knobs(sizes: &Sizes) -> Vec<(&'static str, String, Setting)> {
     out
 }
 
-fn scenes(quick: bool) -> anyhow::Result<Vec<(&'static str, Scene, Camera)>> {
+/// The small model, framed.
+fn teapot() -> anyhow::Result<(Scene, Camera)> {
     let teapot = octovox::io::load_scene(&super::bench::assets().join("vox/seed/teapot256.vox"), 0)?;
-    let teapot_camera = crate::cli::camera_or_framing(None, 50.0, &teapot);
+    let camera = crate::cli::camera_or_framing(None, 50.0, &teapot);
+    Ok((teapot, camera))
+}
+
+fn scenes(quick: bool) -> anyhow::Result<Vec<(&'static str, Scene, Camera)>> {
+    let (teapot, teapot_camera) = teapot()?;
     let mut out = vec![("teapot256 (small)", teapot, teapot_camera)];
     if !quick {
         let sculpture = super::bench::sculpture_scene()?;
@@ -142,8 +148,7 @@ const LOD_VALUES: [f32; 5] = [0.0, 1.0, 2.0, 4.0, 8.0];
 /// 320×180 image; in both a voxel is about a third of a pixel.
 fn level_of_detail(renderer: &mut Renderer, quick: bool) -> anyhow::Result<Vec<LodRow>> {
     let (mut scene, views) = if quick {
-        let teapot = octovox::io::load_scene(&super::bench::assets().join("vox/seed/teapot256.vox"), 0)?;
-        let camera = crate::cli::camera_or_framing(None, 50.0, &teapot);
+        let (teapot, camera) = teapot()?;
         (teapot, vec![("teapot256 at 160×90", camera, (160, 90))])
     } else {
         let sculpture = super::bench::sculpture_scene()?;
@@ -174,16 +179,14 @@ fn lod_rows(
 ) -> anyhow::Result<Vec<LodRow>> {
     let settings = |lod| RenderSettings { lod, ..RenderSettings::default() };
     let mut measured = Vec::new();
+    // The picture and the steps from one frame with hit records; the timed
+    // frames below write none.
+    renderer.hit_records = true;
     for lod in LOD_VALUES {
         renderer.render(&scene.tree, camera, size, &settings(lod), None)?;
-        let image = renderer.read_image()?;
-        renderer.hit_records = true;
-        renderer.render(&scene.tree, camera, size, &settings(lod), None)?;
-        let hits = renderer.read_hits()?;
-        renderer.hit_records = false;
-        let steps = hits.iter().map(|h| f64::from(h.iterations)).sum::<f64>() / hits.len().max(1) as f64;
-        measured.push((lod, image, steps, Vec::new()));
+        measured.push((lod, renderer.read_image()?, super::bench::mean_steps(&renderer.read_hits()?), Vec::new()));
     }
+    renderer.hit_records = false;
     // Frames interleaved, so the machine's noise falls on every footprint alike.
     for _ in 0..frames {
         for (lod, _, _, times) in &mut measured {
