@@ -288,9 +288,9 @@ impl NodePool {
             return Ok(self.take((None, None)));
         }
         let bytes = |n: usize, b: usize| n as u64 * NODE_BYTES + b as u64 * BRICK_BYTES;
-        let current = |arena: Option<usize>| arena.unwrap_or(0);
+        // What the buffer holds after this flush: the new capacity, else the current one.
         let planned =
-            (nodes.unwrap_or(current(self.nodes.gpu_capacity)), bricks.unwrap_or(current(self.bricks.gpu_capacity)));
+            (nodes.or(self.nodes.gpu_capacity).unwrap_or(0), bricks.or(self.bricks.gpu_capacity).unwrap_or(0));
         if bytes(planned.0, planned.1) <= max_bytes {
             return Ok(self.take((nodes, bricks)));
         }
