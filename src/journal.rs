@@ -70,5 +70,5 @@ pub fn recover(document: &Path) -> Result<Scene, RecoverError> {
     if let Some(failure) = report.failures.first() {
         return Err(RecoverError::Failed { path: journal, message: failure.to_string() });
     }
-    Ok(runner.scene)
+    Ok(runner.editor.scene)
 }

@@ -6,6 +6,7 @@
 pub mod budget;
 pub mod camera;
 pub mod edit;
+pub mod editor;
 pub mod gpu;
 pub mod gpu_pool;
 pub mod io;

@@ -280,3 +280,106 @@ fn a_line_places_one_brush_per_step_in_one_undo_step() {
         replay_passes(&path, cpu, "8 passed, 0 failed");
     }
 }
+
+/// Box selection: copy, paste, move, cut and delete, each checked voxel by
+/// voxel against this test's own map arithmetic, with undo and redo.
+#[test]
+fn select_copy_paste_move_cut_and_delete_in_one_step_each() {
+    use glam::IVec3;
+    use octovox::scene::{Op, Scene, Shape};
+    use std::collections::HashMap;
+    type Voxels = HashMap<IVec3, u8>;
+    let mut base: Voxels = HashMap::new();
+    // Block A (colour 3, one voxel of 5, a hole at (2, 2, 1)), a voxel of 9
+    // where A's hole lands after the paste, and a voxel of 7 apart.
+    for x in 0..4 {
+        for y in 0..3 {
+            for z in 0..2 {
+                base.insert(IVec3::new(x, y, z), 3);
+            }
+        }
+    }
+    base.insert(IVec3::new(1, 1, 0), 5);
+    base.remove(&IVec3::new(2, 2, 1));
+    base.insert(IVec3::new(12, 2, 1), 9);
+    base.insert(IVec3::new(0, 0, 5), 7);
+    let dir = tempfile::tempdir().unwrap();
+    let mut scene = Scene::default();
+    for (p, c) in &base {
+        scene.tree.apply_brush(&Shape::Voxel(*p), Op::Place(*c)).unwrap();
+    }
+    octovox::io::save_scene(&dir.path().join("blocks.vox"), &scene, Default::default()).unwrap();
+
+    let inside = |p: IVec3, lo: IVec3, hi: IVec3| p.cmpge(lo).all() && p.cmple(hi).all();
+    let boxed = |v: &Voxels, lo: IVec3, hi: IVec3| -> Voxels {
+        v.iter().filter(|(p, _)| inside(**p, lo, hi)).map(|(p, c)| (*p, *c)).collect()
+    };
+    let without = |v: &Voxels, lo: IVec3, hi: IVec3| -> Voxels {
+        v.iter().filter(|(p, _)| !inside(**p, lo, hi)).map(|(p, c)| (*p, *c)).collect()
+    };
+    let put = |v: &Voxels, block: &Voxels, by: IVec3| -> Voxels {
+        let mut out = v.clone();
+        out.extend(block.iter().map(|(p, c)| (*p + by, *c)));
+        out
+    };
+    let (a_lo, a_hi) = (IVec3::ZERO, IVec3::new(3, 2, 1));
+    let copied = boxed(&base, a_lo, a_hi);
+    let pasted = put(&base, &copied, IVec3::new(10, 0, 0));
+    let (m_lo, m_hi) = (IVec3::ZERO, IVec3::new(1, 2, 1));
+    let moved = put(&without(&pasted, m_lo, m_hi), &boxed(&pasted, m_lo, m_hi), IVec3::new(0, 5, 0));
+    let (c_lo, c_hi) = (IVec3::new(0, 5, 0), IVec3::new(1, 7, 1));
+    let cut_block = boxed(&moved, c_lo, c_hi);
+    let cut = without(&moved, c_lo, c_hi);
+    let cut_pasted = put(&cut, &cut_block, IVec3::new(20, 0, 0) - c_lo);
+    let deleted = without(&cut_pasted, IVec3::new(20, 0, 0), IVec3::new(20, 2, 1));
+    assert!(pasted[&IVec3::new(12, 2, 1)] == 9 && deleted.len() < cut_pasted.len(), "the cases are not trivial");
+
+    let script = format!(
+        "load blocks.vox\nselect 3 2 1 0 0 0\ncopy\npaste 10 0 0\nsave pasted.vox\nundo\nexpect count {}\nredo\n\
+         select 0 0 0 1 2 1\nmove 0 5 0\nsave moved.vox\nundo\nsave move_undone.vox\nredo\n\
+         cut\nsave cut.vox\npaste 20 0 0\nsave cut_pasted.vox\nselect 20 0 0 20 2 1\ndelete\nsave deleted.vox\n\
+         undo\nexpect count {}\nredo\nexpect count {}\n",
+        base.len(),
+        cut_pasted.len(),
+        deleted.len()
+    );
+    let path = dir.path().join("select.ovr");
+    std::fs::write(&path, script).unwrap();
+    let read = |name: &str| -> Voxels {
+        octovox::io::load_scene(&dir.path().join(name), 0).unwrap().tree.voxels().into_iter().collect()
+    };
+    for cpu in [false, true] {
+        replay_passes(&path, cpu, "3 passed, 0 failed");
+        for (name, want) in [
+            ("pasted.vox", &pasted),
+            ("moved.vox", &moved),
+            ("move_undone.vox", &pasted),
+            ("cut.vox", &cut),
+            ("cut_pasted.vox", &cut_pasted),
+            ("deleted.vox", &deleted),
+        ] {
+            assert_eq!(&read(name), want, "{name}");
+        }
+        for name in ["pasted.vox", "moved.vox", "move_undone.vox", "cut.vox", "cut_pasted.vox", "deleted.vox"] {
+            std::fs::remove_file(dir.path().join(name)).unwrap();
+        }
+    }
+}
+
+/// Lines that need a selection, a clipboard or room in the world say so
+/// with file:line and change nothing.
+#[test]
+fn selection_lines_that_cannot_run_are_refused() {
+    for (script, message) in [
+        ("new\ncopy\n", "nothing is selected"),
+        ("new\npaste 0 0 0\n", "nothing to paste"),
+        ("new\nplace 0 0 0\nplace 1 0 0\nselect 0 0 0 1 0 0\nmove 16777215 0 0\n", "outside the world"),
+        ("new\nselect 0 0 0 9000 0 0\n", "at most 4096 voxels wide"),
+        ("new\nmove 1 2\n", "missing Z"),
+    ] {
+        let (out, text) = run_script(script);
+        assert!(!out.status.success(), "{script}");
+        let line = script.lines().count();
+        assert!(text.contains(message) && text.contains(&format!("bad.ovr:{line}")), "{script}: {text}");
+    }
+}

@@ -77,15 +77,39 @@ fn window_plays_a_script_through_the_edit_path() {
     )
     .unwrap();
     let (_xvfb, display) = start_xvfb(1);
-    let args = ["--size".to_string(), "640x480".into(), "--replay".into(), script.display().to_string()];
+    let recording = dir.path().join("rec.ovr");
+    let args = [
+        "--size".to_string(),
+        "640x480".into(),
+        "--replay".into(),
+        script.display().to_string(),
+        "--record".into(),
+        recording.display().to_string(),
+    ];
     let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
     find_window(&display, &mut app, &stderr_path);
     let summary = lines.wait_for("replay:", Duration::from_secs(120));
     assert_eq!(summary, "replay: 7 passed, 0 failed", "{:?}", lines.seen);
+    // The played lines went through the same path as the mouse, so the
+    // recording (flushed per line) replays to the same scene.
+    let mut recorded = std::fs::read_to_string(&recording).unwrap();
+    recorded.push_str("save replayed.vox\n");
+    std::fs::write(&recording, recorded).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_octovox"))
+        .args(["replay", "--cpu", recording.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stdout));
+    let replayed = octovox::io::load_scene(&dir.path().join("replayed.vox"), 0).unwrap();
     let saved = octovox::io::load_scene(&dir.path().join("out.vox"), 0).unwrap();
     assert_eq!(saved.tree.solid_voxels(), 27);
     // Palette edits went through the window's edit path, undo included.
     assert_eq!(saved.palette.color(9), [200, 100, 50, 255]);
     assert_eq!(saved.palette.material(9).kind, octovox::scene::MaterialKind::Metal);
     assert_eq!(saved.palette.material(9).roughness(), 0.2);
+    assert_eq!(replayed.tree.voxels(), saved.tree.voxels(), "the recording replays to the same voxels");
+    assert_eq!(
+        (replayed.palette.color(9), replayed.palette.material(9)),
+        (saved.palette.color(9), saved.palette.material(9))
+    );
 }

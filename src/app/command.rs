@@ -22,6 +22,17 @@ pub enum StrokePhase {
     Click,
 }
 
+/// A direction on screen for the arrow keys, as the camera sees it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Nudge {
+    Left,
+    Right,
+    Away,
+    Near,
+    Up,
+    Down,
+}
+
 /// What the unsaved-changes prompt was opened for.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Pending {
@@ -40,8 +51,6 @@ pub enum Choice {
 
 #[derive(Clone, Debug, PartialEq)]
 pub enum Command {
-    /// Apply an edit (scripts; mouse edits arrive as `PointerEdit` and end here too).
-    Edit(Edit),
     /// Edit with `tool` at the window pixel `(x, y)` (physical pixels).
     PointerEdit {
         phase: StrokePhase,
@@ -78,6 +87,20 @@ pub enum Command {
     },
     /// Line mode on or off (L).
     ToggleLine,
+    /// Box select mode on or off (B): a left drag selects a box, or drags
+    /// a face of the selected one.
+    ToggleSelect,
+    /// Edit ▸ Copy, Cut, Delete, Select none: the `copy`, `cut`, `delete`
+    /// and `select off` lines.
+    Copy,
+    Cut,
+    DeleteSelection,
+    SelectNone,
+    /// `paste` with the block's min corner in front of the face under the cursor.
+    PasteAtCursor,
+    /// `move` the selection one voxel along the world axis nearest to a
+    /// direction on screen (arrow keys, Page Up / Page Down).
+    Nudge(Nudge),
     /// Set the quality knobs to preset `PRESETS[i]`.
     ApplyPreset(usize),
     /// Measure what each preset costs and how far it is from the reference.

@@ -34,14 +34,13 @@ impl App {
             octovox::replay::Command::Load(_) => Some(line),
             _ => None,
         };
-        self.scene = scene;
-        self.history.clear();
+        self.editor.set_scene(scene);
         self.stroke = None;
         // An imported mesh has no .vox to save back to: Save asks for one
         // rather than writing .vox bytes over the .obj.
         self.state.path = path.filter(|p| !octovox::io::is_mesh_path(p));
         self.state.dirty = false;
-        self.state.color = first_used_color(&self.scene).unwrap_or(self.state.color);
+        self.editor.tools.color = first_used_color(&self.editor.scene).unwrap_or(self.editor.tools.color);
         self.grid_stale = true;
         self.path_stale = true;
         let upload = self.upload();
@@ -90,8 +89,9 @@ impl App {
                 self.replace_scene(Scene::default(), octovox::replay::Command::New);
                 self.state.camera = Camera { fov_y_deg: self.state.camera.fov_y_deg, ..Camera::default() };
                 // A lone voxel to attach to: an empty scene gives the mouse nothing to hit.
-                let color = self.state.color.max(1);
+                let color = self.editor.tools.color.max(1);
                 if let Err(err) = self
+                    .editor
                     .scene
                     .tree
                     .apply_brush(&octovox::scene::Shape::Voxel(IVec3::ZERO), octovox::scene::Op::Place(color))
@@ -154,7 +154,7 @@ impl App {
             self.ui.read_only = Some(path.to_path_buf());
             return false;
         }
-        match octovox::io::save_scene(path, &self.scene, options) {
+        match octovox::io::save_scene(path, &self.editor.scene, options) {
             Ok(()) => {
                 report!("saved: {}", path.display());
                 self.state.dirty = false;
@@ -179,7 +179,7 @@ impl App {
         let inputs: Vec<&Path> = self.state.path.iter().map(PathBuf::as_path).collect();
         let result =
             octovox::io::export::check_outputs(path, &inputs, false).map_err(|e| e.to_string()).and_then(|()| {
-                octovox::io::export::export_mesh(path, &self.scene, 1.0, WriteOptions::default())
+                octovox::io::export::export_mesh(path, &self.editor.scene, 1.0, WriteOptions::default())
                     .map_err(|e| e.to_string())
             });
         match result {

@@ -82,26 +82,29 @@ impl App {
         let mut commands = Vec::new();
         let mut full = {
             let info = ui::Info {
-                palette: &self.scene.palette,
-                tree: &self.scene.tree,
+                palette: &self.editor.scene.palette,
+                tree: &self.editor.scene.tree,
                 stats: &self.stats,
                 adapter: &gfx.renderer.gpu.adapter_name,
                 timestamps: gfx.renderer.timed_by_gpu(),
                 loading: loading.as_ref().map(|(p, s, f)| (p.as_path(), *s, *f)),
-                can_undo: self.history.can_undo(),
-                can_redo: self.history.can_redo(),
+                can_undo: self.editor.history.can_undo(),
+                can_redo: self.editor.history.can_redo(),
                 history: {
-                    let (steps, bytes) = self.history.usage();
-                    (steps, bytes, self.history.memory_limit_bytes)
+                    let (steps, bytes) = self.editor.history.usage();
+                    (steps, bytes, self.editor.history.memory_limit_bytes)
                 },
                 presets: self.presets_measured.as_deref(),
+                selection: self.state.select_preview.or(self.editor.selection),
+                has_clipboard: self.editor.clipboard().is_some(),
             };
-            let (state, ui_state) = (&mut self.state, &mut self.ui);
+            let (state, ui_state, tools) = (&mut self.state, &mut self.ui, &mut self.editor.tools);
             let pick = self.pick;
             ctx.run_ui(raw_input, |ui| {
-                commands = ui::show(ui, state, ui_state, &info);
-                if let Some(pick) = pick {
-                    ui::draw_brush_outline(ui, state, &pick, &info);
+                commands = ui::show(ui, state, tools, ui_state, &info);
+                ui::draw_selection(ui, state, &info);
+                if let Some(pick) = pick.filter(|_| !state.select_mode) {
+                    ui::draw_brush_outline(ui, state, tools, &pick, &info);
                 }
             })
         };
@@ -150,7 +153,7 @@ impl App {
         if path_traced(&self.state, self.motion.moving()) {
             let changed = std::mem::take(&mut self.path_stale);
             gfx.renderer.sample_target = self.state.sample_target.max(1);
-            let (scene, state) = (&self.scene, &self.state);
+            let (scene, state) = (&self.editor.scene, &self.state);
             let frame = gfx.renderer.render_path(
                 &scene.tree,
                 &scene.palette,
@@ -173,9 +176,14 @@ impl App {
                 Err(err) => log::error!("path tracing failed: {err}"),
             }
         } else {
-            let highlight = self.pick.map(|pick| self.state.preview_box(&pick));
+            // Select mode tints the selected voxels; the other modes what the brush would touch.
+            let highlight = if self.state.select_mode {
+                self.state.select_preview.or(self.editor.selection).map(|r| (r.min, r.max))
+            } else {
+                self.pick.map(|pick| self.state.preview_box(&self.editor.tools, &pick))
+            };
             let settings = &self.state.settings;
-            match gfx.renderer.render(&self.scene.tree, &self.state.camera, trace_size, settings, highlight) {
+            match gfx.renderer.render(&self.editor.scene.tree, &self.state.camera, trace_size, settings, highlight) {
                 Ok(ms) => self.stats.trace_ms = ms,
                 Err(err) => log::error!("trace failed: {err}"),
             }
@@ -249,7 +257,7 @@ impl App {
             return;
         }
         let Some(gfx) = &mut self.gfx else { return };
-        match DenseGrid::from_octree(&self.scene.tree) {
+        match DenseGrid::from_octree(&self.editor.scene.tree) {
             Ok(grid) => match gfx.renderer.set_grid(&grid) {
                 Ok(()) => self.grid_stale = false,
                 Err(err) => {

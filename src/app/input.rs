@@ -180,36 +180,14 @@ impl Input {
         out
     }
 
-    /// Keyboard shortcuts (physical keys, so they work on any layout).
+    /// Keyboard shortcuts (physical keys, so they work on any layout), from
+    /// the one table of actions.
     fn shortcut(&self, code: KeyCode, repeat: bool) -> Option<Command> {
-        let ctrl = self.modifiers.control_key();
-        let shift = self.modifiers.shift_key();
-        if ctrl {
-            return match code {
-                KeyCode::KeyZ if shift => Some(Command::Redo),
-                KeyCode::KeyZ => Some(Command::Undo),
-                KeyCode::KeyY => Some(Command::Redo),
-                KeyCode::KeyS if repeat => None,
-                KeyCode::KeyS if shift => Some(Command::AskSaveAs),
-                KeyCode::KeyS => Some(Command::Save),
-                KeyCode::KeyO => Some(Command::AskOpen),
-                KeyCode::KeyN => Some(Command::New),
-                KeyCode::KeyQ => Some(Command::Quit),
-                _ => None,
-            };
-        }
-        if repeat {
+        let action = super::actions::for_key(code, self.modifiers.control_key(), self.modifiers.shift_key(), repeat)?;
+        // While the right button is held, WASDQE fly, and F is not "frame".
+        if action.command == Command::FrameModel && self.right.is_some() {
             return None;
         }
-        // While the right button is held, WASDQE fly; the tool keys still work.
-        match code {
-            KeyCode::KeyT => Some(Command::SetTool(Tool::Attach)),
-            KeyCode::KeyR => Some(Command::SetTool(Tool::Erase)),
-            KeyCode::KeyG => Some(Command::SetTool(Tool::Paint)),
-            KeyCode::KeyL => Some(Command::ToggleLine),
-            KeyCode::KeyF if self.right.is_none() => Some(Command::FrameModel),
-            KeyCode::F12 => Some(Command::Screenshot),
-            _ => None,
-        }
+        Some(action.command.clone())
     }
 }

@@ -12,6 +12,7 @@ macro_rules! report {
     }};
 }
 
+mod actions;
 mod camera_control;
 mod capture;
 mod command;
@@ -21,6 +22,7 @@ mod input;
 mod motion;
 mod presets;
 mod script;
+mod selection;
 mod state;
 mod ui;
 
@@ -39,7 +41,8 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::window::{Window, WindowId};
 
 use octovox::camera::Camera;
-use octovox::edit::{Edit, History};
+use octovox::edit::Edit;
+use octovox::editor::{Editor, Outcome};
 use octovox::gpu::scene_buffers::UploadStats;
 use octovox::gpu::{BlitPass, GpuContext, Renderer};
 use octovox::io::atomic::WriteOptions;
@@ -47,7 +50,7 @@ use octovox::scene::Scene;
 use octovox::trace::svo;
 
 use crate::cli::WindowArgs;
-pub use command::{Choice, Command, Pending, StrokePhase};
+pub use command::{Choice, Command, Nudge, Pending, StrokePhase};
 use input::Input;
 use state::{EditorState, Pick, Tool};
 use ui::{DialogKind, Stats, UiState};
@@ -119,8 +122,9 @@ struct App {
     instance: Option<wgpu::Instance>,
     args: WindowArgs,
     gfx: Option<Gfx>,
-    scene: Scene,
-    history: History,
+    /// Scene, history, brush, colour, mirror, selection: the engine's editor,
+    /// which played scripts drive too.
+    editor: Editor,
     state: EditorState,
     ui: UiState,
     input: Input,
@@ -156,6 +160,8 @@ struct App {
     /// and the line that loads the document as saved, which starts it.
     journal: Option<octovox::replay::Recorder>,
     journal_source: Option<octovox::replay::Command>,
+    /// A box-select drag under way (select mode).
+    select_drag: Option<selection::SelectDrag>,
     /// The face a Ctrl+drag extrude started on and where the drag began.
     extrude_from: Option<(Pick, (f64, f64))>,
     /// Where the next screenshot goes (a script's `render PATH`), else `saves/`.
@@ -167,8 +173,7 @@ impl App {
         let mut app = App {
             instance: Some(instance),
             gfx: None,
-            scene: Scene::default(),
-            history: History::default(),
+            editor: Editor::default(),
             state: EditorState::default(),
             ui: UiState::default(),
             input: Input::default(),
@@ -194,6 +199,7 @@ impl App {
             recorder: None,
             journal: None,
             journal_source: None,
+            select_drag: None,
             extrude_from: None,
             screenshot_path: None,
             args,
@@ -287,22 +293,57 @@ impl App {
 
     // ----- the one path for changes: edit → history → octree → upload ------------
 
-    /// Applies an edit the way every edit is applied: `History::apply` on the
-    /// octree, then the pool's dirty ranges go to the GPU.
+    /// Applies an edit and its mirror images the way every edit is
+    /// applied: through the editor's history onto the octree, then the
+    /// pool's dirty ranges go to the GPU.
     pub fn apply_edit(&mut self, edit: Edit) -> bool {
-        self.apply_edits(vec![edit], "edit")
-    }
-
-    /// Several edits (a line) and their mirror images as one undo step (or
-    /// part of the open stroke); `what` names it in the printed line.
-    pub fn apply_edits(&mut self, edits: Vec<Edit>, what: &str) -> bool {
-        let edits = edits.into_iter().flat_map(|e| self.state.mirror.edits(e)).collect();
-        match self.commit(edits, what) {
-            Ok(()) => true,
+        match self.editor.apply_mirrored(vec![edit]) {
+            Ok(()) => {
+                self.after_change("edit");
+                true
+            }
             Err(err) => {
                 self.ui.error(format!("edit refused: {err}"));
                 false
             }
+        }
+    }
+
+    /// Runs one editor line (a played script line, or what a mouse action
+    /// became) and follows it up: an edit goes to the GPU, the recording
+    /// and the journal. New and demo lines replace the scene as Open does.
+    pub(super) fn run_line(&mut self, line: &octovox::replay::Command) -> Result<Outcome, String> {
+        if let octovox::replay::Command::New | octovox::replay::Command::Demo(_) = line {
+            let scene = match line {
+                octovox::replay::Command::Demo(built_in) => built_in.scene(),
+                _ => Scene::default(),
+            };
+            self.replace_scene(scene, line.clone());
+            return Ok(Outcome::Replaced);
+        }
+        let outcome = self.editor.run(line)?;
+        match outcome {
+            Outcome::Changed => {
+                // The line's command word names it in the printed line (`fill: N bytes written`).
+                let text = line.to_string();
+                self.after_change(text.split(' ').next().unwrap_or("edit"));
+            }
+            Outcome::State => {
+                report!("ran: {line}");
+                self.request_redraw();
+            }
+            Outcome::Replaced | Outcome::Checked { .. } | Outcome::Host => return Ok(outcome),
+        }
+        let (tools, camera) = (self.editor.tools, self.state.camera);
+        self.record(|r| r.ran(line, &tools, &camera));
+        Ok(outcome)
+    }
+
+    /// A mouse or key action as an editor line; a refusal goes to the
+    /// message line as `what refused: …`.
+    fn act(&mut self, line: octovox::replay::Command, what: &str) {
+        if let Err(err) = self.run_line(&line) {
+            self.ui.error(format!("{what} refused: {err}"));
         }
     }
 
@@ -329,7 +370,7 @@ impl App {
     /// which palette edits change) to the GPU buffers; the stats count the pool.
     fn upload(&mut self) -> UploadStats {
         match &mut self.gfx {
-            Some(gfx) => gfx.renderer.sync(&mut self.scene.tree, &self.scene.palette),
+            Some(gfx) => gfx.renderer.sync(&mut self.editor.scene.tree, &self.editor.scene.palette),
             // No device yet: the ranges stay dirty and go up with the first frame.
             None => UploadStats::default(),
         }
@@ -348,13 +389,14 @@ impl App {
     fn execute(&mut self, command: Command, event_loop: &ActiveEventLoop) {
         let busy_loading = self.loading.is_some();
         match command {
-            Command::Edit(edit) if !busy_loading => {
-                self.apply_edit(edit);
-            }
             Command::PointerEdit { phase, tool, x, y } if !busy_loading => self.pointer_edit(phase, tool, x, y),
             Command::ExtrudeDrag { phase, x, y } if !busy_loading => self.extrude_drag(phase, x, y),
             Command::EditPalette { edit, dragging } if !busy_loading => self.palette_edit(edit, dragging),
-            Command::Undo if !busy_loading => match self.history.undo(&mut self.scene) {
+            Command::Cut if !busy_loading => self.act(octovox::replay::Command::Cut, "cut"),
+            Command::DeleteSelection if !busy_loading => self.act(octovox::replay::Command::Delete, "delete"),
+            Command::PasteAtCursor if !busy_loading => self.paste_at_cursor(),
+            Command::Nudge(nudge) if !busy_loading => self.nudge(nudge),
+            Command::Undo if !busy_loading => match self.editor.undo() {
                 Ok(true) => {
                     self.record(|r| r.undo());
                     self.after_change("undo");
@@ -362,7 +404,7 @@ impl App {
                 Ok(false) => self.ui.info("nothing to undo"),
                 Err(err) => self.ui.error(format!("undo failed: {err}")),
             },
-            Command::Redo if !busy_loading => match self.history.redo(&mut self.scene) {
+            Command::Redo if !busy_loading => match self.editor.redo() {
                 Ok(true) => {
                     self.record(|r| r.redo());
                     self.after_change("redo");
@@ -370,8 +412,11 @@ impl App {
                 Ok(false) => self.ui.info("nothing to redo"),
                 Err(err) => self.ui.error(format!("redo failed: {err}")),
             },
-            Command::Edit(_)
-            | Command::PointerEdit { .. }
+            Command::PointerEdit { .. }
+            | Command::Cut
+            | Command::DeleteSelection
+            | Command::PasteAtCursor
+            | Command::Nudge(_)
             | Command::ExtrudeDrag { .. }
             | Command::EditPalette { .. }
             | Command::Undo
@@ -384,21 +429,19 @@ impl App {
                 }
             }
             Command::MeasurePresets => self.measure_presets(),
-            Command::ToggleLine => {
-                self.state.line_mode = !self.state.line_mode;
-                self.state.line_start = None;
-            }
+            Command::ToggleLine => self.state.toggle_line_mode(),
+            Command::ToggleSelect => self.state.toggle_select_mode(),
+            Command::Copy => self.act(octovox::replay::Command::Copy, "copy"),
+            Command::SelectNone => self.act(octovox::replay::Command::Select(None), "select"),
             Command::FillAt { x, y } => {
-                if let Some(pick) = self.pick_or_say(x, y, "no voxel there to fill")
-                    && let Err(err) = self.fill(pick.voxel, self.state.color.max(1))
-                {
-                    self.ui.error(format!("fill refused: {err}"));
+                if let Some(pick) = self.pick_or_say(x, y, "no voxel there to fill") {
+                    self.act(octovox::replay::Command::Fill(pick.voxel), "fill");
                 }
             }
             Command::PickColor { x, y } => {
                 if let Some(pick) = self.pick_or_say(x, y, "no voxel there to pick a colour from") {
-                    self.state.color = pick.value;
-                    report!("picked colour {}", pick.value);
+                    self.act(octovox::replay::Command::Pick(pick.voxel), "pick");
+                    report!("picked colour {}", self.editor.tools.color);
                 }
             }
             Command::SetTool(tool) => self.state.tool = tool,
@@ -449,7 +492,7 @@ impl App {
     /// Frames the whole model, centred in the part of the window that the
     /// side panel leaves free.
     fn frame_model(&mut self) {
-        camera_control::frame_model(&mut self.state.camera, self.scene.tree.solid_bounds());
+        camera_control::frame_model(&mut self.state.camera, self.editor.scene.tree.solid_bounds());
         let (scale, height) =
             self.gfx.as_ref().map_or((1.0, self.args.size.1), |g| (g.window.scale_factor(), g.config.height));
         camera_control::pan(&mut self.state.camera, f64::from(ui::PANEL_WIDTH) * scale * 0.5, 0.0, height);
@@ -487,7 +530,7 @@ impl App {
         }
         let px = ((x * f64::from(w) / f64::from(window_w)) as u32).min(w - 1);
         let py = ((y * f64::from(h) / f64::from(window_h)) as u32).min(h - 1);
-        let hit = svo::pick(&self.scene.tree, &self.state.camera, (w, h), px, py)?;
+        let hit = svo::pick(&self.editor.scene.tree, &self.state.camera, (w, h), px, py)?;
         Ok(hit.map(|hit| Pick { voxel: hit.voxel, normal: hit.normal, value: hit.value }))
     }
 
@@ -524,25 +567,10 @@ impl App {
             StrokePhase::End | StrokePhase::Click => {
                 let start = self.state.line_start.take().or(target);
                 if let (Some(a), Some(b)) = (start, target) {
-                    let (brush, color) = (self.state.brush(), self.state.color.max(1));
-                    let edits = octovox::tool::line_edits(&brush, color, a, b);
-                    if self.apply_edits(edits, "line") {
-                        let (camera, mirror) = (self.state.camera, self.state.mirror);
-                        self.record(|r| r.line_drawn(&camera, brush, color, &mirror, (a, b)));
-                    }
+                    self.act(octovox::replay::Command::Line(a, b), "line");
                 }
             }
         }
-    }
-
-    /// Recolours the region of `start`'s colour with `color`, as one undo
-    /// step, through the edit path; recorded as a `fill` line.
-    pub(super) fn fill(&mut self, start: IVec3, color: u8) -> Result<(), octovox::scene::EditError> {
-        // Not mirrored: the region follows the colour, not the brush.
-        let edits = octovox::scene::fill::fill_edits(&self.scene.tree, start, color)?;
-        self.commit(edits, "fill")?;
-        self.record(|r| r.fill(color, start));
-        Ok(())
     }
 
     /// A Ctrl+drag extrude: the face under the press, then at the release
@@ -567,48 +595,31 @@ impl App {
                 let layers = self.extrude_layers(x, y);
                 let Some((pick, _)) = self.extrude_from.take() else { return };
                 let Some(layers) = layers.filter(|l| *l != 0) else { return };
-                if let Err(err) = self.extrude(pick.voxel, pick.normal, layers) {
-                    self.ui.error(format!("extrude refused: {err}"));
-                }
+                self.act(octovox::replay::Command::Extrude(pick.voxel, pick.normal, layers), "extrude");
             }
             StrokePhase::Click => {}
         }
     }
 
-    /// The layers a Ctrl+drag from its start to (x, y) covers: the drag
-    /// along the face normal's on-screen step, in whole steps.
+    /// The layers a Ctrl+drag from its start to (x, y) covers.
     fn extrude_layers(&self, x: f64, y: f64) -> Option<i32> {
         let (pick, start) = self.extrude_from?;
+        let face = (pick.voxel - self.editor.scene.tree.origin()).as_vec3()
+            + glam::Vec3::splat(0.5)
+            + pick.normal.as_vec3() * 0.5;
+        self.screen_steps(face, pick.normal, start, (x, y))
+    }
+
+    /// The whole voxel steps along `normal` that a drag from window pixel
+    /// `start` to `end` covers, as the step from the (tree-local) point
+    /// `face` is drawn on screen: extrudes and selection handles.
+    fn screen_steps(&self, face: glam::Vec3, normal: IVec3, start: (f64, f64), end: (f64, f64)) -> Option<i32> {
         let (w, h) = self.window_size();
-        let basis = self.state.camera.basis(w, h, self.scene.tree.origin());
-        let normal = pick.normal.as_vec3();
-        let face = (pick.voxel - self.scene.tree.origin()).as_vec3() + glam::Vec3::splat(0.5) + normal * 0.5;
-        let (a, b) = (basis.project(face)?, basis.project(face + normal)?);
+        let basis = self.state.camera.basis(w, h, self.editor.scene.tree.origin());
+        let (a, b) = (basis.project(face)?, basis.project(face + normal.as_vec3())?);
         let step = glam::DVec2::new(f64::from(b.0 - a.0), f64::from(b.1 - a.1));
-        let drag = glam::DVec2::new(x - start.0, y - start.1);
+        let drag = glam::DVec2::new(end.0 - start.0, end.1 - start.1);
         Some((drag.dot(step) / step.length_squared().max(1e-6)).round() as i32)
-    }
-
-    /// Extrudes the face region of `start` toward `normal` by `layers` (one
-    /// undo step, not mirrored: the region follows the faces).
-    pub(super) fn extrude(
-        &mut self,
-        start: IVec3,
-        normal: IVec3,
-        layers: i32,
-    ) -> Result<(), octovox::scene::EditError> {
-        let edits = octovox::scene::extrude::extrude_edits(&self.scene.tree, start, normal, layers)?;
-        self.commit(edits, "extrude")?;
-        self.record(|r| r.extrude(start, normal, layers));
-        Ok(())
-    }
-
-    /// Edits as one undo step (or part of the open stroke), then what
-    /// depends on the voxels; `what` names it in the printed line.
-    fn commit(&mut self, edits: Vec<Edit>, what: &str) -> Result<(), octovox::scene::EditError> {
-        self.history.apply_group(&mut self.scene, edits)?;
-        self.after_change(what);
-        Ok(())
     }
 
     /// Measures the quality presets from the current camera (a second or
@@ -616,7 +627,7 @@ impl App {
     fn measure_presets(&mut self) {
         let window = self.window_size();
         let Some(gfx) = &mut self.gfx else { return };
-        match presets::measure(&mut gfx.renderer, &self.scene, &self.state.camera, window) {
+        match presets::measure(&mut gfx.renderer, &self.editor.scene, &self.state.camera, window) {
             Ok(measured) => {
                 let line: Vec<String> = presets::PRESETS
                     .iter()
@@ -638,12 +649,12 @@ impl App {
         let Edit::Palette { index, .. } = &edit else { return };
         let index = *index;
         if dragging && !self.palette_stroke {
-            self.history.begin_stroke();
+            self.editor.history.begin_stroke();
             self.palette_stroke = true;
         }
-        let before = (self.scene.palette.color(index), self.scene.palette.material(index).clone());
+        let before = (self.editor.scene.palette.color(index), self.editor.scene.palette.material(index).clone());
         if self.apply_edit(edit) {
-            let after = (self.scene.palette.color(index), self.scene.palette.material(index).clone());
+            let after = (self.editor.scene.palette.color(index), self.editor.scene.palette.material(index).clone());
             self.record(|r| r.palette(index, &before, &after));
         }
         if !dragging {
@@ -654,7 +665,7 @@ impl App {
     /// Closes the undo step of a held palette control.
     pub(super) fn end_palette_stroke(&mut self) {
         if std::mem::take(&mut self.palette_stroke) {
-            self.history.end_stroke();
+            self.editor.history.end_stroke();
         }
         self.record(|r| {
             r.end_step();
@@ -666,15 +677,18 @@ impl App {
         if self.state.line_mode {
             return self.line_edit(phase, x, y);
         }
+        if self.state.select_mode {
+            return self.select_drag(phase, x, y);
+        }
         match phase {
             StrokePhase::Begin => {
-                self.history.begin_stroke();
+                self.editor.history.begin_stroke();
                 self.stroke = Some(Stroke { tool, plane: None, last_center: None });
                 self.stroke_step(x, y);
             }
             StrokePhase::Move => self.stroke_step(x, y),
             StrokePhase::End => {
-                self.history.end_stroke();
+                self.editor.history.end_stroke();
                 self.stroke = None;
                 self.record(|r| {
                     r.end_step();
@@ -708,12 +722,12 @@ impl App {
         // the brush's reach of its layer: the cells they reveal or create
         // would otherwise be picked next and the stroke would dig or pile up
         // toward the camera.
-        let reach = self.state.brush().reach();
+        let reach = self.editor.tools.brush.reach();
         let off_layer = |(normal, depth): (IVec3, i32)| normal != layer.0 || (layer.1 - depth).abs() > reach;
         if stroke.tool != Tool::Paint && stroke.plane.is_some_and(off_layer) {
             return;
         }
-        let (center, edit) = self.state.edit_at(stroke.tool, &pick);
+        let (center, edit) = self.state.edit_at(&self.editor.tools, stroke.tool, &pick);
         if stroke.last_center == Some(center) {
             return;
         }
@@ -723,9 +737,8 @@ impl App {
         {
             stroke.plane.get_or_insert(layer);
             stroke.last_center = Some(center);
-            let (camera, brush, color) = (self.state.camera, self.state.brush(), self.state.color.max(1));
-            let mirror = self.state.mirror;
-            self.record(|r| r.edit(&camera, brush, color, (tool, &mirror), center));
+            let (camera, tools) = (self.state.camera, self.editor.tools);
+            self.record(|r| r.edit(&camera, tools.brush, tools.color.max(1), (tool, &tools.mirror), center));
         }
     }
 }

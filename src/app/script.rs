@@ -1,14 +1,14 @@
-//! `--replay SCRIPT` plays a script visibly, one line per frame, through the
-//! window's own commands; `--record PATH` writes the session as a script.
-//! Both use the same edit path as the mouse (`App::apply_edit`).
+//! `--replay SCRIPT` plays a script visibly, one line per frame: the lines
+//! that edit or read the scene go to the editor, as in `octovox replay`, and
+//! through `App::run_line`, as mouse actions do (so they are recorded and
+//! journaled); files, the camera and pixels are the window's. `--record
+//! PATH` writes the session as a script.
 
 use std::path::{Path, PathBuf};
 
 use octovox::camera::Camera;
-use octovox::edit::Edit;
+use octovox::editor::Outcome;
 use octovox::replay::{Command as Line, Script};
-use octovox::scene::{Op, Scene};
-use octovox::tool::{Brush, click_edit};
 
 use super::{App, Command};
 
@@ -17,8 +17,6 @@ pub struct Player {
     script: Script,
     base: PathBuf,
     next: usize,
-    brush: Brush,
-    color: u8,
     passed: usize,
     failed: usize,
 }
@@ -26,7 +24,7 @@ pub struct Player {
 impl Player {
     pub fn new(script: Script) -> Player {
         let base = script.path.parent().unwrap_or(Path::new(".")).to_path_buf();
-        Player { script, base, next: 0, brush: Brush::Voxel, color: 1, passed: 0, failed: 0 }
+        Player { script, base, next: 0, passed: 0, failed: 0 }
     }
 }
 
@@ -81,66 +79,23 @@ impl App {
 
     /// Carries out one line.
     fn play_line(&mut self, base: &Path, line: &Line, event_loop: &winit::event_loop::ActiveEventLoop) -> Played {
-        let (brush, color) = self.player.as_ref().map_or((Brush::Voxel, 1), |p| (p.brush, p.color));
-        let brush_edit = |at, op| Edit::Brush { shape: brush.shape_at(at), op };
         match line {
             Line::Load(path) => self.start_loading(base.join(path)),
-            Line::New => self.replace_scene(Scene::default(), Line::New),
-            Line::Demo(built_in) => self.replace_scene(built_in.scene(), Line::Demo(*built_in)),
             Line::Camera { eye, target, fov } => {
                 let fov_y_deg = fov.unwrap_or(self.state.camera.fov_y_deg);
                 self.execute(Command::SetCamera(Camera { eye: *eye, target: *target, fov_y_deg }), event_loop);
             }
             // The window's size is the viewport.
             Line::Viewport(..) => {}
-            Line::Brush(b) => self.with_player(|p| p.brush = *b),
-            Line::Color(c) => {
-                self.with_player(|p| p.color = *c);
-                self.state.color = *c;
-            }
-            Line::Line(a, b) => {
-                self.apply_edits(octovox::tool::line_edits(&brush, color, *a, *b), "line");
-            }
-            Line::Mirror(plane) => self.state.mirror.apply_line(*plane),
-            Line::Fill(p) => {
-                if let Err(err) = self.fill(*p, color) {
-                    return Played::Failed(err.to_string());
-                }
-            }
-            Line::Extrude(p, normal, layers) => {
-                if let Err(err) = self.extrude(*p, *normal, *layers) {
-                    return Played::Failed(err.to_string());
-                }
-            }
-            Line::Pick(p) => match octovox::replay::picked_color(&self.scene, *p) {
-                Ok(value) => {
-                    self.with_player(|player| player.color = value);
-                    self.state.color = value;
-                }
-                Err(message) => return Played::Failed(message),
-            },
-            Line::Rgb(..) | Line::Material(..) => {
-                if let Some(edit) = octovox::replay::palette_edit(line, &self.scene.palette) {
-                    self.execute(Command::Edit(edit), event_loop);
-                }
-            }
-            Line::Place(at) => self.execute(Command::Edit(brush_edit(*at, Op::Place(color))), event_loop),
-            Line::Remove(at) => self.execute(Command::Edit(brush_edit(*at, Op::Remove)), event_loop),
-            Line::Paint(at) => self.execute(Command::Edit(brush_edit(*at, Op::Paint(color))), event_loop),
             Line::Click { x, y, tool } => match self.pick_at(f64::from(*x) + 0.5, f64::from(*y) + 0.5) {
+                // A click is the place, remove or paint of the cell it picks.
                 Ok(Some(pick)) => {
-                    let (_, edit) = click_edit(*tool, &brush, color, pick.voxel, pick.normal);
-                    self.execute(Command::Edit(edit), event_loop);
+                    let center = octovox::tool::click_target(*tool, pick.voxel, pick.normal);
+                    return self.play_editor_line(&octovox::replay::edit_command(*tool, center));
                 }
                 Ok(None) => return Played::Failed(format!("expected pixel ({x}, {y}) to hit a voxel, got nothing")),
                 Err(gave_up) => return Played::Failed(format!("expected pixel ({x}, {y}) to hit a voxel: {gave_up}")),
             },
-            Line::Undo(n) | Line::Redo(n) => {
-                let command = if matches!(line, Line::Undo(_)) { Command::Undo } else { Command::Redo };
-                for _ in 0..*n {
-                    self.execute(command.clone(), event_loop);
-                }
-            }
             Line::Save(path) => {
                 if !self.save(&base.join(path), octovox::io::atomic::WriteOptions::default()) {
                     return Played::Failed(format!("could not save {}", path.display()));
@@ -150,20 +105,12 @@ impl App {
                 self.screenshot_path = Some(base.join(path));
                 self.execute(Command::Screenshot, event_loop);
             }
-            Line::ExpectVoxel(p, want) => {
-                let got = self.scene.tree.get(*p);
-                return Played::check(got == *want, format!("expected voxel {p} = {want}, got {got}"));
-            }
-            Line::ExpectCount(want) => {
-                let got = self.scene.tree.solid_voxels();
-                return Played::check(got == *want, format!("expected {want} voxels, got {got}"));
-            }
             Line::ExpectWritten(limit) => {
                 let got = self.stats.last_edit_bytes;
                 return Played::check(got <= *limit, format!("expected at most {limit} bytes written, got {got}"));
             }
             Line::ExpectEffects(want) => {
-                let (ok, got) = octovox::replay::effects_match(&self.scene, &self.state.path_settings, want);
+                let (ok, got) = octovox::replay::effects_match(&self.editor.scene, &self.state.path_settings, want);
                 let message = format!("expected effects [{}], got [{}]", want.join(" "), got.join(" "));
                 return Played::check(ok, message);
             }
@@ -171,8 +118,18 @@ impl App {
             Line::ExpectImage(..) => {
                 report!("replay: 'expect image' is checked by `octovox replay`, not in the window")
             }
+            _ => return self.play_editor_line(line),
         }
         Played::Done
+    }
+
+    /// A line the editor carries out, as `octovox replay` would.
+    fn play_editor_line(&mut self, line: &Line) -> Played {
+        match self.run_line(line) {
+            Ok(Outcome::Checked { ok, expected, got }) => Played::check(ok, format!("expected {expected}, got {got}")),
+            Ok(_) => Played::Done,
+            Err(message) => Played::Failed(message),
+        }
     }
 
     /// Runs `f` on the recorder and on the document's journal (created at

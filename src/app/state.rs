@@ -1,7 +1,8 @@
-//! Plain editor state: tool, brush, colour, camera and render settings. No
-//! wgpu, winit or egui types live here, so the UI, the input handler and a
-//! replay script all read and change the same data. Tools, brushes and
-//! what a click does come from `octovox::tool`, shared with replay's `click`.
+//! Plain window state: the tool, the remembered brush sizes, the camera and
+//! render settings. No wgpu, winit or egui types live here. The brush,
+//! colour and mirror planes are the editor's (`octovox::editor::Tools`), so
+//! the panel shows what a played script set; what a click does comes from
+//! `octovox::tool`, shared with replay's `click`.
 
 use std::path::PathBuf;
 
@@ -9,6 +10,8 @@ use glam::IVec3;
 
 use octovox::camera::Camera;
 use octovox::edit::Edit;
+use octovox::editor::Tools;
+use octovox::scene::selection::Region;
 use octovox::settings::{PathSettings, RenderSettings, Shading};
 pub use octovox::tool::{Brush, Tool, click_edit};
 
@@ -20,25 +23,32 @@ pub struct Pick {
     pub value: u8,
 }
 
-/// Which brush-size widget the panel shows; the numbers live in `EditorState`
-/// so that switching shapes keeps each one's size.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+/// The brush shapes the panel offers; switching shapes keeps each one's
+/// last size (in `EditorState`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BrushKind {
-    #[default]
     Voxel,
     Sphere,
     Box,
+}
+
+impl BrushKind {
+    pub fn of(brush: Brush) -> BrushKind {
+        match brush {
+            Brush::Voxel => BrushKind::Voxel,
+            Brush::Sphere(_) => BrushKind::Sphere,
+            Brush::Box(_) => BrushKind::Box,
+        }
+    }
 }
 
 /// Everything the user chose, as plain data.
 #[derive(Clone, Debug)]
 pub struct EditorState {
     pub tool: Tool,
-    pub brush_kind: BrushKind,
+    /// The sizes a sphere and a box brush get when the panel switches to them.
     pub sphere_radius: i32,
     pub box_size: i32,
-    /// Palette index used by Attach and Paint (1..=255).
-    pub color: u8,
     pub camera: Camera,
     pub settings: RenderSettings,
     /// The file Save writes to; `None` for a new or demo scene.
@@ -52,22 +62,22 @@ pub struct EditorState {
     pub path_settings: PathSettings,
     /// Samples the path tracer accumulates at rest before it stops.
     pub sample_target: u32,
-    /// Mirror planes in force for brush edits.
-    pub mirror: octovox::mirror::Mirror,
     /// Line mode (L): a press-drag-release places the brush along a line.
     pub line_mode: bool,
     /// Where the line being dragged starts (the cell in front of the face).
     pub line_start: Option<IVec3>,
+    /// Box select mode (B): a left drag selects a box or moves a face of it.
+    pub select_mode: bool,
+    /// The box a selection drag would select, while it is dragged.
+    pub select_preview: Option<Region>,
 }
 
 impl Default for EditorState {
     fn default() -> EditorState {
         EditorState {
             tool: Tool::Attach,
-            brush_kind: BrushKind::Voxel,
             sphere_radius: 3,
             box_size: 3,
-            color: 1,
             camera: Camera::default(),
             settings: RenderSettings::default(),
             path: None,
@@ -76,16 +86,18 @@ impl Default for EditorState {
             shading: Shading::default(),
             path_settings: PathSettings::default(),
             sample_target: octovox::settings::DEFAULT_SAMPLE_TARGET,
-            mirror: octovox::mirror::Mirror::default(),
             line_mode: false,
             line_start: None,
+            select_mode: false,
+            select_preview: None,
         }
     }
 }
 
 impl EditorState {
-    pub fn brush(&self) -> Brush {
-        match self.brush_kind {
+    /// The brush of `kind` at its remembered size.
+    pub fn brush_of(&self, kind: BrushKind) -> Brush {
+        match kind {
             BrushKind::Voxel => Brush::Voxel,
             BrushKind::Sphere => Brush::Sphere(self.sphere_radius.max(0)),
             BrushKind::Box => Brush::Box(IVec3::splat(self.box_size.max(1))),
@@ -94,20 +106,37 @@ impl EditorState {
 
     /// The edit the current tool makes at `pick`, with `tool` overriding the
     /// current one (a right click erases while Attach is active).
-    pub fn edit_at(&self, tool: Tool, pick: &Pick) -> (IVec3, Edit) {
-        click_edit(tool, &self.brush(), self.color.max(1), pick.voxel, pick.normal)
+    pub fn edit_at(&self, tools: &Tools, tool: Tool, pick: &Pick) -> (IVec3, Edit) {
+        click_edit(tool, &tools.brush, tools.color.max(1), pick.voxel, pick.normal)
     }
 
     /// Inclusive world box of the cells the brush would touch at `pick`.
-    pub fn preview_box(&self, pick: &Pick) -> (IVec3, IVec3) {
+    pub fn preview_box(&self, tools: &Tools, pick: &Pick) -> (IVec3, IVec3) {
         if let Some(start) = self.line_start {
             // While a line is dragged: the box from its start to here.
             let end = pick.voxel + pick.normal;
-            let ((a, b), (c, d)) = (self.brush().shape_at(start).bounds(), self.brush().shape_at(end).bounds());
+            let ((a, b), (c, d)) = (tools.brush.shape_at(start).bounds(), tools.brush.shape_at(end).bounds());
             return (a.min(c), b.max(d));
         }
-        let (center, _) = self.edit_at(self.tool, pick);
-        self.brush().shape_at(center).bounds()
+        let (center, _) = self.edit_at(tools, self.tool, pick);
+        tools.brush.shape_at(center).bounds()
+    }
+
+    /// Line mode on or off; it ends select mode.
+    pub fn toggle_line_mode(&mut self) {
+        self.line_mode = !self.line_mode;
+        self.line_start = None;
+        self.select_mode &= !self.line_mode;
+    }
+
+    /// Select mode on or off; it ends line mode.
+    pub fn toggle_select_mode(&mut self) {
+        self.select_mode = !self.select_mode;
+        self.select_preview = None;
+        if self.select_mode {
+            self.line_mode = false;
+            self.line_start = None;
+        }
     }
 
     /// Title-bar text: file name and an asterisk for unsaved changes.
@@ -128,24 +157,26 @@ mod tests {
 
     #[test]
     fn attach_places_in_front_of_the_face() {
-        let state = EditorState { color: 7, ..EditorState::default() };
+        let (state, tools) = (EditorState::default(), Tools { color: 7, ..Tools::default() });
         let pick = Pick { voxel: IVec3::new(1, 2, 3), normal: IVec3::Y, value: 4 };
-        let (center, edit) = state.edit_at(Tool::Attach, &pick);
+        let (center, edit) = state.edit_at(&tools, Tool::Attach, &pick);
         assert_eq!(center, IVec3::new(1, 3, 3));
         assert_eq!(edit, Edit::Brush { shape: Shape::Voxel(center), op: Op::Place(7) });
-        let (center, edit) = state.edit_at(Tool::Erase, &pick);
+        let (center, edit) = state.edit_at(&tools, Tool::Erase, &pick);
         assert_eq!(center, pick.voxel);
         assert_eq!(edit, Edit::Brush { shape: Shape::Voxel(pick.voxel), op: Op::Remove });
     }
 
     #[test]
     fn brush_sizes_follow_the_kind() {
-        let mut state = EditorState { brush_kind: BrushKind::Box, box_size: 4, ..EditorState::default() };
+        let mut state = EditorState { box_size: 4, ..EditorState::default() };
+        let mut tools = Tools { brush: state.brush_of(BrushKind::Box), ..Tools::default() };
         let pick = Pick { voxel: IVec3::ZERO, normal: IVec3::X, value: 1 };
-        assert_eq!(state.preview_box(&pick), (IVec3::new(-1, -2, -2), IVec3::new(2, 1, 1)));
-        state.brush_kind = BrushKind::Sphere;
+        assert_eq!(state.preview_box(&tools, &pick), (IVec3::new(-1, -2, -2), IVec3::new(2, 1, 1)));
         state.sphere_radius = 2;
+        tools.brush = state.brush_of(BrushKind::Sphere);
         state.tool = Tool::Paint;
-        assert_eq!(state.preview_box(&pick), (IVec3::splat(-2), IVec3::splat(2)));
+        assert_eq!(state.preview_box(&tools, &pick), (IVec3::splat(-2), IVec3::splat(2)));
+        assert_eq!(BrushKind::of(tools.brush), BrushKind::Sphere);
     }
 }

@@ -16,6 +16,9 @@ use octovox::settings::{EffectsChoice, Shading, Sky, TraceMode, View};
 use super::command::{Choice, Command, Pending};
 use super::state::{BrushKind, EditorState, Pick, Tool};
 use glam::{IVec3, Vec3};
+use octovox::editor::Tools;
+use octovox::scene::selection::Region;
+use octovox::tool::Brush;
 
 /// Width of the left panel in points.
 pub const PANEL_WIDTH: f32 = 236.0;
@@ -59,6 +62,8 @@ pub struct Info<'a> {
     pub history: (usize, usize, usize),
     /// The last measurement of the quality presets, if any.
     pub presets: Option<&'a [super::presets::Measured]>,
+    pub selection: Option<Region>,
+    pub has_clipboard: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -101,16 +106,22 @@ fn rgba(palette: &Palette, index: u8) -> Color32 {
 }
 
 /// Draws every panel; returns what the user asked for.
-pub fn show(ui: &mut egui::Ui, state: &mut EditorState, ui_state: &mut UiState, info: &Info) -> Vec<Command> {
+pub fn show(
+    ui: &mut egui::Ui,
+    state: &mut EditorState,
+    tools: &mut Tools,
+    ui_state: &mut UiState,
+    info: &Info,
+) -> Vec<Command> {
     let mut out = Vec::new();
     egui::Panel::top("menu").show(ui, |ui| menu_bar(ui, info, ui_state, &mut out));
     egui::Panel::left("tools").resizable(false).exact_size(PANEL_WIDTH).show(ui, |ui| {
         egui::ScrollArea::vertical().show(ui, |ui| {
-            tools(ui, state);
-            mirror(ui, state);
+            tool_panel(ui, state, tools);
+            mirror(ui, tools);
             ui.separator();
-            palette(ui, state, info.palette);
-            material_editor(ui, state.color, info.palette, &mut out);
+            palette(ui, tools, info.palette);
+            material_editor(ui, tools.color, info.palette, &mut out);
             ui.separator();
             render(ui, state);
             quality(ui, info.presets, &mut out);
@@ -127,43 +138,16 @@ pub fn show(ui: &mut egui::Ui, state: &mut EditorState, ui_state: &mut UiState, 
 
 fn menu_bar(ui: &mut egui::Ui, info: &Info, ui_state: &mut UiState, out: &mut Vec<Command>) {
     egui::MenuBar::new().ui(ui, |ui| {
-        ui.menu_button("File", |ui| {
-            if ui.button("New          Ctrl+N").clicked() {
-                out.push(Command::New);
-            }
-            if ui.button("Open…        Ctrl+O").clicked() {
-                out.push(Command::AskOpen);
-            }
-            if ui.button("Save         Ctrl+S").clicked() {
-                out.push(Command::Save);
-            }
-            if ui.button("Save As…     Ctrl+Shift+S").clicked() {
-                out.push(Command::AskSaveAs);
-            }
-            if ui.button("Export mesh…").clicked() {
-                out.push(Command::AskExport);
-            }
-            if ui.button("Screenshot   F12").clicked() {
-                out.push(Command::Screenshot);
-            }
-            ui.separator();
-            if ui.button("Quit         Ctrl+Q").clicked() {
-                out.push(Command::Quit);
-            }
-        });
-        ui.menu_button("Edit", |ui| {
-            if ui.add_enabled(info.can_undo, egui::Button::new("Undo   Ctrl+Z")).clicked() {
-                out.push(Command::Undo);
-            }
-            if ui.add_enabled(info.can_redo, egui::Button::new("Redo   Ctrl+Shift+Z / Ctrl+Y")).clicked() {
-                out.push(Command::Redo);
-            }
-        });
-        ui.menu_button("View", |ui| {
-            if ui.button("Frame model   F").clicked() {
-                out.push(Command::FrameModel);
-            }
-        });
+        for (menu, actions) in super::actions::menus() {
+            ui.menu_button(menu, |ui| {
+                for action in actions {
+                    let text = format!("{}   {}", action.label, super::actions::shortcut_text(action));
+                    if ui.add_enabled(available(&action.command, info), egui::Button::new(text)).clicked() {
+                        out.push(action.command.clone());
+                    }
+                }
+            });
+        }
         if let Some((path, seconds, fraction)) = info.loading {
             match fraction {
                 Some(f) => {
@@ -179,55 +163,81 @@ fn menu_bar(ui: &mut egui::Ui, info: &Info, ui_state: &mut UiState, out: &mut Ve
     });
 }
 
+/// Whether a menu entry can act now (greyed out otherwise).
+fn available(command: &Command, info: &Info) -> bool {
+    match command {
+        Command::Undo => info.can_undo,
+        Command::Redo => info.can_redo,
+        Command::Copy | Command::Cut | Command::DeleteSelection | Command::SelectNone => info.selection.is_some(),
+        Command::PasteAtCursor => info.has_clipboard,
+        _ => true,
+    }
+}
+
 /// Mirror planes: a checkbox and the plane's coordinate per axis.
-fn mirror(ui: &mut egui::Ui, state: &mut EditorState) {
+fn mirror(ui: &mut egui::Ui, tools: &mut Tools) {
     ui.horizontal(|ui| {
         ui.label("Mirror");
         for (axis, name) in ["x", "y", "z"].into_iter().enumerate() {
-            let mut on = state.mirror.planes[axis].is_some();
-            let mut c = state.mirror.plane(axis).unwrap_or(0.0);
+            let mut on = tools.mirror.planes[axis].is_some();
+            let mut c = tools.mirror.plane(axis).unwrap_or(0.0);
             ui.checkbox(&mut on, name);
             if on {
                 ui.add(egui::DragValue::new(&mut c).speed(0.5).fixed_decimals(1));
             }
-            state.mirror.set(axis, on.then_some(c));
+            tools.mirror.set(axis, on.then_some(c));
         }
     });
 }
 
-fn tools(ui: &mut egui::Ui, state: &mut EditorState) {
+fn tool_panel(ui: &mut egui::Ui, state: &mut EditorState, tools: &mut Tools) {
     ui.heading("Tool");
     ui.horizontal(|ui| {
         for tool in Tool::ALL {
             ui.selectable_value(&mut state.tool, tool, tool_label(tool));
         }
     });
-    if ui
-        .toggle_value(&mut state.line_mode, "Line (L)")
-        .on_hover_text("press, drag and release: the brush along a line")
-        .changed()
-    {
-        state.line_start = None;
-    }
+    ui.horizontal(|ui| {
+        let line = ui.selectable_label(state.line_mode, "Line (L)");
+        if line.on_hover_text("press, drag and release: the brush along a line").clicked() {
+            state.toggle_line_mode();
+        }
+        let select = ui.selectable_label(state.select_mode, "Select (B)");
+        let hint = "drag a box; drag a face of it to resize; Ctrl+C/X/V, Delete, arrows move it";
+        if select.on_hover_text(hint).clicked() {
+            state.toggle_select_mode();
+        }
+    });
     ui.label("Brush");
     ui.horizontal(|ui| {
-        ui.selectable_value(&mut state.brush_kind, BrushKind::Voxel, "Voxel");
-        ui.selectable_value(&mut state.brush_kind, BrushKind::Sphere, "Sphere");
-        ui.selectable_value(&mut state.brush_kind, BrushKind::Box, "Box");
-    });
-    match state.brush_kind {
-        BrushKind::Voxel => {}
-        BrushKind::Sphere => {
-            ui.add(egui::Slider::new(&mut state.sphere_radius, 0..=32).text("radius"));
+        for (kind, label) in [(BrushKind::Voxel, "Voxel"), (BrushKind::Sphere, "Sphere"), (BrushKind::Box, "Box")] {
+            if ui.selectable_label(BrushKind::of(tools.brush) == kind, label).clicked() {
+                tools.brush = state.brush_of(kind);
+            }
         }
-        BrushKind::Box => {
-            ui.add(egui::Slider::new(&mut state.box_size, 1..=64).text("size"));
+    });
+    // The sliders show the brush in force (a script may have set it) and
+    // remember their sizes for the next switch.
+    match &mut tools.brush {
+        Brush::Voxel => {}
+        Brush::Sphere(radius) => {
+            ui.add(egui::Slider::new(radius, 0..=32).text("radius"));
+            state.sphere_radius = *radius;
+        }
+        Brush::Box(size) => {
+            let mut side = size.max_element();
+            if ui.add(egui::Slider::new(&mut side, 1..=64).text("size")).changed() || size.min_element() == side {
+                *size = IVec3::splat(side);
+            } else {
+                ui.small(format!("{} × {} × {} (a script's box)", size.x, size.y, size.z));
+            }
+            state.box_size = side;
         }
     }
     ui.small("left: apply · Ctrl+drag a face: extrude · right-drag: orbit · right-click: erase (Attach) · middle: pan · wheel: zoom · WASDQE + right: fly · F: frame");
 }
 
-fn palette(ui: &mut egui::Ui, state: &mut EditorState, palette: &Palette) {
+fn palette(ui: &mut egui::Ui, tools: &mut Tools, palette: &Palette) {
     ui.heading("Palette");
     // One 16×16 block painted by hand: 256 widgets would be slow and loose.
     let cell = ((ui.available_width() - 4.0) / 16.0).floor().clamp(8.0, 16.0);
@@ -246,7 +256,7 @@ fn palette(ui: &mut egui::Ui, state: &mut EditorState, palette: &Palette) {
             painter.rect_filled(r, 0.0, rgba(palette, index));
         }
     }
-    let selected = cell_rect(state.color);
+    let selected = cell_rect(tools.color);
     painter.rect_stroke(selected, 0.0, Stroke::new(2.0, Color32::WHITE), egui::StrokeKind::Inside);
     let index_at = |pos: egui::Pos2| {
         let offset = (pos - rect.min) / cell;
@@ -256,16 +266,16 @@ fn palette(ui: &mut egui::Ui, state: &mut EditorState, palette: &Palette) {
     if response.clicked()
         && let Some(index) = response.interact_pointer_pos().and_then(index_at).filter(|i| *i != 0)
     {
-        state.color = index;
+        tools.color = index;
     }
     if let Some(index) = response.hover_pos().and_then(index_at) {
         response.on_hover_text(format!("{index}"));
     }
-    let material = palette.material(state.color);
-    let [r, g, b, _] = palette.color(state.color);
+    let material = palette.material(tools.color);
+    let [r, g, b, _] = palette.color(tools.color);
     ui.label(format!(
         "colour {} · #{r:02x}{g:02x}{b:02x} · {}",
-        state.color,
+        tools.color,
         material.kind.vox_name().trim_start_matches('_')
     ));
     let params: Vec<String> =
@@ -623,22 +633,46 @@ fn tool_label(tool: Tool) -> &'static str {
 /// Outlines the cells the brush would touch (projected with the trace
 /// camera), so the preview also shows Attach's target cells, which are empty
 /// and so cannot be tinted by the shader.
-pub fn draw_brush_outline(ui: &egui::Ui, state: &EditorState, pick: &Pick, info: &Info) {
-    let (lo, hi) = state.preview_box(pick);
+pub fn draw_brush_outline(ui: &egui::Ui, state: &EditorState, tools: &Tools, pick: &Pick, info: &Info) {
+    let (lo, hi) = state.preview_box(tools, pick);
+    let color = match state.tool {
+        Tool::Attach => egui::Color32::from_rgb(120, 255, 140),
+        Tool::Erase => egui::Color32::from_rgb(255, 100, 90),
+        Tool::Paint => egui::Color32::from_rgb(255, 220, 90),
+    };
+    outline_box(ui, state, info, (lo, hi), color, false);
+}
+
+/// Outlines the selected box (or the one being dragged); in select mode
+/// with a dot on each face, the handle that resizes it.
+pub fn draw_selection(ui: &egui::Ui, state: &EditorState, info: &Info) {
+    if let Some(region) = info.selection {
+        outline_box(
+            ui,
+            state,
+            info,
+            (region.min, region.max),
+            egui::Color32::from_rgb(90, 220, 255),
+            state.select_mode,
+        );
+    }
+}
+
+/// Draws the edges of the cells `lo..=hi` over the image, and the centres
+/// of its faces when `handles`.
+fn outline_box(
+    ui: &egui::Ui,
+    state: &EditorState,
+    info: &Info,
+    (lo, hi): (IVec3, IVec3),
+    color: Color32,
+    handles: bool,
+) {
     let screen = ui.ctx().content_rect();
     let (w, h) = (screen.width().max(1.0), screen.height().max(1.0));
     let basis = state.camera.basis(w as u32, h as u32, info.tree.origin());
     let origin = info.tree.origin().as_vec3();
-    let project = |p: Vec3| -> Option<egui::Pos2> {
-        let d = p - origin - basis.eye;
-        let depth = d.dot(basis.forward);
-        if depth <= 0.05 {
-            return None;
-        }
-        let nx = d.dot(basis.right) / basis.right.length_squared() / depth;
-        let ny = d.dot(basis.up) / basis.up.length_squared() / depth;
-        Some(egui::pos2((nx + 1.0) * 0.5 * w, (1.0 - ny) * 0.5 * h))
-    };
+    let project = |p: Vec3| basis.project(p - origin).map(|(x, y)| egui::pos2(x, y));
     let (a, b) = (lo.as_vec3(), (hi + IVec3::ONE).as_vec3());
     let corner = |i: usize| {
         Vec3::new(
@@ -647,13 +681,7 @@ pub fn draw_brush_outline(ui: &egui::Ui, state: &EditorState, pick: &Pick, info:
             if i & 4 == 0 { a.z } else { b.z },
         )
     };
-    let painter =
-        ui.ctx().layer_painter(egui::LayerId::new(egui::Order::Background, egui::Id::unique("brush outline")));
-    let color = match state.tool {
-        Tool::Attach => egui::Color32::from_rgb(120, 255, 140),
-        Tool::Erase => egui::Color32::from_rgb(255, 100, 90),
-        Tool::Paint => egui::Color32::from_rgb(255, 220, 90),
-    };
+    let painter = ui.ctx().layer_painter(egui::LayerId::new(egui::Order::Background, egui::Id::unique("box outline")));
     for i in 0..8usize {
         for bit in [1usize, 2, 4] {
             let j = i | bit;
@@ -662,6 +690,14 @@ pub fn draw_brush_outline(ui: &egui::Ui, state: &EditorState, pick: &Pick, info:
             }
             if let (Some(p), Some(q)) = (project(corner(i)), project(corner(j))) {
                 painter.line_segment([p, q], egui::Stroke::new(1.5, color));
+            }
+        }
+    }
+    if handles {
+        let center = (a + b) * 0.5;
+        for normal in [Vec3::X, Vec3::NEG_X, Vec3::Y, Vec3::NEG_Y, Vec3::Z, Vec3::NEG_Z] {
+            if let Some(p) = project(center + normal * (b - a) * 0.5) {
+                painter.circle_filled(p, 4.0, color);
             }
         }
     }

@@ -70,6 +70,21 @@ pub enum Command {
     /// `material INDEX KIND [KEY VALUE]...`: a palette entry's material,
     /// with exactly these parameters (an undoable edit).
     Material(u8, Box<crate::scene::Material>),
+    /// `select X1 Y1 Z1 X2 Y2 Z2`: the inclusive box later `copy`, `cut`,
+    /// `delete` and `move` act on; `select off` clears it.
+    Select(Option<(IVec3, IVec3)>),
+    /// `copy`: the selected voxels go to the clipboard.
+    Copy,
+    /// `cut`: copy, then delete (one undo step).
+    Cut,
+    /// `delete`: empties the selected box (one undo step).
+    Delete,
+    /// `paste X Y Z`: the clipboard's voxels with its box's min corner at
+    /// (X, Y, Z), which becomes the selection (one undo step).
+    Paste(IVec3),
+    /// `move DX DY DZ`: the selected voxels move by (DX, DY, DZ), and the
+    /// selection with them (one undo step).
+    Move(IVec3),
 }
 
 /// A parsed command with its 1-based line number.
@@ -130,6 +145,13 @@ impl fmt::Display for Command {
                 write!(f, "material {index} {}", &material.kind.vox_name()[1..])?;
                 material.params.iter().try_for_each(|(key, value)| write!(f, " {key} {value}"))
             }
+            Command::Select(None) => write!(f, "select off"),
+            Command::Select(Some((a, b))) => write!(f, "select {} {}", v(*a), v(*b)),
+            Command::Copy => write!(f, "copy"),
+            Command::Cut => write!(f, "cut"),
+            Command::Delete => write!(f, "delete"),
+            Command::Paste(p) => write!(f, "paste {}", v(*p)),
+            Command::Move(d) => write!(f, "move {}", v(*d)),
             Command::ExpectEffects(names) if names.is_empty() => write!(f, "expect effects none"),
             Command::ExpectEffects(names) => write!(f, "expect effects {}", names.join(" ")),
         }

@@ -101,6 +101,13 @@ impl Cursor {
         token
     }
 
+    /// Consumes the next word if it is `word`.
+    fn take(&mut self, word: &str) -> bool {
+        let found = self.tokens.get(self.next).is_some_and(|t| t.text == word);
+        self.next += usize::from(found);
+        found
+    }
+
     fn number<T: std::str::FromStr>(&mut self, what: &str) -> Result<T, Fail> {
         let token = self.word(what)?;
         token.text.parse().map_err(|_| (token.column, format!("expected {what}, found '{}'", token.text)))
@@ -242,6 +249,19 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
             Command::Extrude(at, normal, c.int_in("layers", -limit..=limit)? as i32)
         }
         "line" => Command::Line(c.position()?, c.position()?),
+        "select" if c.take("off") => Command::Select(None),
+        "select" => {
+            let (a, b) = (c.position()?, c.position()?);
+            if (a - b).abs().max_element() >= MAX_BRUSH_EXTENT {
+                return Err((name.column, format!("a selection is at most {MAX_BRUSH_EXTENT} voxels wide")));
+            }
+            Command::Select(Some((a, b)))
+        }
+        "copy" => Command::Copy,
+        "cut" => Command::Cut,
+        "delete" => Command::Delete,
+        "paste" => Command::Paste(c.position()?),
+        "move" => Command::Move(c.position()?),
         "mirror" => {
             let axis = c.word("x, y, z or off")?;
             match axis.text.as_str() {
@@ -410,6 +430,8 @@ mod tests {
         assert_eq!(errors("expect written < 3"), vec!["expected '<=', found '<' at build.ovr:1:16"]);
         assert_eq!(errors("new extra"), vec!["unexpected 'extra' after the command at build.ovr:1:5"]);
         assert_eq!(errors("click 3 4 smash"), vec!["expected attach, erase or paint, found 'smash' at build.ovr:1:11"]);
+        assert_eq!(errors("select 0 0 0 5000 0 0"), vec!["a selection is at most 4096 voxels wide at build.ovr:1:1"]);
+        assert_eq!(errors("paste 1 2"), vec!["missing Z at build.ovr:1:10"]);
         assert_eq!(
             errors("demo castle"),
             vec!["expected terrain, showroom or interior, found 'castle' at build.ovr:1:6"]
@@ -425,7 +447,8 @@ mod tests {
         let text = "load a.vox\nnew\ndemo\ncamera 1 2 3 4 5 6.5 40\nviewport 64 48\nbrush voxel\nbrush sphere 3\nbrush box 1 2 3\n\
                     color 7\nplace -1 2 3\nremove 1 2 3\npaint 1 2 -3\nclick 3 4 erase\nundo 2\nredo 1\nsave b.vox\n\
                     render c.png\nexpect voxel 1 2 3 0\nexpect count 5\nexpect written <= 512\nexpect image c.png 0.01\n\
-                    demo showroom\nexpect effects sun glass\nexpect effects none\nrgb 4 1 2 3\n\
+                    demo showroom\nexpect effects sun glass\nexpect effects none\nrgb 4 1 2 3\nselect 1 2 3 -4 5 6\nselect off\ncopy\ncut\ndelete\n\
+                    paste 1 -2 3\nmove 0 0 -1\n\
                     material 4 glass _ri 1.45 _trans 0.5\nmaterial 5 diffuse\npick 1 -2 3\nfill 0 0 -1\nmirror x 4.5\nmirror z -2\nmirror off\nline 1 2 3 -4 5 6\n\
                     extrude 1 2 3 0 -1 0 -2\n";
         let script = parse_script(Path::new("t.ovr"), text).unwrap();
@@ -435,7 +458,7 @@ mod tests {
             script.lines.iter().map(|l| &l.command).collect::<Vec<_>>(),
             again.lines.iter().map(|l| &l.command).collect::<Vec<_>>()
         );
-        assert_eq!(script.lines.len(), 34);
+        assert_eq!(script.lines.len(), 41);
     }
 
     #[test]

@@ -9,6 +9,7 @@ use glam::IVec3;
 
 use super::{Command, edit_command};
 use crate::camera::Camera;
+use crate::editor::Tools;
 use crate::mirror::Mirror;
 use crate::scene::Material;
 use crate::tool::{Brush, Tool};
@@ -115,24 +116,33 @@ impl Recorder {
         self.command(&edit_command(tool, center))
     }
 
-    /// A flood fill: the colour it used if that changed, then the `fill`
-    /// line, one undo step of its own.
-    pub fn fill(&mut self, color: u8, at: IVec3) -> std::io::Result<()> {
+    /// A line the editor ran (`octovox::editor::Editor::run`) with `tools`
+    /// in force: edit lines as one undo step each, after the state they
+    /// depend on where it changed; `select` and `copy` as they are. Brush,
+    /// colour and mirror lines are written before the next edit that uses
+    /// them; expectations and file lines are not part of a recording.
+    pub fn ran(&mut self, command: &Command, tools: &Tools, camera: &Camera) -> std::io::Result<()> {
+        let color = match command {
+            Command::Place(_) | Command::Paint(_) | Command::Line(..) | Command::Fill(_) => Some(tools.color),
+            Command::Remove(_)
+            | Command::Extrude(..)
+            | Command::Cut
+            | Command::Delete
+            | Command::Paste(_)
+            | Command::Move(_)
+            | Command::Rgb(..)
+            | Command::Material(..) => None,
+            Command::Select(_) | Command::Copy => return self.command(command),
+            Command::Undo(n) => return (0..*n).try_for_each(|_| self.undo()),
+            Command::Redo(n) => return (0..*n).try_for_each(|_| self.redo()),
+            _ => return Ok(()),
+        };
         self.end_step();
-        if self.color != Some(color) {
-            self.color = Some(color);
-            self.command(&Command::Color(color))?;
-        }
-        self.one_step(&Command::Fill(at))
+        self.edit_state(camera, tools.brush, color, &tools.mirror)?;
+        self.one_step(command)
     }
 
-    /// An extrude: the `extrude` line, one undo step of its own.
-    pub fn extrude(&mut self, at: IVec3, normal: IVec3, layers: i32) -> std::io::Result<()> {
-        self.end_step();
-        self.one_step(&Command::Extrude(at, normal, layers))
-    }
-
-    /// A line that is an undo step of its own (a fill, an extrude).
+    /// A line that is an undo step of its own.
     fn one_step(&mut self, command: &Command) -> std::io::Result<()> {
         self.undone.clear();
         self.open_stroke += 1;
@@ -159,25 +169,6 @@ impl Recorder {
             self.open_stroke += 1;
             self.command(&Command::Material(index, Box::new(after.1.clone())))?;
         }
-        Ok(())
-    }
-
-    /// A line drawn in line mode: the state it depends on, then the `line`
-    /// command, one undo step.
-    pub fn line_drawn(
-        &mut self,
-        camera: &Camera,
-        brush: Brush,
-        color: u8,
-        mirror: &Mirror,
-        (a, b): (IVec3, IVec3),
-    ) -> std::io::Result<()> {
-        self.end_step();
-        self.edit_state(camera, brush, Some(color), mirror)?;
-        self.undone.clear();
-        self.open_stroke += 1;
-        self.command(&Command::Line(a, b))?;
-        self.end_step();
         Ok(())
     }
 

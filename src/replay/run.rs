@@ -1,5 +1,6 @@
-//! Running scripts: every edit goes through [`History`] (the same `Edit` path
-//! as the mouse), then the pool is flushed, to the GPU when there is one.
+//! Running scripts: the [`Editor`] carries out every line that edits or
+//! reads the scene (the window drives the same one); the runner adds files,
+//! the camera, pixels and the pool flush, to the GPU when there is one.
 
 use std::path::{Path, PathBuf};
 
@@ -7,14 +8,13 @@ use glam::IVec3;
 
 use super::{Command, Line, Script};
 use crate::camera::Camera;
-use crate::edit::{Edit, History};
+use crate::editor::{Editor, Outcome};
 use crate::gpu::Renderer;
 use crate::io::atomic::WriteOptions;
 use crate::io::output::{OutputKind, check_output};
 use crate::io::png::{differing_fraction, load_png, save_png};
-use crate::scene::{Op, Scene};
 use crate::settings::RenderSettings;
-use crate::tool::{Brush, click_edit};
+use crate::tool::click_edit;
 use crate::trace::render::render_scene_cpu;
 use crate::trace::svo;
 
@@ -48,16 +48,11 @@ pub struct ScriptReport {
     pub failures: Vec<Failure>,
 }
 
-/// The state a script drives: scene, history, camera, brush and colour.
+/// The state a script drives: the editor, the camera and the viewport.
 pub struct Runner {
-    pub scene: Scene,
-    pub history: History,
+    pub editor: Editor,
     pub camera: Camera,
     pub viewport: (u32, u32),
-    pub brush: Brush,
-    pub color: u8,
-    /// Mirror planes in force for brush edits.
-    pub mirror: crate::mirror::Mirror,
     pub settings: RenderSettings,
     /// Bytes the pool flush after the last edit line wrote.
     pub last_written: Option<u64>,
@@ -84,13 +79,9 @@ pub enum StepResult {
 impl Runner {
     pub fn new(mode: RunnerMode) -> Runner {
         Runner {
-            scene: Scene::default(),
-            history: History::default(),
+            editor: Editor::default(),
             camera: Camera::default(),
             viewport: (640, 480),
-            brush: Brush::Voxel,
-            color: 1,
-            mirror: crate::mirror::Mirror::default(),
             settings: RenderSettings::default(),
             last_written: None,
             last_render: None,
@@ -130,47 +121,31 @@ impl Runner {
 
     /// Runs one line. `Err` is an error that stops the script.
     pub fn step(&mut self, base: &Path, line: &Line) -> Result<StepResult, String> {
+        match self.editor.run(&line.command)? {
+            Outcome::State => {}
+            Outcome::Changed => self.last_written = Some(self.flush()),
+            Outcome::Replaced => self.scene_replaced(),
+            Outcome::Checked { ok, expected, got } => return Ok(check(ok, expected, || got)),
+            Outcome::Host => return self.host_step(base, &line.command),
+        }
+        Ok(StepResult::Done)
+    }
+
+    /// The lines that are the runner's own: files, the camera and pixels.
+    fn host_step(&mut self, base: &Path, command: &Command) -> Result<StepResult, String> {
         let resolve = |p: &Path| base.join(p);
-        match &line.command {
+        let scene = &self.editor.scene;
+        match command {
             Command::Load(path) => {
                 let path = resolve(path);
-                self.set_scene(crate::io::load_scene(&path, 0).map_err(|e| e.to_string())?);
+                self.editor.set_scene(crate::io::load_scene(&path, 0).map_err(|e| e.to_string())?);
+                self.scene_replaced();
                 self.inputs.push(path);
             }
-            Command::New => self.set_scene(Scene::default()),
-            Command::Demo(built_in) => self.set_scene(built_in.scene()),
             Command::Camera { eye, target, fov } => {
                 self.camera = Camera { eye: *eye, target: *target, fov_y_deg: fov.unwrap_or(self.camera.fov_y_deg) };
             }
             Command::Viewport(w, h) => self.viewport = (*w, *h),
-            Command::Brush(brush) => self.brush = *brush,
-            Command::Color(c) => self.color = *c,
-            Command::Line(a, b) => {
-                let edits = crate::tool::line_edits(&self.brush, self.color, *a, *b);
-                self.apply_all(edits)?;
-            }
-            Command::Mirror(plane) => self.mirror.apply_line(*plane),
-            Command::Pick(p) => self.color = super::picked_color(&self.scene, *p)?,
-            Command::Rgb(..) | Command::Material(..) => {
-                if let Some(edit) = super::palette_edit(&line.command, &self.scene.palette) {
-                    self.apply(edit)?;
-                }
-            }
-            Command::Place(p) => self.brush_edit(*p, Op::Place(self.color))?,
-            Command::Remove(p) => self.brush_edit(*p, Op::Remove)?,
-            Command::Paint(p) => self.brush_edit(*p, Op::Paint(self.color))?,
-            Command::Fill(p) => {
-                // Not mirrored: the region follows the colour, not the brush.
-                let edits =
-                    crate::scene::fill::fill_edits(&self.scene.tree, *p, self.color).map_err(|e| e.to_string())?;
-                self.commit(edits)?;
-            }
-            Command::Extrude(p, normal, layers) => {
-                // Not mirrored: the region follows the faces, not the brush.
-                let edits = crate::scene::extrude::extrude_edits(&self.scene.tree, *p, *normal, *layers)
-                    .map_err(|e| e.to_string())?;
-                self.commit(edits)?;
-            }
             Command::Click { x, y, tool } => {
                 let expected = format!("pixel ({x}, {y}) to hit a voxel");
                 let (voxel, normal) = match self.pick(*x, *y) {
@@ -178,16 +153,16 @@ impl Runner {
                     Ok(None) => return Ok(StepResult::Failed { expected, got: "no voxel under it".into() }),
                     Err(gave_up) => return Ok(StepResult::Failed { expected, got: gave_up.to_string() }),
                 };
-                let (_, edit) = click_edit(*tool, &self.brush, self.color, voxel, normal);
-                self.apply(edit)?;
+                let tools = self.editor.tools;
+                let (_, edit) = click_edit(*tool, &tools.brush, tools.color, voxel, normal);
+                self.editor.apply_mirrored(vec![edit]).map_err(|e| e.to_string())?;
+                self.last_written = Some(self.flush());
             }
-            Command::Undo(n) => self.repeat(*n, true)?,
-            Command::Redo(n) => self.repeat(*n, false)?,
             Command::Save(path) => {
                 let path = resolve(path);
                 self.check_output(&path, OutputKind::Scene)?;
                 let options = WriteOptions { overwrite_read_only: self.force };
-                crate::io::save_scene(&path, &self.scene, options).map_err(|e| e.to_string())?;
+                crate::io::save_scene(&path, scene, options).map_err(|e| e.to_string())?;
                 self.written.push(path);
             }
             Command::Render(path) => {
@@ -198,24 +173,16 @@ impl Runner {
                 self.written.push(path);
                 self.last_render = Some(image);
             }
-            Command::ExpectVoxel(p, want) => {
-                return Ok(check(self.scene.tree.get(*p) == *want, format!("voxel {p} = {want}"), || {
-                    format!("{}", self.scene.tree.get(*p))
-                }));
-            }
-            Command::ExpectCount(want) => {
-                let got = self.scene.tree.solid_voxels();
-                return Ok(check(got == *want, format!("{want} voxels"), || got.to_string()));
-            }
             Command::ExpectWritten(limit) => {
                 let got = self.last_written.ok_or("'expect written' needs an edit line before it")?;
                 return Ok(check(got <= *limit, format!("at most {limit} bytes written"), || format!("{got} bytes")));
             }
             Command::ExpectImage(path, tolerance) => return self.expect_image(&resolve(path), *tolerance),
             Command::ExpectEffects(want) => {
-                let (ok, got) = super::effects_match(&self.scene, &crate::settings::PathSettings::default(), want);
+                let (ok, got) = super::effects_match(scene, &crate::settings::PathSettings::default(), want);
                 return Ok(check(ok, format!("effects [{}]", want.join(" ")), || format!("[{}]", got.join(" "))));
             }
+            other => return Err(format!("'{other}' is not a line octovox replay runs")),
         }
         Ok(StepResult::Done)
     }
@@ -228,57 +195,22 @@ impl Runner {
         check_output(path, kind, &inputs, self.force || ours).map_err(|e| e.to_string())
     }
 
-    fn set_scene(&mut self, scene: Scene) {
-        self.scene = scene;
-        self.history.clear();
+    /// After a new scene: nothing was written by an edit yet; all of it goes up.
+    fn scene_replaced(&mut self) {
         self.last_written = None;
         self.flush();
     }
 
     /// The world voxel and face normal under a pixel (what the mouse picks).
     pub fn pick(&self, x: u32, y: u32) -> Result<Option<(IVec3, IVec3)>, svo::GaveUp> {
-        Ok(svo::pick(&self.scene.tree, &self.camera, self.viewport, x, y)?.map(|hit| (hit.voxel, hit.normal)))
-    }
-
-    fn brush_edit(&mut self, at: IVec3, op: Op) -> Result<(), String> {
-        self.apply(Edit::Brush { shape: self.brush.shape_at(at), op })
-    }
-
-    /// The one edit path: history → octree → pool flush (→ GPU).
-    pub fn apply(&mut self, edit: Edit) -> Result<(), String> {
-        self.apply_all(vec![edit])
-    }
-
-    /// Several edits (a line) and their mirror images as one step.
-    fn apply_all(&mut self, edits: Vec<Edit>) -> Result<(), String> {
-        let edits = edits.into_iter().flat_map(|e| self.mirror.edits(e)).collect();
-        self.commit(edits)
-    }
-
-    /// Edits as one undo step, then the pool flush.
-    fn commit(&mut self, edits: Vec<Edit>) -> Result<(), String> {
-        self.history.apply_group(&mut self.scene, edits).map_err(|e| e.to_string())?;
-        self.last_written = Some(self.flush());
-        Ok(())
-    }
-
-    fn repeat(&mut self, n: u32, undo: bool) -> Result<(), String> {
-        for _ in 0..n {
-            let scene = &mut self.scene;
-            let did = if undo { self.history.undo(scene) } else { self.history.redo(scene) };
-            if !did.map_err(|e| e.to_string())? {
-                return Err(format!("nothing to {}", if undo { "undo" } else { "redo" }));
-            }
-        }
-        self.last_written = Some(self.flush());
-        Ok(())
+        Ok(svo::pick(&self.editor.scene.tree, &self.camera, self.viewport, x, y)?.map(|hit| (hit.voxel, hit.normal)))
     }
 
     /// Sends the pool's dirty ranges; returns the bytes written.
     fn flush(&mut self) -> u64 {
         match &mut self.mode {
-            RunnerMode::Gpu(renderer) => renderer.sync(&mut self.scene.tree, &self.scene.palette).bytes,
-            RunnerMode::Cpu => self.scene.tree.pool_mut().flush().byte_count(),
+            RunnerMode::Gpu(renderer) => renderer.sync(&mut self.editor.scene.tree, &self.editor.scene.palette).bytes,
+            RunnerMode::Cpu => self.editor.scene.tree.pool_mut().flush().byte_count(),
         }
     }
 
@@ -286,11 +218,13 @@ impl Runner {
         match &mut self.mode {
             RunnerMode::Gpu(renderer) => {
                 renderer
-                    .render(&self.scene.tree, &self.camera, self.viewport, &self.settings, None)
+                    .render(&self.editor.scene.tree, &self.camera, self.viewport, &self.settings, None)
                     .map_err(|e| e.to_string())?;
                 renderer.read_image().map_err(|e| e.to_string())
             }
-            RunnerMode::Cpu => Ok(render_scene_cpu(&self.scene, None, &self.camera, self.viewport, &self.settings)),
+            RunnerMode::Cpu => {
+                Ok(render_scene_cpu(&self.editor.scene, None, &self.camera, self.viewport, &self.settings))
+            }
         }
     }
 

@@ -10,6 +10,7 @@ pub mod lod;
 pub mod octree;
 pub mod palette;
 pub mod sculpture;
+pub mod selection;
 pub mod shape;
 pub mod showroom;
 

@@ -1,0 +1,180 @@
+//! Box selection in the window. In select mode (B) a left drag selects the
+//! box between the voxels under the press and the release; a drag that
+//! starts on a face of the selected box (the face is its handle) moves that
+//! face by the voxel steps the drag covers on screen. Ctrl+C / Ctrl+X /
+//! Ctrl+V, Delete, Escape and the arrow keys act on it. Everything ends as
+//! an editor line (`select`, `copy`, `paste`, `move`…), as a script would.
+
+use glam::{DVec3, IVec3, Vec3};
+
+use octovox::camera::Camera;
+use octovox::replay::Command as Line;
+use octovox::scene::selection::Region;
+
+use super::{App, Nudge, StrokePhase};
+
+/// A selection drag under way.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum SelectDrag {
+    /// A new box from this voxel.
+    NewBox(IVec3),
+    /// A face of the selected box, by its outward normal, dragged from
+    /// this window pixel.
+    Face { normal: IVec3, start: (f64, f64) },
+}
+
+impl App {
+    pub(super) fn select_drag(&mut self, phase: StrokePhase, x: f64, y: f64) {
+        match phase {
+            StrokePhase::Begin => {
+                self.select_drag = match self.handle_at(x, y) {
+                    Some(normal) => Some(SelectDrag::Face { normal, start: (x, y) }),
+                    None => {
+                        self.pick_or_say(x, y, "no voxel there to select from").map(|p| SelectDrag::NewBox(p.voxel))
+                    }
+                };
+                self.state.select_preview = self.dragged_box(x, y);
+            }
+            StrokePhase::Move => self.state.select_preview = self.dragged_box(x, y),
+            StrokePhase::End => {
+                let region = self.dragged_box(x, y);
+                self.select_drag = None;
+                self.state.select_preview = None;
+                if let Some(r) = region {
+                    self.act(Line::Select(Some((r.min, r.max))), "select");
+                }
+            }
+            StrokePhase::Click => {}
+        }
+    }
+
+    /// The box the drag so far would select.
+    fn dragged_box(&self, x: f64, y: f64) -> Option<Region> {
+        match self.select_drag? {
+            SelectDrag::NewBox(from) => {
+                let to = self.pick_at(x, y).ok().flatten().map_or(from, |pick| pick.voxel);
+                Region::new(from, to).ok()
+            }
+            SelectDrag::Face { normal, start } => {
+                let region = self.editor.selection?;
+                let (lo, hi) = box_corners(&region, self.editor.scene.tree.origin());
+                let face = (lo + hi) * 0.5 + normal.as_vec3() * (hi - lo) * 0.5;
+                let steps = self.screen_steps(face, normal, start, (x, y))?;
+                // The face moves along its normal; the box never turns inside out.
+                let (mut min, mut max) = (region.min, region.max);
+                if normal.element_sum() > 0 {
+                    max = (max + normal * steps).max(min);
+                } else {
+                    min = (min + normal * steps).min(max);
+                }
+                Region::new(min, max).ok()
+            }
+        }
+    }
+
+    /// The outward normal of the selected box's face under window pixel
+    /// (x, y), if the pointer is on the box.
+    fn handle_at(&self, x: f64, y: f64) -> Option<IVec3> {
+        let region = self.editor.selection?;
+        let (w, h) = self.window_size();
+        let origin = self.editor.scene.tree.origin();
+        let (eye, dir) = self.state.camera.basis(w, h, origin).ray_through(x as f32, y as f32);
+        let (lo, hi) = box_corners(&region, origin);
+        entry_face(eye, dir, lo, hi)
+    }
+
+    /// Edit ▸ Paste: the block's min corner in the cell in front of the
+    /// face under the cursor.
+    pub(super) fn paste_at_cursor(&mut self) {
+        let Some((x, y)) = self.input.cursor() else { return };
+        if let Some(pick) = self.pick_or_say(x, y, "no face under the cursor to paste on") {
+            self.act(Line::Paste(pick.voxel + pick.normal), "paste");
+        }
+    }
+
+    /// An arrow key: `move` the selection one voxel along the world axis
+    /// nearest to that direction as the camera sees it.
+    pub(super) fn nudge(&mut self, nudge: Nudge) {
+        if self.editor.selection.is_none() {
+            self.ui.info("nothing is selected: B, then drag a box");
+            return;
+        }
+        self.act(Line::Move(nudge_step(&self.state.camera, nudge)), "move");
+    }
+}
+
+/// The box's corners in tree-local coordinates (what camera rays use).
+fn box_corners(region: &Region, origin: IVec3) -> (Vec3, Vec3) {
+    ((region.min - origin).as_vec3(), (region.max + IVec3::ONE - origin).as_vec3())
+}
+
+/// Where the ray from `eye` along `dir` enters the box `lo..hi`: the
+/// outward normal of the face it crosses; `None` if it misses, or starts
+/// inside.
+fn entry_face(eye: Vec3, dir: Vec3, lo: Vec3, hi: Vec3) -> Option<IVec3> {
+    let (mut near, mut far, mut normal) = (f32::NEG_INFINITY, f32::INFINITY, IVec3::ZERO);
+    for axis in 0..3 {
+        if dir[axis] == 0.0 {
+            if eye[axis] < lo[axis] || eye[axis] > hi[axis] {
+                return None;
+            }
+            continue;
+        }
+        let (t0, t1) = ((lo[axis] - eye[axis]) / dir[axis], (hi[axis] - eye[axis]) / dir[axis]);
+        let mut outward = IVec3::ZERO;
+        outward[axis] = if t0 < t1 { -1 } else { 1 };
+        if t0.min(t1) > near {
+            (near, normal) = (t0.min(t1), outward);
+        }
+        far = far.min(t0.max(t1));
+    }
+    (near > 0.0 && near <= far).then_some(normal)
+}
+
+/// One voxel along the world axis nearest to `nudge` as the camera sees
+/// it: left/right and away/near on the ground (x or z), up/down along y.
+fn nudge_step(camera: &Camera, nudge: Nudge) -> IVec3 {
+    let forward = DVec3::new(camera.target.x - camera.eye.x, 0.0, camera.target.z - camera.eye.z);
+    let right = forward.cross(DVec3::Y);
+    let ground = |v: DVec3| {
+        if v.x.abs() >= v.z.abs() {
+            IVec3::new(v.x.signum() as i32, 0, 0)
+        } else {
+            IVec3::new(0, 0, v.z.signum() as i32)
+        }
+    };
+    match nudge {
+        Nudge::Right => ground(right),
+        Nudge::Left => -ground(right),
+        Nudge::Away => ground(forward),
+        Nudge::Near => -ground(forward),
+        Nudge::Up => IVec3::Y,
+        Nudge::Down => IVec3::NEG_Y,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_ray_enters_the_face_it_crosses_first() {
+        let (lo, hi) = (Vec3::ZERO, Vec3::splat(4.0));
+        let down = entry_face(Vec3::new(2.0, 10.0, 2.0), Vec3::new(0.1, -1.0, 0.0), lo, hi);
+        assert_eq!(down, Some(IVec3::Y));
+        assert_eq!(entry_face(Vec3::new(-5.0, 1.0, 1.0), Vec3::X, lo, hi), Some(IVec3::NEG_X));
+        assert_eq!(entry_face(Vec3::new(-5.0, 9.0, 1.0), Vec3::X, lo, hi), None);
+        assert_eq!(entry_face(Vec3::splat(2.0), Vec3::X, lo, hi), None, "from inside");
+    }
+
+    #[test]
+    fn arrows_follow_the_camera() {
+        let from_front = Camera { eye: DVec3::new(0.0, 5.0, 20.0), target: DVec3::ZERO, fov_y_deg: 50.0 };
+        assert_eq!(nudge_step(&from_front, Nudge::Right), IVec3::X);
+        assert_eq!(nudge_step(&from_front, Nudge::Away), IVec3::NEG_Z);
+        let from_side = Camera { eye: DVec3::new(20.0, 5.0, 1.0), target: DVec3::ZERO, fov_y_deg: 50.0 };
+        assert_eq!(nudge_step(&from_side, Nudge::Right), IVec3::NEG_Z);
+        assert_eq!(nudge_step(&from_side, Nudge::Near), IVec3::X);
+        assert_eq!(nudge_step(&from_side, Nudge::Down), IVec3::NEG_Y);
+    }
+}

@@ -1,0 +1,253 @@
+//! The editor: the scene, its undo history, the tool state (brush, colour,
+//! mirror planes), the box selection and the clipboard, and what every
+//! script line that edits or reads them means. `octovox replay` and the
+//! window both drive one `Editor`, so a line means one thing in both; what
+//! a host does around it (files, cameras, pixels, the GPU) stays the host's.
+
+use glam::IVec3;
+
+use crate::edit::{Edit, History};
+use crate::mirror::Mirror;
+use crate::replay::Command;
+use crate::scene::selection::{self, Block, Region};
+use crate::scene::{EditError, Op, Scene};
+use crate::tool::Brush;
+
+/// What brush edits use: the brush, the colour and the mirror planes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Tools {
+    pub brush: Brush,
+    /// Palette index of Attach, Paint, lines and fills (1..=255).
+    pub color: u8,
+    pub mirror: Mirror,
+}
+
+impl Default for Tools {
+    fn default() -> Tools {
+        Tools { brush: Brush::Voxel, color: 1, mirror: Mirror::default() }
+    }
+}
+
+/// What a line did, for the host to follow up.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    /// Tool state, selection or clipboard changed; the voxels did not.
+    State,
+    /// The voxels or the palette changed: the host flushes the pool.
+    Changed,
+    /// A new scene is in place: the host uploads it whole.
+    Replaced,
+    /// An expectation: whether it held, what it wanted and what it found.
+    Checked { ok: bool, expected: String, got: String },
+    /// Not the editor's line (files, camera, pixels): the host runs it.
+    Host,
+}
+
+/// The scene and everything the user edits it with.
+#[derive(Default)]
+pub struct Editor {
+    pub scene: Scene,
+    pub history: History,
+    pub tools: Tools,
+    /// The selected box, if any.
+    pub selection: Option<Region>,
+    clipboard: Option<Block>,
+}
+
+impl Editor {
+    /// Puts `scene` in place with an empty history and no selection; the
+    /// tools and the clipboard stay (pasting between documents works).
+    pub fn set_scene(&mut self, scene: Scene) {
+        self.scene = scene;
+        self.history.clear();
+        self.selection = None;
+    }
+
+    pub fn clipboard(&self) -> Option<&Block> {
+        self.clipboard.as_ref()
+    }
+
+    /// Carries out one line. `Err` is a line that could not run (a refused
+    /// edit changes nothing).
+    pub fn run(&mut self, command: &Command) -> Result<Outcome, String> {
+        let text = |e: EditError| e.to_string();
+        let tools = self.tools;
+        match command {
+            Command::New => self.set_scene(Scene::default()),
+            Command::Demo(built_in) => self.set_scene(built_in.scene()),
+            Command::Brush(brush) => self.tools.brush = *brush,
+            Command::Color(c) => self.tools.color = *c,
+            Command::Mirror(plane) => self.tools.mirror.apply_line(*plane),
+            Command::Pick(p) => self.tools.color = crate::replay::picked_color(&self.scene, *p)?,
+            Command::Place(p) => {
+                self.apply_mirrored(vec![brush_edit(&tools, *p, Op::Place(tools.color))]).map_err(text)?
+            }
+            Command::Remove(p) => self.apply_mirrored(vec![brush_edit(&tools, *p, Op::Remove)]).map_err(text)?,
+            Command::Paint(p) => {
+                self.apply_mirrored(vec![brush_edit(&tools, *p, Op::Paint(tools.color))]).map_err(text)?
+            }
+            Command::Line(a, b) => {
+                self.apply_mirrored(crate::tool::line_edits(&tools.brush, tools.color, *a, *b)).map_err(text)?;
+            }
+            // Fills and extrudes are not mirrored: their regions follow the
+            // colours and faces, not the brush.
+            Command::Fill(p) => {
+                let edits = crate::scene::fill::fill_edits(&self.scene.tree, *p, tools.color).map_err(text)?;
+                self.commit(edits).map_err(text)?;
+            }
+            Command::Extrude(p, normal, layers) => {
+                let edits =
+                    crate::scene::extrude::extrude_edits(&self.scene.tree, *p, *normal, *layers).map_err(text)?;
+                self.commit(edits).map_err(text)?;
+            }
+            Command::Rgb(..) | Command::Material(..) => {
+                if let Some(edit) = crate::replay::palette_edit(command, &self.scene.palette) {
+                    self.commit(vec![edit]).map_err(text)?;
+                }
+            }
+            Command::Undo(n) => self.repeat(*n, true)?,
+            Command::Redo(n) => self.repeat(*n, false)?,
+            Command::Select(None) => self.selection = None,
+            Command::Select(Some((a, b))) => self.selection = Some(Region::new(*a, *b).map_err(text)?),
+            Command::Copy => self.clipboard = Some(selection::copy(&self.scene.tree, self.selected()?).map_err(text)?),
+            Command::Cut => {
+                let region = self.selected()?;
+                let block = selection::copy(&self.scene.tree, region).map_err(text)?;
+                self.commit(vec![region.clear_edit()]).map_err(text)?;
+                self.clipboard = Some(block);
+            }
+            Command::Delete => self.commit(vec![self.selected()?.clear_edit()]).map_err(text)?,
+            Command::Paste(at) => {
+                let block = self.clipboard.as_ref().ok_or("nothing to paste: copy or cut a selection first")?;
+                let (edits, region) = (block.place_edits(*at), block.region_at(*at));
+                self.commit(edits).map_err(text)?;
+                self.selection = Some(region);
+            }
+            Command::Move(by) => self.move_selection(*by)?,
+            Command::ExpectVoxel(p, want) => {
+                let got = self.scene.tree.get(*p);
+                return Ok(checked(got == *want, format!("voxel {p} = {want}"), got));
+            }
+            Command::ExpectCount(want) => {
+                let got = self.scene.tree.solid_voxels();
+                return Ok(checked(got == *want, format!("{want} voxels"), got));
+            }
+            _ => return Ok(Outcome::Host),
+        }
+        Ok(match command {
+            Command::New | Command::Demo(_) => Outcome::Replaced,
+            Command::Brush(_)
+            | Command::Color(_)
+            | Command::Mirror(_)
+            | Command::Pick(_)
+            | Command::Select(_)
+            | Command::Copy => Outcome::State,
+            _ => Outcome::Changed,
+        })
+    }
+
+    /// The selected box, or why a line that needs one cannot run.
+    fn selected(&self) -> Result<Region, String> {
+        self.selection.ok_or_else(|| "nothing is selected: select a box first".to_string())
+    }
+
+    /// `move`: the selected voxels leave their box and land `by` away, as
+    /// one undo step; the selection follows. Refused as a whole when the
+    /// new place is outside the world.
+    fn move_selection(&mut self, by: IVec3) -> Result<(), String> {
+        let region = self.selected()?;
+        let block = selection::copy(&self.scene.tree, region).map_err(|e| e.to_string())?;
+        let mut edits = vec![region.clear_edit()];
+        edits.extend(block.place_edits(region.min + by));
+        self.commit(edits).map_err(|e| e.to_string())?;
+        self.selection = Some(region.shifted(by));
+        Ok(())
+    }
+
+    /// Brush edits and their mirror images as one undo step (or part of the
+    /// open stroke).
+    ///
+    /// # Errors
+    /// A refused edit; then nothing changed.
+    pub fn apply_mirrored(&mut self, edits: Vec<Edit>) -> Result<(), EditError> {
+        let edits = edits.into_iter().flat_map(|e| self.tools.mirror.edits(e)).collect();
+        self.commit(edits)
+    }
+
+    /// Edits as one undo step (or part of the open stroke).
+    ///
+    /// # Errors
+    /// A refused edit; then nothing changed.
+    pub fn commit(&mut self, edits: Vec<Edit>) -> Result<(), EditError> {
+        self.history.apply_group(&mut self.scene, edits)
+    }
+
+    /// Undoes one step; `false` when there is none.
+    ///
+    /// # Errors
+    /// An undo the octree refuses (out of memory).
+    pub fn undo(&mut self) -> Result<bool, EditError> {
+        self.history.undo(&mut self.scene)
+    }
+
+    /// Redoes one step; `false` when there is none.
+    ///
+    /// # Errors
+    /// A redo the octree refuses (out of memory).
+    pub fn redo(&mut self) -> Result<bool, EditError> {
+        self.history.redo(&mut self.scene)
+    }
+
+    fn repeat(&mut self, n: u32, undo: bool) -> Result<(), String> {
+        for _ in 0..n {
+            let did = if undo { self.undo() } else { self.redo() };
+            if !did.map_err(|e| e.to_string())? {
+                return Err(format!("nothing to {}", if undo { "undo" } else { "redo" }));
+            }
+        }
+        Ok(())
+    }
+}
+
+fn brush_edit(tools: &Tools, at: IVec3, op: Op) -> Edit {
+    Edit::Brush { shape: tools.brush.shape_at(at), op }
+}
+
+fn checked(ok: bool, expected: String, got: impl ToString) -> Outcome {
+    Outcome::Checked { ok, expected, got: got.to_string() }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(editor: &mut Editor, line: &str) -> Result<Outcome, String> {
+        let script = crate::replay::parse_script(std::path::Path::new("t.ovr"), line).unwrap();
+        editor.run(&script.lines[0].command)
+    }
+
+    #[test]
+    fn a_refused_paste_leaves_scene_selection_and_history_alone() {
+        let mut editor = Editor::default();
+        for line in ["place 0 0 0", "place 1 0 0", "select 0 0 0 1 0 0", "copy"] {
+            run(&mut editor, line).unwrap();
+        }
+        let limit = crate::scene::octree::WORLD_LIMIT - 1;
+        let err = run(&mut editor, &format!("paste {limit} 0 0")).unwrap_err();
+        assert!(err.contains("outside the world"), "{err}");
+        assert_eq!(editor.scene.tree.solid_voxels(), 2);
+        assert_eq!(editor.selection, Some(Region { min: IVec3::ZERO, max: IVec3::X }));
+        assert_eq!(editor.history.usage().0, 2);
+        assert!(run(&mut editor, &format!("move {limit} 0 0")).is_err());
+        assert_eq!((editor.scene.tree.get(IVec3::ZERO), editor.scene.tree.get(IVec3::X)), (1, 1));
+    }
+
+    #[test]
+    fn lines_that_need_a_selection_or_clipboard_say_so() {
+        let mut editor = Editor::default();
+        for line in ["copy", "cut", "delete", "move 1 0 0"] {
+            assert!(run(&mut editor, line).unwrap_err().contains("nothing is selected"), "{line}");
+        }
+        assert!(run(&mut editor, "paste 0 0 0").unwrap_err().contains("nothing to paste"));
+    }
+}
