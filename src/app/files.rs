@@ -77,7 +77,7 @@ impl App {
                 None => {
                     // Ask for a path; SaveAs carries on with the pending action.
                     self.ui.pending = Some(pending);
-                    self.ui.dialog = Some((DialogKind::SaveAs, "saves/untitled.vox".into()));
+                    self.ask_path(DialogKind::SaveAs, "saves/untitled.vox".into());
                 }
             },
         }
@@ -138,6 +138,7 @@ impl App {
     /// that waited for a path to save to.
     pub(super) fn save_as(&mut self, path: PathBuf, options: WriteOptions, event_loop: &ActiveEventLoop) {
         if self.save(&path, options) {
+            self.recent.add(&path);
             self.state.path = Some(path);
             self.update_title();
             if let Some(pending) = self.ui.pending.take() {
@@ -220,6 +221,7 @@ impl App {
         let Some(loading) = self.loading.take() else { return };
         match result {
             Ok(scene) => {
+                self.recent.add(&loading.path);
                 let seconds = loading.started.elapsed().as_secs_f64();
                 report!("loaded: {} ({} voxels, {seconds:.2} s)", loading.path.display(), scene.tree.solid_voxels());
                 self.replace_scene(scene, octovox::replay::Command::Load(loading.path.clone()));

@@ -18,6 +18,7 @@ impl App {
         let interval_ms = self.last_frame.map(|last| started.duration_since(last).as_secs_f64() * 1e3);
         let seconds = self.measure_interval(started);
         self.poll_loading();
+        self.poll_file_dialog(event_loop);
         if self.ready {
             self.play_step(event_loop);
         }
@@ -97,6 +98,7 @@ impl App {
                 presets: self.presets_measured.as_deref(),
                 selection: self.state.select_preview.or(self.editor.selection),
                 has_clipboard: self.editor.clipboard().is_some(),
+                recent: self.recent.files().cloned().collect(),
             };
             let (state, ui_state, tools) = (&mut self.state, &mut self.ui, &mut self.editor.tools);
             let pick = self.pick;
@@ -246,6 +248,8 @@ impl App {
             || self.player.is_some();
         self.next_repaint = match repaint_delay {
             _ if animating => Some(Instant::now()),
+            // An open native dialog is looked at ten times a second.
+            _ if self.file_dialog.is_some() => Some(Instant::now() + Duration::from_millis(100)),
             Some(delay) if delay < Duration::from_secs(5) => Some(Instant::now() + delay),
             _ => None,
         };

@@ -16,11 +16,13 @@ mod actions;
 mod camera_control;
 mod capture;
 mod command;
+mod file_dialog;
 mod files;
 mod frame;
 mod input;
 mod motion;
 mod presets;
+mod recent;
 mod script;
 mod selection;
 mod state;
@@ -160,6 +162,10 @@ struct App {
     /// and the line that loads the document as saved, which starts it.
     journal: Option<octovox::replay::Recorder>,
     journal_source: Option<octovox::replay::Command>,
+    /// A native file dialog that is open.
+    file_dialog: Option<file_dialog::NativeDialog>,
+    /// File ▸ Open recent.
+    recent: recent::Recent,
     /// A box-select drag under way (select mode).
     select_drag: Option<selection::SelectDrag>,
     /// The face a Ctrl+drag extrude started on and where the drag began.
@@ -199,6 +205,8 @@ impl App {
             recorder: None,
             journal: None,
             journal_source: None,
+            file_dialog: None,
+            recent: recent::Recent::load(),
             select_drag: None,
             extrude_from: None,
             screenshot_path: None,
@@ -460,21 +468,21 @@ impl App {
                 Some(path) => {
                     self.save(&path, WriteOptions::default());
                 }
-                None => self.ui.dialog = Some((DialogKind::SaveAs, "saves/untitled.vox".into())),
+                None => self.ask_path(DialogKind::SaveAs, "saves/untitled.vox".into()),
             },
             Command::SaveAs(path) => self.save_as(path, WriteOptions::default(), event_loop),
             Command::SaveOver(path) => self.save_as(path, WriteOptions { overwrite_read_only: true }, event_loop),
             Command::AskOpen => {
                 let start = self.state.path.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
-                self.ui.dialog = Some((DialogKind::Open, start));
+                self.ask_path(DialogKind::Open, start);
             }
             Command::AskSaveAs => {
                 let start = self.state.path.as_ref().map_or("saves/untitled.vox".into(), |p| p.display().to_string());
-                self.ui.dialog = Some((DialogKind::SaveAs, start));
+                self.ask_path(DialogKind::SaveAs, start);
             }
             Command::AskExport => {
                 let start = self.state.path.as_ref().map_or("saves/untitled.obj".into(), |p| p.with_extension("obj"));
-                self.ui.dialog = Some((DialogKind::Export, start.display().to_string()));
+                self.ask_path(DialogKind::Export, start.display().to_string());
             }
             Command::Export(path) => self.export(&path),
             Command::Screenshot => self.screenshot_requested = true,

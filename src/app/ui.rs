@@ -64,6 +64,8 @@ pub struct Info<'a> {
     pub presets: Option<&'a [super::presets::Measured]>,
     pub selection: Option<Region>,
     pub has_clipboard: bool,
+    /// File ▸ Open recent, newest first.
+    pub recent: Vec<PathBuf>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -145,6 +147,9 @@ fn menu_bar(ui: &mut egui::Ui, info: &Info, ui_state: &mut UiState, out: &mut Ve
                     if ui.add_enabled(available(&action.command, info), egui::Button::new(text)).clicked() {
                         out.push(action.command.clone());
                     }
+                    if action.command == Command::AskOpen {
+                        recent_menu(ui, info, out);
+                    }
                 }
             });
         }
@@ -160,6 +165,19 @@ fn menu_bar(ui: &mut egui::Ui, info: &Info, ui_state: &mut UiState, out: &mut Ve
             ui.label(format!("loading {} … {seconds:.1} s", path.display()));
         }
         message(ui, ui_state);
+    });
+}
+
+/// File ▸ Open recent.
+fn recent_menu(ui: &mut egui::Ui, info: &Info, out: &mut Vec<Command>) {
+    ui.add_enabled_ui(!info.recent.is_empty(), |ui| {
+        ui.menu_button("Open recent", |ui| {
+            for path in &info.recent {
+                if ui.button(path.display().to_string()).clicked() {
+                    out.push(Command::Open(path.clone()));
+                }
+            }
+        });
     });
 }
 
@@ -508,7 +526,7 @@ fn dialog(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
     let title = match kind {
         DialogKind::Open => "Open .vox, .ovx or .obj",
         DialogKind::SaveAs => "Save as .vox or .ovx",
-        DialogKind::Export => "Export a mesh (.obj or .ply)",
+        DialogKind::Export => "Export a mesh (.obj, .ply or .glb)",
     };
     let mut close = false;
     egui::Window::new(title).collapsible(false).resizable(false).show(ctx, |ui| {

@@ -269,8 +269,21 @@ pub fn save(display: &str, lines: &mut Lines, file: &Path) {
 }
 
 /// Starts the real binary on `display` in `dir`, stdout piped to a
-/// [`Lines`] and stderr to a file (shown if the app dies early).
+/// [`Lines`] and stderr to a file (shown if the app dies early). Native
+/// file dialogs are off (a desktop's would wait for a person); the
+/// recent-files list lives in `dir`.
 pub fn spawn_app(display: &str, dir: &Path, args: &[String]) -> (KillOnDrop, Lines, PathBuf) {
+    spawn_app_with(display, dir, args, &[("OCTOVOX_NO_NATIVE_DIALOGS", "1")])
+}
+
+/// [`spawn_app`] with these environment variables (and native dialogs as
+/// the machine has them).
+pub fn spawn_app_with(
+    display: &str,
+    dir: &Path,
+    args: &[String],
+    env: &[(&str, &str)],
+) -> (KillOnDrop, Lines, PathBuf) {
     let stderr_path = dir.join("octovox.stderr");
     let runtime_dir = dir.join("xdg");
     std::fs::create_dir_all(&runtime_dir).unwrap();
@@ -279,7 +292,10 @@ pub fn spawn_app(display: &str, dir: &Path, args: &[String]) -> (KillOnDrop, Lin
         .current_dir(dir)
         .env("DISPLAY", display)
         .env("XDG_RUNTIME_DIR", &runtime_dir)
+        .env("XDG_CONFIG_HOME", dir.join("config"))
         .env_remove("WAYLAND_DISPLAY")
+        .env_remove("DBUS_SESSION_BUS_ADDRESS")
+        .envs(env.iter().copied())
         .stdout(Stdio::piped())
         .stderr(std::fs::File::create(&stderr_path).unwrap())
         .spawn()

@@ -1,0 +1,122 @@
+//! Native file dialogs (rfd: the desktop portal over D-Bus, else zenity),
+//! run on a thread of their own so the window keeps drawing. Where neither
+//! is there, or a dialog gives up without showing itself, the window's own
+//! path field (`ui::dialog`) asks instead.
+
+use std::path::{Path, PathBuf};
+use std::sync::mpsc::{self, Receiver, TryRecvError};
+use std::time::{Duration, Instant};
+
+use winit::event_loop::ActiveEventLoop;
+
+use super::ui::DialogKind;
+use super::{App, Command};
+
+/// A dialog that answers faster than this never showed itself: nobody
+/// picks or cancels a file that fast.
+const NO_DIALOG_WITHIN: Duration = Duration::from_millis(300);
+
+/// A native dialog that is open.
+pub struct NativeDialog {
+    kind: DialogKind,
+    /// What the path field starts with if the dialog never shows.
+    start: String,
+    opened: Instant,
+    answer: Receiver<Option<PathBuf>>,
+}
+
+/// Whether a native dialog can show: zenity is installed, or a desktop
+/// portal is on the session bus (it starts on demand, so its service file
+/// is what tells). `OCTOVOX_NO_NATIVE_DIALOGS` turns them off.
+pub fn available() -> bool {
+    if std::env::var_os("OCTOVOX_NO_NATIVE_DIALOGS").is_some() {
+        return false;
+    }
+    let on_path = |name: &str| {
+        std::env::var_os("PATH").is_some_and(|paths| std::env::split_paths(&paths).any(|d| d.join(name).is_file()))
+    };
+    let portal = || {
+        let dirs = std::env::var("XDG_DATA_DIRS").unwrap_or_else(|_| "/usr/local/share:/usr/share".into());
+        std::env::split_paths(&dirs).any(|d| d.join("dbus-1/services/org.freedesktop.portal.Desktop.service").is_file())
+    };
+    on_path("zenity") || (std::env::var_os("DBUS_SESSION_BUS_ADDRESS").is_some() && portal())
+}
+
+/// The rfd dialog of `kind`, starting at `start` (a path, maybe relative).
+fn dialog(kind: DialogKind, start: &Path) -> rfd::FileDialog {
+    let folder = match start.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let folder = std::fs::canonicalize(&folder).unwrap_or(folder);
+    let dialog = rfd::FileDialog::new().set_directory(folder);
+    match kind {
+        DialogKind::Open => dialog
+            .set_title("Open")
+            .add_filter("Voxel scenes and meshes", &["vox", "ovx", "obj"])
+            .add_filter("All files", &["*"]),
+        DialogKind::SaveAs => dialog
+            .set_title("Save as")
+            .add_filter("MagicaVoxel .vox or octovox .ovx", &["vox", "ovx"])
+            .set_file_name(start.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned())),
+        DialogKind::Export => dialog
+            .set_title("Export a mesh")
+            .add_filter("Meshes", &["obj", "ply", "glb"])
+            .set_file_name(start.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned())),
+    }
+}
+
+impl App {
+    /// Asks for a path for `kind`: in a native dialog where there is one,
+    /// else in the window's path field, starting at `start`.
+    pub(super) fn ask_path(&mut self, kind: DialogKind, start: String) {
+        if self.file_dialog.is_some() {
+            return;
+        }
+        if !available() {
+            self.ui.dialog = Some((kind, start));
+            return;
+        }
+        let (tx, rx) = mpsc::channel();
+        let from = PathBuf::from(&start);
+        let spawned = std::thread::Builder::new().name("file dialog".into()).spawn(move || {
+            let d = dialog(kind, &from);
+            let _ = tx.send(if kind == DialogKind::Open { d.pick_file() } else { d.save_file() });
+        });
+        match spawned {
+            Ok(_) => {
+                report!("file dialog: native");
+                self.file_dialog = Some(NativeDialog { kind, start, opened: Instant::now(), answer: rx });
+            }
+            Err(_) => self.ui.dialog = Some((kind, start)),
+        }
+    }
+
+    /// Carries out the answer of the open native dialog, once it came.
+    pub(super) fn poll_file_dialog(&mut self, event_loop: &ActiveEventLoop) {
+        let Some(open) = &self.file_dialog else { return };
+        let answer = match open.answer.try_recv() {
+            Ok(answer) => answer,
+            Err(TryRecvError::Empty) => return,
+            Err(TryRecvError::Disconnected) => None,
+        };
+        let Some(open) = self.file_dialog.take() else { return };
+        match answer {
+            Some(path) => {
+                let command = match open.kind {
+                    DialogKind::Open => Command::Open(path),
+                    DialogKind::SaveAs => Command::SaveAs(path),
+                    DialogKind::Export => Command::Export(path),
+                };
+                self.execute(command, event_loop);
+            }
+            None if open.opened.elapsed() < NO_DIALOG_WITHIN => {
+                report!("file dialog: none showed; asking in the window");
+                self.ui.dialog = Some((open.kind, open.start));
+            }
+            // Cancelled: an action that waited for a path waits no more.
+            None => self.ui.pending = None,
+        }
+        self.request_redraw();
+    }
+}

@@ -1,0 +1,84 @@
+//! Native file dialogs and the recent-files list in the real window. A
+//! stand-in `zenity` on PATH (rfd's dialog where no desktop portal is)
+//! answers Open and Save As with paths; one that gives up at once sends the
+//! window to its own path field, where typing the path still works.
+#![allow(clippy::unwrap_used)] // in tests a panic is the failure report
+
+mod common;
+
+use std::path::Path;
+use std::time::Duration;
+
+use common::window::*;
+use glam::IVec3;
+use octovox::scene::{Op, Scene, Shape};
+
+fn save_box(path: &Path, max: IVec3) -> u64 {
+    let mut scene = Scene::default();
+    scene.tree.apply_brush(&Shape::Box { min: IVec3::ZERO, max }, Op::Place(12)).unwrap();
+    octovox::io::save_scene(path, &scene, Default::default()).unwrap();
+    scene.tree.solid_voxels()
+}
+
+#[test]
+fn open_and_save_as_go_through_the_native_dialog_or_the_path_field() {
+    for tool in ["Xvfb", "xdotool"] {
+        require_tool(tool);
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let root = std::fs::canonicalize(dir.path()).unwrap();
+    let (a, b, c, d) = (root.join("a.vox"), root.join("b.vox"), root.join("c.vox"), root.join("d.vox"));
+    save_box(&a, IVec3::new(7, 0, 7));
+    let b_count = save_box(&b, IVec3::new(3, 3, 3));
+    save_box(&d, IVec3::new(1, 1, 1));
+    // The stand-in dialog: "picks" b.vox to open and c.vox to save as,
+    // logs its arguments, and gives up at once while `fail` exists.
+    let bin = root.join("bin");
+    std::fs::create_dir(&bin).unwrap();
+    let script = format!(
+        "#!/bin/sh\necho \"$@\" >> {log}\n[ -e {fail} ] && exit 1\n\
+         case \"$*\" in *--save*) echo {c} ;; *) echo {b} ;; esac\n",
+        log = root.join("zenity.log").display(),
+        fail = root.join("fail").display(),
+        c = c.display(),
+        b = b.display(),
+    );
+    let zenity = bin.join("zenity");
+    std::fs::write(&zenity, script).unwrap();
+    std::fs::set_permissions(&zenity, std::os::unix::fs::PermissionsExt::from_mode(0o755)).unwrap();
+    let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap());
+
+    let (_xvfb, display) = start_xvfb(10);
+    let args = [a.display().to_string(), "--size".into(), "640x480".into()];
+    let (mut app, mut lines, stderr_path) = spawn_app_with(&display, &root, &args, &[("PATH", &path)]);
+    let window = find_window(&display, &mut app, &stderr_path);
+    lines.wait_for("octovox: ready", Duration::from_secs(90));
+    xdotool(&display, &["windowfocus", "--sync", &window]);
+
+    xdotool(&display, &["key", "ctrl+o"]);
+    lines.wait_for("file dialog: native", Duration::from_secs(30));
+    let loaded = lines.wait_for("loaded:", Duration::from_secs(30));
+    assert!(loaded.contains("b.vox") && loaded.contains(&format!("({b_count} voxels")), "{loaded}");
+    xdotool(&display, &["key", "ctrl+shift+s"]);
+    let saved = lines.wait_for("saved:", Duration::from_secs(30));
+    assert!(saved.ends_with("c.vox"), "{saved}");
+    assert_eq!(octovox::io::load_scene(&c, 0).unwrap().tree.solid_voxels(), b_count);
+    let log = std::fs::read_to_string(root.join("zenity.log")).unwrap();
+    assert!(log.contains("--file-selection") && log.contains("--save"), "{log}");
+
+    // A dialog that never shows: the path field asks instead.
+    std::fs::write(root.join("fail"), "").unwrap();
+    xdotool(&display, &["key", "ctrl+o"]);
+    lines.wait_for("file dialog: none showed", Duration::from_secs(30));
+    std::thread::sleep(Duration::from_millis(500));
+    xdotool(&display, &["key", "ctrl+a"]);
+    xdotool(&display, &["type", "d.vox"]);
+    xdotool(&display, &["key", "Return"]);
+    assert!(lines.wait_for("loaded:", Duration::from_secs(30)).contains("d.vox"));
+
+    // Newest first: d (opened), c (saved as), b (opened), a (the first file).
+    let recent = std::fs::read_to_string(root.join("config/octovox/recent.txt")).unwrap();
+    let listed: Vec<&str> = recent.lines().collect();
+    let want: Vec<String> = [&d, &c, &b, &a].iter().map(|p| p.display().to_string()).collect();
+    assert_eq!(listed, want);
+}
