@@ -42,6 +42,7 @@ impl App {
             Some((x, y)) if !self.pointer_over_ui && self.loading.is_none() => self.pick_at(x, y).ok().flatten(),
             _ => None,
         };
+        self.update_extrude_preview();
         self.sync_grid();
         let repaint_delay = full.viewport_output.get(&egui::ViewportId::ROOT).map(|v| v.repaint_delay);
         let Some(window_copy) = self.trace_and_present(&ctx, full) else { return };
@@ -99,13 +100,16 @@ impl App {
                 selection: self.state.select_preview.or(self.editor.selection),
                 has_clipboard: self.editor.clipboard().is_some(),
                 recent: self.recent.files().cloned().collect(),
+                extrude: self.extrude_preview.as_ref().map(|p| (p.voxels.as_slice(), p.face.1, p.layers)),
             };
             let (state, ui_state, tools) = (&mut self.state, &mut self.ui, &mut self.editor.tools);
             let pick = self.pick;
             ctx.run_ui(raw_input, |ui| {
                 commands = ui::show(ui, state, tools, ui_state, &info);
                 ui::draw_selection(ui, state, &info);
-                if let Some(pick) = pick.filter(|_| !state.select_mode) {
+                if let Some((voxels, normal, layers)) = info.extrude {
+                    ui::draw_extrude(ui, state, &info, voxels, normal, layers);
+                } else if let Some(pick) = pick.filter(|_| !state.select_mode) {
                     ui::draw_brush_outline(ui, state, tools, &pick, &info);
                 }
             })

@@ -35,6 +35,11 @@ impl Input {
         self.cursor
     }
 
+    /// Ctrl is held: a left drag from a face extrudes it.
+    pub fn ctrl_held(&self) -> bool {
+        self.modifiers.control_key()
+    }
+
     /// Fly direction (right, up, forward) while the right button is held.
     pub fn fly_direction(&self) -> Option<DVec3> {
         self.right?;

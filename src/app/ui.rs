@@ -66,6 +66,8 @@ pub struct Info<'a> {
     pub has_clipboard: bool,
     /// File ▸ Open recent, newest first.
     pub recent: Vec<PathBuf>,
+    /// The faces an extrude would move (voxels, normal) and its layers so far.
+    pub extrude: Option<(&'a [IVec3], IVec3, i32)>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -659,6 +661,35 @@ pub fn draw_brush_outline(ui: &egui::Ui, state: &EditorState, tools: &Tools, pic
         Tool::Paint => egui::Color32::from_rgb(255, 220, 90),
     };
     outline_box(ui, state, info, (lo, hi), color, false);
+}
+
+/// Most faces the extrude preview draws (a larger region shows its first ones).
+const MAX_PREVIEW_FACES: usize = 20_000;
+
+/// The faces an extrude would move, drawn where the drag puts them:
+/// `layers` voxels out along `normal` (in, when negative; green out, red in).
+pub fn draw_extrude(ui: &egui::Ui, state: &EditorState, info: &Info, voxels: &[IVec3], normal: IVec3, layers: i32) {
+    let screen = ui.ctx().content_rect();
+    let basis = state.camera.basis(screen.width().max(1.0) as u32, screen.height().max(1.0) as u32, info.tree.origin());
+    let origin = info.tree.origin().as_vec3();
+    let n = normal.as_vec3();
+    // The two axes of the face's plane, half a voxel each.
+    let (u, v) = match normal.abs() {
+        IVec3 { x: 1, .. } => (Vec3::Y * 0.5, Vec3::Z * 0.5),
+        IVec3 { y: 1, .. } => (Vec3::Z * 0.5, Vec3::X * 0.5),
+        _ => (Vec3::X * 0.5, Vec3::Y * 0.5),
+    };
+    let color = if layers < 0 { Color32::from_rgb(255, 100, 90) } else { Color32::from_rgb(120, 255, 140) };
+    let painter = ui.ctx().layer_painter(egui::LayerId::new(egui::Order::Background, egui::Id::unique("extrude")));
+    for voxel in voxels.iter().take(MAX_PREVIEW_FACES) {
+        let center = voxel.as_vec3() - origin + Vec3::splat(0.5) + n * (0.5 + layers as f32);
+        let corners = [center - u - v, center + u - v, center + u + v, center - u + v];
+        let points: Option<Vec<egui::Pos2>> =
+            corners.iter().map(|c| basis.project(*c).map(|(x, y)| egui::pos2(x, y))).collect();
+        if let Some(points) = points {
+            painter.add(egui::Shape::convex_polygon(points, color.gamma_multiply(0.35), Stroke::new(1.0, color)));
+        }
+    }
 }
 
 /// Outlines the selected box (or the one being dragged); in select mode
