@@ -100,7 +100,9 @@ pub enum Command {
     #[command(allow_negative_numbers = true)]
     Import(ImportArgs),
     /// Apply the crash-recovery journal the window left beside FILE (its
-    /// unsaved edits) and save the result as OUT; FILE and the journal stay.
+    /// unsaved edits), or FILE itself when it is a journal (an untitled
+    /// scene's, in saves/), and save the result as OUT; FILE and the
+    /// journal stay.
     Recover {
         file: PathBuf,
         #[arg(short, long)]

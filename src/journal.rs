@@ -4,6 +4,9 @@
 //! removes it when the document is saved or the edits are discarded. A
 //! journal still there when the document is opened again means a crash:
 //! the window offers to replay it, and `octovox recover` does so headless.
+//! A scene without a file (the demo, a new scene, an imported mesh) is
+//! journaled in `saves/` under the session's process id; the next window
+//! started without a file offers the journal of a session that is gone.
 //! `docs/recovery.md` describes it.
 
 use std::path::{Path, PathBuf};
@@ -15,6 +18,38 @@ use crate::scene::Scene;
 pub fn journal_path(document: &Path) -> PathBuf {
     let name = document.file_name().map_or_else(|| "untitled".into(), |n| n.to_string_lossy().into_owned());
     document.with_file_name(format!(".{name}.octovox-journal.ovr"))
+}
+
+/// The journal file names end so; `octovox recover` takes one directly.
+const JOURNAL_SUFFIX: &str = ".octovox-journal.ovr";
+
+/// Whether `path` names a journal (rather than a document).
+pub fn is_journal(path: &Path) -> bool {
+    path.file_name().is_some_and(|n| n.to_string_lossy().ends_with(JOURNAL_SUFFIX))
+}
+
+/// The journal of the untitled scene of the session with process id `pid`:
+/// `.untitled-PID.octovox-journal.ovr` in `dir`.
+pub fn untitled_journal_path(dir: &Path, pid: u32) -> PathBuf {
+    dir.join(format!(".untitled-{pid}{JOURNAL_SUFFIX}"))
+}
+
+/// Untitled journals in `dir` of sessions no longer running (no
+/// `/proc/PID`), newest first.
+pub fn orphaned_untitled(dir: &Path) -> Vec<PathBuf> {
+    let Ok(entries) = std::fs::read_dir(dir) else { return Vec::new() };
+    let mut found: Vec<(std::time::SystemTime, PathBuf)> = entries
+        .filter_map(Result::ok)
+        .filter(|entry| {
+            let name = entry.file_name().to_string_lossy().into_owned();
+            let pid = name.strip_prefix(".untitled-").and_then(|rest| rest.strip_suffix(JOURNAL_SUFFIX));
+            pid.and_then(|p| p.parse::<u32>().ok())
+                .is_some_and(|pid| pid != std::process::id() && !Path::new("/proc").join(pid.to_string()).exists())
+        })
+        .filter_map(|entry| Some((entry.metadata().ok()?.modified().ok()?, entry.path())))
+        .collect();
+    found.sort_by_key(|(modified, _)| std::cmp::Reverse(*modified));
+    found.into_iter().map(|(_, path)| path).collect()
 }
 
 /// The journal of `document` if one was left behind.
@@ -36,39 +71,61 @@ pub enum RecoverError {
     Failed { path: PathBuf, message: String },
 }
 
-/// Reads a journal and checks that it starts by loading `document`.
+/// Reads a journal. Its first scene line must load `document` when one is
+/// given (the journal found beside it); a journal named directly (an
+/// untitled one) must start with a scene line (`load`, `new`, `demo`).
 ///
 /// # Errors
 /// A journal that does not parse, or one written for another file.
-pub fn read(journal: &Path, document: &Path) -> Result<Script, RecoverError> {
+pub fn read(journal: &Path, document: Option<&Path>) -> Result<Script, RecoverError> {
     let script = load_script(journal).map_err(|errors| RecoverError::Unreadable {
         path: journal.to_path_buf(),
         errors: errors.iter().map(ToString::to_string).collect(),
     })?;
-    let document_id = std::fs::canonicalize(document).unwrap_or_else(|_| document.to_path_buf());
-    let first_load = script.lines.iter().find(|l| !matches!(l.command, Command::Viewport(..)));
-    match first_load.map(|l| &l.command) {
-        Some(Command::Load(owner)) if std::fs::canonicalize(owner).is_ok_and(|p| p == document_id) => Ok(script),
-        other => Err(RecoverError::Foreign {
-            path: journal.to_path_buf(),
-            owner: other.map_or_else(|| "nothing".into(), ToString::to_string),
-            document: document.to_path_buf(),
-        }),
+    let first = script.lines.iter().find(|l| !matches!(l.command, Command::Viewport(..))).map(|l| &l.command);
+    let owned = match (first, document) {
+        (Some(Command::Load(owner)), Some(document)) => {
+            let document_id = std::fs::canonicalize(document).unwrap_or_else(|_| document.to_path_buf());
+            std::fs::canonicalize(owner).is_ok_and(|p| p == document_id)
+        }
+        (Some(Command::Load(_) | Command::New | Command::Demo(_)), None) => true,
+        _ => false,
+    };
+    if owned {
+        return Ok(script);
     }
+    let owner = first.map_or_else(|| "nothing".into(), ToString::to_string);
+    Err(match document {
+        Some(document) => {
+            RecoverError::Foreign { path: journal.to_path_buf(), owner, document: document.to_path_buf() }
+        }
+        None => RecoverError::Failed {
+            path: journal.to_path_buf(),
+            message: format!("it starts with '{owner}', not with the scene it edits (load, new or demo)"),
+        },
+    })
 }
 
-/// The document as it was after the journal's last edit: the journal
+/// The scene as it was after the journal's last edit: the journal
 /// replayed, headless, on the CPU. All or nothing.
 ///
 /// # Errors
 /// As [`read`], or a line that does not apply.
-pub fn recover(document: &Path) -> Result<Scene, RecoverError> {
-    let journal = find(document).ok_or_else(|| RecoverError::NoJournal(document.to_path_buf()))?;
-    let script = read(&journal, document)?;
+pub fn recover_from(journal: &Path, document: Option<&Path>) -> Result<Scene, RecoverError> {
+    let script = read(journal, document)?;
     let mut runner = Runner::new(RunnerMode::Cpu);
     let report = runner.run(&script);
     if let Some(failure) = report.failures.first() {
-        return Err(RecoverError::Failed { path: journal, message: failure.to_string() });
+        return Err(RecoverError::Failed { path: journal.to_path_buf(), message: failure.to_string() });
     }
     Ok(runner.editor.scene)
+}
+
+/// The document as it was after its journal's last edit.
+///
+/// # Errors
+/// No journal beside it, or as [`recover_from`].
+pub fn recover(document: &Path) -> Result<Scene, RecoverError> {
+    let journal = find(document).ok_or_else(|| RecoverError::NoJournal(document.to_path_buf()))?;
+    recover_from(&journal, Some(document))
 }

@@ -132,3 +132,65 @@ fn damaged_and_foreign_journals_are_refused_and_left_in_place() {
         assert!(!out.exists(), "nothing is written from a bad journal");
     }
 }
+
+/// An untitled scene is journaled in saves/ under the session's process
+/// id; after a SIGKILL, `octovox recover JOURNAL` gives its voxels, and the
+/// next window started without a file offers it back.
+#[test]
+fn an_untitled_scene_is_recovered_after_a_kill() {
+    for tool in ["Xvfb", "xdotool"] {
+        require_tool(tool);
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let edits = [IVec3::new(0, 100, 0), IVec3::new(1, 100, 0), IVec3::new(2, 101, 0)];
+    let script: String = std::iter::once("color 5\n".to_string())
+        .chain(edits.iter().map(|p| format!("place {} {} {}\n", p.x, p.y, p.z)))
+        .collect();
+    std::fs::write(dir.path().join("edits.ovr"), script).unwrap();
+    let demo = octovox::scene::demo::BuiltIn::Terrain.scene();
+    let mut expected: HashSet<(IVec3, u8)> = demo.tree.voxels().into_iter().collect();
+    expected.extend(edits.iter().map(|p| (*p, 5)));
+
+    let (_xvfb, display) = start_xvfb(11);
+    let args = ["--size".to_string(), "640x480".into(), "--replay".into(), "edits.ovr".into()];
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
+    find_window(&display, &mut app, &stderr_path);
+    lines.wait_for("replay:", Duration::from_secs(90));
+    let journal = octovox::journal::untitled_journal_path(&dir.path().join("saves"), app.0.id());
+    assert!(journal.is_file(), "the untitled scene's edits are journaled in saves/");
+    app.0.kill().unwrap();
+    app.0.wait().unwrap();
+
+    let recovered = dir.path().join("recovered.vox");
+    let run = octovox(&["recover", s(&journal), "-o", s(&recovered)]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let voxels = |p: &Path| -> HashSet<(IVec3, u8)> {
+        octovox::io::load_scene(p, 0).unwrap().tree.voxels().into_iter().collect()
+    };
+    assert_eq!(voxels(&recovered), expected, "the demo plus the three edits");
+
+    // A window started without a file offers the orphaned journal.
+    let args = ["--size".to_string(), "640x480".into()];
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
+    let window = find_window(&display, &mut app, &stderr_path);
+    let asked = lines.wait_for("asking: recover", Duration::from_secs(90));
+    assert!(asked.ends_with(&*journal.file_name().unwrap().to_string_lossy()), "{asked}");
+    lines.wait_for("octovox: ready", Duration::from_secs(90));
+    xdotool(&display, &["windowfocus", "--sync", &window]);
+    xdotool(&display, &["key", "Tab", "Return"]);
+    assert_eq!(lines.wait_for("recovered:", Duration::from_secs(30)), "recovered: the untitled scene");
+    assert!(!journal.exists(), "this session took the journal over");
+    assert!(octovox::journal::untitled_journal_path(&dir.path().join("saves"), app.0.id()).is_file());
+    xdotool(&display, &["key", "Escape"]);
+    std::thread::sleep(Duration::from_millis(500));
+    // Save asks for a path (the path field: no native dialogs in tests).
+    xdotool(&display, &["key", "ctrl+s"]);
+    std::thread::sleep(Duration::from_millis(700));
+    xdotool(&display, &["key", "ctrl+a"]);
+    xdotool(&display, &["type", "kept.vox"]);
+    xdotool(&display, &["key", "Return"]);
+    lines.wait_for("saved:", Duration::from_secs(30));
+    assert_eq!(voxels(&dir.path().join("kept.vox")), expected, "Recover then Save keeps the session's voxels");
+    let left = std::fs::read_dir(dir.path().join("saves")).unwrap().count();
+    assert_eq!(left, 0, "saving removed the untitled journal");
+}

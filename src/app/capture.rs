@@ -9,7 +9,7 @@ use winit::event_loop::ActiveEventLoop;
 
 use octovox::gpu::readback::{padded_row_bytes, read_buffer, staging_buffer};
 
-use super::{App, Gfx, SCREENSHOT_DIR};
+use super::{App, Gfx, SAVES_DIR};
 
 /// The window's image copied for a screenshot: buffer, width, height, and
 /// whether its bytes are BGRA.
@@ -24,10 +24,10 @@ impl App {
         // A script's `render PATH` names the file; otherwise a stamped name in saves/.
         let view_path = self.screenshot_path.take().unwrap_or_else(|| {
             // The screenshot folder is ours to make; a path a script names is not.
-            if let Err(err) = std::fs::create_dir_all(SCREENSHOT_DIR) {
-                log::warn!("cannot create {SCREENSHOT_DIR}: {err}");
+            if let Err(err) = std::fs::create_dir_all(SAVES_DIR) {
+                log::warn!("cannot create {SAVES_DIR}: {err}");
             }
-            Path::new(SCREENSHOT_DIR).join(format!("octovox-{stamp}.png"))
+            Path::new(SAVES_DIR).join(format!("octovox-{stamp}.png"))
         });
         let base = view_path.with_extension("");
         let result = gfx.renderer.read_image().map_err(anyhow::Error::from).and_then(|image| {

@@ -141,6 +141,6 @@ pub enum Command {
     Resolve(Choice),
     /// Answers to the crash-recovery prompt: apply the open document's
     /// journal, or delete it.
-    RecoverJournal,
-    DiscardJournal,
+    RecoverJournal(PathBuf),
+    DiscardJournal(PathBuf),
 }

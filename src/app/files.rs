@@ -30,10 +30,8 @@ impl App {
         self.record(|r| r.scene(line.clone()));
         // The old document's edits were saved or discarded before this.
         self.close_journal();
-        self.journal_source = match &line {
-            octovox::replay::Command::Load(_) => Some(line),
-            _ => None,
-        };
+        // The line that makes the scene starts its journal (untitled ones too).
+        self.journal_source = vec![line];
         self.editor.set_scene(scene);
         self.stroke = None;
         // An imported mesh has no .vox to save back to: Save asks for one
@@ -99,6 +97,12 @@ impl App {
                     self.ui.error(format!("cannot seed the new scene: {err}"));
                 }
                 self.record(|r| r.seed(color, IVec3::ZERO));
+                // The journal starts from the seeded scene too.
+                self.journal_source.extend([
+                    octovox::replay::Command::Brush(octovox::tool::Brush::Voxel),
+                    octovox::replay::Command::Color(color),
+                    octovox::replay::Command::Place(IVec3::ZERO),
+                ]);
                 self.upload();
                 self.state.dirty = false;
                 camera_control::frame_model(&mut self.state.camera, Some((IVec3::splat(-4), IVec3::splat(4))));
@@ -112,26 +116,40 @@ impl App {
         }
     }
 
-    /// Applies the open document's crash-recovery journal (what `octovox
-    /// recover` does), then goes on journaling at its end.
-    pub(super) fn recover_journal(&mut self) {
-        let Some(document) = self.state.path.clone() else { return };
-        match octovox::journal::recover(&document) {
-            Ok(scene) => {
-                self.replace_scene(scene, octovox::replay::Command::Load(document.clone()));
-                // What is shown is the document plus its journal, not yet saved.
-                self.state.dirty = true;
-                let journal = octovox::journal::journal_path(&document);
-                match octovox::replay::Recorder::append(&journal) {
-                    Ok(recorder) => self.journal = Some(recorder),
-                    Err(err) => self.ui.error(format!("cannot go on with the journal {}: {err}", journal.display())),
-                }
-                report!("recovered: {}", document.display());
-                self.ui.info(format!("recovered the unsaved edits of {}", document.display()));
-                self.update_title();
-            }
-            Err(err) => self.ui.error(format!("cannot recover: {err}")),
+    /// Applies a crash-recovery journal (what `octovox recover` does): the
+    /// open document's, or an untitled scene's, which this session then
+    /// takes over. Journaling goes on at its end.
+    pub(super) fn recover_journal(&mut self, journal: &Path) {
+        let document = self.state.path.clone().filter(|d| octovox::journal::journal_path(d) == journal);
+        let recovered = match &document {
+            Some(document) => octovox::journal::recover(document),
+            None => octovox::journal::recover_from(journal, None),
+        };
+        let scene = match recovered {
+            Ok(scene) => scene,
+            Err(err) => return self.ui.error(format!("cannot recover: {err}")),
+        };
+        let (source, continued) = match &document {
+            Some(document) => (octovox::replay::Command::Load(document.clone()), journal.to_path_buf()),
+            None => (octovox::replay::Command::New, self.untitled_journal_path()),
+        };
+        self.replace_scene(scene, source);
+        // What is shown is the scene plus its journal, not yet saved.
+        self.state.dirty = true;
+        let taken_over = if continued == journal { Ok(()) } else { std::fs::rename(journal, &continued) };
+        match taken_over.and_then(|()| octovox::replay::Recorder::append(&continued)) {
+            Ok(recorder) => self.journal = Some(recorder),
+            Err(err) => self.ui.error(format!("cannot go on with the journal {}: {err}", journal.display())),
         }
+        let what = document.as_ref().map_or_else(|| "the untitled scene".to_string(), |d| d.display().to_string());
+        report!("recovered: {what}");
+        self.ui.info(format!("recovered the unsaved edits of {what}"));
+        self.update_title();
+    }
+
+    /// Where this session journals a scene that has no file.
+    pub(super) fn untitled_journal_path(&self) -> PathBuf {
+        octovox::journal::untitled_journal_path(Path::new(super::SAVES_DIR), std::process::id())
     }
 
     /// Saves, then makes `path` the document and carries on with an action
@@ -162,7 +180,7 @@ impl App {
                 // The file now holds every edit: the journal starts again from it.
                 self.close_journal();
                 let absolute = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
-                self.journal_source = Some(octovox::replay::Command::Load(absolute));
+                self.journal_source = vec![octovox::replay::Command::Load(absolute)];
                 self.ui.info(format!("saved {}", path.display()));
                 self.update_title();
                 true

@@ -57,8 +57,9 @@ use input::Input;
 use state::{EditorState, Pick, Tool};
 use ui::{DialogKind, Stats, UiState};
 
-/// Where Screenshot writes, relative to the working directory.
-const SCREENSHOT_DIR: &str = "saves";
+/// Where screenshots and the journal of an untitled scene go, relative to
+/// the working directory.
+const SAVES_DIR: &str = "saves";
 
 /// Opens the window and runs until it is closed.
 pub fn run(args: WindowArgs) -> anyhow::Result<ExitCode> {
@@ -169,7 +170,7 @@ struct App {
     /// The crash-recovery journal of the open document (`octovox::journal`),
     /// and the line that loads the document as saved, which starts it.
     journal: Option<octovox::replay::Recorder>,
-    journal_source: Option<octovox::replay::Command>,
+    journal_source: Vec<octovox::replay::Command>,
     /// A native file dialog that is open.
     file_dialog: Option<file_dialog::NativeDialog>,
     /// File ▸ Open recent.
@@ -215,7 +216,7 @@ impl App {
             player: None,
             recorder: None,
             journal: None,
-            journal_source: None,
+            journal_source: Vec::new(),
             file_dialog: None,
             recent: recent::Recent::load(),
             select_drag: None,
@@ -240,6 +241,11 @@ impl App {
                 app.replace_scene(built_in.scene(), octovox::replay::Command::Demo(built_in));
                 if app.args.camera.is_none() {
                     app.frame_model();
+                }
+                // An untitled scene of a session that died: offer it back.
+                if let Some(journal) = octovox::journal::orphaned_untitled(std::path::Path::new(SAVES_DIR)).first() {
+                    report!("asking: recover {}", journal.display());
+                    app.ui.recover = Some(journal.clone());
                 }
             }
         }
@@ -500,11 +506,9 @@ impl App {
             Command::Export(path) => self.export(&path),
             Command::Screenshot => self.screenshot_requested = true,
             Command::Resolve(choice) => self.resolve(choice, event_loop),
-            Command::RecoverJournal => self.recover_journal(),
-            Command::DiscardJournal => {
-                if let Some(path) = &self.state.path {
-                    let _ = std::fs::remove_file(octovox::journal::journal_path(path));
-                }
+            Command::RecoverJournal(journal) => self.recover_journal(&journal),
+            Command::DiscardJournal(journal) => {
+                let _ = std::fs::remove_file(journal);
             }
         }
         self.request_redraw();

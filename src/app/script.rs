@@ -147,27 +147,40 @@ impl App {
         {
             self.ui.error(format!("the crash-recovery journal {} stopped: {err}", journal.path().display()));
             self.journal = None;
-            self.journal_source = None;
+            self.journal_source.clear();
         }
     }
 
-    /// Starts the journal of the open document once it has unsaved edits:
-    /// its first line loads the document as it is on disk.
+    /// Starts the journal of the open scene once it has unsaved edits: its
+    /// first lines make the scene as it is on disk (or as it started, for
+    /// an untitled one, journaled in saves/).
     fn open_journal(&mut self) {
-        if self.journal.is_some() || !self.state.dirty {
+        if self.journal.is_some() || !self.state.dirty || self.journal_source.is_empty() {
             return;
         }
-        let (Some(source), Some(document)) = (self.journal_source.clone(), self.state.path.clone()) else { return };
-        let path = octovox::journal::journal_path(&document);
-        let header = format!("crash-recovery journal of {}: `octovox recover` replays it", document.display());
+        let (path, header) = match &self.state.path {
+            Some(document) => (
+                octovox::journal::journal_path(document),
+                format!("crash-recovery journal of {}: `octovox recover` replays it", document.display()),
+            ),
+            None => (
+                self.untitled_journal_path(),
+                "crash-recovery journal of an untitled scene: `octovox recover THIS_FILE -o OUT.vox` replays it"
+                    .to_string(),
+            ),
+        };
+        if let Some(dir) = path.parent() {
+            let _ = std::fs::create_dir_all(dir);
+        }
+        let source = &self.journal_source;
         match octovox::replay::Recorder::with_header(&path, &header).and_then(|mut journal| {
-            journal.scene(source)?;
+            source.iter().try_for_each(|line| journal.scene(line.clone()))?;
             Ok(journal)
         }) {
             Ok(journal) => self.journal = Some(journal),
             Err(err) => {
                 self.ui.error(format!("cannot write the crash-recovery journal {}: {err}", path.display()));
-                self.journal_source = None;
+                self.journal_source.clear();
             }
         }
     }

@@ -602,18 +602,15 @@ fn recover_prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Com
     let Some(journal) = ui_state.recover.clone() else { return };
     egui::Modal::new(egui::Id::unique("recover")).show(ctx, |ui| {
         ui.heading("Recover unsaved edits?");
-        ui.label(format!(
-            "A session that ended without saving left its edits in {}. Apply them to the document?",
-            journal.display()
-        ));
+        ui.label(format!("A session that ended without saving left its edits in {}. Apply them?", journal.display()));
         ui.horizontal(|ui| {
             if ui.button("Recover").clicked() {
                 ui_state.recover = None;
-                out.push(Command::RecoverJournal);
+                out.push(Command::RecoverJournal(journal.clone()));
             }
             if ui.button("Discard").clicked() {
                 ui_state.recover = None;
-                out.push(Command::DiscardJournal);
+                out.push(Command::DiscardJournal(journal.clone()));
             }
         });
     });
