@@ -159,15 +159,17 @@ fn bad_export_targets_are_refused() {
         let out = octovox(args);
         assert!(!out.status.success() && text(&out).contains(needle), "{args:?}: {}", text(&out));
     };
-    refused(&["export", v, "-o", v], "writes .obj or .ply files");
-    refused(&["export", v, "-o", dir.path().join("x.glb").to_str().unwrap()], "writes .obj or .ply files");
+    refused(&["export", v, "-o", v], "writes .obj, .ply or .glb files");
+    refused(&["export", v, "-o", dir.path().join("x.stl").to_str().unwrap()], "writes .obj, .ply or .glb files");
     let folder = dir.path().join("folder.obj");
     std::fs::create_dir(&folder).unwrap();
     refused(&["export", v, "-o", folder.to_str().unwrap(), "--force"], "is a folder");
-    let existing = dir.path().join("mine.ply");
-    std::fs::write(&existing, b"my mesh").unwrap();
-    refused(&["export", v, "-o", existing.to_str().unwrap()], "already exists");
-    assert_eq!(std::fs::read(&existing).unwrap(), b"my mesh");
+    for name in ["mine.ply", "mine.glb"] {
+        let existing = dir.path().join(name);
+        std::fs::write(&existing, b"my mesh").unwrap();
+        refused(&["export", v, "-o", existing.to_str().unwrap()], "already exists");
+        assert_eq!(std::fs::read(&existing).unwrap(), b"my mesh");
+    }
     let mtl = dir.path().join("other.mtl");
     std::fs::write(&mtl, b"my materials").unwrap();
     refused(&["export", v, "-o", dir.path().join("other.obj").to_str().unwrap()], "other.mtl already exists");

@@ -498,7 +498,7 @@ fn dialog(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
     let title = match kind {
         DialogKind::Open => "Open .vox, .ovx or .obj",
         DialogKind::SaveAs => "Save as .vox or .ovx",
-        DialogKind::Export => "Export a mesh (.obj or .ply)",
+        DialogKind::Export => "Export a mesh (.obj, .ply or .glb)",
     };
     let mut close = false;
     egui::Window::new(title).collapsible(false).resizable(false).show(ctx, |ui| {
