@@ -111,7 +111,7 @@ pub enum Command {
         #[arg(long)]
         force: bool,
     },
-    /// Export the visible faces as a mesh (.obj with .mtl, or .ply), greedy-meshed.
+    /// Export the visible faces as a mesh (.obj with .mtl, .ply, or .glb with PBR materials), greedy-meshed.
     #[command(allow_negative_numbers = true)]
     Export {
         /// A .vox (or .obj, voxelized) scene.

@@ -74,6 +74,83 @@ fn read_ply(path: &Path) -> Ply {
     Ply { positions, colors, triangles }
 }
 
+/// A .glb read back: its JSON, and the positions and triangles of all its
+/// primitives together.
+struct Glb {
+    json: serde_json::Value,
+    positions: Vec<[f64; 3]>,
+    triangles: Vec<[usize; 3]>,
+}
+
+fn read_glb(path: &Path) -> Glb {
+    let bytes = std::fs::read(path).unwrap();
+    let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+    assert_eq!((&bytes[..4], word(4), word(8)), (&b"glTF"[..], 2, bytes.len()), "GLB header");
+    let json_length = word(12);
+    assert_eq!((&bytes[16..20], json_length % 4), (&b"JSON"[..], 0), "JSON chunk");
+    let json: serde_json::Value = serde_json::from_slice(&bytes[20..20 + json_length]).unwrap();
+    let bin_at = 20 + json_length;
+    let bin_length = word(bin_at);
+    assert_eq!((&bytes[bin_at + 4..bin_at + 8], bin_length % 4), (&b"BIN\0"[..], 0), "BIN chunk");
+    assert_eq!(bin_at + 8 + bin_length, bytes.len(), "trailing bytes");
+    let bin = &bytes[bin_at + 8..];
+    assert!(json["buffers"][0]["byteLength"].as_u64().unwrap() as usize <= bin.len());
+    // An accessor's numbers, tightly packed 4-byte floats or unsigned ints.
+    let accessor = |index: &serde_json::Value| -> Vec<f64> {
+        let accessor = &json["accessors"][index.as_u64().unwrap() as usize];
+        let view = &json["bufferViews"][accessor["bufferView"].as_u64().unwrap() as usize];
+        let components = match accessor["type"].as_str().unwrap() {
+            "SCALAR" => 1,
+            "VEC3" => 3,
+            other => panic!("accessor type {other}"),
+        };
+        assert!(view["byteStride"].is_null() || view["byteStride"] == 4 * components, "{view}");
+        let start = (view["byteOffset"].as_u64().unwrap_or(0) + accessor["byteOffset"].as_u64().unwrap_or(0)) as usize;
+        let count = accessor["count"].as_u64().unwrap() as usize * components;
+        let words = bin[start..start + 4 * count].chunks_exact(4).map(|w| w.try_into().unwrap());
+        match accessor["componentType"].as_u64().unwrap() {
+            5126 => words.map(|w| f64::from(f32::from_le_bytes(w))).collect(),
+            5125 => words.map(|w| f64::from(u32::from_le_bytes(w))).collect(),
+            other => panic!("component type {other}"),
+        }
+    };
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    for mesh in json["meshes"].as_array().unwrap() {
+        for primitive in mesh["primitives"].as_array().unwrap() {
+            assert_eq!(primitive["mode"], 4, "triangles");
+            let base = positions.len();
+            positions
+                .extend(accessor(&primitive["attributes"]["POSITION"]).chunks_exact(3).map(|p| [p[0], p[1], p[2]]));
+            let indices = accessor(&primitive["indices"]);
+            triangles.extend(indices.chunks_exact(3).map(|t| [0, 1, 2].map(|k| base + t[k] as usize)));
+        }
+    }
+    Glb { json, positions, triangles }
+}
+
+/// Runs the Khronos glTF validator (`tests/gltf/validate.js`) on `files`
+/// and prints its report; fails on any error or warning, and when Node.js
+/// or the validator is missing.
+fn validate_gltf(files: &[&Path]) {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/gltf/validate.js");
+    let out = Command::new("node").arg(script).args(files).output().unwrap_or_else(|err| {
+        panic!(
+            "cannot run node ({err}); the glTF test needs Node.js and the Khronos validator: \
+             apt-get install -y nodejs npm && npm ci --prefix tests/gltf"
+        )
+    });
+    let report = text(&out);
+    println!("{report}");
+    assert!(out.status.success(), "glTF validation failed ({}):\n{report}", out.status);
+}
+
+/// A palette byte as the linear value of a glTF colour factor.
+fn linear(byte: u8) -> f64 {
+    let c = f64::from(byte) / 255.0;
+    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}
+
 /// Every directed edge between two positions has as many reverse edges
 /// (closed and consistently oriented); returns the signed volume.
 fn closed_volume(positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> f64 {
@@ -118,14 +195,23 @@ fn a_box_is_twelve_triangles() {
     assert_eq!(closed_volume(&positions, &triangles).round() as i64, 5 * 3 * 4);
     let mtl = std::fs::read_to_string(dir.path().join("box.mtl")).unwrap();
     assert!(mtl.contains("newmtl palette_7"), "{mtl}");
+    let glb = dir.path().join("box.glb");
+    let out = octovox(&["export", dir.path().join("box.vox").to_str().unwrap(), "-o", glb.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out));
+    let Glb { json, positions, triangles } = read_glb(&glb);
+    // A corner per face that meets there: each copy has its face's normal.
+    assert_eq!((positions.len(), triangles.len()), (24, 12));
+    assert_eq!(closed_volume(&positions, &triangles).round() as i64, 5 * 3 * 4);
+    assert_eq!(json["materials"].as_array().unwrap().len(), 1);
+    assert_eq!(json["materials"][0]["name"], "palette_7");
 }
 
 #[test]
-fn obj_and_ply_exports_are_closed_outward_and_hold_the_voxels() {
+fn obj_ply_and_glb_exports_are_closed_outward_and_hold_the_voxels() {
     let dir = tempfile::tempdir().unwrap();
     let (vox, voxels) = sculpture_file(dir.path());
-    let (obj, ply) = (dir.path().join("s.obj"), dir.path().join("s.ply"));
-    for (out, scale) in [(&obj, "1"), (&ply, "0.5")] {
+    let (obj, ply, glb) = (dir.path().join("s.obj"), dir.path().join("s.ply"), dir.path().join("s.glb"));
+    for (out, scale) in [(&obj, "1"), (&ply, "0.5"), (&glb, "2")] {
         let done = octovox(&["export", vox.to_str().unwrap(), "-o", out.to_str().unwrap(), "--scale", scale]);
         assert!(done.status.success(), "{}", text(&done));
     }
@@ -140,6 +226,87 @@ fn obj_and_ply_exports_are_closed_outward_and_hold_the_voxels() {
         let c = palette.color(index);
         assert!(used.contains(&[c[0], c[1], c[2]]), "colour of palette index {index} missing");
     }
+    let Glb { json, positions, triangles } = read_glb(&glb);
+    // Two units per voxel: eight times the volume.
+    assert_eq!((closed_volume(&positions, &triangles) / 8.0).round() as u64, voxels);
+    // One diffuse material per palette index, its colour made linear.
+    let materials = json["materials"].as_array().unwrap();
+    assert_eq!(materials.len(), json["meshes"][0]["primitives"].as_array().unwrap().len());
+    for index in [3u8, 17, 80, 200, 255] {
+        let material = materials.iter().find(|m| m["name"] == format!("palette_{index}")).unwrap();
+        let pbr = &material["pbrMetallicRoughness"];
+        let factor: Vec<f64> = pbr["baseColorFactor"].as_array().unwrap().iter().map(|c| c.as_f64().unwrap()).collect();
+        let c = palette.color(index);
+        for (k, expected) in [linear(c[0]), linear(c[1]), linear(c[2]), 1.0].into_iter().enumerate() {
+            assert!((factor[k] - expected).abs() < 1e-6, "palette_{index}: {factor:?}");
+        }
+        assert_eq!((pbr["metallicFactor"].as_f64(), pbr["roughnessFactor"].as_f64()), (Some(0.0), Some(1.0)));
+    }
+    validate_gltf(&[&glb]);
+}
+
+#[test]
+fn glb_materials_follow_matl_and_pass_the_khronos_validator() {
+    use octovox::scene::MaterialKind;
+    let dir = tempfile::tempdir().unwrap();
+    let scene = octovox::scene::showroom::showroom_scene();
+    let vox = dir.path().join("showroom.vox");
+    octovox::io::save_scene(&vox, &scene, Default::default()).unwrap();
+    let glb = dir.path().join("showroom.glb");
+    let out = octovox(&["export", vox.to_str().unwrap(), "-o", glb.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out));
+    let Glb { json, positions, triangles } = read_glb(&glb);
+    assert_eq!(closed_volume(&positions, &triangles).round() as u64, scene.tree.solid_voxels());
+    let close = |value: &serde_json::Value, expected: f32| {
+        value.as_f64().is_some_and(|v| (v - f64::from(expected)).abs() < 1e-6)
+    };
+    let mut kinds = std::collections::BTreeSet::new();
+    for material in json["materials"].as_array().unwrap() {
+        let index: u8 = material["name"].as_str().unwrap().strip_prefix("palette_").unwrap().parse().unwrap();
+        let matl = scene.palette.material(index);
+        let (pbr, extensions) = (&material["pbrMetallicRoughness"], &material["extensions"]);
+        match matl.kind {
+            MaterialKind::Metal => {
+                assert!(close(&pbr["metallicFactor"], matl.metalness()), "{material}");
+                assert!(close(&pbr["roughnessFactor"], matl.roughness()), "{material}");
+            }
+            MaterialKind::Glass => {
+                let transmission = &extensions["KHR_materials_transmission"]["transmissionFactor"];
+                assert!(close(transmission, matl.transparency()), "{material}");
+                assert!(close(&extensions["KHR_materials_ior"]["ior"], matl.ior()), "{material}");
+                assert!(material["alphaMode"].is_null() || material["alphaMode"] == "OPAQUE", "{material}");
+            }
+            MaterialKind::Emit => {
+                // The path tracer's radiance: _emit · 2^_flux · EMIT_SCALE.
+                let strength = matl.emission() * matl.flux().exp2() * octovox::trace::path::materials::EMIT_SCALE;
+                assert!(strength > 1.0);
+                let factor = &material["emissiveFactor"];
+                let c = scene.palette.color(index);
+                assert!((0..3).all(|k| close(&factor[k], linear(c[k]) as f32)), "{material}");
+                assert!(close(&extensions["KHR_materials_emissive_strength"]["emissiveStrength"], strength));
+            }
+            MaterialKind::Diffuse | MaterialKind::Media => {
+                assert!(extensions.is_null() && material["emissiveFactor"].is_null(), "{material}");
+            }
+        }
+        kinds.insert(matl.kind);
+    }
+    assert!([MaterialKind::Metal, MaterialKind::Glass, MaterialKind::Emit].iter().all(|k| kinds.contains(k)));
+    let used: Vec<&str> = json["extensionsUsed"].as_array().unwrap().iter().map(|e| e.as_str().unwrap()).collect();
+    assert_eq!(
+        used,
+        ["KHR_materials_emissive_strength", "KHR_materials_ior", "KHR_materials_transmission"],
+        "sorted, each once"
+    );
+    assert!(json["extensionsRequired"].is_null(), "a viewer without them still shows the colours");
+    // An empty scene is a valid file too: a node without a mesh.
+    let empty = dir.path().join("empty.vox");
+    let nothing = octovox::scene::Scene { palette: Default::default(), tree: Default::default() };
+    octovox::io::save_scene(&empty, &nothing, Default::default()).unwrap();
+    let empty_glb = dir.path().join("empty.glb");
+    let out = octovox(&["export", empty.to_str().unwrap(), "-o", empty_glb.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out));
+    validate_gltf(&[&glb, &empty_glb]);
 }
 
 #[test]
@@ -159,15 +326,17 @@ fn bad_export_targets_are_refused() {
         let out = octovox(args);
         assert!(!out.status.success() && text(&out).contains(needle), "{args:?}: {}", text(&out));
     };
-    refused(&["export", v, "-o", v], "writes .obj or .ply files");
-    refused(&["export", v, "-o", dir.path().join("x.glb").to_str().unwrap()], "writes .obj or .ply files");
+    refused(&["export", v, "-o", v], "writes .obj, .ply or .glb files");
+    refused(&["export", v, "-o", dir.path().join("x.stl").to_str().unwrap()], "writes .obj, .ply or .glb files");
     let folder = dir.path().join("folder.obj");
     std::fs::create_dir(&folder).unwrap();
     refused(&["export", v, "-o", folder.to_str().unwrap(), "--force"], "is a folder");
-    let existing = dir.path().join("mine.ply");
-    std::fs::write(&existing, b"my mesh").unwrap();
-    refused(&["export", v, "-o", existing.to_str().unwrap()], "already exists");
-    assert_eq!(std::fs::read(&existing).unwrap(), b"my mesh");
+    for name in ["mine.ply", "mine.glb"] {
+        let existing = dir.path().join(name);
+        std::fs::write(&existing, b"my mesh").unwrap();
+        refused(&["export", v, "-o", existing.to_str().unwrap()], "already exists");
+        assert_eq!(std::fs::read(&existing).unwrap(), b"my mesh");
+    }
     let mtl = dir.path().join("other.mtl");
     std::fs::write(&mtl, b"my materials").unwrap();
     refused(&["export", v, "-o", dir.path().join("other.obj").to_str().unwrap()], "other.mtl already exists");

@@ -1,4 +1,4 @@
-//! `octovox export FILE -o OUT.obj|OUT.ply [--scale S] [--frame N] [--force]`.
+//! `octovox export FILE -o OUT.obj|OUT.ply|OUT.glb [--scale S] [--frame N] [--force]`.
 
 use std::path::Path;
 use std::process::ExitCode;

@@ -1,5 +1,5 @@
 //! Which outputs a command may write: never one of its inputs, never over an
-//! existing document (.vox, .obj, .ovr, .ply, .mtl) unless the user said
+//! existing document (.vox, .obj, .ovr, .ply, .glb, .mtl) unless the user said
 //! `--force`, and only in the format the file's extension names.
 
 use std::path::{Path, PathBuf};
@@ -13,7 +13,7 @@ pub enum OutputKind {
     Scene,
     /// A replay script (`--record`): any name, `.ovr` by convention.
     Script,
-    /// An exported mesh: `.obj` or `.ply`.
+    /// An exported mesh: `.obj`, `.ply` or `.glb`.
     Mesh,
     /// The materials of an exported .obj: `.mtl`.
     Materials,
@@ -26,7 +26,7 @@ impl OutputKind {
             OutputKind::Image => &["png"],
             OutputKind::Scene => &["vox", "ovx"],
             OutputKind::Script => &[],
-            OutputKind::Mesh => &["obj", "ply"],
+            OutputKind::Mesh => &["obj", "ply", "glb"],
             OutputKind::Materials => &["mtl"],
         }
     }
@@ -35,7 +35,7 @@ impl OutputKind {
 /// Extensions of the files users make by hand or with other tools (meshes
 /// and their materials included); an existing one is only replaced with
 /// `--force`.
-const DOCUMENT_EXTENSIONS: [&str; 6] = ["vox", "ovx", "obj", "ovr", "ply", "mtl"];
+const DOCUMENT_EXTENSIONS: [&str; 7] = ["vox", "ovx", "obj", "ovr", "ply", "glb", "mtl"];
 
 /// Why an output was refused.
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]
@@ -56,7 +56,9 @@ pub fn check_output(output: &Path, kind: OutputKind, inputs: &[&Path], force: bo
     let extension = extension_of(output);
     let allowed = kind.extensions();
     if !allowed.is_empty() && !allowed.contains(&extension.as_str()) {
-        let expected = allowed.iter().map(|e| format!(".{e}")).collect::<Vec<_>>().join(" or ");
+        let mut names: Vec<String> = allowed.iter().map(|e| format!(".{e}")).collect();
+        let last = names.pop().unwrap_or_default();
+        let expected = if names.is_empty() { last } else { format!("{} or {last}", names.join(", ")) };
         return Err(OutputError::WrongExtension { path: output.to_path_buf(), found: extension, expected });
     }
     if force {

@@ -1,8 +1,10 @@
 //! Mesh export: the scene's visible faces, greedy-meshed ([`greedy`]),
-//! as Wavefront .obj (with an .mtl of one material per palette colour) or
-//! binary .ply (with vertex colours). One unit is one voxel times `scale`;
-//! axes are octovox's (y up), which both formats expect.
+//! as Wavefront .obj (with an .mtl of one material per palette colour),
+//! binary .ply (with vertex colours) or glTF binary .glb (with a PBR
+//! material per palette entry used). One unit is one voxel times `scale`;
+//! axes are octovox's (y up, right-handed), which all three formats expect.
 
+mod gltf;
 pub mod greedy;
 mod obj;
 mod ply;
@@ -20,6 +22,7 @@ use crate::scene::Scene;
 pub enum MeshFormat {
     Obj,
     Ply,
+    Glb,
 }
 
 impl MeshFormat {
@@ -28,6 +31,7 @@ impl MeshFormat {
         match path.extension()?.to_string_lossy().to_ascii_lowercase().as_str() {
             "obj" => Some(MeshFormat::Obj),
             "ply" => Some(MeshFormat::Ply),
+            "glb" => Some(MeshFormat::Glb),
             _ => None,
         }
     }
@@ -36,8 +40,10 @@ impl MeshFormat {
 /// Why an export failed.
 #[derive(Debug, thiserror::Error)]
 pub enum ExportError {
-    #[error("{}: octovox exports .obj and .ply meshes", path.display())]
+    #[error("{}: octovox exports .obj, .ply and .glb meshes", path.display())]
     Format { path: PathBuf },
+    #[error("{}: the mesh passes the 4 GiB a .glb can hold", path.display())]
+    TooLarge { path: PathBuf },
     #[error("cannot write {}: {source}", path.display())]
     Write { path: PathBuf, source: std::io::Error },
     #[error(transparent)]
@@ -71,7 +77,8 @@ pub fn check_outputs(path: &Path, inputs: &[&Path], force: bool) -> Result<(), O
 /// Meshes `scene` and writes it to `path` in the format its extension names.
 ///
 /// # Errors
-/// [`ExportError::Format`] for another extension, the memory budget, and
+/// [`ExportError::Format`] for another extension, [`ExportError::TooLarge`]
+/// for a .glb past 4 GiB, the memory budget, and
 /// any refusal of [`write_atomically`] (devices, read-only files, a missing
 /// folder) naming the file.
 pub fn export_mesh(path: &Path, scene: &Scene, scale: f32, options: WriteOptions) -> Result<ExportStats, ExportError> {
@@ -93,6 +100,11 @@ pub fn export_mesh(path: &Path, scene: &Scene, scale: f32, options: WriteOptions
             files.push(mtl);
         }
         MeshFormat::Ply => write(path, ply::ply(&mesh, &scene.palette, scale))?,
+        MeshFormat::Glb => {
+            let glb = gltf::glb(&mesh, &scene.palette, scale)
+                .ok_or_else(|| ExportError::TooLarge { path: path.to_path_buf() })?;
+            write(path, glb)?;
+        }
     }
     Ok(ExportStats {
         triangles: mesh.triangles.len(),

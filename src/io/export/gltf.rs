@@ -1,0 +1,218 @@
+//! glTF 2.0 binary (.glb): one mesh with a primitive per palette index used,
+//! each with a metallic-roughness material made from the palette colour and
+//! its MATL entry as the path tracer reads it (`docs/export.md` has the table).
+
+use std::collections::{BTreeMap, BTreeSet, HashMap};
+
+use glam::IVec3;
+use serde_json::{Map, Value, json};
+
+use super::VoxelMesh;
+use crate::scene::Palette;
+use crate::trace::path::materials::{MATERIAL_EMIT, MATERIAL_GLASS, MATERIAL_METAL, gpu_material};
+
+// Codes from the glTF 2.0 specification (accessor.componentType,
+// bufferView.target, mesh.primitive.mode).
+const FLOAT: u32 = 5126;
+const UNSIGNED_INT: u32 = 5125;
+const ARRAY_BUFFER: u32 = 34962;
+const ELEMENT_ARRAY_BUFFER: u32 = 34963;
+const TRIANGLES: u32 = 4;
+
+/// The .glb of `mesh`, one unit (metre) per voxel times `scale`; `None`
+/// when it would pass the 4 GiB a .glb can hold (its lengths are 32-bit).
+pub fn glb(mesh: &VoxelMesh, palette: &Palette, scale: f32) -> Option<Vec<u8>> {
+    let mut by_color: BTreeMap<u8, Vec<[u32; 3]>> = BTreeMap::new();
+    for (triangle, color) in &mesh.triangles {
+        by_color.entry(*color).or_default().push(*triangle);
+    }
+    let mut bin = Vec::new();
+    let mut views = Vec::new();
+    let mut accessors = Vec::new();
+    let mut primitives = Vec::new();
+    let mut materials = Vec::new();
+    let mut extensions_used = BTreeSet::new();
+    for (color, triangles) in &by_color {
+        let part = Part::of(mesh, triangles, scale);
+        let first = accessors.len();
+        // The validator requires the bounds of POSITION, and checks them
+        // against the data: both are the same f32 values.
+        let lo = part.positions.iter().fold([f32::INFINITY; 3], |lo, p| [0, 1, 2].map(|k| lo[k].min(p[k])));
+        let hi = part.positions.iter().fold([f32::NEG_INFINITY; 3], |hi, p| [0, 1, 2].map(|k| hi[k].max(p[k])));
+        let count = part.positions.len();
+        let view = push_view(&mut bin, &mut views, le_floats(&part.positions), ARRAY_BUFFER);
+        accessors.push(json!({
+            "bufferView": view, "componentType": FLOAT, "count": count, "type": "VEC3", "min": lo, "max": hi
+        }));
+        let view = push_view(&mut bin, &mut views, le_floats(&part.normals), ARRAY_BUFFER);
+        accessors.push(json!({"bufferView": view, "componentType": FLOAT, "count": count, "type": "VEC3"}));
+        let view = push_view(&mut bin, &mut views, part.indices.iter().map(|i| i.to_le_bytes()), ELEMENT_ARRAY_BUFFER);
+        accessors.push(
+            json!({"bufferView": view, "componentType": UNSIGNED_INT, "count": part.indices.len(), "type": "SCALAR"}),
+        );
+        primitives.push(json!({
+            "attributes": {"POSITION": first, "NORMAL": first + 1},
+            "indices": first + 2,
+            "material": materials.len(),
+            "mode": TRIANGLES,
+        }));
+        materials.push(material(palette, *color, &mut extensions_used));
+    }
+
+    let mut node = json!({"name": "voxels"});
+    let mut root = Map::new();
+    root.insert("asset".into(), json!({"version": "2.0", "generator": "octovox"}));
+    root.insert("scene".into(), json!(0));
+    root.insert("scenes".into(), json!([{"nodes": [0]}]));
+    // An empty scene is a node without a mesh: glTF allows no empty mesh,
+    // array or buffer.
+    if !primitives.is_empty() {
+        node["mesh"] = json!(0);
+        root.insert("meshes".into(), json!([{"name": "voxels", "primitives": primitives}]));
+        root.insert("materials".into(), Value::Array(materials));
+        root.insert("accessors".into(), Value::Array(accessors));
+        root.insert("bufferViews".into(), Value::Array(views));
+        root.insert("buffers".into(), json!([{"byteLength": bin.len()}]));
+    }
+    root.insert("nodes".into(), json!([node]));
+    if !extensions_used.is_empty() {
+        root.insert("extensionsUsed".into(), json!(extensions_used));
+    }
+    container(Value::Object(root).to_string().as_bytes(), &bin)
+}
+
+/// One primitive's vertices: a copy of a mesh vertex per face direction
+/// that uses it, so that each copy has its face's flat normal.
+#[derive(Default)]
+struct Part {
+    positions: Vec<[f32; 3]>,
+    normals: Vec<[f32; 3]>,
+    indices: Vec<u32>,
+}
+
+impl Part {
+    fn of(mesh: &VoxelMesh, triangles: &[[u32; 3]], scale: f32) -> Part {
+        let mut part = Part::default();
+        let mut index: HashMap<(u32, IVec3), u32> = HashMap::new();
+        for triangle in triangles {
+            let [a, b, c] = triangle.map(|v| mesh.positions_x2[v as usize].as_i64vec3());
+            // Every triangle lies in an axis-aligned face (none is degenerate), so
+            // the signs of its normal are the unit normal. In i64: the
+            // product of two coordinates can pass i32.
+            let normal = (b - a).cross(c - a).signum().as_ivec3();
+            for v in *triangle {
+                let i = *index.entry((v, normal)).or_insert_with(|| {
+                    part.positions.push(mesh.position(v).map(|c| c * scale));
+                    part.normals.push(normal.as_vec3().to_array());
+                    u32::try_from(part.positions.len() - 1).unwrap_or(u32::MAX)
+                });
+                part.indices.push(i);
+            }
+        }
+        part
+    }
+}
+
+/// Appends `words` (little-endian, as glTF stores numbers) to the binary
+/// buffer as a buffer view of its own; returns the view's index.
+fn push_view(bin: &mut Vec<u8>, views: &mut Vec<Value>, words: impl Iterator<Item = [u8; 4]>, target: u32) -> usize {
+    let offset = bin.len();
+    bin.extend(words.flatten());
+    views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": bin.len() - offset, "target": target}));
+    views.len() - 1
+}
+
+fn le_floats(vectors: &[[f32; 3]]) -> impl Iterator<Item = [u8; 4]> {
+    vectors.as_flattened().iter().map(|c| c.to_le_bytes())
+}
+
+/// The material of palette entry `index`; adds the extensions it uses to
+/// `extensions_used`. The kind and emission come from [`gpu_material`], so
+/// media and emitters without emission are diffuse here as in the render.
+fn material(palette: &Palette, index: u8, extensions_used: &mut BTreeSet<String>) -> Value {
+    let [r, g, b, _] = palette.color(index).map(srgb_to_linear);
+    let matl = gpu_material(palette, index);
+    // A diffuse voxel is Lambertian: fully rough, not metal.
+    let (metallic, roughness) = match matl.kind {
+        MATERIAL_METAL => (matl.metalness, matl.roughness),
+        MATERIAL_GLASS => (0.0, matl.roughness),
+        _ => (0.0, 1.0),
+    };
+    let mut material = json!({
+        "name": format!("palette_{index}"),
+        "pbrMetallicRoughness": {"baseColorFactor": [r, g, b, 1.0], "metallicFactor": metallic, "roughnessFactor": roughness},
+    });
+    let mut extensions = Map::new();
+    if matl.kind == MATERIAL_GLASS {
+        // Transmission keeps alphaMode OPAQUE (the default): the surface is
+        // see-through by refraction, not blended.
+        extensions.insert("KHR_materials_transmission".into(), json!({"transmissionFactor": matl.transparency}));
+        extensions.insert("KHR_materials_ior".into(), json!({"ior": matl.ior}));
+    }
+    if matl.kind == MATERIAL_EMIT {
+        // emissiveFactor stops at 1; the extension multiplies it past that.
+        material["emissiveFactor"] = json!([r, g, b].map(|c| c * matl.emission.min(1.0)));
+        if matl.emission > 1.0 {
+            extensions.insert("KHR_materials_emissive_strength".into(), json!({"emissiveStrength": matl.emission}));
+        }
+    }
+    if !extensions.is_empty() {
+        extensions_used.extend(extensions.keys().cloned());
+        material["extensions"] = Value::Object(extensions);
+    }
+    material
+}
+
+/// A palette byte, sRGB-encoded as MagicaVoxel and the colour picker show
+/// it, as the linear value glTF's colour factors hold (a viewer encodes it
+/// back, so it shows the palette colour).
+fn srgb_to_linear(byte: u8) -> f32 {
+    let c = f32::from(byte) / 255.0;
+    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}
+
+/// The GLB container: a 12-byte header, the JSON chunk padded with spaces
+/// and the binary chunk (left out when empty) padded with zeros, each to
+/// 4 bytes. `None` when a length passes 32 bits.
+fn container(json: &[u8], bin: &[u8]) -> Option<Vec<u8>> {
+    let json_length = u32::try_from(json.len().next_multiple_of(4)).ok()?;
+    let bin_length = u32::try_from(bin.len().next_multiple_of(4)).ok()?;
+    let bin_chunk = if bin.is_empty() { 0 } else { 8 + bin_length };
+    let total = 12u32.checked_add(8 + json_length)?.checked_add(bin_chunk)?;
+    let mut out = Vec::with_capacity(total as usize);
+    out.extend(b"glTF");
+    out.extend(2u32.to_le_bytes());
+    out.extend(total.to_le_bytes());
+    let mut chunk = |kind: &[u8; 4], data: &[u8], length: u32, pad: u8| {
+        out.extend(length.to_le_bytes());
+        out.extend(kind);
+        out.extend(data);
+        out.resize(out.len() + length as usize - data.len(), pad);
+    };
+    chunk(b"JSON", json, json_length, b' ');
+    if !bin.is_empty() {
+        chunk(b"BIN\0", bin, bin_length, 0);
+    }
+    Some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn srgb_ends_and_middle() {
+        assert_eq!(srgb_to_linear(0), 0.0);
+        assert_eq!(srgb_to_linear(255), 1.0);
+        assert!((srgb_to_linear(188) - 0.5).abs() < 0.005);
+    }
+
+    #[test]
+    fn chunks_are_aligned_and_padded() {
+        let glb = container(b"{}", &[1, 2, 3, 4, 5]).unwrap();
+        assert_eq!(glb.len(), 12 + 8 + 4 + 8 + 8);
+        assert_eq!(&glb[8..12], &(glb.len() as u32).to_le_bytes());
+        assert_eq!(&glb[12..24], b"\x04\0\0\0JSON{}  ");
+        assert_eq!(&glb[24..40], b"\x08\0\0\0BIN\0\x01\x02\x03\x04\x05\0\0\0");
+    }
+}
