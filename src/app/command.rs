@@ -129,7 +129,7 @@ pub enum Command {
     /// Save As, replacing the file even though it is read-only (the user
     /// said so in the prompt).
     SaveOver(PathBuf),
-    /// Write the visible faces as an .obj or .ply mesh.
+    /// Write the visible faces as an .obj, .ply or .glb mesh.
     Export(PathBuf),
     /// Show the Open, Save As or Export path dialog.
     AskOpen,
