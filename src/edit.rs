@@ -183,6 +183,12 @@ impl History {
         !self.undone.is_empty()
     }
 
+    /// Steps that undo and redo can take now (an open stroke counts as one).
+    pub fn steps(&self) -> (usize, usize) {
+        let stroke = self.stroke.as_ref().is_some_and(|s| !s.edits.is_empty());
+        (self.done.len() + usize::from(stroke), self.undone.len())
+    }
+
     /// Undo steps kept and the memory their undo data holds (what the
     /// budget `memory_limit_bytes` is checked against).
     pub fn usage(&self) -> (usize, usize) {

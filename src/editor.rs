@@ -72,13 +72,22 @@ impl Editor {
     pub fn run(&mut self, command: &Command) -> Result<Outcome, String> {
         let text = |e: EditError| e.to_string();
         let tools = self.tools;
-        match command {
-            Command::New => self.set_scene(Scene::default()),
-            Command::Demo(built_in) => self.set_scene(built_in.scene()),
-            Command::Brush(brush) => self.tools.brush = *brush,
-            Command::Color(c) => self.tools.color = *c,
-            Command::Mirror(plane) => self.tools.mirror.apply_line(*plane),
-            Command::Pick(p) => self.tools.color = crate::replay::picked_color(&self.scene, *p)?,
+        let changed = match command {
+            Command::New | Command::Demo(_) => {
+                let scene = match command {
+                    Command::Demo(built_in) => built_in.scene(),
+                    _ => Scene::default(),
+                };
+                self.set_scene(scene);
+                return Ok(Outcome::Replaced);
+            }
+            Command::Brush(brush) => self.set(|e| e.tools.brush = *brush),
+            Command::Color(c) => self.set(|e| e.tools.color = *c),
+            Command::Mirror(plane) => self.set(|e| e.tools.mirror.apply_line(*plane)),
+            Command::Pick(p) => {
+                let color = crate::replay::picked_color(&self.scene, *p)?;
+                self.set(|e| e.tools.color = color)
+            }
             Command::Place(p) => {
                 self.apply_mirrored(vec![brush_edit(&tools, *p, Op::Place(tools.color))]).map_err(text)?
             }
@@ -87,41 +96,49 @@ impl Editor {
                 self.apply_mirrored(vec![brush_edit(&tools, *p, Op::Paint(tools.color))]).map_err(text)?
             }
             Command::Line(a, b) => {
-                self.apply_mirrored(crate::tool::line_edits(&tools.brush, tools.color, *a, *b)).map_err(text)?;
+                self.apply_mirrored(crate::tool::line_edits(&tools.brush, tools.color, *a, *b)).map_err(text)?
             }
             // Fills and extrudes are not mirrored: their regions follow the
             // colours and faces, not the brush.
             Command::Fill(p) => {
                 let edits = crate::scene::fill::fill_edits(&self.scene.tree, *p, tools.color).map_err(text)?;
-                self.commit(edits).map_err(text)?;
+                self.commit(edits).map_err(text)?
             }
             Command::Extrude(p, normal, layers) => {
                 let edits =
                     crate::scene::extrude::extrude_edits(&self.scene.tree, *p, *normal, *layers).map_err(text)?;
-                self.commit(edits).map_err(text)?;
+                self.commit(edits).map_err(text)?
             }
-            Command::Rgb(..) | Command::Material(..) => {
-                if let Some(edit) = crate::replay::palette_edit(command, &self.scene.palette) {
-                    self.commit(vec![edit]).map_err(text)?;
-                }
-            }
+            Command::Rgb(..) | Command::Material(..) => match crate::replay::palette_edit(command, &self.scene.palette)
+            {
+                Some(edit) => self.commit(vec![edit]).map_err(text)?,
+                None => false,
+            },
             Command::Undo(n) => self.repeat(*n, true)?,
             Command::Redo(n) => self.repeat(*n, false)?,
-            Command::Select(None) => self.selection = None,
-            Command::Select(Some((a, b))) => self.selection = Some(Region::new(*a, *b).map_err(text)?),
-            Command::Copy => self.clipboard = Some(selection::copy(&self.scene.tree, self.selected()?).map_err(text)?),
+            Command::Select(None) => self.set(|e| e.selection = None),
+            Command::Select(Some((a, b))) => {
+                let region = Region::new(*a, *b).map_err(text)?;
+                self.set(|e| e.selection = Some(region))
+            }
+            Command::Copy => {
+                let block = selection::copy(&self.scene.tree, self.selected()?).map_err(text)?;
+                self.set(|e| e.clipboard = Some(block))
+            }
             Command::Cut => {
                 let region = self.selected()?;
                 let block = selection::copy(&self.scene.tree, region).map_err(text)?;
-                self.commit(vec![region.clear_edit()]).map_err(text)?;
+                let changed = self.commit(vec![region.clear_edit()]).map_err(text)?;
                 self.clipboard = Some(block);
+                changed
             }
             Command::Delete => self.commit(vec![self.selected()?.clear_edit()]).map_err(text)?,
             Command::Paste(at) => {
                 let block = self.clipboard.as_ref().ok_or("nothing to paste: copy or cut a selection first")?;
-                let (edits, region) = (block.place_edits(*at), block.region_at(*at));
-                self.commit(edits).map_err(text)?;
+                let region = block.region_at(*at).inside_world().map_err(text)?;
+                let changed = self.commit(block.place_edits(*at)).map_err(text)?;
                 self.selection = Some(region);
+                changed
             }
             Command::Move(by) => self.move_selection(*by)?,
             Command::ExpectVoxel(p, want) => {
@@ -133,17 +150,14 @@ impl Editor {
                 return Ok(checked(got == *want, format!("{want} voxels"), got));
             }
             _ => return Ok(Outcome::Host),
-        }
-        Ok(match command {
-            Command::New | Command::Demo(_) => Outcome::Replaced,
-            Command::Brush(_)
-            | Command::Color(_)
-            | Command::Mirror(_)
-            | Command::Pick(_)
-            | Command::Select(_)
-            | Command::Copy => Outcome::State,
-            _ => Outcome::Changed,
-        })
+        };
+        Ok(if changed { Outcome::Changed } else { Outcome::State })
+    }
+
+    /// A change of tool state, selection or clipboard: never an edit.
+    fn set(&mut self, change: impl FnOnce(&mut Editor)) -> bool {
+        change(self);
+        false
     }
 
     /// The selected box, or why a line that needs one cannot run.
@@ -153,33 +167,38 @@ impl Editor {
 
     /// `move`: the selected voxels leave their box and land `by` away, as
     /// one undo step; the selection follows. Refused as a whole when the
-    /// new place is outside the world.
-    fn move_selection(&mut self, by: IVec3) -> Result<(), String> {
+    /// new place is outside the world. Whether the voxels changed.
+    fn move_selection(&mut self, by: IVec3) -> Result<bool, String> {
+        let text = |e: EditError| e.to_string();
         let region = self.selected()?;
-        let block = selection::copy(&self.scene.tree, region).map_err(|e| e.to_string())?;
+        let moved = region.shifted(by).inside_world().map_err(text)?;
+        let block = selection::copy(&self.scene.tree, region).map_err(text)?;
         let mut edits = vec![region.clear_edit()];
-        edits.extend(block.place_edits(region.min + by));
-        self.commit(edits).map_err(|e| e.to_string())?;
-        self.selection = Some(region.shifted(by));
-        Ok(())
+        edits.extend(block.place_edits(moved.min));
+        let changed = self.commit(edits).map_err(text)?;
+        self.selection = Some(moved);
+        Ok(changed)
     }
 
     /// Brush edits and their mirror images as one undo step (or part of the
-    /// open stroke).
+    /// open stroke); whether there was any.
     ///
     /// # Errors
     /// A refused edit; then nothing changed.
-    pub fn apply_mirrored(&mut self, edits: Vec<Edit>) -> Result<(), EditError> {
+    pub fn apply_mirrored(&mut self, edits: Vec<Edit>) -> Result<bool, EditError> {
         let edits = edits.into_iter().flat_map(|e| self.tools.mirror.edits(e)).collect();
         self.commit(edits)
     }
 
-    /// Edits as one undo step (or part of the open stroke).
+    /// Edits as one undo step (or part of the open stroke); whether there
+    /// was any (no edits make no step).
     ///
     /// # Errors
     /// A refused edit; then nothing changed.
-    pub fn commit(&mut self, edits: Vec<Edit>) -> Result<(), EditError> {
-        self.history.apply_group(&mut self.scene, edits)
+    pub fn commit(&mut self, edits: Vec<Edit>) -> Result<bool, EditError> {
+        let any = !edits.is_empty();
+        self.history.apply_group(&mut self.scene, edits)?;
+        Ok(any)
     }
 
     /// Undoes one step; `false` when there is none.
@@ -198,14 +217,20 @@ impl Editor {
         self.history.redo(&mut self.scene)
     }
 
-    fn repeat(&mut self, n: u32, undo: bool) -> Result<(), String> {
-        for _ in 0..n {
-            let did = if undo { self.undo() } else { self.redo() };
-            if !did.map_err(|e| e.to_string())? {
-                return Err(format!("nothing to {}", if undo { "undo" } else { "redo" }));
-            }
+    /// `undo N` / `redo N`: all N steps, or (fewer there) none.
+    fn repeat(&mut self, n: u32, undo: bool) -> Result<bool, String> {
+        let (undoable, redoable) = self.history.steps();
+        let (what, available) = if undo { ("undo", undoable) } else { ("redo", redoable) };
+        if available == 0 {
+            return Err(format!("nothing to {what}"));
         }
-        Ok(())
+        if usize::try_from(n).map_or(true, |n| n > available) {
+            return Err(format!("only {available} step(s) to {what}, not {n}"));
+        }
+        for _ in 0..n {
+            if undo { self.undo() } else { self.redo() }.map_err(|e| e.to_string())?;
+        }
+        Ok(true)
     }
 }
 
@@ -249,5 +274,30 @@ mod tests {
             assert!(run(&mut editor, line).unwrap_err().contains("nothing is selected"), "{line}");
         }
         assert!(run(&mut editor, "paste 0 0 0").unwrap_err().contains("nothing to paste"));
+    }
+
+    #[test]
+    fn an_empty_block_makes_no_step_and_stays_inside_the_world() {
+        let mut editor = Editor::default();
+        for line in ["place 0 0 0", "select 5 5 5 6 6 6", "copy"] {
+            run(&mut editor, line).unwrap();
+        }
+        assert_eq!(run(&mut editor, "paste 10 0 0"), Ok(Outcome::State), "nothing to place: no step");
+        assert_eq!(editor.history.steps(), (1, 0));
+        let far = crate::scene::octree::WORLD_LIMIT - 1;
+        assert!(run(&mut editor, &format!("move {far} 0 0")).unwrap_err().contains("outside the world"));
+        assert_eq!(editor.selection, Some(Region { min: IVec3::new(10, 0, 0), max: IVec3::new(11, 1, 1) }));
+    }
+
+    #[test]
+    fn undo_n_takes_all_n_steps_or_none() {
+        let mut editor = Editor::default();
+        for line in ["place 0 0 0", "place 1 0 0"] {
+            run(&mut editor, line).unwrap();
+        }
+        assert!(run(&mut editor, "undo 3").unwrap_err().contains("only 2 step(s) to undo"));
+        assert_eq!(editor.scene.tree.solid_voxels(), 2, "nothing was undone");
+        assert_eq!(run(&mut editor, "undo 2"), Ok(Outcome::Changed));
+        assert_eq!(editor.scene.tree.solid_voxels(), 0);
     }
 }

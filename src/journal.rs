@@ -52,6 +52,13 @@ pub fn orphaned_untitled(dir: &Path) -> Vec<PathBuf> {
     found.into_iter().map(|(_, path)| path).collect()
 }
 
+/// The snapshot a journal may start from (`load` of it as its first line):
+/// the journal's path with `.ovx` for `.ovr`. The window writes one when a
+/// change cannot be journaled as a line; it goes with its journal.
+pub fn snapshot_path(journal: &Path) -> PathBuf {
+    journal.with_extension("ovx")
+}
+
 /// The journal of `document` if one was left behind.
 pub fn find(document: &Path) -> Option<PathBuf> {
     let path = journal_path(document);
@@ -71,9 +78,10 @@ pub enum RecoverError {
     Failed { path: PathBuf, message: String },
 }
 
-/// Reads a journal. Its first scene line must load `document` when one is
-/// given (the journal found beside it); a journal named directly (an
-/// untitled one) must start with a scene line (`load`, `new`, `demo`).
+/// Reads a journal. Its first scene line must load `document` (or the
+/// journal's own snapshot) when one is given (the journal found beside
+/// it); a journal named directly (an untitled one) must start with a scene
+/// line (`load`, `new`, `demo`).
 ///
 /// # Errors
 /// A journal that does not parse, or one written for another file.
@@ -85,12 +93,20 @@ pub fn read(journal: &Path, document: Option<&Path>) -> Result<Script, RecoverEr
     let first = script.lines.iter().find(|l| !matches!(l.command, Command::Viewport(..))).map(|l| &l.command);
     let owned = match (first, document) {
         (Some(Command::Load(owner)), Some(document)) => {
-            let document_id = std::fs::canonicalize(document).unwrap_or_else(|_| document.to_path_buf());
-            std::fs::canonicalize(owner).is_ok_and(|p| p == document_id)
+            let id = |p: &Path| std::fs::canonicalize(p).ok();
+            let owner = id(owner);
+            owner.is_some() && (owner == id(document) || owner == id(&snapshot_path(journal)))
         }
         (Some(Command::Load(_) | Command::New | Command::Demo(_)), None) => true,
         _ => false,
     };
+    // A journal only edits: one that writes files (planted, or damaged) is refused.
+    if let Some(line) = script.lines.iter().find(|l| matches!(l.command, Command::Save(_) | Command::Render(_))) {
+        return Err(RecoverError::Failed {
+            path: journal.to_path_buf(),
+            message: format!("line {} writes a file ('{}'), which no journal does", line.number, line.command),
+        });
+    }
     if owned {
         return Ok(script);
     }

@@ -194,3 +194,47 @@ fn an_untitled_scene_is_recovered_after_a_kill() {
     let left = std::fs::read_dir(dir.path().join("saves")).unwrap().count();
     assert_eq!(left, 0, "saving removed the untitled journal");
 }
+
+/// Changes a journal cannot hold as lines still survive a kill: an undo
+/// of a step saved before the journal started, a selection made while the
+/// document was clean, a paste of a block copied before the journal
+/// started. The window plays the script (its lines go the mouse's way,
+/// saves included), is killed, and `recover` must equal the same script
+/// run headless.
+#[test]
+fn undo_past_a_save_selections_and_old_clipboards_survive_a_kill() {
+    for tool in ["Xvfb", "xdotool"] {
+        require_tool(tool);
+    }
+    let script = "color 7\nplace 3 1 3\nsave doc.vox\n\
+                  select 0 0 0 3 1 3\ncopy\ncut\npaste 8 0 8\nundo\npaste 9 0 9\n\
+                  save doc.vox\nundo\nplace 5 2 5\n\
+                  save doc.vox\npaste 12 0 12\nplace 6 3 6\n";
+    let (window_dir, headless_dir) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    for dir in [window_dir.path(), headless_dir.path()] {
+        let mut scene = octovox::scene::Scene::default();
+        let floor = octovox::scene::Shape::Box { min: IVec3::ZERO, max: IVec3::new(15, 0, 15) };
+        scene.tree.apply_brush(&floor, octovox::scene::Op::Place(20)).unwrap();
+        octovox::io::save_scene(&dir.join("doc.vox"), &scene, Default::default()).unwrap();
+    }
+    std::fs::write(window_dir.path().join("play.ovr"), script).unwrap();
+    std::fs::write(headless_dir.path().join("play.ovr"), format!("load doc.vox\n{script}save expected.vox\n")).unwrap();
+    let run = octovox(&["replay", "--cpu", "--force", s(&headless_dir.path().join("play.ovr"))]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stdout));
+
+    let (_xvfb, display) = start_xvfb(12);
+    let args = ["doc.vox".to_string(), "--size".into(), "640x480".into(), "--replay".into(), "play.ovr".into()];
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, window_dir.path(), &args);
+    find_window(&display, &mut app, &stderr_path);
+    assert_eq!(lines.wait_for("replay:", Duration::from_secs(90)), "replay: 0 passed, 0 failed");
+    app.0.kill().unwrap();
+    app.0.wait().unwrap();
+
+    let (doc, recovered) = (window_dir.path().join("doc.vox"), window_dir.path().join("recovered.vox"));
+    let run = octovox(&["recover", s(&doc), "-o", s(&recovered)]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let voxels = |p: &Path| -> HashSet<(IVec3, u8)> {
+        octovox::io::load_scene(p, 0).unwrap().tree.voxels().into_iter().collect()
+    };
+    assert_eq!(voxels(&recovered), voxels(&headless_dir.path().join("expected.vox")));
+}

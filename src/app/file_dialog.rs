@@ -21,8 +21,9 @@ pub struct NativeDialog {
     kind: DialogKind,
     /// What the path field starts with if the dialog never shows.
     start: String,
-    opened: Instant,
-    answer: Receiver<Option<PathBuf>>,
+    /// The path chosen (`None`: cancelled, or no dialog), and how long the
+    /// dialog took, measured by its thread.
+    answer: Receiver<(Option<PathBuf>, Duration)>,
 }
 
 /// Whether a native dialog can show: zenity is installed, or a desktop
@@ -71,7 +72,7 @@ impl App {
     /// else in the window's path field, starting at `start`.
     pub(super) fn ask_path(&mut self, kind: DialogKind, start: String) {
         if self.file_dialog.is_some() {
-            return;
+            return self.ui.info("a file dialog is open");
         }
         if !available() {
             self.ui.dialog = Some((kind, start));
@@ -80,13 +81,14 @@ impl App {
         let (tx, rx) = mpsc::channel();
         let from = PathBuf::from(&start);
         let spawned = std::thread::Builder::new().name("file dialog".into()).spawn(move || {
-            let d = dialog(kind, &from);
-            let _ = tx.send(if kind == DialogKind::Open { d.pick_file() } else { d.save_file() });
+            let (d, opened) = (dialog(kind, &from), Instant::now());
+            let chosen = if kind == DialogKind::Open { d.pick_file() } else { d.save_file() };
+            let _ = tx.send((chosen, opened.elapsed()));
         });
         match spawned {
             Ok(_) => {
                 report!("file dialog: native");
-                self.file_dialog = Some(NativeDialog { kind, start, opened: Instant::now(), answer: rx });
+                self.file_dialog = Some(NativeDialog { kind, start, answer: rx });
             }
             Err(_) => self.ui.dialog = Some((kind, start)),
         }
@@ -95,10 +97,10 @@ impl App {
     /// Carries out the answer of the open native dialog, once it came.
     pub(super) fn poll_file_dialog(&mut self, event_loop: &ActiveEventLoop) {
         let Some(open) = &self.file_dialog else { return };
-        let answer = match open.answer.try_recv() {
+        let (answer, took) = match open.answer.try_recv() {
             Ok(answer) => answer,
             Err(TryRecvError::Empty) => return,
-            Err(TryRecvError::Disconnected) => None,
+            Err(TryRecvError::Disconnected) => (None, Duration::ZERO),
         };
         let Some(open) = self.file_dialog.take() else { return };
         match answer {
@@ -110,7 +112,7 @@ impl App {
                 };
                 self.execute(command, event_loop);
             }
-            None if open.opened.elapsed() < NO_DIALOG_WITHIN => {
+            None if took < NO_DIALOG_WITHIN => {
                 report!("file dialog: none showed; asking in the window");
                 self.ui.dialog = Some((open.kind, open.start));
             }

@@ -117,8 +117,8 @@ impl App {
     }
 
     /// Applies a crash-recovery journal (what `octovox recover` does): the
-    /// open document's, or an untitled scene's, which this session then
-    /// takes over. Journaling goes on at its end.
+    /// open document's, and journaling goes on at its end; or an untitled
+    /// scene's, which this session's own journal then replaces.
     pub(super) fn recover_journal(&mut self, journal: &Path) {
         let document = self.state.path.clone().filter(|d| octovox::journal::journal_path(d) == journal);
         let recovered = match &document {
@@ -129,17 +129,23 @@ impl App {
             Ok(scene) => scene,
             Err(err) => return self.ui.error(format!("cannot recover: {err}")),
         };
-        let (source, continued) = match &document {
-            Some(document) => (octovox::replay::Command::Load(document.clone()), journal.to_path_buf()),
-            None => (octovox::replay::Command::New, self.untitled_journal_path()),
-        };
+        let source = document.clone().map_or(octovox::replay::Command::New, octovox::replay::Command::Load);
         self.replace_scene(scene, source);
         // What is shown is the scene plus its journal, not yet saved.
         self.state.dirty = true;
-        let taken_over = if continued == journal { Ok(()) } else { std::fs::rename(journal, &continued) };
-        match taken_over.and_then(|()| octovox::replay::Recorder::append(&continued)) {
-            Ok(recorder) => self.journal = Some(recorder),
-            Err(err) => self.ui.error(format!("cannot go on with the journal {}: {err}", journal.display())),
+        if document.is_some() {
+            match octovox::replay::Recorder::append(journal) {
+                Ok(recorder) => self.journal = Some(recorder),
+                Err(err) => self.ui.error(format!("cannot go on with the journal {}: {err}", journal.display())),
+            }
+        } else {
+            // This session's own journal starts from the recovered scene;
+            // the dead session's journal and snapshot go.
+            self.restart_journal_from_snapshot();
+            if self.journal.is_some() {
+                let _ = std::fs::remove_file(octovox::journal::snapshot_path(journal));
+                let _ = std::fs::remove_file(journal);
+            }
         }
         let what = document.as_ref().map_or_else(|| "the untitled scene".to_string(), |d| d.display().to_string());
         report!("recovered: {what}");
@@ -156,7 +162,6 @@ impl App {
     /// that waited for a path to save to.
     pub(super) fn save_as(&mut self, path: PathBuf, options: WriteOptions, event_loop: &ActiveEventLoop) {
         if self.save(&path, options) {
-            self.recent.add(&path);
             self.state.path = Some(path);
             self.update_title();
             if let Some(pending) = self.ui.pending.take() {
@@ -175,6 +180,7 @@ impl App {
         }
         match octovox::io::save_scene(path, &self.editor.scene, options) {
             Ok(()) => {
+                self.recent.add(path);
                 report!("saved: {}", path.display());
                 self.state.dirty = false;
                 // The file now holds every edit: the journal starts again from it.

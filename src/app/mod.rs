@@ -20,6 +20,7 @@ mod file_dialog;
 mod files;
 mod frame;
 mod input;
+mod journal;
 mod motion;
 mod presets;
 mod recent;
@@ -48,6 +49,7 @@ use octovox::editor::{Editor, Outcome};
 use octovox::gpu::scene_buffers::UploadStats;
 use octovox::gpu::{BlitPass, GpuContext, Renderer};
 use octovox::io::atomic::WriteOptions;
+use octovox::replay::Recorder;
 use octovox::scene::Scene;
 use octovox::trace::svo;
 
@@ -171,6 +173,9 @@ struct App {
     /// and the line that loads the document as saved, which starts it.
     journal: Option<octovox::replay::Recorder>,
     journal_source: Vec<octovox::replay::Command>,
+    /// The clipboard was filled by a `copy` or `cut` the open journal holds
+    /// (else a paste starts the journal again from a snapshot).
+    clipboard_journaled: bool,
     /// A native file dialog that is open.
     file_dialog: Option<file_dialog::NativeDialog>,
     /// File ▸ Open recent.
@@ -217,6 +222,7 @@ impl App {
             recorder: None,
             journal: None,
             journal_source: Vec::new(),
+            clipboard_journaled: false,
             file_dialog: None,
             recent: recent::Recent::load(),
             select_drag: None,
@@ -319,13 +325,14 @@ impl App {
 
     // ----- the one path for changes: edit → history → octree → upload ------------
 
-    /// Applies an edit and its mirror images the way every edit is
-    /// applied: through the editor's history onto the octree, then the
+    /// Applies an edit and its mirror images (a stroke step, a palette
+    /// change) the way every edit is applied: through the editor's history
+    /// onto the octree, `record` to the recording and the journal, then the
     /// pool's dirty ranges go to the GPU.
-    pub fn apply_edit(&mut self, edit: Edit) -> bool {
+    fn apply_edit(&mut self, edit: Edit, record: impl Fn(&mut Recorder) -> std::io::Result<()>) -> bool {
         match self.editor.apply_mirrored(vec![edit]) {
-            Ok(()) => {
-                self.after_change("edit");
+            Ok(_) => {
+                self.after_change("edit", record);
                 true
             }
             Err(err) => {
@@ -348,21 +355,49 @@ impl App {
             return Ok(Outcome::Replaced);
         }
         let outcome = self.editor.run(line)?;
-        match outcome {
-            Outcome::Changed => {
+        let (tools, camera) = (self.editor.tools, self.state.camera);
+        let ran = |r: &mut Recorder| r.ran(line, &tools, &camera);
+        match (&outcome, line) {
+            // Undo and redo: the journal gets them as lines only if it holds the steps.
+            (Outcome::Changed, octovox::replay::Command::Undo(n) | octovox::replay::Command::Redo(n)) => {
+                let undo = matches!(line, octovox::replay::Command::Undo(_));
+                self.state.dirty = true;
+                (0..*n).for_each(|_| self.record_undo(undo));
+                self.after_change(if undo { "undo" } else { "redo" }, |_| Ok(()));
+            }
+            // A block copied before the journal started: the journal starts again after the paste.
+            (Outcome::Changed, octovox::replay::Command::Paste(_)) if !self.clipboard_journaled => {
+                self.state.dirty = true;
+                self.record_to_recording(ran);
+                self.restart_journal_from_snapshot();
+                self.after_change("paste", |_| Ok(()));
+            }
+            (Outcome::Changed, _) => {
                 // The line's command word names it in the printed line (`fill: N bytes written`).
                 let text = line.to_string();
-                self.after_change(text.split(' ').next().unwrap_or("edit"));
+                self.after_change(text.split(' ').next().unwrap_or("edit"), ran);
             }
-            Outcome::State => {
+            (Outcome::State, _) => {
+                self.record(ran);
                 report!("ran: {line}");
                 self.request_redraw();
             }
-            Outcome::Replaced | Outcome::Checked { .. } | Outcome::Host => return Ok(outcome),
+            (Outcome::Replaced | Outcome::Checked { .. } | Outcome::Host, _) => return Ok(outcome),
         }
-        let (tools, camera) = (self.editor.tools, self.state.camera);
-        self.record(|r| r.ran(line, &tools, &camera));
+        if matches!(line, octovox::replay::Command::Copy | octovox::replay::Command::Cut) {
+            self.clipboard_journaled = self.journal.is_some();
+        }
         Ok(outcome)
+    }
+
+    /// Ctrl+Z / Ctrl+Shift+Z: one step, if there is one.
+    fn undo_redo(&mut self, undo: bool) {
+        let what = if undo { "undo" } else { "redo" };
+        let (undoable, redoable) = self.editor.history.steps();
+        if (if undo { undoable } else { redoable }) == 0 {
+            return self.ui.info(format!("nothing to {what}"));
+        }
+        self.act(if undo { octovox::replay::Command::Undo(1) } else { octovox::replay::Command::Redo(1) }, what);
     }
 
     /// A mouse or key action as an editor line; a refusal goes to the
@@ -373,9 +408,14 @@ impl App {
         }
     }
 
-    /// Sends what changed to the GPU and refreshes everything that depends on
-    /// the voxels. Prints `WHAT: N bytes written` (the e2e test reads it).
-    fn after_change(&mut self, what: &str) {
+    /// Follows up a change: the scene is unsaved; `record` writes it to the
+    /// recording and the journal *before* it is reported done (a crash
+    /// after the report loses nothing); what changed goes to the GPU and
+    /// everything that depends on the voxels is refreshed. Prints `WHAT: N
+    /// bytes written` (the tests read it).
+    fn after_change(&mut self, what: &str, record: impl Fn(&mut Recorder) -> std::io::Result<()>) {
+        self.state.dirty = true;
+        self.record(record);
         let upload = self.upload();
         self.stats.last_edit_bytes = upload.bytes;
         self.stats.last_edit_ranges = upload.ranges;
@@ -385,7 +425,6 @@ impl App {
             upload.ranges,
             if upload.grew { " (buffer grew)" } else { "" }
         );
-        self.state.dirty = true;
         self.extrude_preview = None;
         self.grid_stale = true;
         self.path_stale = true;
@@ -423,22 +462,8 @@ impl App {
             Command::DeleteSelection if !busy_loading => self.act(octovox::replay::Command::Delete, "delete"),
             Command::PasteAtCursor if !busy_loading => self.paste_at_cursor(),
             Command::Nudge(nudge) if !busy_loading => self.nudge(nudge),
-            Command::Undo if !busy_loading => match self.editor.undo() {
-                Ok(true) => {
-                    self.record(|r| r.undo());
-                    self.after_change("undo");
-                }
-                Ok(false) => self.ui.info("nothing to undo"),
-                Err(err) => self.ui.error(format!("undo failed: {err}")),
-            },
-            Command::Redo if !busy_loading => match self.editor.redo() {
-                Ok(true) => {
-                    self.record(|r| r.redo());
-                    self.after_change("redo");
-                }
-                Ok(false) => self.ui.info("nothing to redo"),
-                Err(err) => self.ui.error(format!("redo failed: {err}")),
-            },
+            Command::Undo if !busy_loading => self.undo_redo(true),
+            Command::Redo if !busy_loading => self.undo_redo(false),
             Command::PointerEdit { .. }
             | Command::Cut
             | Command::DeleteSelection
@@ -458,7 +483,13 @@ impl App {
             Command::MeasurePresets => self.measure_presets(),
             Command::ToggleLine => self.state.toggle_line_mode(),
             Command::ToggleSelect => self.state.toggle_select_mode(),
-            Command::Copy => self.act(octovox::replay::Command::Copy, "copy"),
+            Command::Copy => match self.run_line(&octovox::replay::Command::Copy) {
+                Ok(_) => {
+                    let voxels = self.editor.clipboard().map_or(0, octovox::scene::selection::Block::voxels);
+                    self.ui.info(format!("copied {voxels} voxels"));
+                }
+                Err(err) => self.ui.error(format!("copy refused: {err}")),
+            },
             Command::SelectNone => self.act(octovox::replay::Command::Select(None), "select"),
             Command::FillAt { x, y } => {
                 if let Some(pick) = self.pick_or_say(x, y, "no voxel there to fill") {
@@ -705,10 +736,9 @@ impl App {
             self.palette_stroke = true;
         }
         let before = (self.editor.scene.palette.color(index), self.editor.scene.palette.material(index).clone());
-        if self.apply_edit(edit) {
-            let after = (self.editor.scene.palette.color(index), self.editor.scene.palette.material(index).clone());
-            self.record(|r| r.palette(index, &before, &after));
-        }
+        let Edit::Palette { color, material, .. } = &edit else { return };
+        let after = (*color, (**material).clone());
+        self.apply_edit(edit.clone(), |r| r.palette(index, &before, &after));
         if !dragging {
             self.end_palette_stroke();
         }
@@ -783,14 +813,13 @@ impl App {
         if stroke.last_center == Some(center) {
             return;
         }
-        let tool = stroke.tool;
-        if self.apply_edit(edit)
+        let (tool, camera, tools) = (stroke.tool, self.state.camera, self.editor.tools);
+        let record = |r: &mut Recorder| r.edit(&camera, tools.brush, tools.color.max(1), (tool, &tools.mirror), center);
+        if self.apply_edit(edit, record)
             && let Some(stroke) = &mut self.stroke
         {
             stroke.plane.get_or_insert(layer);
             stroke.last_center = Some(center);
-            let (camera, tools) = (self.state.camera, self.editor.tools);
-            self.record(|r| r.edit(&camera, tools.brush, tools.color.max(1), (tool, &tools.mirror), center));
         }
     }
 }

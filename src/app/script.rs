@@ -131,66 +131,6 @@ impl App {
             Err(message) => Played::Failed(message),
         }
     }
-
-    /// Runs `f` on the recorder and on the document's journal (created at
-    /// the first unsaved edit); an I/O error stops that one with a message.
-    pub(super) fn record(&mut self, f: impl Fn(&mut octovox::replay::Recorder) -> std::io::Result<()>) {
-        if let Some(recorder) = &mut self.recorder
-            && let Err(err) = f(recorder)
-        {
-            self.ui.error(format!("recording to {} stopped: {err}", recorder.path().display()));
-            self.recorder = None;
-        }
-        self.open_journal();
-        if let Some(journal) = &mut self.journal
-            && let Err(err) = f(journal)
-        {
-            self.ui.error(format!("the crash-recovery journal {} stopped: {err}", journal.path().display()));
-            self.journal = None;
-            self.journal_source.clear();
-        }
-    }
-
-    /// Starts the journal of the open scene once it has unsaved edits: its
-    /// first lines make the scene as it is on disk (or as it started, for
-    /// an untitled one, journaled in saves/).
-    fn open_journal(&mut self) {
-        if self.journal.is_some() || !self.state.dirty || self.journal_source.is_empty() {
-            return;
-        }
-        let (path, header) = match &self.state.path {
-            Some(document) => (
-                octovox::journal::journal_path(document),
-                format!("crash-recovery journal of {}: `octovox recover` replays it", document.display()),
-            ),
-            None => (
-                self.untitled_journal_path(),
-                "crash-recovery journal of an untitled scene: `octovox recover THIS_FILE -o OUT.vox` replays it"
-                    .to_string(),
-            ),
-        };
-        if let Some(dir) = path.parent() {
-            let _ = std::fs::create_dir_all(dir);
-        }
-        let source = &self.journal_source;
-        match octovox::replay::Recorder::with_header(&path, &header).and_then(|mut journal| {
-            source.iter().try_for_each(|line| journal.scene(line.clone()))?;
-            Ok(journal)
-        }) {
-            Ok(journal) => self.journal = Some(journal),
-            Err(err) => {
-                self.ui.error(format!("cannot write the crash-recovery journal {}: {err}", path.display()));
-                self.journal_source.clear();
-            }
-        }
-    }
-
-    /// Removes the journal: the document was saved, or its edits discarded.
-    pub(super) fn close_journal(&mut self) {
-        if let Some(journal) = self.journal.take() {
-            let _ = std::fs::remove_file(journal.path());
-        }
-    }
 }
 
 impl App {

@@ -209,6 +209,17 @@ impl Recorder {
         Ok(())
     }
 
+    /// Whether an `undo` would be written: a step made since this recorder
+    /// started is left to undo.
+    pub fn can_undo(&self) -> bool {
+        !self.done.is_empty() || self.open_stroke > 0
+    }
+
+    /// Whether a `redo` would be written.
+    pub fn can_redo(&self) -> bool {
+        !self.undone.is_empty()
+    }
+
     /// Ends an undo step (a click or a whole drag).
     pub fn end_step(&mut self) {
         if self.open_stroke > 0 {

@@ -177,6 +177,35 @@ impl Octree {
         self.visit_cells(self.root, self.origin, self.depth, &mut f);
     }
 
+    /// [`Octree::for_each_solid_cell`] for the cells that meet the box
+    /// `lo..=hi`, skipping the subtrees outside it (a cell may reach past
+    /// the box).
+    pub fn for_each_solid_cell_in(&self, lo: IVec3, hi: IVec3, mut f: impl FnMut(IVec3, i32, u8)) {
+        self.visit_cells_in(self.root, self.origin, self.depth, (lo, hi), &mut f);
+    }
+
+    fn visit_cells_in(
+        &self,
+        word: u32,
+        min: IVec3,
+        level: u32,
+        (lo, hi): (IVec3, IVec3),
+        f: &mut impl FnMut(IVec3, i32, u8),
+    ) {
+        let max = min + IVec3::splat((1 << level) - 1);
+        if max.cmplt(lo).any() || min.cmpgt(hi).any() {
+            return;
+        }
+        if !is_pointer(word) || level <= 1 {
+            return self.visit_cells(word, min, level, f);
+        }
+        let half = 1 << (level - 1);
+        for octant in 0..8 {
+            let child_min = min + octant_offset(octant) * half;
+            self.visit_cells_in(self.node(word)[octant], child_min, level - 1, (lo, hi), f);
+        }
+    }
+
     /// The non-empty cells of level `level` (or the root, when the tree is no
     /// deeper) as (min corner, child word, level), in octant order: what a
     /// saver walks to write the scene one block at a time.

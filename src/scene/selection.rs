@@ -9,8 +9,12 @@ use super::shape::MAX_BRUSH_EXTENT;
 use super::{EditError, Octree, Op, Shape};
 use crate::edit::Edit;
 
-/// Most voxels one copy holds: 16 Mi voxels, at most 256 MiB of runs.
+/// Most voxels one copy holds (16 Mi).
 pub const MAX_CLIPBOARD_VOXELS: u64 = 1 << 24;
+
+/// Peak bytes a copied voxel may take at worst (each its own run): the
+/// clipped cell, its run, and the edit and undo patch a paste makes of it.
+const BYTES_PER_COPIED_VOXEL: u64 = 160;
 
 /// An inclusive box of cells, `min` ≤ `max` on every axis.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -43,6 +47,18 @@ impl Region {
 
     pub fn shifted(&self, by: IVec3) -> Region {
         Region { min: self.min + by, max: self.max + by }
+    }
+
+    /// The box as it may be placed: inside the world's limits.
+    ///
+    /// # Errors
+    /// [`EditError::OutsideWorld`], as an edit there would get.
+    pub fn inside_world(self) -> Result<Region, EditError> {
+        let limit = super::octree::WORLD_LIMIT;
+        if self.min.min_element() <= -limit || self.max.max_element() >= limit {
+            return Err(EditError::OutsideWorld { min: self.min, max: self.max });
+        }
+        Ok(self)
     }
 
     /// The edit that empties the box.
@@ -101,7 +117,7 @@ pub fn copy(tree: &Octree, region: Region) -> Result<Block, EditError> {
     // The tree's uniform cells clipped to the box, as (min, max) and colour.
     let mut pieces = Vec::new();
     let mut voxels = 0u64;
-    tree.for_each_solid_cell(|min, size, color| {
+    tree.for_each_solid_cell_in(region.min, region.max, |min, size, color| {
         let (lo, hi) = (min.max(region.min), (min + IVec3::splat(size - 1)).min(region.max));
         if lo.cmple(hi).all() {
             voxels += (hi - lo + IVec3::ONE).as_u64vec3().element_product();
@@ -115,6 +131,11 @@ pub fn copy(tree: &Octree, region: Region) -> Result<Block, EditError> {
             "the selection holds {voxels} voxels; copy takes at most {MAX_CLIPBOARD_VOXELS}"
         )));
     }
+    let pieces_count = pieces.len() as u64;
+    crate::budget::check(
+        || format!("copying {voxels} voxels in {pieces_count} cells"),
+        pieces_count.saturating_mul(BYTES_PER_COPIED_VOXEL),
+    )?;
     let mut runs: Vec<Run> = pieces
         .into_iter()
         .flat_map(|(lo, hi, color)| {
