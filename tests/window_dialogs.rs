@@ -22,9 +22,7 @@ fn save_box(path: &Path, max: IVec3) -> u64 {
 
 #[test]
 fn open_and_save_as_go_through_the_native_dialog_or_the_path_field() {
-    for tool in ["Xvfb", "xdotool"] {
-        require_tool(tool);
-    }
+    require_window_tools();
     let dir = tempfile::tempdir().unwrap();
     let root = std::fs::canonicalize(dir.path()).unwrap();
     let (a, b, c, d) = (root.join("a.vox"), root.join("b.vox"), root.join("c.vox"), root.join("d.vox"));

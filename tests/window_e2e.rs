@@ -224,9 +224,7 @@ fn set_read_only(file: &std::path::Path, read_only: bool) {
 /// clamped to it, so the window opens and draws.
 #[test]
 fn a_window_wider_than_8192_pixels_opens_and_draws() {
-    for tool in ["Xvfb", "xdotool"] {
-        require_tool(tool);
-    }
+    require_window_tools();
     let dir = tempfile::tempdir().unwrap();
     let (_xvfb, display) = start_xvfb(2);
     let args =
@@ -262,9 +260,7 @@ fn the_window_path_traces_the_showroom_at_rest() {
 /// attach uses it, as the saved file shows.
 #[test]
 fn alt_click_picks_a_colour_and_shift_click_paint_fills_with_it() {
-    for tool in ["Xvfb", "xdotool"] {
-        require_tool(tool);
-    }
+    require_window_tools();
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("two.vox");
     let mut scene = octovox::scene::Scene::default();
@@ -314,9 +310,7 @@ fn alt_click_picks_a_colour_and_shift_click_paint_fills_with_it() {
 /// and one Ctrl+Z takes both away.
 #[test]
 fn a_mirrored_click_places_both_sides_and_undoes_in_one_step() {
-    for tool in ["Xvfb", "xdotool"] {
-        require_tool(tool);
-    }
+    require_window_tools();
     let dir = tempfile::tempdir().unwrap();
     let (file, scene, camera) = floor_scene(dir.path());
     let script = dir.path().join("mirror.ovr");
@@ -356,9 +350,7 @@ fn a_mirrored_click_places_both_sides_and_undoes_in_one_step() {
 /// other; one Ctrl+Z takes the line away.
 #[test]
 fn a_dragged_line_in_line_mode() {
-    for tool in ["Xvfb", "xdotool"] {
-        require_tool(tool);
-    }
+    require_window_tools();
     let dir = tempfile::tempdir().unwrap();
     let (file, scene, camera) = floor_scene(dir.path());
     let (xa, ya, va, na) = stable_pixel(&scene.tree, &camera, |v, n| n == IVec3::Y && v.x < 4);

@@ -138,9 +138,7 @@ fn damaged_and_foreign_journals_are_refused_and_left_in_place() {
 /// next window started without a file offers it back.
 #[test]
 fn an_untitled_scene_is_recovered_after_a_kill() {
-    for tool in ["Xvfb", "xdotool"] {
-        require_tool(tool);
-    }
+    require_window_tools();
     let dir = tempfile::tempdir().unwrap();
     let edits = [IVec3::new(0, 100, 0), IVec3::new(1, 100, 0), IVec3::new(2, 101, 0)];
     let script: String = std::iter::once("color 5\n".to_string())
@@ -203,9 +201,7 @@ fn an_untitled_scene_is_recovered_after_a_kill() {
 /// run headless.
 #[test]
 fn undo_past_a_save_selections_and_old_clipboards_survive_a_kill() {
-    for tool in ["Xvfb", "xdotool"] {
-        require_tool(tool);
-    }
+    require_window_tools();
     let script = "color 7\nplace 3 1 3\nsave doc.vox\n\
                   select 0 0 0 3 1 3\ncopy\ncut\npaste 8 0 8\nundo\npaste 9 0 9\n\
                   save doc.vox\nundo\nplace 5 2 5\n\

@@ -43,9 +43,7 @@ fn drag(display: &str, window: &str, from: (f32, f32), to: (f32, f32)) {
 
 #[test]
 fn a_box_selection_moves_with_the_arrows_resizes_by_a_handle_and_copies() {
-    for tool in ["Xvfb", "xdotool"] {
-        require_tool(tool);
-    }
+    require_window_tools();
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("blocks.vox");
     let floor = cells(IVec3::ZERO, IVec3::new(15, 0, 15));

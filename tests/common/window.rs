@@ -43,6 +43,13 @@ pub fn require_tool(name: &str) {
     );
 }
 
+/// What every window test needs: Xvfb for a display, xdotool for input.
+pub fn require_window_tools() {
+    for tool in ["Xvfb", "xdotool"] {
+        require_tool(tool);
+    }
+}
+
 /// Waits for the app to exit by itself; `what` says what should end it.
 pub fn wait_for_exit(app: &mut KillOnDrop, timeout: Duration, what: &str) -> std::process::ExitStatus {
     let deadline = Instant::now() + timeout;
@@ -313,9 +320,7 @@ pub fn camera_arg(camera: &Camera) -> String {
 /// A writable copy of `torus64.vox` in a new folder, the scene it holds and
 /// a camera framing it: the document the window tests edit.
 pub fn torus_document() -> (tempfile::TempDir, PathBuf, octovox::scene::Scene, Camera) {
-    for tool in ["Xvfb", "xdotool"] {
-        require_tool(tool);
-    }
+    require_window_tools();
     let source = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/vox/seed/torus64.vox");
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("torus.vox");
