@@ -42,7 +42,7 @@ impl App {
             Some((x, y)) if !self.pointer_over_ui && self.loading.is_none() => self.pick_at(x, y).ok().flatten(),
             _ => None,
         };
-        self.update_extrude_preview();
+        self.update_previews();
         self.sync_grid();
         let repaint_delay = full.viewport_output.get(&egui::ViewportId::ROOT).map(|v| v.repaint_delay);
         let Some(window_copy) = self.trace_and_present(&ctx, full) else { return };
@@ -76,6 +76,7 @@ impl App {
 
     /// Lays out the panels and carries out the commands they produced.
     fn run_panels(&mut self, event_loop: &ActiveEventLoop) -> Option<(egui::Context, egui::FullOutput)> {
+        let (paste, eyedropper) = (self.paste_preview(), self.eyedropper_preview());
         let gfx = self.gfx.as_mut()?;
         let raw_input = gfx.egui_state.take_egui_input(&gfx.window);
         let ctx = gfx.egui_state.egui_ctx().clone();
@@ -101,15 +102,19 @@ impl App {
                 has_clipboard: self.editor.clipboard().is_some(),
                 recent: self.recent.files().cloned().collect(),
                 extrude: self.extrude_preview.as_ref().map(|p| (p.voxels.as_slice(), p.face.1, p.layers)),
+                fill: self.fill_preview.as_ref().map(|p| p.region),
+                paste,
+                eyedropper,
             };
             let (state, ui_state, tools) = (&mut self.state, &mut self.ui, &mut self.editor.tools);
             let pick = self.pick;
             ctx.run_ui(raw_input, |ui| {
                 commands = ui::show(ui, state, tools, ui_state, &info);
                 ui::draw_selection(ui, state, &info);
+                ui::draw_action_previews(ui, state, &info);
                 if let Some((voxels, normal, layers)) = info.extrude {
                     ui::draw_extrude(ui, state, &info, voxels, normal, layers);
-                } else if let Some(pick) = pick.filter(|_| !state.select_mode) {
+                } else if let Some(pick) = pick.filter(|_| !state.select_mode && info.fill.is_none()) {
                     ui::draw_brush_outline(ui, state, tools, &pick, &info);
                 }
             })

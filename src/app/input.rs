@@ -40,6 +40,16 @@ impl Input {
         self.modifiers.control_key()
     }
 
+    /// Shift is held: a click with Paint fills.
+    pub fn shift_held(&self) -> bool {
+        self.modifiers.shift_key()
+    }
+
+    /// Alt is held: a click picks a colour.
+    pub fn alt_held(&self) -> bool {
+        self.modifiers.alt_key()
+    }
+
     /// Fly direction (right, up, forward) while the right button is held.
     pub fn fly_direction(&self) -> Option<DVec3> {
         self.right?;

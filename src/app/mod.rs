@@ -23,6 +23,7 @@ mod input;
 mod journal;
 mod motion;
 mod presets;
+mod preview;
 mod recent;
 mod script;
 mod selection;
@@ -115,14 +116,6 @@ struct Stroke {
     last_center: Option<IVec3>,
 }
 
-/// The faces an extrude would move: those of the region around `face`
-/// (voxel, normal), and the layers the drag covers so far.
-struct ExtrudePreview {
-    face: (IVec3, IVec3),
-    voxels: Vec<IVec3>,
-    layers: i32,
-}
-
 /// `--bench-frames`: frames left and the measurements so far.
 struct Bench {
     left: u32,
@@ -184,7 +177,9 @@ struct App {
     select_drag: Option<selection::SelectDrag>,
     /// What an extrude from the face under the cursor (Ctrl held) or the
     /// Ctrl+drag under way would move.
-    extrude_preview: Option<ExtrudePreview>,
+    extrude_preview: Option<preview::ExtrudePreview>,
+    /// What a Shift+click fill with Paint would recolour.
+    fill_preview: Option<preview::FillPreview>,
     /// The face a Ctrl+drag extrude started on and where the drag began.
     extrude_from: Option<(Pick, (f64, f64))>,
     /// Where the next screenshot goes (a script's `render PATH`), else `saves/`.
@@ -227,6 +222,7 @@ impl App {
             recent: recent::Recent::load(),
             select_drag: None,
             extrude_preview: None,
+            fill_preview: None,
             extrude_from: None,
             screenshot_path: None,
             args,
@@ -426,6 +422,7 @@ impl App {
             if upload.grew { " (buffer grew)" } else { "" }
         );
         self.extrude_preview = None;
+        self.fill_preview = None;
         self.grid_stale = true;
         self.path_stale = true;
         self.update_title();
@@ -654,33 +651,6 @@ impl App {
                 self.act(octovox::replay::Command::Extrude(pick.voxel, pick.normal, layers), "extrude");
             }
             StrokePhase::Click => {}
-        }
-    }
-
-    /// Keeps the extrude preview up to date: the region of the face a
-    /// Ctrl+drag started on, else of the face under the cursor while Ctrl
-    /// is held (line and select modes have no extrude).
-    fn update_extrude_preview(&mut self) {
-        let face = match self.extrude_from {
-            Some((pick, _)) => Some(pick),
-            None if self.input.ctrl_held() && !self.state.line_mode && !self.state.select_mode => self.pick,
-            None => None,
-        }
-        .filter(|p| p.normal != IVec3::ZERO)
-        .map(|p| (p.voxel, p.normal));
-        let Some(face) = face else {
-            self.extrude_preview = None;
-            return;
-        };
-        if self.extrude_preview.as_ref().is_none_or(|p| p.face != face) {
-            // A region too large to extrude previews nothing; the release says why.
-            let region = octovox::scene::extrude::face_region(&self.editor.scene.tree, face.0, face.1);
-            let voxels = region.map(|r| r.into_iter().map(|(p, _)| p).collect()).unwrap_or_default();
-            self.extrude_preview = Some(ExtrudePreview { face, voxels, layers: 0 });
-        }
-        let layers = self.input.cursor().and_then(|(x, y)| self.extrude_layers(x, y)).unwrap_or(0);
-        if let Some(preview) = &mut self.extrude_preview {
-            preview.layers = layers;
         }
     }
 

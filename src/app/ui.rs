@@ -68,6 +68,12 @@ pub struct Info<'a> {
     pub recent: Vec<PathBuf>,
     /// The faces an extrude would move (voxels, normal) and its layers so far.
     pub extrude: Option<(&'a [IVec3], IVec3, i32)>,
+    /// What a fill would recolour (bounds and count; `None` inside: too large).
+    pub fill: Option<Option<((IVec3, IVec3), usize)>>,
+    /// The box a paste would fill.
+    pub paste: Option<Region>,
+    /// The colour the eyedropper would pick.
+    pub eyedropper: Option<u8>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -657,7 +663,43 @@ pub fn draw_brush_outline(ui: &egui::Ui, state: &EditorState, tools: &Tools, pic
         Tool::Erase => egui::Color32::from_rgb(255, 100, 90),
         Tool::Paint => egui::Color32::from_rgb(255, 220, 90),
     };
-    outline_box(ui, state, info, (lo, hi), color, false);
+    // With mirror planes on, where the images of the edit land too.
+    let brush = octovox::edit::Edit::Brush {
+        shape: octovox::scene::Shape::Box { min: lo, max: hi },
+        op: octovox::scene::Op::Remove,
+    };
+    for image in tools.mirror.edits(brush) {
+        if let octovox::edit::Edit::Brush { shape, .. } = image {
+            outline_box(ui, state, info, shape.bounds(), color, false);
+        }
+    }
+}
+
+/// The fill, paste and eyedropper previews: an outline where the action
+/// lands, and a line of text beside the cursor saying what it does.
+pub fn draw_action_previews(ui: &egui::Ui, state: &EditorState, info: &Info) {
+    let yellow = Color32::from_rgb(255, 220, 90);
+    let (hint, swatch) = match (info.fill, info.paste, info.eyedropper) {
+        (Some(Some((bounds, voxels))), _, _) => {
+            outline_box(ui, state, info, bounds, yellow, false);
+            (format!("fill: {voxels} voxels"), None)
+        }
+        (Some(None), _, _) => ("fill: the region is too large".to_string(), None),
+        (_, Some(region), _) => {
+            outline_box(ui, state, info, (region.min, region.max), Color32::from_rgb(255, 160, 60), false);
+            ("Ctrl+V pastes here".to_string(), None)
+        }
+        (_, _, Some(index)) => (format!("pick colour {index}"), Some(rgba(info.palette, index))),
+        _ => return,
+    };
+    let Some(at) = ui.ctx().pointer_hover_pos() else { return };
+    let painter = ui.ctx().layer_painter(egui::LayerId::new(egui::Order::Foreground, egui::Id::unique("action hint")));
+    let mut text_at = at + Vec2::new(16.0, 12.0);
+    if let Some(color) = swatch {
+        painter.rect_filled(egui::Rect::from_min_size(text_at, Vec2::splat(14.0)), 2.0, color);
+        text_at.x += 18.0;
+    }
+    painter.text(text_at, egui::Align2::LEFT_TOP, hint, egui::FontId::proportional(13.0), Color32::WHITE);
 }
 
 /// Most faces the extrude preview draws (a larger region shows its first ones).

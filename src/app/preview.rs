@@ -1,0 +1,96 @@
+//! Hover previews of the actions that are not brush clicks, worked out when
+//! the cursor reaches another voxel and drawn over the image by `ui`: the
+//! faces an extrude moves (Ctrl held, or a Ctrl+drag), the voxels a fill
+//! recolours (Shift held with Paint), the box a paste fills (select mode
+//! with a clipboard) and the colour the eyedropper takes (Alt held).
+
+use glam::IVec3;
+
+use octovox::scene::selection::Region;
+
+use super::App;
+use super::state::Tool;
+
+/// The faces an extrude would move: those of the region around `face`
+/// (voxel, normal), and the layers the drag covers so far.
+pub(super) struct ExtrudePreview {
+    pub face: (IVec3, IVec3),
+    pub voxels: Vec<IVec3>,
+    pub layers: i32,
+}
+
+/// What a fill from `start` would recolour: its voxels' bounds and count
+/// (`None`: a region too large to fill).
+pub(super) struct FillPreview {
+    start: IVec3,
+    pub region: Option<((IVec3, IVec3), usize)>,
+}
+
+impl App {
+    pub(super) fn update_previews(&mut self) {
+        self.update_extrude_preview();
+        self.update_fill_preview();
+    }
+
+    /// Keeps the extrude preview up to date: the region of the face a
+    /// Ctrl+drag started on, else of the face under the cursor while Ctrl
+    /// is held (line and select modes have no extrude).
+    fn update_extrude_preview(&mut self) {
+        let face = match self.extrude_from {
+            Some((pick, _)) => Some(pick),
+            None if self.input.ctrl_held() && !self.state.line_mode && !self.state.select_mode => self.pick,
+            None => None,
+        }
+        .filter(|p| p.normal != IVec3::ZERO)
+        .map(|p| (p.voxel, p.normal));
+        let Some(face) = face else {
+            self.extrude_preview = None;
+            return;
+        };
+        if self.extrude_preview.as_ref().is_none_or(|p| p.face != face) {
+            // A region too large to extrude previews nothing; the release says why.
+            let region = octovox::scene::extrude::face_region(&self.editor.scene.tree, face.0, face.1);
+            let voxels = region.map(|r| r.into_iter().map(|(p, _)| p).collect()).unwrap_or_default();
+            self.extrude_preview = Some(ExtrudePreview { face, voxels, layers: 0 });
+        }
+        let layers = self.input.cursor().and_then(|(x, y)| self.extrude_layers(x, y)).unwrap_or(0);
+        if let Some(preview) = &mut self.extrude_preview {
+            preview.layers = layers;
+        }
+    }
+
+    /// Keeps the fill preview up to date: the region a Shift+click with
+    /// Paint would recolour.
+    fn update_fill_preview(&mut self) {
+        let plain_mode = !self.state.line_mode && !self.state.select_mode;
+        let start = self
+            .pick
+            .filter(|_| plain_mode && self.state.tool == Tool::Paint && self.input.shift_held())
+            .map(|p| p.voxel);
+        let Some(start) = start else {
+            self.fill_preview = None;
+            return;
+        };
+        if self.fill_preview.as_ref().is_some_and(|p| p.start == start) {
+            return;
+        }
+        let region = octovox::scene::fill::fill_region(&self.editor.scene.tree, start).ok().map(|voxels| {
+            let lo = voxels.iter().copied().reduce(IVec3::min).unwrap_or(start);
+            let hi = voxels.iter().copied().reduce(IVec3::max).unwrap_or(start);
+            ((lo, hi), voxels.len())
+        });
+        self.fill_preview = Some(FillPreview { start, region });
+    }
+
+    /// The box Ctrl+V would fill: in select mode, the clipboard's block in
+    /// front of the face under the cursor.
+    pub(super) fn paste_preview(&self) -> Option<Region> {
+        let pick = self.pick.filter(|_| self.state.select_mode)?;
+        Some(self.editor.clipboard()?.region_at(pick.voxel + pick.normal))
+    }
+
+    /// The colour Alt+click would pick: the voxel's under the cursor.
+    pub(super) fn eyedropper_preview(&self) -> Option<u8> {
+        self.pick.filter(|_| self.input.alt_held()).map(|p| p.value)
+    }
+}
