@@ -305,20 +305,23 @@ fn alt_click_picks_a_colour_and_shift_click_paint_fills_with_it() {
     assert!(filled.tree.voxels().iter().all(|(_, c)| *c == 12), "the 77 region was filled with 12");
 }
 
-/// A mirrored click: with `mirror x 8` (the floor's middle) in force (set by a replayed script
-/// line), one real click attaches a voxel and its image across the plane,
-/// and one Ctrl+Z takes both away.
+/// A mirrored stroke: with `mirror x 8` (the floor's middle) in force (set
+/// by a replayed script line), a real drag across the floor attaches the
+/// voxels it passes over and their images across the plane, and one Ctrl+Z
+/// takes the whole stroke away.
 #[test]
-fn a_mirrored_click_places_both_sides_and_undoes_in_one_step() {
+fn a_mirrored_stroke_places_both_sides_and_undoes_in_one_step() {
     require_window_tools();
     let dir = tempfile::tempdir().unwrap();
     let (file, scene, camera) = floor_scene(dir.path());
     let script = dir.path().join("mirror.ovr");
     std::fs::write(&script, "mirror x 8\n").unwrap();
-    // A floor voxel left of the plane, hit from above.
+    // A floor voxel left of the plane, hit from above, and another of the
+    // same layer a little away from it: the stroke goes from one to the other.
     let (x, y, voxel, normal) = stable_pixel(&scene.tree, &camera, |v, n| n == IVec3::Y && v.x < 6);
+    let (ex, ey) = same_layer_pixel(&scene.tree, &camera, (x, y), voxel, normal);
     let placed = voxel + normal;
-    let image = IVec3::new(15 - placed.x, placed.y, placed.z);
+    let image = |p: IVec3| IVec3::new(15 - p.x, p.y, p.z);
     let args = [
         file.display().to_string(),
         "--size".into(),
@@ -334,15 +337,26 @@ fn a_mirrored_click_places_both_sides_and_undoes_in_one_step() {
     let window = find_window(&display, &mut app, &stderr_path);
     lines.wait_for("replay:", Duration::from_secs(90));
     xdotool(&display, &["windowfocus", "--sync", &window]);
-    click(&display, &window, &mut lines, x, y);
+    xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y.to_string()]);
+    std::thread::sleep(Duration::from_millis(300));
+    xdotool(&display, &["mousedown", "1"]);
+    lines.wait_for("edit:", Duration::from_secs(30));
+    for i in 1..=4 {
+        let (px, py) = (x as i32 + (ex as i32 - x as i32) * i / 4, y as i32 + (ey as i32 - y as i32) * i / 4);
+        xdotool(&display, &["mousemove", "--window", &window, &px.to_string(), &py.to_string()]);
+        std::thread::sleep(Duration::from_millis(150));
+    }
+    xdotool(&display, &["mouseup", "1"]);
     save(&display, &mut lines, &file);
     let saved = octovox::io::load_scene(&file, 0).unwrap();
-    assert_eq!((saved.tree.get(placed), saved.tree.get(image)), (20, 20), "{placed} and its image {image}");
-    assert_eq!(saved.tree.solid_voxels(), 258);
+    let added: Vec<IVec3> = saved.tree.voxels().into_iter().map(|(p, _)| p).filter(|p| p.y == 1).collect();
+    assert!(added.contains(&placed) && added.contains(&image(placed)), "{placed} and its image: {added:?}");
+    assert!(added.len() >= 4, "the stroke passed over at least two cells: {added:?}");
+    assert!(added.iter().all(|p| added.contains(&image(*p))), "every voxel has its image: {added:?}");
     xdotool(&display, &["key", "ctrl+z"]);
     lines.wait_for("undo:", Duration::from_secs(30));
     save(&display, &mut lines, &file);
-    assert_eq!(octovox::io::load_scene(&file, 0).unwrap().tree.solid_voxels(), 256, "one undo took both away");
+    assert_eq!(octovox::io::load_scene(&file, 0).unwrap().tree.solid_voxels(), 256, "one undo took the stroke away");
 }
 
 /// Line mode (L): a real press-drag-release across the floor places one
