@@ -350,6 +350,9 @@ impl App {
             self.replace_scene(scene, line.clone());
             return Ok(Outcome::Replaced);
         }
+        // A key action during a drag ends the drag's undo step first: the
+        // history and the recording count steps alike.
+        self.close_strokes();
         let outcome = self.editor.run(line)?;
         let (tools, camera) = (self.editor.tools, self.state.camera);
         let ran = |r: &mut Recorder| r.ran(line, &tools, &camera);
@@ -716,7 +719,13 @@ impl App {
 
     /// Closes the undo step of a held palette control.
     pub(super) fn end_palette_stroke(&mut self) {
-        if std::mem::take(&mut self.palette_stroke) {
+        self.close_strokes();
+    }
+
+    /// Closes the open undo step of a mouse drag or a held palette control,
+    /// in the history and the recording alike.
+    fn close_strokes(&mut self) {
+        if self.stroke.take().is_some() | std::mem::take(&mut self.palette_stroke) {
             self.editor.history.end_stroke();
         }
         self.record(|r| {
@@ -739,14 +748,7 @@ impl App {
                 self.stroke_step(x, y);
             }
             StrokePhase::Move => self.stroke_step(x, y),
-            StrokePhase::End => {
-                self.editor.history.end_stroke();
-                self.stroke = None;
-                self.record(|r| {
-                    r.end_step();
-                    Ok(())
-                });
-            }
+            StrokePhase::End => self.close_strokes(),
             StrokePhase::Click => {
                 self.pointer_edit(StrokePhase::Begin, tool, x, y);
                 self.pointer_edit(StrokePhase::End, tool, x, y);
