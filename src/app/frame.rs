@@ -26,7 +26,9 @@ impl App {
             camera_control::fly(&mut self.state.camera, dir, seconds);
         }
         // Panels first: they may change settings and produce commands.
+        let panels_started = Instant::now();
         let Some((ctx, full)) = self.run_panels(event_loop) else { return };
+        self.stats.panels_ms = panels_started.elapsed().as_secs_f64() * 1e3;
         // The camera is final for this frame: pick how many pixels to trace.
         let screenshot = self.screenshot_requested || self.screenshot_path.is_some();
         let last = motion::FrameTimes { frame_ms: self.stats.frame_ms, trace_ms: self.stats.trace_ms };
@@ -34,7 +36,16 @@ impl App {
         self.stats.scale = self.render_scale();
         self.stats.moving = self.motion.moving();
         if let (Some(frames), Some(interval_ms), true) = (&mut self.moving_frames, interval_ms, self.motion.moving()) {
-            frames.push(interval_ms, self.stats.trace_ms, self.stats.present_ms, self.stats.scale);
+            let s = &self.stats;
+            frames.push(motion::FrameParts {
+                interval_ms,
+                trace_ms: s.trace_ms,
+                panels_ms: s.panels_ms,
+                acquire_ms: s.acquire_ms,
+                draw_ms: s.draw_ms,
+                submit_ms: s.submit_ms,
+                scale: s.scale,
+            });
         }
         // Hover pick: what a click would edit, highlighted before any click.
         self.pick = match self.input.cursor() {
@@ -144,7 +155,9 @@ impl App {
     ) -> Option<Option<capture::WindowCopy>> {
         let trace_size = self.trace_size();
         let gfx = self.gfx.as_mut()?;
+        let tessellate_started = Instant::now();
         let prims = ctx.tessellate(full.shapes, full.pixels_per_point);
+        self.stats.panels_ms += tessellate_started.elapsed().as_secs_f64() * 1e3;
         // Textures are uploaded before the swapchain image is acquired, so a
         // skipped frame never loses them.
         let mut textures = full.textures_delta;
@@ -204,6 +217,7 @@ impl App {
         // Blit + egui onto the swapchain image.
         let present_started = Instant::now();
         let frame = acquire_frame(gfx, &self.redraw_wanted)?;
+        let acquired = Instant::now();
         let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
         gfx.blit.prepare(&gfx.renderer.gpu.device, gfx.renderer.output_view());
         let mut encoder =
@@ -234,13 +248,17 @@ impl App {
         }
         let window_copy = (self.screenshot_requested && gfx.can_copy_frame)
             .then(|| capture::copy_frame(gfx, &mut encoder, &frame.texture));
+        let recorded = Instant::now();
         gfx.renderer.gpu.queue.submit(user_buffers.into_iter().chain([encoder.finish()]));
         gfx.window.pre_present_notify();
         gfx.renderer.gpu.queue.present(frame);
         for id in std::mem::take(&mut gfx.textures_to_free) {
             gfx.egui_renderer.free_texture(&id);
         }
-        self.stats.present_ms = present_started.elapsed().as_secs_f64() * 1e3;
+        let ms = |from: Instant, to: Instant| to.duration_since(from).as_secs_f64() * 1e3;
+        let now = Instant::now();
+        (self.stats.acquire_ms, self.stats.draw_ms) = (ms(present_started, acquired), ms(acquired, recorded));
+        (self.stats.submit_ms, self.stats.present_ms) = (ms(recorded, now), ms(present_started, now));
         Some(window_copy)
     }
 

@@ -10,46 +10,64 @@ pub const MIN_FACTOR: f32 = 0.25;
 /// Default frame-time target while the camera moves, milliseconds.
 pub const DEFAULT_TARGET_MS: f32 = 33.0;
 
-/// Frame intervals while the camera moved, for `--frame-stats`.
+/// Where one frame's time went, milliseconds (wall time of each part; on
+/// a CPU-emulated GPU the queue's work runs inside submit, present and the
+/// next acquire).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrameParts {
+    /// The time since the frame before.
+    pub interval_ms: f64,
+    /// The trace pass (GPU timestamps where trusted).
+    pub trace_ms: f64,
+    /// Laying out the panels and tessellating them.
+    pub panels_ms: f64,
+    /// Waiting for a swapchain image.
+    pub acquire_ms: f64,
+    /// Recording the blit and egui's buffers and pass.
+    pub draw_ms: f64,
+    /// Submitting and presenting.
+    pub submit_ms: f64,
+    pub scale: f32,
+}
+
+/// The frames while the camera moved, for `--frame-stats`.
 #[derive(Clone, Debug, Default)]
 pub struct MovingFrames {
-    intervals_ms: Vec<f64>,
-    trace_ms: Vec<f64>,
-    present_ms: Vec<f64>,
-    scales: Vec<f64>,
+    frames: Vec<FrameParts>,
 }
 
 impl MovingFrames {
-    /// One moving frame: the time since the frame before, and the last
-    /// frame's trace and present times and scale.
-    pub fn push(&mut self, interval_ms: f64, trace_ms: f64, present_ms: f64, scale: f32) {
-        self.intervals_ms.push(interval_ms);
-        self.trace_ms.push(trace_ms);
-        self.present_ms.push(present_ms);
-        self.scales.push(f64::from(scale));
+    pub fn push(&mut self, frame: FrameParts) {
+        self.frames.push(frame);
     }
 
     /// "N frames while moving: F fps, median M ms, worst W ms; median trace
-    /// T ms, present P ms, scale S".
+    /// T ms, present P ms (acquire A, blit+egui B, submit+present C),
+    /// panels U ms, scale S".
     pub fn summary(&self) -> String {
-        let n = self.intervals_ms.len();
-        let total: f64 = self.intervals_ms.iter().sum();
+        let n = self.frames.len();
+        let total: f64 = self.frames.iter().map(|f| f.interval_ms).sum();
         let fps = if total > 0.0 { n as f64 * 1e3 / total } else { 0.0 };
-        let worst = self.intervals_ms.iter().copied().fold(0.0, f64::max);
+        let worst = self.frames.iter().map(|f| f.interval_ms).fold(0.0, f64::max);
+        let m = |part: fn(&FrameParts) -> f64| median(self.frames.iter().map(part).collect());
         format!(
-            "{n} frames while moving: {fps:.1} fps, median {:.1} ms, worst {worst:.1} ms; median trace {:.1} ms, present {:.1} ms, scale {:.2}",
-            median(&self.intervals_ms),
-            median(&self.trace_ms),
-            median(&self.present_ms),
-            median(&self.scales)
+            "{n} frames while moving: {fps:.1} fps, median {:.1} ms, worst {worst:.1} ms; median trace {:.1} ms, \
+             present {:.1} ms (acquire {:.1}, blit+egui {:.1}, submit+present {:.1}), panels {:.1} ms, scale {:.2}",
+            m(|f| f.interval_ms),
+            m(|f| f.trace_ms),
+            m(|f| f.acquire_ms + f.draw_ms + f.submit_ms),
+            m(|f| f.acquire_ms),
+            m(|f| f.draw_ms),
+            m(|f| f.submit_ms),
+            m(|f| f.panels_ms),
+            m(|f| f64::from(f.scale)),
         )
     }
 }
 
-fn median(values: &[f64]) -> f64 {
-    let mut sorted = values.to_vec();
-    sorted.sort_by(f64::total_cmp);
-    sorted.get(sorted.len() / 2).copied().unwrap_or(0.0)
+fn median(mut values: Vec<f64>) -> f64 {
+    values.sort_by(f64::total_cmp);
+    values.get(values.len() / 2).copied().unwrap_or(0.0)
 }
 
 /// What the last frame took, milliseconds.

@@ -34,6 +34,11 @@ pub struct Stats {
     pub trace_ms: f64,
     /// Wall time of acquire, blit, egui, submit and present, milliseconds.
     pub present_ms: f64,
+    /// Its parts, and the panels' layout and tessellation, milliseconds.
+    pub acquire_ms: f64,
+    pub draw_ms: f64,
+    pub submit_ms: f64,
+    pub panels_ms: f64,
     /// Render scale of the last frame (lower while the camera moves).
     pub scale: f32,
     /// Whether the camera moved since the frame before.
@@ -470,6 +475,8 @@ fn stats(ui: &mut egui::Ui, info: &Info) {
         row("frame", format!("{:.2} ms", s.frame_ms));
         row("trace", format!("{:.2} ms ({trace})", s.trace_ms));
         row("present", format!("{:.2} ms", s.present_ms));
+        row("  acquire · draw · submit", format!("{:.1} · {:.1} · {:.1} ms", s.acquire_ms, s.draw_ms, s.submit_ms));
+        row("panels", format!("{:.2} ms", s.panels_ms));
         row("scale", format!("{:.2}{}", s.scale, if s.moving { " (moving)" } else { "" }));
         if let Some(path) = &s.path {
             let effects = path.effects.names();
