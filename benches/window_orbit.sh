@@ -31,10 +31,12 @@ orbit() {
     local window
     window="$(xdotool search --sync --name octovox | head -1)"
     xdotool windowfocus --sync "$window"
-    # Three seconds of steady dragging, the way a hand orbits a model.
-    xdotool mousemove --window "$window" 760 360 mousedown 3
-    for _ in $(seq 100); do xdotool mousemove_relative -- 6 1; sleep 0.03; done
-    xdotool mouseup 3
+    # Three seconds of steady dragging, the way a hand orbits a model: one
+    # xdotool process for the whole drag (a process per move would take
+    # the two cores from the window it measures).
+    local moves=()
+    for _ in $(seq 100); do moves+=(mousemove_relative -- 6 1 sleep 0.03); done
+    xdotool mousemove --window "$window" 760 360 mousedown 3 "${moves[@]}" mouseup 3
     xdotool key ctrl+q
     wait "$app"
     printf '| %s | %s |\n' "$name" "$(grep -o 'frame-stats: .*' "$log" | cut -d' ' -f2-)"
