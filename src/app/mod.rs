@@ -278,8 +278,8 @@ impl App {
         if can_copy_frame {
             config.usage |= wgpu::TextureUsages::COPY_SRC;
         }
-        config.present_mode =
-            if self.bench.is_some() { wgpu::PresentMode::AutoNoVsync } else { wgpu::PresentMode::AutoVsync };
+        let cpu = gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu;
+        config.present_mode = present_mode(&caps.present_modes, cpu, self.bench.is_some());
         surface.configure(&gpu.device, &config);
         let blit = BlitPass::new(&gpu, config.format)?;
         let mut renderer = Renderer::new(gpu)?;
@@ -295,7 +295,14 @@ impl App {
             Some(gpu.device.limits().max_texture_dimension_2d as usize),
         );
         let egui_renderer = egui_wgpu::Renderer::new(&gpu.device, config.format, egui_wgpu::RendererOptions::default());
-        log::info!("window on {} ({:?}, {}x{})", gpu.adapter_name, config.format, config.width, config.height);
+        log::info!(
+            "window on {} ({:?}, {:?}, {}x{})",
+            gpu.adapter_name,
+            config.format,
+            config.present_mode,
+            config.width,
+            config.height
+        );
         Ok(Gfx {
             window,
             surface,
@@ -880,6 +887,25 @@ impl ApplicationHandler for App {
     }
 }
 
+/// How frames reach the window. Mailbox where there is one: no tearing,
+/// and no wait for a vertical blank (the window draws only when something
+/// changed, so it never spins). On a CPU adapter (lavapipe), Immediate: its
+/// frames are copied to the window whole, so they cannot tear, and its FIFO
+/// held orbiting at 9–14 fps where Immediate gives 20–22 (docs/window.md).
+/// Else FIFO, the vsync every adapter has. `--bench-frames` never waits.
+fn present_mode(available: &[wgpu::PresentMode], cpu: bool, bench: bool) -> wgpu::PresentMode {
+    use wgpu::PresentMode::{AutoNoVsync, AutoVsync, Immediate, Mailbox};
+    if bench {
+        AutoNoVsync
+    } else if available.contains(&Mailbox) {
+        Mailbox
+    } else if cpu && available.contains(&Immediate) {
+        Immediate
+    } else {
+        AutoVsync
+    }
+}
+
 /// The surface size for a window size: never zero, and never larger than
 /// the GPU's textures allow (wgpu panics past that); a window larger than
 /// the limit shows the image stretched, with a warning.
@@ -889,4 +915,18 @@ fn surface_size(size: winit::dpi::PhysicalSize<u32>, gpu: &GpuContext) -> (u32, 
         log::warn!("the window is {}x{}; this GPU draws at most {limit}x{limit}", size.width, size.height);
     }
     (size.width.clamp(1, limit), size.height.clamp(1, limit))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::present_mode;
+    use wgpu::PresentMode::{AutoNoVsync, AutoVsync, Fifo, Immediate, Mailbox};
+
+    #[test]
+    fn frames_reach_the_window_without_waiting_for_a_blank_where_they_can() {
+        assert_eq!(present_mode(&[Fifo, Mailbox, Immediate], false, false), Mailbox);
+        assert_eq!(present_mode(&[Fifo, Immediate], true, false), Immediate, "a CPU adapter copies frames whole");
+        assert_eq!(present_mode(&[Fifo, Immediate], false, false), AutoVsync, "a GPU without Mailbox would tear");
+        assert_eq!(present_mode(&[Fifo], true, true), AutoNoVsync, "--bench-frames never waits");
+    }
 }
