@@ -74,11 +74,7 @@ impl Editor {
         let tools = self.tools;
         let changed = match command {
             Command::New | Command::Demo(_) => {
-                let scene = match command {
-                    Command::Demo(built_in) => built_in.scene(),
-                    _ => Scene::default(),
-                };
-                self.set_scene(scene);
+                self.set_scene(built_scene(command).unwrap_or_default());
                 return Ok(Outcome::Replaced);
             }
             Command::Brush(brush) => self.set(|e| e.tools.brush = *brush),
@@ -201,22 +197,6 @@ impl Editor {
         Ok(any)
     }
 
-    /// Undoes one step; `false` when there is none.
-    ///
-    /// # Errors
-    /// An undo the octree refuses (out of memory).
-    pub fn undo(&mut self) -> Result<bool, EditError> {
-        self.history.undo(&mut self.scene)
-    }
-
-    /// Redoes one step; `false` when there is none.
-    ///
-    /// # Errors
-    /// A redo the octree refuses (out of memory).
-    pub fn redo(&mut self) -> Result<bool, EditError> {
-        self.history.redo(&mut self.scene)
-    }
-
     /// `undo N` / `redo N`: all N steps, or (fewer there) none.
     fn repeat(&mut self, n: u32, undo: bool) -> Result<bool, String> {
         let (undoable, redoable) = self.history.steps();
@@ -228,9 +208,19 @@ impl Editor {
             return Err(format!("only {available} step(s) to {what}, not {n}"));
         }
         for _ in 0..n {
-            if undo { self.undo() } else { self.redo() }.map_err(|e| e.to_string())?;
+            let scene = &mut self.scene;
+            if undo { self.history.undo(scene) } else { self.history.redo(scene) }.map_err(|e| e.to_string())?;
         }
         Ok(true)
+    }
+}
+
+/// The scene a `new` or `demo` line makes; `None` for other lines.
+pub fn built_scene(command: &Command) -> Option<Scene> {
+    match command {
+        Command::New => Some(Scene::default()),
+        Command::Demo(built_in) => Some(built_in.scene()),
+        _ => None,
     }
 }
 

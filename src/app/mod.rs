@@ -349,11 +349,7 @@ impl App {
     /// became) and follows it up: an edit goes to the GPU, the recording
     /// and the journal. New and demo lines replace the scene as Open does.
     pub(super) fn run_line(&mut self, line: &octovox::replay::Command) -> Result<Outcome, String> {
-        if let octovox::replay::Command::New | octovox::replay::Command::Demo(_) = line {
-            let scene = match line {
-                octovox::replay::Command::Demo(built_in) => built_in.scene(),
-                _ => Scene::default(),
-            };
+        if let Some(scene) = octovox::editor::built_scene(line) {
             self.replace_scene(scene, line.clone());
             return Ok(Outcome::Replaced);
         }
@@ -709,29 +705,22 @@ impl App {
     /// A palette change from the panel, recorded as `rgb`/`material` lines;
     /// changes while a control is held form one undo step.
     fn palette_edit(&mut self, edit: Edit, dragging: bool) {
-        let Edit::Palette { index, .. } = &edit else { return };
-        let index = *index;
+        let Edit::Palette { index, color, material } = &edit else { return };
+        let (index, after) = (*index, (*color, (**material).clone()));
         if dragging && !self.palette_stroke {
             self.editor.history.begin_stroke();
             self.palette_stroke = true;
         }
         let before = (self.editor.scene.palette.color(index), self.editor.scene.palette.material(index).clone());
-        let Edit::Palette { color, material, .. } = &edit else { return };
-        let after = (*color, (**material).clone());
-        self.apply_edit(edit.clone(), |r| r.palette(index, &before, &after));
+        self.apply_edit(edit, |r| r.palette(index, &before, &after));
         if !dragging {
-            self.end_palette_stroke();
+            self.close_strokes();
         }
-    }
-
-    /// Closes the undo step of a held palette control.
-    pub(super) fn end_palette_stroke(&mut self) {
-        self.close_strokes();
     }
 
     /// Closes the open undo step of a mouse drag or a held palette control,
     /// in the history and the recording alike.
-    fn close_strokes(&mut self) {
+    pub(super) fn close_strokes(&mut self) {
         if self.stroke.take().is_some() | std::mem::take(&mut self.palette_stroke) {
             self.editor.history.end_stroke();
         }

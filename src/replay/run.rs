@@ -14,7 +14,7 @@ use crate::io::atomic::WriteOptions;
 use crate::io::output::{OutputKind, check_output};
 use crate::io::png::{differing_fraction, load_png, save_png};
 use crate::settings::RenderSettings;
-use crate::tool::click_edit;
+use crate::tool::click_target;
 use crate::trace::render::render_scene_cpu;
 use crate::trace::svo;
 
@@ -121,12 +121,16 @@ impl Runner {
 
     /// Runs one line. `Err` is an error that stops the script.
     pub fn step(&mut self, base: &Path, line: &Line) -> Result<StepResult, String> {
-        match self.editor.run(&line.command)? {
+        self.run_command(base, &line.command)
+    }
+
+    fn run_command(&mut self, base: &Path, command: &Command) -> Result<StepResult, String> {
+        match self.editor.run(command)? {
             Outcome::State => {}
             Outcome::Changed => self.last_written = Some(self.flush()),
             Outcome::Replaced => self.scene_replaced(),
             Outcome::Checked { ok, expected, got } => return Ok(check(ok, expected, || got)),
-            Outcome::Host => return self.host_step(base, &line.command),
+            Outcome::Host => return self.host_step(base, command),
         }
         Ok(StepResult::Done)
     }
@@ -153,10 +157,9 @@ impl Runner {
                     Ok(None) => return Ok(StepResult::Failed { expected, got: "no voxel under it".into() }),
                     Err(gave_up) => return Ok(StepResult::Failed { expected, got: gave_up.to_string() }),
                 };
-                let tools = self.editor.tools;
-                let (_, edit) = click_edit(*tool, &tools.brush, tools.color, voxel, normal);
-                self.editor.apply_mirrored(vec![edit]).map_err(|e| e.to_string())?;
-                self.last_written = Some(self.flush());
+                // The place, remove or paint of the cell it picks, as in the window.
+                let center = click_target(*tool, voxel, normal);
+                return self.run_command(base, &super::edit_command(*tool, center));
             }
             Command::Save(path) => {
                 let path = resolve(path);
