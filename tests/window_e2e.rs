@@ -55,7 +55,7 @@ fn click_attach_save_erase_save_in_a_real_window() {
     eprintln!("click at ({x}, {y}): hits {hit_voxel} through face {normal}; attach goes to {placed}");
 
     let (_xvfb, display) = start_xvfb(0);
-    let args = [file.display().to_string(), "--size".into(), format!("{WIDTH}x{HEIGHT}"), camera_arg(&camera)];
+    let args = document_args(&file, &camera, &[]);
     let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
 
     let window = find_window(&display, &mut app, &stderr_path);
@@ -274,10 +274,9 @@ fn alt_click_picks_a_colour_and_shift_click_paint_fills_with_it() {
     let camera =
         Camera { eye: glam::DVec3::new(8.0, 14.0, 30.0), target: glam::DVec3::new(8.0, 4.0, 4.0), fov_y_deg: 50.0 };
     let (x, y, voxel, normal) = stable_pixel(&scene.tree, &camera, |v, n| scene.tree.get(v) == 77 && n == IVec3::Z);
-    let args = [file.display().to_string(), "--size".into(), format!("{WIDTH}x{HEIGHT}"), camera_arg(&camera)];
+    let args = document_args(&file, &camera, &["--shading", "preview"]);
     let (_xvfb, display) = start_xvfb(4);
-    let (mut app, mut lines, stderr_path) =
-        spawn_app(&display, dir.path(), &[&args[..], &["--shading".into(), "preview".into()]].concat());
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
     let window = find_window(&display, &mut app, &stderr_path);
     lines.wait_for("octovox: ready", Duration::from_secs(90));
     xdotool(&display, &["windowfocus", "--sync", &window]);
@@ -322,16 +321,7 @@ fn a_mirrored_stroke_places_both_sides_and_undoes_in_one_step() {
     let (ex, ey) = same_layer_pixel(&scene.tree, &camera, (x, y), voxel, normal);
     let placed = voxel + normal;
     let image = |p: IVec3| IVec3::new(15 - p.x, p.y, p.z);
-    let args = [
-        file.display().to_string(),
-        "--size".into(),
-        format!("{WIDTH}x{HEIGHT}"),
-        camera_arg(&camera),
-        "--shading".into(),
-        "preview".into(),
-        "--replay".into(),
-        script.display().to_string(),
-    ];
+    let args = document_args(&file, &camera, &["--shading", "preview", "--replay", &script.display().to_string()]);
     let (_xvfb, display) = start_xvfb(5);
     let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
     let window = find_window(&display, &mut app, &stderr_path);
@@ -370,10 +360,9 @@ fn a_dragged_line_in_line_mode() {
     let (xa, ya, va, na) = stable_pixel(&scene.tree, &camera, |v, n| n == IVec3::Y && v.x < 4);
     let (xb, yb, vb, nb) = stable_pixel(&scene.tree, &camera, |v, n| n == IVec3::Y && v.x > 11);
     let (a, b) = (va + na, vb + nb);
-    let args = [file.display().to_string(), "--size".into(), format!("{WIDTH}x{HEIGHT}"), camera_arg(&camera)];
+    let args = document_args(&file, &camera, &["--shading", "preview"]);
     let (_xvfb, display) = start_xvfb(6);
-    let (mut app, mut lines, stderr_path) =
-        spawn_app(&display, dir.path(), &[&args[..], &["--shading".into(), "preview".into()]].concat());
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
     let window = find_window(&display, &mut app, &stderr_path);
     lines.wait_for("octovox: ready", Duration::from_secs(90));
     xdotool(&display, &["windowfocus", "--sync", &window]);

@@ -52,7 +52,7 @@ fn ctrl_drag_extrudes_a_face_in_a_real_window() {
     assert!(end.1 > 40.0, "the drag stays in the window: {end:?}");
 
     let (_xvfb, display) = start_xvfb(8);
-    let args = [file.display().to_string(), "--size".into(), format!("{WIDTH}x{HEIGHT}"), camera_arg(&camera)];
+    let args = document_args(&file, &camera, &[]);
     let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
     let window = find_window(&display, &mut app, &stderr_path);
     lines.wait_for("octovox: ready", Duration::from_secs(90));

@@ -22,14 +22,7 @@ fn recorded_window_session_replays_to_the_same_voxels() {
 
     let (_xvfb, display) = start_xvfb(0);
     let script = dir.path().join("session.ovr");
-    let args = [
-        file.display().to_string(),
-        "--size".into(),
-        format!("{WIDTH}x{HEIGHT}"),
-        camera_arg(&camera),
-        "--record".into(),
-        script.display().to_string(),
-    ];
+    let args = document_args(&file, &camera, &["--record", &script.display().to_string()]);
     let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
     let window = find_window(&display, &mut app, &stderr_path);
     lines.wait_for("octovox: ready", Duration::from_secs(90));

@@ -38,7 +38,7 @@ fn a_killed_window_loses_no_finished_edit() {
     }
 
     let (_xvfb, display) = start_xvfb(7);
-    let args = [file.display().to_string(), "--size".into(), format!("{WIDTH}x{HEIGHT}"), camera_arg(&camera)];
+    let args = document_args(&file, &camera, &[]);
     let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
     let window = find_window(&display, &mut app, &stderr_path);
     lines.wait_for("octovox: ready", Duration::from_secs(90));

@@ -59,14 +59,7 @@ fn a_box_selection_moves_with_the_arrows_resizes_by_a_handle_and_copies() {
     let (xf, yf, ..) = stable_pixel(&scene.tree, &camera, |v, n| v == IVec3::new(12, 0, 10) && n == IVec3::Y);
 
     let (_xvfb, display) = start_xvfb(9);
-    let args = [
-        file.display().to_string(),
-        "--size".into(),
-        format!("{WIDTH}x{HEIGHT}"),
-        camera_arg(&camera),
-        "--shading".into(),
-        "preview".into(),
-    ];
+    let args = document_args(&file, &camera, &["--shading", "preview"]);
     let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
     let window = find_window(&display, &mut app, &stderr_path);
     lines.wait_for("octovox: ready", Duration::from_secs(90));

@@ -87,7 +87,7 @@ impl App {
 
     /// Lays out the panels and carries out the commands they produced.
     fn run_panels(&mut self, event_loop: &ActiveEventLoop) -> Option<(egui::Context, egui::FullOutput)> {
-        let (paste, eyedropper) = (self.paste_preview(), self.eyedropper_preview());
+        let (paste, eyedropper, selection) = (self.paste_preview(), self.eyedropper_preview(), self.shown_selection());
         let gfx = self.gfx.as_mut()?;
         let raw_input = gfx.egui_state.take_egui_input(&gfx.window);
         let ctx = gfx.egui_state.egui_ctx().clone();
@@ -109,7 +109,7 @@ impl App {
                     (steps, bytes, self.editor.history.memory_limit_bytes)
                 },
                 presets: self.presets_measured.as_deref(),
-                selection: self.state.select_preview.or(self.editor.selection),
+                selection,
                 has_clipboard: self.editor.clipboard().is_some(),
                 recent: self.recent.files().cloned().collect(),
                 extrude: self.extrude_preview.as_ref().map(|p| (p.voxels.as_slice(), p.face.1, p.layers)),
@@ -140,7 +140,7 @@ impl App {
         }
         // A palette control let go without a last change still ends its step.
         if self.palette_stroke && !ctx.input(|i| i.pointer.any_down()) {
-            self.end_palette_stroke();
+            self.close_strokes();
         }
         Some((ctx, full))
     }
@@ -153,7 +153,7 @@ impl App {
         ctx: &egui::Context,
         full: egui::FullOutput,
     ) -> Option<Option<capture::WindowCopy>> {
-        let trace_size = self.trace_size();
+        let (trace_size, selection) = (self.trace_size(), self.shown_selection());
         let gfx = self.gfx.as_mut()?;
         let tessellate_started = Instant::now();
         let prims = ctx.tessellate(full.shapes, full.pixels_per_point);
@@ -202,7 +202,7 @@ impl App {
         } else {
             // Select mode tints the selected voxels; the other modes what the brush would touch.
             let highlight = if self.state.select_mode {
-                self.state.select_preview.or(self.editor.selection).map(|r| (r.min, r.max))
+                selection.map(|r| (r.min, r.max))
             } else {
                 self.pick.map(|pick| self.state.preview_box(&self.editor.tools, &pick))
             };

@@ -48,6 +48,12 @@ impl App {
         }
     }
 
+    /// The box to show as the selection: the one being dragged, else the
+    /// selected one.
+    pub(super) fn shown_selection(&self) -> Option<Region> {
+        self.state.select_preview.or(self.editor.selection)
+    }
+
     /// The box the drag so far would select.
     fn dragged_box(&self, x: f64, y: f64) -> Option<Region> {
         match self.select_drag? {

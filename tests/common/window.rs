@@ -311,6 +311,13 @@ pub fn spawn_app_with(
     (KillOnDrop(child, "octovox"), lines, stderr_path)
 }
 
+/// The window's arguments for `file` seen through `camera` at the tests'
+/// size, then `extra`.
+pub fn document_args(file: &Path, camera: &Camera, extra: &[&str]) -> Vec<String> {
+    let base = [file.display().to_string(), "--size".into(), format!("{WIDTH}x{HEIGHT}"), camera_arg(camera)];
+    base.into_iter().chain(extra.iter().map(|a| (*a).to_string())).collect()
+}
+
 /// `--camera=EX,EY,EZ:TX,TY,TZ` for a camera.
 pub fn camera_arg(camera: &Camera) -> String {
     let (e, t) = (camera.eye, camera.target);
