@@ -44,8 +44,17 @@ pub enum OutputError {
     IsInput { path: PathBuf },
     #[error("{} already exists; refusing to replace it (--force replaces it)", path.display())]
     Exists { path: PathBuf },
-    #[error("{} names a .{found} file, but this command writes {expected} files", path.display())]
+    #[error("{} {}, but this command writes {expected} files", path.display(), named(found))]
     WrongExtension { path: PathBuf, found: String, expected: String },
+}
+
+/// What an output's extension makes of it, for [`OutputError::WrongExtension`].
+fn named(extension: &str) -> String {
+    if extension.is_empty() {
+        "has no file extension (a folder?)".to_string()
+    } else {
+        format!("names a .{extension} file")
+    }
 }
 
 /// Checks that `output` may be written by a command that read `inputs`.
@@ -110,5 +119,8 @@ mod tests {
         // The format comes from the extension, in any case.
         assert_eq!(check_output(&dir.path().join("X.PNG"), OutputKind::Image, &[], false), Ok(()));
         assert!(check_output(&dir.path().join("x.jpg"), OutputKind::Image, &[], true).is_err());
+        // A folder (or any name without an extension) is named as such.
+        let err = check_output(dir.path(), OutputKind::Mesh, &[], false).unwrap_err();
+        assert!(err.to_string().contains("has no file extension (a folder?), but this command writes"), "{err}");
     }
 }
