@@ -32,7 +32,8 @@ struct FrameUniforms {
     lod_per_t: f32,
 }
 
-@group(0) @binding(0) var<uniform> u: FrameUniforms;
+// Read-only storage, not uniform: see `constants_entry` in src/gpu/trace_pass.rs.
+@group(0) @binding(0) var<storage, read> u: FrameUniforms;
 // Nodes (NODE_WORDS words each) and then bricks (2 words each) of the node pool.
 @group(0) @binding(1) var<storage, read> pool: array<u32>;
 @group(0) @binding(3) var<storage, read> palette: array<u32>;

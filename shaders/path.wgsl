@@ -24,8 +24,11 @@ struct PathUniforms {
     bounces: u32,
     shadow_samples: u32,
     emitter_count: u32,
-    _pad0: u32,
-    _pad1: u32,
+    // This dispatch traces the rows first_row..end_row (a band of the
+    // image; the window spreads a sample over several frames on slow
+    // adapters).
+    first_row: u32,
+    end_row: u32,
 }
 
 // Twin of `GpuMaterial` in src/trace/path/materials.rs.
@@ -50,7 +53,7 @@ struct Emitter {
     _pad1: u32,
 }
 
-@group(0) @binding(8) var<uniform> pu: PathUniforms;
+@group(0) @binding(8) var<storage, read> pu: PathUniforms;
 @group(0) @binding(9) var<storage, read> materials: array<Material>;
 @group(0) @binding(10) var<storage, read> emitters: array<Emitter>;
 @group(0) @binding(11) var<storage, read_write> accum: array<vec4<f32>>;
@@ -475,18 +478,19 @@ fn clamp_sample(v: vec3<f32>) -> vec3<f32> {
 
 @compute @workgroup_size(8, 8)
 fn path(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if (gid.x >= u.width || gid.y >= u.height) {
+    let px = vec2<u32>(gid.x, gid.y + pu.first_row);
+    if (px.x >= u.width || px.y >= pu.end_row) {
         return;
     }
-    let pixel = gid.y * u.width + gid.x;
+    let pixel = px.y * u.width + px.x;
     rng_init(pixel, pu.sample_index);
     let jx = rng_next();
     let jy = rng_next();
-    let ndc_x = 2.0 * (f32(gid.x) + jx) / f32(u.width) - 1.0;
-    let ndc_y = 1.0 - 2.0 * (f32(gid.y) + jy) / f32(u.height);
+    let ndc_x = 2.0 * (f32(px.x) + jx) / f32(u.width) - 1.0;
+    let ndc_y = 1.0 - 2.0 * (f32(px.y) + jy) / f32(u.height);
     let r = make_ray(u.eye, u.forward + u.right * ndc_x + u.up * ndc_y);
     let sample = clamp_sample(radiance(r));
     let sum = select(accum[pixel].rgb, vec3<f32>(0.0), pu.sample_index == 0u) + sample;
     accum[pixel] = vec4<f32>(sum, f32(pu.sample_index + 1u));
-    textureStore(out_color, vec2<i32>(gid.xy), vec4<f32>(sum / f32(pu.sample_index + 1u), 1.0));
+    textureStore(out_color, vec2<i32>(px), vec4<f32>(sum / f32(pu.sample_index + 1u), 1.0));
 }

@@ -345,3 +345,35 @@ fn a_new_effect_set_is_compiled_off_the_frame_path() {
     let frame = renderer.render_path(&tree, &palette, &camera, (16, 12), &settings, false).unwrap();
     assert_eq!(frame.kernel, frame.effects);
 }
+
+#[test]
+fn a_sample_split_in_bands_equals_a_whole_one() {
+    // The window spreads a slow sample over frames (`Renderer::path_bands`):
+    // each band traces its rows with the same random numbers, so the
+    // accumulation is the whole-sample one, and a sample counts once all
+    // its bands are in. A band of 37 rows does not divide into workgroups.
+    let (mut tree, palette) = material_scene();
+    let camera = look(DVec3::new(3.0, 8.0, 14.0), DVec3::new(0.0, 1.0, 0.0));
+    let (size, settings) = ((40, 37), PathSettings { bounces: 3, ..PathSettings::default() });
+    let (whole, _) = render_gpu(&mut tree, &palette, &camera, size, &settings, 3);
+    // A second renderer needs the whole pool: a sync uploads what changed since the last.
+    let (mut tree, palette) = material_scene();
+    let mut renderer = Renderer::headless().expect("a GPU adapter (lavapipe on CI)");
+    renderer.sync(&mut tree, &palette);
+    for bands in [4, 37, 100] {
+        renderer.path_bands = bands;
+        let used = bands.min(size.1);
+        for sample in 0..3 {
+            for band in 0..used {
+                let first = sample == 0 && band == 0;
+                let frame = renderer.render_path(&tree, &palette, &camera, size, &settings, first).unwrap();
+                assert_eq!(frame.added, band == used - 1, "{bands} bands: band {band} of sample {sample}");
+                assert_eq!(frame.samples, sample + u32::from(frame.added));
+            }
+        }
+        let banded = renderer.read_radiance().unwrap();
+        assert!(all_finite(&banded) && mean(&banded).max_element() > 0.05, "{bands} bands: a dark image");
+        let differing = banded.iter().zip(&whole).filter(|(a, b)| a != b).count();
+        assert_eq!(differing, 0, "{bands} bands: {differing} of {} pixels differ", whole.len());
+    }
+}

@@ -1,12 +1,25 @@
-//! Draws the trace output onto a render target (the window's swapchain image)
-//! with a fullscreen triangle. A render-scaled trace is stretched with linear
-//! filtering; at scale 1 every pixel centre samples its own texel exactly.
+//! Draws a texture onto a render target (the window's swapchain image) with
+//! a fullscreen triangle: the trace output, replacing what the target held
+//! (a render-scaled trace is stretched with linear filtering; at scale 1
+//! every pixel centre samples its own texel exactly), or a layer of the
+//! target's size with premultiplied alpha, over what the target holds (the
+//! window's panels, kept across frames).
 
 use super::{GpuContext, GpuError};
 
 const BLIT_WGSL: &str = include_str!("../../shaders/blit.wgsl");
 
+/// How the blit meets what the target already holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BlitMode {
+    /// Clears the target and stretches the source over it, opaque.
+    Replace,
+    /// Draws a source of the target's size over it, premultiplied alpha, texel for pixel.
+    Over,
+}
+
 pub struct BlitPass {
+    mode: BlitMode,
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::RenderPipeline,
     sampler: wgpu::Sampler,
@@ -15,7 +28,7 @@ pub struct BlitPass {
 
 impl BlitPass {
     /// A blit into targets of `target_format`.
-    pub fn new(gpu: &GpuContext, target_format: wgpu::TextureFormat) -> Result<BlitPass, GpuError> {
+    pub fn new(gpu: &GpuContext, target_format: wgpu::TextureFormat, mode: BlitMode) -> Result<BlitPass, GpuError> {
         let device = &gpu.device;
         let module = gpu.shader("blit.wgsl", BLIT_WGSL)?;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -44,6 +57,10 @@ impl BlitPass {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
+        let (entry_point, blend) = match mode {
+            BlitMode::Replace => ("fs_main", None),
+            BlitMode::Over => ("fs_over", Some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING)),
+        };
         let pipeline = gpu.validated("blit", |device| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some("blit"),
@@ -56,11 +73,11 @@ impl BlitPass {
                 },
                 fragment: Some(wgpu::FragmentState {
                     module: &module,
-                    entry_point: Some("fs_main"),
+                    entry_point: Some(entry_point),
                     compilation_options: wgpu::PipelineCompilationOptions::default(),
                     targets: &[Some(wgpu::ColorTargetState {
                         format: target_format,
-                        blend: None,
+                        blend,
                         write_mask: wgpu::ColorWrites::ALL,
                     })],
                 }),
@@ -77,7 +94,7 @@ impl BlitPass {
             min_filter: wgpu::FilterMode::Linear,
             ..Default::default()
         });
-        Ok(BlitPass { layout, pipeline, sampler, bind_group: None })
+        Ok(BlitPass { mode, layout, pipeline, sampler, bind_group: None })
     }
 
     /// Binds the texture to draw. Called every frame: the trace output is
@@ -93,16 +110,21 @@ impl BlitPass {
         }));
     }
 
-    /// Records the draw into `target`, replacing its contents.
-    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, target: &wgpu::TextureView) {
+    /// Records the draw into `target`; with `areas` (pixel rectangles x, y,
+    /// width, height, which must not overlap), into those only.
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, target: &wgpu::TextureView, areas: Option<&[[u32; 4]]>) {
         let Some(bind_group) = &self.bind_group else { return };
+        let load = match self.mode {
+            BlitMode::Replace => wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+            BlitMode::Over => wgpu::LoadOp::Load,
+        };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("blit"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                 view: target,
                 resolve_target: None,
                 depth_slice: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
+                ops: wgpu::Operations { load, store: wgpu::StoreOp::Store },
             })],
             depth_stencil_attachment: None,
             timestamp_writes: None,
@@ -111,6 +133,14 @@ impl BlitPass {
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, bind_group, &[]);
-        pass.draw(0..3, 0..1);
+        match areas {
+            None => pass.draw(0..3, 0..1),
+            Some(areas) => {
+                for &[x, y, width, height] in areas {
+                    pass.set_scissor_rect(x, y, width, height);
+                    pass.draw(0..3, 0..1);
+                }
+            }
+        }
     }
 }

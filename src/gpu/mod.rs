@@ -11,7 +11,7 @@ pub mod scene_buffers;
 pub mod timer;
 pub mod trace_pass;
 
-pub use blit_pass::BlitPass;
+pub use blit_pass::{BlitMode, BlitPass};
 pub use context::{GpuContext, GpuError};
 pub use path_pass::{PathPass, PathUniforms};
 pub use renderer::{PathFrame, Renderer};

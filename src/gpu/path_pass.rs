@@ -16,7 +16,7 @@ use glam::Vec3;
 use super::context::compute_pipeline;
 use super::prelude::with_prelude;
 use super::readback::{read_storage, read_texture_rgba8};
-use super::trace_pass::{FrameUniforms, buffer_entry, output_entry, output_texture, uniform_entry};
+use super::trace_pass::{FrameUniforms, buffer_entry, constants_entry, output_entry, output_texture};
 use super::{GpuContext, GpuError, SceneBuffers};
 use crate::trace::path::lights::Emitter;
 use crate::trace::path::materials::{Effects, GpuMaterial};
@@ -35,7 +35,9 @@ pub struct PathUniforms {
     pub bounces: u32,
     pub shadow_samples: u32,
     pub emitter_count: u32,
-    pub _pad: [u32; 2],
+    /// The band of rows this dispatch traces (`end_row` at most the height).
+    pub first_row: u32,
+    pub end_row: u32,
 }
 
 /// A kernel: compiled, or being compiled on a worker thread.
@@ -123,7 +125,7 @@ fn uniform_buffer(device: &wgpu::Device, label: &str, size: usize) -> wgpu::Buff
     device.create_buffer(&wgpu::BufferDescriptor {
         label: Some(label),
         size: size as u64,
-        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     })
 }
@@ -143,11 +145,11 @@ impl PathPass {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("path bind group layout"),
             entries: &[
-                uniform_entry(0, std::mem::size_of::<FrameUniforms>()),
+                constants_entry(0, std::mem::size_of::<FrameUniforms>()),
                 buffer_entry(1, true),
                 buffer_entry(3, true),
                 output_entry(5),
-                uniform_entry(8, std::mem::size_of::<PathUniforms>()),
+                constants_entry(8, std::mem::size_of::<PathUniforms>()),
                 buffer_entry(9, true),
                 buffer_entry(10, true),
                 buffer_entry(11, false),
@@ -326,23 +328,25 @@ impl PathPass {
         self.ready(effects, true).map(|_| ())
     }
 
-    /// Records one sample's dispatch for `effects`; returns the effect set
-    /// of the kernel that ran (see [`PathPass::kernel_for`]).
+    /// Records one sample's dispatch for `effects` over `rows` rows (the
+    /// uniforms' band); returns the effect set of the kernel that ran (see
+    /// [`PathPass::kernel_for`]).
     pub fn encode(
         &mut self,
         gpu: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         effects: Effects,
+        rows: u32,
         timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) -> Result<Effects, GpuError> {
-        let (width, height) = self.size();
+        let width = self.size().0;
         let used = self.kernel_for(&gpu.device, effects)?;
         let Some(Compiled::Ready(pipeline)) = self.kernels.get(&used) else { return Err(thread_gone()) };
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("path"), timestamp_writes: timestamps });
         pass.set_bind_group(0, &self.bind_group, &[]);
         pass.set_pipeline(pipeline);
-        pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
+        pass.dispatch_workgroups(width.div_ceil(8), rows.div_ceil(8), 1);
         Ok(used)
     }
 

@@ -25,7 +25,7 @@ enum Shown {
 /// What a path-traced frame did.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PathFrame {
-    /// Milliseconds of this frame's sample.
+    /// Milliseconds of the sample this frame completed (all its bands).
     pub ms: f64,
     /// Samples accumulated so far, this one included.
     pub samples: u32,
@@ -35,7 +35,8 @@ pub struct PathFrame {
     pub kernel: Effects,
     /// Emissive cells sampled as lights.
     pub lights: usize,
-    /// Whether this call added a sample (none once `sample_target` is reached).
+    /// Whether this call completed a sample (none once `sample_target` is
+    /// reached, nor after a band that is not the image's last).
     pub added: bool,
 }
 
@@ -58,6 +59,15 @@ pub struct Renderer {
     path_key: Option<PathKey>,
     path_samples: u32,
     path_lights: usize,
+    /// The band of the sample under way, of how many, and the milliseconds
+    /// of its bands so far.
+    path_band: (u32, u32),
+    path_band_ms: f64,
+    /// Bands a path-traced sample is split into, one per call (taken when a
+    /// sample starts; 1 by default): the window spreads a slow sample over
+    /// several frames, so that a frame that must show a moved camera never
+    /// waits for a whole one.
+    pub path_bands: u32,
     /// Whether a frame waits for the GPU (headless renders, tests, benches);
     /// the window turns it off, so its trace, blit and present are queued
     /// back to back and the times shown are a frame old.
@@ -91,6 +101,9 @@ impl Renderer {
             path_key: None,
             path_samples: 0,
             path_lights: 0,
+            path_band: (0, 1),
+            path_band_ms: 0.0,
+            path_bands: 1,
             sample_target: u32::MAX,
             wait_for_frames: true,
             hit_records: false,
@@ -220,16 +233,24 @@ impl Renderer {
             let basis = camera.basis(size.0.max(1), size.1.max(1), tree.origin());
             let effects = effects_for(tree, palette, settings);
             let key = PathKey { basis, settings: *settings, effects };
-            if scene_changed || resized || self.path_key.is_none_or(|k| k.effects != effects) {
+            let restart = scene_changed || resized || self.path_key.is_none_or(|k| k.effects != effects);
+            if restart {
                 let lights = if effects.emit { lights::emitters(tree, palette) } else { Vec::new() };
                 self.path.upload_scene(gpu, &self.buffers, &material_table(palette), &lights);
                 self.path_lights = lights.len();
-                self.path_samples = 0;
             }
-            if self.path_key != Some(key) {
+            if restart || self.path_key != Some(key) {
                 self.path_samples = 0;
                 self.path_key = Some(key);
+                self.path_band.0 = 0;
             }
+            if self.path_band.0 == 0 {
+                self.path_band = (0, self.path_bands.clamp(1, size.1.max(1)));
+                self.path_band_ms = 0.0;
+            }
+            let (band, bands) = self.path_band;
+            let band_rows = |band: u32| size.1.max(1) * band / bands;
+            let (first_row, end_row) = (band_rows(band), band_rows(band + 1));
             if self.path_samples >= self.sample_target && self.shown == Shown::Path {
                 let lights = self.path_lights;
                 let samples = self.path_samples;
@@ -243,18 +264,23 @@ impl Renderer {
                 bounces: settings.bounces,
                 shadow_samples: settings.shadow_samples,
                 emitter_count: self.path_lights as u32,
-                _pad: [0; 2],
+                first_row,
+                end_row,
             };
             let frame = FrameUniforms::new(&basis, tree, &self.buffers, View::Shaded, None, Footprint::EXACT);
             self.path.prepare(gpu, &self.buffers, &frame, &path);
             let mut encoder =
                 gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("path frame") });
-            let kernel = self.path.encode(gpu, &mut encoder, effects, self.timer.pass_writes())?;
+            let rows = end_row - first_row;
+            let kernel = self.path.encode(gpu, &mut encoder, effects, rows, self.timer.pass_writes())?;
             self.timer.resolve(&mut encoder);
-            let ms = submit(&mut self.timer, gpu, self.wait_for_frames, encoder)?;
-            self.path_samples += 1;
+            self.path_band_ms += submit(&mut self.timer, gpu, self.wait_for_frames, encoder)?;
+            self.path_band.0 = (band + 1) % bands;
+            let added = self.path_band.0 == 0;
+            self.path_samples += u32::from(added);
             self.shown = Shown::Path;
-            Ok(PathFrame { ms, samples: self.path_samples, effects, kernel, lights: self.path_lights, added: true })
+            let (ms, samples, lights) = (self.path_band_ms, self.path_samples, self.path_lights);
+            Ok(PathFrame { ms, samples, effects, kernel, lights, added })
         })
     }
 

@@ -138,13 +138,18 @@ pub struct TracePass {
     bound_generation: u64,
 }
 
-/// A compute-visible uniform buffer binding of `size` bytes.
-pub(super) fn uniform_entry(binding: u32, size: usize) -> wgpu::BindGroupLayoutEntry {
+/// A compute-visible binding of a frame's constants (`size` bytes): a
+/// read-only storage buffer, not a uniform buffer. Lavapipe (Mesa 22)
+/// compiles a kernel again, on the queue, whenever its uniform buffer is
+/// bound anew, with the values that decide branches folded in ("inlined
+/// uniforms"): 70–100 ms stalls every few frames while the camera moved.
+/// No uniform buffer, nothing to fold in.
+pub(super) fn constants_entry(binding: u32, size: usize) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::COMPUTE,
         ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
+            ty: wgpu::BufferBindingType::Storage { read_only: true },
             has_dynamic_offset: false,
             min_binding_size: wgpu::BufferSize::new(size as u64),
         },
@@ -209,7 +214,7 @@ impl TracePass {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("trace bind group layout"),
             entries: &[
-                uniform_entry(0, std::mem::size_of::<FrameUniforms>()),
+                constants_entry(0, std::mem::size_of::<FrameUniforms>()),
                 buffer_entry(1, true),
                 buffer_entry(3, true),
                 buffer_entry(4, true),
@@ -241,7 +246,7 @@ impl TracePass {
         let uniform_buf = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("frame uniforms"),
             size: std::mem::size_of::<FrameUniforms>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let target = Self::make_target(device, 1, 1, false);
