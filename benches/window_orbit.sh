@@ -31,11 +31,12 @@ orbit() {
     local window
     window="$(xdotool search --sync --name octovox | head -1)"
     xdotool windowfocus --sync "$window"
-    # Three seconds of steady dragging, the way a hand orbits a model: one
-    # xdotool process for the whole drag (a process per move would take
+    # Three seconds of steady dragging, the way a hand orbits a model, from
+    # a mouse reporting at 125 Hz (USB's default rate; a move every 8 ms):
+    # one xdotool process for the whole drag (a process per move would take
     # the two cores from the window it measures).
     local moves=()
-    for _ in $(seq 100); do moves+=(mousemove_relative -- 6 1 sleep 0.03); done
+    for _ in $(seq 375); do moves+=(mousemove_relative -- 2 0 sleep 0.008); done
     xdotool mousemove --window "$window" 760 360 mousedown 3 "${moves[@]}" mouseup 3
     xdotool key ctrl+q
     wait "$app"

@@ -1,6 +1,6 @@
-// Copies the trace output onto the swapchain image: one triangle that covers
-// the whole target, sampling the (possibly smaller, render-scaled) texture.
-// Used by src/gpu/blit_pass.rs.
+// Draws a texture onto the swapchain image with one triangle that covers the
+// whole target: the trace output (possibly smaller, render-scaled), or a
+// layer of the target's size over it. Used by src/gpu/blit_pass.rs.
 
 @group(0) @binding(0) var source: texture_2d<f32>;
 @group(0) @binding(1) var source_sampler: sampler;
@@ -27,4 +27,11 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
     // The trace output already holds display (sRGB-encoded) values and the
     // swapchain is a non-sRGB format, so the bytes pass through unchanged.
     return vec4<f32>(textureSample(source, source_sampler, in.uv).rgb, 1.0);
+}
+
+// A layer of the target's size, premultiplied alpha, texel for pixel (the
+// pipeline blends it over the target).
+@fragment
+fn fs_over(in: VertexOut) -> @location(0) vec4<f32> {
+    return textureLoad(source, vec2<i32>(in.position.xy), 0);
 }

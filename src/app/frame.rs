@@ -12,6 +12,12 @@ use octovox::trace::grid::DenseGrid;
 
 use super::{App, Gfx, camera_control, capture, motion, ui};
 
+/// Most bands a path-traced sample is split into.
+pub(super) const MAX_PATH_BANDS: u32 = 16;
+
+/// Shapes drawn over the scene this frame (`ui::take_scene_overlays`).
+type Overlays = Vec<egui::epaint::ClippedShape>;
+
 impl App {
     pub(super) fn frame(&mut self, event_loop: &ActiveEventLoop) {
         let started = Instant::now();
@@ -27,12 +33,12 @@ impl App {
         }
         // Panels first: they may change settings and produce commands.
         let panels_started = Instant::now();
-        let Some((ctx, full)) = self.run_panels(event_loop) else { return };
+        let Some((ctx, full, overlays)) = self.run_panels(event_loop) else { return };
         self.stats.panels_ms = panels_started.elapsed().as_secs_f64() * 1e3;
         // The camera is final for this frame: pick how many pixels to trace.
         let screenshot = self.screenshot_requested || self.screenshot_path.is_some();
         let last = motion::FrameTimes { frame_ms: self.stats.frame_ms, trace_ms: self.stats.trace_ms };
-        self.motion.update(&self.state.camera, last, self.state.frame_target_ms, screenshot);
+        self.motion.update(&self.state.camera, started, last, self.state.frame_target_ms, screenshot);
         self.stats.scale = self.render_scale();
         self.stats.moving = self.motion.moving();
         if let (Some(frames), Some(interval_ms), true) = (&mut self.moving_frames, interval_ms, self.motion.moving()) {
@@ -56,7 +62,7 @@ impl App {
         self.update_previews();
         self.sync_grid();
         let repaint_delay = full.viewport_output.get(&egui::ViewportId::ROOT).map(|v| v.repaint_delay);
-        let Some(window_copy) = self.trace_and_present(&ctx, full) else { return };
+        let Some(window_copy) = self.trace_and_present(&ctx, full, overlays) else { return };
         if std::mem::take(&mut self.screenshot_requested) {
             self.save_screenshot(window_copy);
         }
@@ -86,7 +92,8 @@ impl App {
     }
 
     /// Lays out the panels and carries out the commands they produced.
-    fn run_panels(&mut self, event_loop: &ActiveEventLoop) -> Option<(egui::Context, egui::FullOutput)> {
+    /// Returns egui's output and, apart, the shapes drawn over the scene.
+    fn run_panels(&mut self, event_loop: &ActiveEventLoop) -> Option<(egui::Context, egui::FullOutput, Overlays)> {
         let (paste, eyedropper, selection) = (self.paste_preview(), self.eyedropper_preview(), self.shown_selection());
         let gfx = self.gfx.as_mut()?;
         let raw_input = gfx.egui_state.take_egui_input(&gfx.window);
@@ -94,11 +101,12 @@ impl App {
         let loading =
             self.loading.as_ref().map(|l| (l.path.clone(), l.started.elapsed().as_secs_f64(), l.progress.fraction()));
         let mut commands = Vec::new();
+        let mut overlays = Vec::new();
         let mut full = {
             let info = ui::Info {
                 palette: &self.editor.scene.palette,
                 tree: &self.editor.scene.tree,
-                stats: &self.stats,
+                stats: self.shown_stats.take(&ctx, &self.stats),
                 adapter: &gfx.renderer.gpu.adapter_name,
                 timestamps: gfx.renderer.timed_by_gpu(),
                 loading: loading.as_ref().map(|(p, s, f)| (p.as_path(), *s, *f)),
@@ -122,12 +130,13 @@ impl App {
             ctx.run_ui(raw_input, |ui| {
                 commands = ui::show(ui, state, tools, ui_state, &info);
                 ui::draw_selection(ui, state, &info);
-                ui::draw_action_previews(ui, state, &info);
                 if let Some((voxels, normal, layers)) = info.extrude {
                     ui::draw_extrude(ui, state, &info, voxels, normal, layers);
                 } else if let Some(pick) = pick.filter(|_| !state.select_mode && info.fill.is_none()) {
                     ui::draw_brush_outline(ui, state, tools, &pick, &info);
                 }
+                ui::draw_action_previews(ui, state, &info);
+                overlays = ui::take_scene_overlays(ui.ctx());
             })
         };
         self.pointer_over_ui = ctx.is_pointer_over_egui();
@@ -142,7 +151,7 @@ impl App {
         if self.palette_stroke && !ctx.input(|i| i.pointer.any_down()) {
             self.close_strokes();
         }
-        Some((ctx, full))
+        Some((ctx, full, overlays))
     }
 
     /// Traces the scene, then draws it and the panels onto the window and
@@ -151,23 +160,16 @@ impl App {
     fn trace_and_present(
         &mut self,
         ctx: &egui::Context,
-        full: egui::FullOutput,
+        mut full: egui::FullOutput,
+        overlays: Overlays,
     ) -> Option<Option<capture::WindowCopy>> {
         let (trace_size, selection) = (self.trace_size(), self.shown_selection());
         let gfx = self.gfx.as_mut()?;
         let tessellate_started = Instant::now();
-        let prims = ctx.tessellate(full.shapes, full.pixels_per_point);
+        let panels = ctx.tessellate(full.shapes, full.pixels_per_point);
+        let overlays = ctx.tessellate(overlays, full.pixels_per_point);
         self.stats.panels_ms += tessellate_started.elapsed().as_secs_f64() * 1e3;
-        // Textures are uploaded before the swapchain image is acquired, so a
-        // skipped frame never loses them.
-        let mut textures = full.textures_delta;
-        for (id, deltas) in textures.set.drain() {
-            for delta in deltas {
-                gfx.egui_renderer.update_texture(&gfx.renderer.gpu.device, &gfx.renderer.gpu.queue, id, &delta);
-            }
-        }
-        // Freed only after a frame that no longer uses them was submitted.
-        gfx.textures_to_free.extend(textures.free.drain());
+        gfx.egui.set_textures(&gfx.renderer.gpu, &mut full.textures_delta);
         let screen = egui_wgpu::ScreenDescriptor {
             size_in_pixels: [gfx.config.width, gfx.config.height],
             pixels_per_point: full.pixels_per_point,
@@ -190,6 +192,11 @@ impl App {
                 Ok(frame) => {
                     if frame.added {
                         self.stats.trace_ms = frame.ms;
+                        // A slow sample is spread over frames of about the
+                        // frame-time target: a frame that must show a moved
+                        // camera then waits for one band, not a whole sample.
+                        let bands = (frame.ms / f64::from(self.state.frame_target_ms)).ceil();
+                        gfx.renderer.path_bands = (bands as u32).clamp(1, MAX_PATH_BANDS);
                         if frame.samples == gfx.renderer.sample_target {
                             let effects = frame.effects.names().join(" ");
                             report!("path: {} samples, effects [{effects}]", frame.samples);
@@ -222,39 +229,17 @@ impl App {
         gfx.blit.prepare(&gfx.renderer.gpu.device, gfx.renderer.output_view());
         let mut encoder =
             gfx.renderer.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("present") });
-        gfx.blit.encode(&mut encoder, &view);
-        let user_buffers = gfx.egui_renderer.update_buffers(
-            &gfx.renderer.gpu.device,
-            &gfx.renderer.gpu.queue,
-            &mut encoder,
-            &prims,
-            &screen,
-        );
-        {
-            let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("egui"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &view,
-                    resolve_target: None,
-                    depth_slice: None,
-                    ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            gfx.egui_renderer.render(&mut pass.forget_lifetime(), &prims, &screen);
-        }
+        gfx.blit.encode(&mut encoder, &view, None);
+        let (user_buffers, redrawn) =
+            gfx.egui.encode(&gfx.renderer.gpu, &mut encoder, &view, &panels, &overlays, &screen);
+        self.stats.panels_redrawn = redrawn;
         let window_copy = (self.screenshot_requested && gfx.can_copy_frame)
             .then(|| capture::copy_frame(gfx, &mut encoder, &frame.texture));
         let recorded = Instant::now();
         gfx.renderer.gpu.queue.submit(user_buffers.into_iter().chain([encoder.finish()]));
         gfx.window.pre_present_notify();
         gfx.renderer.gpu.queue.present(frame);
-        for id in std::mem::take(&mut gfx.textures_to_free) {
-            gfx.egui_renderer.free_texture(&id);
-        }
+        gfx.egui.free_textures();
         let ms = |from: Instant, to: Instant| to.duration_since(from).as_secs_f64() * 1e3;
         let now = Instant::now();
         (self.stats.acquire_ms, self.stats.draw_ms) = (ms(present_started, acquired), ms(acquired, recorded));
@@ -265,10 +250,8 @@ impl App {
     /// Keeps drawing while something moves; otherwise waits for input (or
     /// for when egui asks to be drawn again).
     fn schedule_repaint(&mut self, repaint_delay: Option<Duration>) {
-        // A moving camera asks for one more frame: the resting view at full scale.
         let accumulating = self.stats.path.is_some_and(|p| p.samples < self.state.sample_target);
-        let animating = self.motion.moving()
-            || accumulating
+        let animating = accumulating
             || self.loading.is_some()
             || self.input.fly_direction().is_some()
             || self.bench.is_some()
@@ -280,6 +263,11 @@ impl App {
             Some(delay) if delay < Duration::from_secs(5) => Some(Instant::now() + delay),
             _ => None,
         };
+        // Input draws the frames while the camera moves; once it keeps
+        // still, one more frame draws the resting view at full scale.
+        if let Some(at) = self.motion.settles_at() {
+            self.next_repaint = Some(self.next_repaint.map_or(at, |next| next.min(at)));
+        }
     }
 
     /// Rebuilds and uploads the dense grid while grid mode is on and the voxels changed.

@@ -16,6 +16,7 @@ mod actions;
 mod camera_control;
 mod capture;
 mod command;
+mod egui_layers;
 mod file_dialog;
 mod files;
 mod frame;
@@ -48,7 +49,7 @@ use octovox::camera::Camera;
 use octovox::edit::Edit;
 use octovox::editor::{Editor, Outcome};
 use octovox::gpu::scene_buffers::UploadStats;
-use octovox::gpu::{BlitPass, GpuContext, Renderer};
+use octovox::gpu::{BlitMode, BlitPass, GpuContext, Renderer};
 use octovox::io::atomic::WriteOptions;
 use octovox::replay::Recorder;
 use octovox::scene::Scene;
@@ -56,6 +57,7 @@ use octovox::trace::svo;
 
 use crate::cli::WindowArgs;
 pub use command::{Choice, Command, Nudge, Pending, StrokePhase};
+use egui_layers::EguiLayers;
 use input::Input;
 use state::{EditorState, Pick, Tool};
 use ui::{DialogKind, Stats, UiState};
@@ -96,8 +98,7 @@ struct Gfx {
     renderer: Renderer,
     blit: BlitPass,
     egui_state: egui_winit::State,
-    egui_renderer: egui_wgpu::Renderer,
-    textures_to_free: Vec<egui::TextureId>,
+    egui: EguiLayers,
 }
 
 /// A .vox being read on a background thread.
@@ -135,6 +136,7 @@ struct App {
     ui: UiState,
     input: Input,
     stats: Stats,
+    shown_stats: ui::ShownStats,
     pick: Option<Pick>,
     /// The render scale while the camera moves.
     motion: motion::MotionScale,
@@ -196,6 +198,7 @@ impl App {
             ui: UiState::default(),
             input: Input::default(),
             stats: Stats::default(),
+            shown_stats: ui::ShownStats::default(),
             pick: None,
             motion: motion::MotionScale::default(),
             moving_frames: args.frame_stats.then(motion::MovingFrames::default),
@@ -281,10 +284,14 @@ impl App {
         let cpu = gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu;
         config.present_mode = present_mode(&caps.present_modes, cpu, self.bench.is_some());
         surface.configure(&gpu.device, &config);
-        let blit = BlitPass::new(&gpu, config.format)?;
+        let blit = BlitPass::new(&gpu, config.format, BlitMode::Replace)?;
         let mut renderer = Renderer::new(gpu)?;
         // The trace, blit and present are queued back to back; times shown are a frame old.
         renderer.wait_for_frames = false;
+        // Until a path-traced sample has been timed, each is split in bands
+        // as for a slow adapter (see `frame::MAX_PATH_BANDS`); a fast one
+        // goes back to whole samples after the first.
+        renderer.path_bands = frame::MAX_PATH_BANDS / 2;
         let gpu = &renderer.gpu;
         let egui_state = egui_winit::State::new(
             egui::Context::default(),
@@ -294,7 +301,7 @@ impl App {
             window.theme(),
             Some(gpu.device.limits().max_texture_dimension_2d as usize),
         );
-        let egui_renderer = egui_wgpu::Renderer::new(&gpu.device, config.format, egui_wgpu::RendererOptions::default());
+        let egui = EguiLayers::new(gpu, config.format)?;
         log::info!(
             "window on {} ({:?}, {:?}, {}x{})",
             gpu.adapter_name,
@@ -303,17 +310,7 @@ impl App {
             config.width,
             config.height
         );
-        Ok(Gfx {
-            window,
-            surface,
-            config,
-            can_copy_frame,
-            renderer,
-            blit,
-            egui_state,
-            egui_renderer,
-            textures_to_free: Vec::new(),
-        })
+        Ok(Gfx { window, surface, config, can_copy_frame, renderer, blit, egui_state, egui })
     }
 
     /// Asks for a frame. Only frames asked for here are drawn: on X11 with

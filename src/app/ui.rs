@@ -39,6 +39,8 @@ pub struct Stats {
     pub draw_ms: f64,
     pub submit_ms: f64,
     pub panels_ms: f64,
+    /// Whether the last frame drew the panels again (they are kept while unchanged).
+    pub panels_redrawn: bool,
     /// Render scale of the last frame (lower while the camera moves).
     pub scale: f32,
     /// Whether the camera moved since the frame before.
@@ -49,6 +51,34 @@ pub struct Stats {
     pub last_edit_ranges: usize,
     /// The path tracer's last frame, when it drew it.
     pub path: Option<octovox::gpu::PathFrame>,
+}
+
+/// How often the Stats panel takes new numbers.
+const STATS_REFRESH: std::time::Duration = std::time::Duration::from_millis(250);
+
+/// The numbers the Stats panel shows, taken four times a second: digits
+/// that change every frame cannot be read, and they would make the panels
+/// (kept on the GPU while unchanged, `EguiLayers`) be drawn again every
+/// frame.
+#[derive(Default)]
+pub struct ShownStats {
+    stats: Stats,
+    taken: Option<std::time::Instant>,
+}
+
+impl ShownStats {
+    /// The numbers to show: `current` when the last were taken long enough
+    /// ago, else those, with a frame asked for when they are due.
+    pub fn take(&mut self, ctx: &egui::Context, current: &Stats) -> &Stats {
+        let age = self.taken.map_or(STATS_REFRESH, |at| at.elapsed());
+        if age >= STATS_REFRESH {
+            self.stats = current.clone();
+            self.taken = Some(std::time::Instant::now());
+        } else {
+            ctx.request_repaint_after(STATS_REFRESH - age);
+        }
+        &self.stats
+    }
 }
 
 /// Read-only facts the panels show.
@@ -660,6 +690,31 @@ fn tool_label(tool: Tool) -> &'static str {
     }
 }
 
+/// The layer of everything drawn over the scene (outlines, previews, hints).
+fn scene_layer() -> egui::LayerId {
+    egui::LayerId::new(egui::Order::Background, egui::Id::unique("scene overlays"))
+}
+
+fn scene_painter(ctx: &egui::Context) -> egui::Painter {
+    ctx.layer_painter(scene_layer())
+}
+
+/// Takes this frame's scene overlays out of egui's output, at the end of the
+/// frame's UI pass: they move with the camera, so the window draws them on
+/// every frame under the panels, which it keeps while they do not change
+/// (`EguiLayers`).
+pub fn take_scene_overlays(ctx: &egui::Context) -> Vec<egui::epaint::ClippedShape> {
+    ctx.graphics_mut(|layers| {
+        let Some(list) = layers.get_mut(scene_layer()) else { return Vec::new() };
+        let shapes: Vec<_> = list.all_entries().cloned().collect();
+        // A paint list cannot be emptied from outside; no-ops tessellate to nothing.
+        for i in 0..shapes.len() {
+            list.reset_shape(egui::layers::ShapeIdx(i));
+        }
+        shapes
+    })
+}
+
 /// Outlines the cells the brush would touch (projected with the trace
 /// camera), so the preview also shows Attach's target cells, which are empty
 /// and so cannot be tinted by the shader.
@@ -700,7 +755,7 @@ pub fn draw_action_previews(ui: &egui::Ui, state: &EditorState, info: &Info) {
         _ => return,
     };
     let Some(at) = ui.ctx().pointer_hover_pos() else { return };
-    let painter = ui.ctx().layer_painter(egui::LayerId::new(egui::Order::Foreground, egui::Id::unique("action hint")));
+    let painter = scene_painter(ui.ctx());
     let mut text_at = at + Vec2::new(16.0, 12.0);
     if let Some(color) = swatch {
         painter.rect_filled(egui::Rect::from_min_size(text_at, Vec2::splat(14.0)), 2.0, color);
@@ -726,7 +781,7 @@ pub fn draw_extrude(ui: &egui::Ui, state: &EditorState, info: &Info, voxels: &[I
         _ => (Vec3::X * 0.5, Vec3::Y * 0.5),
     };
     let color = if layers < 0 { Color32::from_rgb(255, 100, 90) } else { Color32::from_rgb(120, 255, 140) };
-    let painter = ui.ctx().layer_painter(egui::LayerId::new(egui::Order::Background, egui::Id::unique("extrude")));
+    let painter = scene_painter(ui.ctx());
     for voxel in voxels.iter().take(MAX_PREVIEW_FACES) {
         let center = voxel.as_vec3() - origin + Vec3::splat(0.5) + n * (0.5 + layers as f32);
         let corners = [center - u - v, center + u - v, center + u + v, center - u + v];
@@ -776,7 +831,7 @@ fn outline_box(
             if i & 4 == 0 { a.z } else { b.z },
         )
     };
-    let painter = ui.ctx().layer_painter(egui::LayerId::new(egui::Order::Background, egui::Id::unique("box outline")));
+    let painter = scene_painter(ui.ctx());
     for i in 0..8usize {
         for bit in [1usize, 2, 4] {
             let j = i | bit;
