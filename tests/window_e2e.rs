@@ -101,7 +101,17 @@ fn click_attach_save_erase_save_in_a_real_window() {
     assert_eq!(again.voxel + edited.tree.origin(), placed);
 
     // Erase it with the R tool, save, and the file is the original again.
+    // The panels are kept between frames while they do not change
+    // (EguiLayers): the key must still light the Erase button up.
+    let tools_before = screenshot_x(&display, &dir.path().join("tools-before.png"));
     xdotool(&display, &["key", "r"]);
+    std::thread::sleep(Duration::from_millis(700));
+    let tools_after = screenshot_x(&display, &dir.path().join("tools-after.png"));
+    let changed = (0..230)
+        .flat_map(|x| (50..72).map(move |y| (x, y)))
+        .filter(|&(x, y)| tools_before.get_pixel(x, y) != tools_after.get_pixel(x, y))
+        .count();
+    assert!(changed > 200, "the tool buttons did not follow the R key ({changed} pixels changed)");
     let bytes = click(&display, &window, &mut lines, x, y);
     assert!(bytes <= 1024, "a one-voxel erase wrote {bytes} bytes to the GPU");
     save(&display, &mut lines, &file);

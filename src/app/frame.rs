@@ -13,7 +13,7 @@ use octovox::trace::grid::DenseGrid;
 use super::{App, Gfx, camera_control, capture, motion, ui};
 
 /// Most bands a path-traced sample is split into.
-pub(super) const MAX_PATH_BANDS: u32 = 16;
+const MAX_PATH_BANDS: u32 = 16;
 
 /// Shapes drawn over the scene this frame (`ui::take_scene_overlays`).
 type Overlays = Vec<egui::epaint::ClippedShape>;

@@ -288,10 +288,6 @@ impl App {
         let mut renderer = Renderer::new(gpu)?;
         // The trace, blit and present are queued back to back; times shown are a frame old.
         renderer.wait_for_frames = false;
-        // Until a path-traced sample has been timed, each is split in bands
-        // as for a slow adapter (see `frame::MAX_PATH_BANDS`); a fast one
-        // goes back to whole samples after the first.
-        renderer.path_bands = frame::MAX_PATH_BANDS / 2;
         let gpu = &renderer.gpu;
         let egui_state = egui_winit::State::new(
             egui::Context::default(),

@@ -63,10 +63,10 @@ pub struct Renderer {
     /// of its bands so far.
     path_band: (u32, u32),
     path_band_ms: f64,
-    /// Bands a path-traced sample is split into, one per call (taken when a
-    /// sample starts; 1 by default): the window spreads a slow sample over
-    /// several frames, so that a frame that must show a moved camera never
-    /// waits for a whole one.
+    /// Bands a path-traced sample after the first is split into, one per
+    /// call (taken when a sample starts; 1 by default): the window spreads a
+    /// slow sample over several frames, so that a frame that must show a
+    /// moved camera does not wait for a whole one.
     pub path_bands: u32,
     /// Whether a frame waits for the GPU (headless renders, tests, benches);
     /// the window turns it off, so its trace, blit and present are queued
@@ -245,7 +245,10 @@ impl Renderer {
                 self.path_band.0 = 0;
             }
             if self.path_band.0 == 0 {
-                self.path_band = (0, self.path_bands.clamp(1, size.1.max(1)));
+                // The first sample is whole: the image shown is the path
+                // tracer's, and rows it had not traced yet would be blank.
+                let bands = if self.path_samples == 0 { 1 } else { self.path_bands };
+                self.path_band = (0, bands.clamp(1, size.1.max(1)));
                 self.path_band_ms = 0.0;
             }
             let (band, bands) = self.path_band;
