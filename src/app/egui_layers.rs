@@ -13,6 +13,7 @@
 use std::hash::{Hash, Hasher};
 
 use egui::epaint::{ClippedPrimitive, Primitive};
+use octovox::gpu::blit_pass::color_pass;
 use octovox::gpu::{BlitMode, BlitPass, GpuContext, GpuError};
 
 pub struct EguiLayers {
@@ -90,7 +91,7 @@ impl EguiLayers {
     ) -> (Vec<wgpu::CommandBuffer>, bool) {
         let mut buffers = self.overlays.update_buffers(&gpu.device, &gpu.queue, encoder, overlays, screen);
         if !overlays.is_empty() {
-            let mut pass = render_pass(encoder, target, wgpu::LoadOp::Load, "egui scene overlays");
+            let mut pass = color_pass(encoder, target, wgpu::LoadOp::Load, "egui scene overlays");
             self.overlays.render(&mut pass, overlays, screen);
         }
         let fingerprint = fingerprint(panels, screen);
@@ -100,7 +101,7 @@ impl EguiLayers {
             buffers.extend(self.panels.update_buffers(&gpu.device, &gpu.queue, encoder, panels, screen));
             let layer = self.layer.as_mut().expect("made by layer_for");
             let mut pass =
-                render_pass(encoder, &layer.view, wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), "egui panels");
+                color_pass(encoder, &layer.view, wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), "egui panels");
             self.panels.render(&mut pass, panels, screen);
             layer.drawn = fingerprint;
             layer.areas = disjoint(&drawn_areas(panels, screen));
@@ -129,29 +130,6 @@ impl EguiLayers {
         }
         self.layer.as_mut().expect("just made")
     }
-}
-
-fn render_pass(
-    encoder: &mut wgpu::CommandEncoder,
-    view: &wgpu::TextureView,
-    load: wgpu::LoadOp<wgpu::Color>,
-    label: &str,
-) -> wgpu::RenderPass<'static> {
-    encoder
-        .begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some(label),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view,
-                resolve_target: None,
-                depth_slice: None,
-                ops: wgpu::Operations { load, store: wgpu::StoreOp::Store },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        })
-        .forget_lifetime()
 }
 
 /// The pixel rectangles (x0, y0, x1, y1) the primitives may draw in: each
