@@ -361,11 +361,20 @@ fn a_sample_split_in_bands_equals_a_whole_one() {
     let (mut tree, palette) = material_scene();
     let mut renderer = Renderer::headless().expect("a GPU adapter (lavapipe on CI)");
     renderer.sync(&mut tree, &palette);
+    // The window traces the preview first when an accumulation would start over.
+    let restarts = |r: &Renderer, camera: &Camera, changed: bool| {
+        r.path_restarts(&tree, &palette, camera, size, &settings, changed)
+    };
+    assert!(restarts(&renderer, &camera, false), "nothing accumulated yet");
+    renderer.render_path(&tree, &palette, &camera, size, &settings, true).unwrap();
+    assert!(!restarts(&renderer, &camera, false), "the same accumulation goes on");
+    assert!(restarts(&renderer, &camera, true), "the scene changed");
+    let moved = look(DVec3::new(3.5, 8.0, 14.0), DVec3::new(0.0, 1.0, 0.0));
+    assert!(restarts(&renderer, &moved, false), "the camera moved");
     for bands in [4, 37, 100] {
         renderer.path_bands = bands;
+        let used = bands.min(size.1);
         for sample in 0..3 {
-            // The first sample is whole: the image shown has every row.
-            let used = if sample == 0 { 1 } else { bands.min(size.1) };
             for band in 0..used {
                 let first = sample == 0 && band == 0;
                 let frame = renderer.render_path(&tree, &palette, &camera, size, &settings, first).unwrap();

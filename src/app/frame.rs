@@ -13,7 +13,7 @@ use octovox::trace::grid::DenseGrid;
 use super::{App, Gfx, camera_control, capture, motion, ui};
 
 /// Most bands a path-traced sample is split into.
-const MAX_PATH_BANDS: u32 = 16;
+pub(super) const MAX_PATH_BANDS: u32 = 16;
 
 /// Shapes drawn over the scene this frame (`ui::take_scene_overlays`).
 type Overlays = Vec<egui::epaint::ClippedShape>;
@@ -175,8 +175,18 @@ impl App {
             pixels_per_point: full.pixels_per_point,
         };
 
-        // Trace: the one encode path that headless rendering uses too.
-        if path_traced(&self.state, self.motion.moving()) {
+        // Trace: the one encode path that headless rendering uses too. An
+        // accumulation that starts over is preceded by a preview frame, shown
+        // until its first sample (which may come in bands) is complete.
+        let wants_path = path_traced(&self.state, self.motion.moving());
+        let restarts = wants_path && {
+            let (scene, state) = (&self.editor.scene, &self.state);
+            let (camera, settings) = (&state.camera, &state.path_settings);
+            gfx.renderer.path_restarts(&scene.tree, &scene.palette, camera, trace_size, settings, self.path_stale)
+        };
+        let path = wants_path && (!restarts || self.preview_before_path);
+        self.preview_before_path = wants_path && !path;
+        if path {
             let changed = std::mem::take(&mut self.path_stale);
             gfx.renderer.sample_target = self.state.sample_target.max(1);
             let (scene, state) = (&self.editor.scene, &self.state);
@@ -252,6 +262,7 @@ impl App {
     fn schedule_repaint(&mut self, repaint_delay: Option<Duration>) {
         let accumulating = self.stats.path.is_some_and(|p| p.samples < self.state.sample_target);
         let animating = accumulating
+            || self.preview_before_path
             || self.loading.is_some()
             || self.input.fly_direction().is_some()
             || self.bench.is_some()

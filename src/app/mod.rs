@@ -137,6 +137,9 @@ struct App {
     input: Input,
     stats: Stats,
     shown_stats: ui::ShownStats,
+    /// The last frame traced the preview in place of a path-traced frame
+    /// that would have started the accumulation over; the next one starts it.
+    preview_before_path: bool,
     pick: Option<Pick>,
     /// The render scale while the camera moves.
     motion: motion::MotionScale,
@@ -199,6 +202,7 @@ impl App {
             input: Input::default(),
             stats: Stats::default(),
             shown_stats: ui::ShownStats::default(),
+            preview_before_path: false,
             pick: None,
             motion: motion::MotionScale::default(),
             moving_frames: args.frame_stats.then(motion::MovingFrames::default),
@@ -288,6 +292,10 @@ impl App {
         let mut renderer = Renderer::new(gpu)?;
         // The trace, blit and present are queued back to back; times shown are a frame old.
         renderer.wait_for_frames = false;
+        // Until a path-traced sample has been timed, samples come in bands
+        // as on a slow adapter; a fast one goes back to whole samples after
+        // the first.
+        renderer.path_bands = frame::MAX_PATH_BANDS / 2;
         let gpu = &renderer.gpu;
         let egui_state = egui_winit::State::new(
             egui::Context::default(),

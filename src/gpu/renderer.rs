@@ -40,6 +40,11 @@ pub struct PathFrame {
     pub added: bool,
 }
 
+fn path_key(tree: &Octree, palette: &Palette, camera: &Camera, size: (u32, u32), settings: &PathSettings) -> PathKey {
+    let basis = camera.basis(size.0.max(1), size.1.max(1), tree.origin());
+    PathKey { basis, settings: *settings, effects: effects_for(tree, palette, settings) }
+}
+
 /// What an accumulation is of: a change restarts it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct PathKey {
@@ -63,10 +68,10 @@ pub struct Renderer {
     /// of its bands so far.
     path_band: (u32, u32),
     path_band_ms: f64,
-    /// Bands a path-traced sample after the first is split into, one per
-    /// call (taken when a sample starts; 1 by default): the window spreads a
-    /// slow sample over several frames, so that a frame that must show a
-    /// moved camera does not wait for a whole one.
+    /// Bands a path-traced sample is split into, one per call (taken when
+    /// a sample starts; 1 by default): the window spreads a slow sample over
+    /// several frames, so that a frame that must show a moved camera does
+    /// not wait for a whole one.
     pub path_bands: u32,
     /// Whether a frame waits for the GPU (headless renders, tests, benches);
     /// the window turns it off, so its trace, blit and present are queued
@@ -230,9 +235,8 @@ impl Renderer {
         let gpu = &self.gpu;
         gpu.checked(|| {
             let resized = self.path.resize(gpu, &self.buffers, size)?;
-            let basis = camera.basis(size.0.max(1), size.1.max(1), tree.origin());
-            let effects = effects_for(tree, palette, settings);
-            let key = PathKey { basis, settings: *settings, effects };
+            let key = path_key(tree, palette, camera, size, settings);
+            let effects = key.effects;
             let restart = scene_changed || resized || self.path_key.is_none_or(|k| k.effects != effects);
             if restart {
                 let lights = if effects.emit { lights::emitters(tree, palette) } else { Vec::new() };
@@ -245,10 +249,7 @@ impl Renderer {
                 self.path_band.0 = 0;
             }
             if self.path_band.0 == 0 {
-                // The first sample is whole: the image shown is the path
-                // tracer's, and rows it had not traced yet would be blank.
-                let bands = if self.path_samples == 0 { 1 } else { self.path_bands };
-                self.path_band = (0, bands.clamp(1, size.1.max(1)));
+                self.path_band = (0, self.path_bands.clamp(1, size.1.max(1)));
                 self.path_band_ms = 0.0;
             }
             let (band, bands) = self.path_band;
@@ -270,7 +271,7 @@ impl Renderer {
                 first_row,
                 end_row,
             };
-            let frame = FrameUniforms::new(&basis, tree, &self.buffers, View::Shaded, None, Footprint::EXACT);
+            let frame = FrameUniforms::new(&key.basis, tree, &self.buffers, View::Shaded, None, Footprint::EXACT);
             self.path.prepare(gpu, &self.buffers, &frame, &path);
             let mut encoder =
                 gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("path frame") });
@@ -281,10 +282,29 @@ impl Renderer {
             self.path_band.0 = (band + 1) % bands;
             let added = self.path_band.0 == 0;
             self.path_samples += u32::from(added);
-            self.shown = Shown::Path;
+            // Until its first sample has every row, the accumulation is not
+            // shown: the trace output is (the window traces the preview first).
+            self.shown = if self.path_samples > 0 { Shown::Path } else { Shown::Trace };
             let (ms, samples, lights) = (self.path_band_ms, self.path_samples, self.path_lights);
             Ok(PathFrame { ms, samples, effects, kernel, lights, added })
         })
+    }
+
+    /// Whether [`Renderer::render_path`] with these arguments would start
+    /// the accumulation over. The window then traces the preview first: it
+    /// is shown until the new accumulation's first sample, which may come
+    /// in bands, is complete.
+    pub fn path_restarts(
+        &self,
+        tree: &Octree,
+        palette: &Palette,
+        camera: &Camera,
+        size: (u32, u32),
+        settings: &PathSettings,
+        scene_changed: bool,
+    ) -> bool {
+        let resized = self.path.size() != (size.0.max(1), size.1.max(1));
+        scene_changed || resized || self.path_key != Some(path_key(tree, palette, camera, size, settings))
     }
 
     /// Compiles the path kernel a scene needs with `settings` now, so that the
