@@ -95,40 +95,39 @@ impl EguiLayers {
             self.overlays.render(&mut pass, overlays, screen);
         }
         let fingerprint = fingerprint(panels, screen);
-        let layer = self.layer_for(&gpu.device, screen.size_in_pixels);
+        let mut layer = self.take_layer(&gpu.device, screen.size_in_pixels);
         let redraw = fingerprint.is_none() || layer.drawn != fingerprint;
         if redraw {
             buffers.extend(self.panels.update_buffers(&gpu.device, &gpu.queue, encoder, panels, screen));
-            let layer = self.layer.as_mut().expect("made by layer_for");
-            let mut pass =
-                color_pass(encoder, &layer.view, wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), "egui panels");
+            let clear = wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT);
+            let mut pass = color_pass(encoder, &layer.view, clear, "egui panels");
             self.panels.render(&mut pass, panels, screen);
             layer.drawn = fingerprint;
             layer.areas = disjoint(&drawn_areas(panels, screen));
         }
-        let layer = self.layer.as_ref().expect("made by layer_for");
         self.composite.prepare(&gpu.device, &layer.view);
         self.composite.encode(encoder, target, Some(&layer.areas));
+        self.layer = Some(layer);
         (buffers, redraw)
     }
 
     /// The layer, made again (empty) when the window's size changed.
-    fn layer_for(&mut self, device: &wgpu::Device, size: [u32; 2]) -> &mut Layer {
-        if self.layer.as_ref().is_none_or(|layer| layer.size != size) {
-            let texture = device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("egui panels layer"),
-                size: wgpu::Extent3d { width: size[0].max(1), height: size[1].max(1), depth_or_array_layers: 1 },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: self.format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            });
-            let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
-            self.layer = Some(Layer { view, size, drawn: None, areas: Vec::new() });
+    fn take_layer(&mut self, device: &wgpu::Device, size: [u32; 2]) -> Layer {
+        if let Some(layer) = self.layer.take().filter(|layer| layer.size == size) {
+            return layer;
         }
-        self.layer.as_mut().expect("just made")
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("egui panels layer"),
+            size: wgpu::Extent3d { width: size[0].max(1), height: size[1].max(1), depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: self.format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&wgpu::TextureViewDescriptor::default());
+        Layer { view, size, drawn: None, areas: Vec::new() }
     }
 }
 
