@@ -136,7 +136,11 @@ impl MotionScale {
         self.moving = self.last_change.is_some_and(|at| now.duration_since(at) < SETTLE);
         if self.moving && last.trace_ms > 0.0 {
             let target = f64::from(target_ms) * AIM;
-            let budget = (target - (last.frame_ms - last.trace_ms)).max(target / 4.0);
+            // The rest of the frame is never below zero: a trace longer than
+            // the frame's wall time ran beside it (a GPU that is not the
+            // CPU), or is a path-traced sample's several bands.
+            let rest = (last.frame_ms - last.trace_ms).max(0.0);
+            let budget = (target - rest).max(target / 4.0);
             let correction = (budget / last.trace_ms).sqrt() as f32;
             if self.last_at_moving_factor {
                 // At most halve or grow by a quarter per frame, so one odd
@@ -235,5 +239,11 @@ mod tests {
         slow.update(&at(0.0), ms(0), times(110.0, 100.0), 33.0, false);
         let started = slow.update(&at(1.0), ms(30), times(110.0, 100.0), 33.0, false);
         assert!((started - (18.05f32 / 100.0).sqrt()).abs() < 0.01, "{started}");
+        // A trace longer than its frame (a sample's bands at rest, or a GPU
+        // beside the CPU) leaves the whole aim to the trace, no more.
+        let mut banded = MotionScale::default();
+        banded.update(&at(0.0), ms(0), times(30.0, 250.0), 33.0, false);
+        let started = banded.update(&at(1.0), ms(30), times(30.0, 250.0), 33.0, false);
+        assert!((started - (28.05f32 / 250.0).sqrt()).abs() < 0.01, "{started}");
     }
 }
