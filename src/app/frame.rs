@@ -40,8 +40,11 @@ impl App {
         let last = motion::FrameTimes { frame_ms: self.stats.frame_ms, trace_ms: self.stats.trace_ms };
         self.motion.update(&self.state.camera, started, last, self.state.frame_target_ms, screenshot);
         self.stats.scale = self.render_scale();
-        self.stats.moving = self.motion.moving();
-        if let (Some(frames), Some(interval_ms), true) = (&mut self.moving_frames, interval_ms, self.motion.moving()) {
+        // The interval since the last frame is a moving frame's time when
+        // that one moved too: before a motion it also holds the time the
+        // window sat idle (the wait for work in flight shows in the next).
+        let counted = std::mem::replace(&mut self.stats.moving, self.motion.moving()) && self.motion.moving();
+        if let (Some(frames), Some(interval_ms), true) = (&mut self.moving_frames, interval_ms, counted) {
             let s = &self.stats;
             frames.push(motion::FrameParts {
                 interval_ms,
