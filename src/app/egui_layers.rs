@@ -78,8 +78,7 @@ impl EguiLayers {
 
     /// Records the overlays onto `target`, the panels into their layer when
     /// they changed, and the layer over `target`. Returns the command
-    /// buffers egui's paint callbacks asked for (to submit first), and
-    /// whether the panels were drawn again.
+    /// buffers egui's paint callbacks asked for (to submit first).
     pub fn encode(
         &mut self,
         gpu: &GpuContext,
@@ -88,7 +87,7 @@ impl EguiLayers {
         panels: &[ClippedPrimitive],
         overlays: &[ClippedPrimitive],
         screen: &egui_wgpu::ScreenDescriptor,
-    ) -> (Vec<wgpu::CommandBuffer>, bool) {
+    ) -> Vec<wgpu::CommandBuffer> {
         let mut buffers = self.overlays.update_buffers(&gpu.device, &gpu.queue, encoder, overlays, screen);
         if !overlays.is_empty() {
             let mut pass = color_pass(encoder, target, wgpu::LoadOp::Load, "egui scene overlays");
@@ -96,8 +95,7 @@ impl EguiLayers {
         }
         let fingerprint = fingerprint(panels, screen);
         let mut layer = self.take_layer(&gpu.device, screen.size_in_pixels);
-        let redraw = fingerprint.is_none() || layer.drawn != fingerprint;
-        if redraw {
+        if fingerprint.is_none() || layer.drawn != fingerprint {
             buffers.extend(self.panels.update_buffers(&gpu.device, &gpu.queue, encoder, panels, screen));
             let clear = wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT);
             let mut pass = color_pass(encoder, &layer.view, clear, "egui panels");
@@ -108,7 +106,7 @@ impl EguiLayers {
         self.composite.prepare(&gpu.device, &layer.view);
         self.composite.encode(encoder, target, Some(&layer.areas));
         self.layer = Some(layer);
-        (buffers, redraw)
+        buffers
     }
 
     /// The layer, made again (empty) when the window's size changed.

@@ -248,9 +248,7 @@ impl App {
         let mut encoder =
             gfx.renderer.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("present") });
         gfx.blit.encode(&mut encoder, &view, None);
-        let (user_buffers, redrawn) =
-            gfx.egui.encode(&gfx.renderer.gpu, &mut encoder, &view, &panels, &overlays, &screen);
-        self.stats.panels_redrawn = redrawn;
+        let user_buffers = gfx.egui.encode(&gfx.renderer.gpu, &mut encoder, &view, &panels, &overlays, &screen);
         let window_copy = (self.screenshot_requested && gfx.can_copy_frame)
             .then(|| capture::copy_frame(gfx, &mut encoder, &frame.texture));
         let recorded = Instant::now();

@@ -39,8 +39,6 @@ pub struct Stats {
     pub draw_ms: f64,
     pub submit_ms: f64,
     pub panels_ms: f64,
-    /// Whether the last frame drew the panels again (they are kept while unchanged).
-    pub panels_redrawn: bool,
     /// Render scale of the last frame (lower while the camera moves).
     pub scale: f32,
     /// Whether the camera moved since the frame before.
