@@ -93,13 +93,11 @@ const AIM: f64 = 0.85;
 /// Picks the per-axis factor on the user's render scale, frame by frame.
 #[derive(Clone, Debug)]
 pub struct MotionScale {
-    /// This frame's factor.
-    factor: f32,
     /// The factor moving frames trace at, kept from one motion to the next
     /// (a new drag starts where the last one ended, not at full scale).
     moving_factor: f32,
-    /// The last frame was traced at `moving_factor`, so its time says how
-    /// to correct it.
+    /// This frame (the last, once the next one updates) is traced at
+    /// `moving_factor`: its time says how to correct it.
     last_at_moving_factor: bool,
     last_camera: Option<Camera>,
     last_change: Option<Instant>,
@@ -109,7 +107,6 @@ pub struct MotionScale {
 impl Default for MotionScale {
     fn default() -> MotionScale {
         MotionScale {
-            factor: 1.0,
             moving_factor: 1.0,
             last_at_moving_factor: false,
             last_camera: None,
@@ -153,12 +150,12 @@ impl MotionScale {
             }
         }
         self.last_at_moving_factor = self.moving && !full_scale;
-        self.factor = if self.last_at_moving_factor { self.moving_factor } else { 1.0 };
-        self.factor
+        self.factor()
     }
 
+    /// This frame's factor.
     pub fn factor(&self) -> f32 {
-        self.factor
+        if self.last_at_moving_factor { self.moving_factor } else { 1.0 }
     }
 
     /// The camera moved less than `SETTLE` ago.
