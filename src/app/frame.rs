@@ -193,10 +193,6 @@ impl App {
             let changed = std::mem::take(&mut self.path_stale);
             gfx.renderer.sample_target = self.state.sample_target.max(1);
             let (scene, state) = (&self.editor.scene, &self.state);
-            // A path-traced frame waits for the GPU: at rest the frames
-            // follow each other without input, and queued ahead they made
-            // the first frame of a drag wait for several bands.
-            gfx.renderer.wait_for_frames = true;
             let frame = gfx.renderer.render_path(
                 &scene.tree,
                 &scene.palette,
@@ -205,7 +201,6 @@ impl App {
                 &state.path_settings,
                 changed,
             );
-            gfx.renderer.wait_for_frames = false;
             match frame {
                 Ok(frame) => {
                     if frame.added {

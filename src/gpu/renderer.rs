@@ -45,6 +45,13 @@ fn path_key(tree: &Octree, palette: &Palette, camera: &Camera, size: (u32, u32),
     PathKey { basis, settings: *settings, effects: effects_for(tree, palette, settings) }
 }
 
+/// Whether an accumulation of `key` starts over: the scene or the size
+/// changed, or the key (camera, settings, effects) differs from the one
+/// `accumulating`.
+fn starts_over(accumulating: Option<PathKey>, key: &PathKey, resized: bool, scene_changed: bool) -> bool {
+    scene_changed || resized || accumulating != Some(*key)
+}
+
 /// What an accumulation is of: a change restarts it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct PathKey {
@@ -73,9 +80,12 @@ pub struct Renderer {
     /// several frames, so that a frame that must show a moved camera does
     /// not wait for a whole one.
     pub path_bands: u32,
-    /// Whether a frame waits for the GPU (headless renders, tests, benches);
-    /// the window turns it off, so its trace, blit and present are queued
-    /// back to back and the times shown are a frame old.
+    /// Whether a traced frame waits for the GPU (headless renders, tests,
+    /// benches); the window turns it off, so its trace, blit and present are
+    /// queued back to back and the times shown are a frame old. A
+    /// path-traced frame always waits: at rest such frames follow each
+    /// other without input, and queued ahead they made the first frame of a
+    /// moving camera wait for several of them.
     pub wait_for_frames: bool,
     /// The accumulation stops growing at this many samples (the window's
     /// resting view); headless renders leave it unbounded.
@@ -237,13 +247,14 @@ impl Renderer {
             let resized = self.path.resize(gpu, &self.buffers, size)?;
             let key = path_key(tree, palette, camera, size, settings);
             let effects = key.effects;
-            let restart = scene_changed || resized || self.path_key.is_none_or(|k| k.effects != effects);
-            if restart {
+            // The materials and lights go up again when the scene or the effect set changed.
+            let send_scene = scene_changed || resized || self.path_key.is_none_or(|k| k.effects != effects);
+            if send_scene {
                 let lights = if effects.emit { lights::emitters(tree, palette) } else { Vec::new() };
                 self.path.upload_scene(gpu, &self.buffers, &material_table(palette), &lights);
                 self.path_lights = lights.len();
             }
-            if restart || self.path_key != Some(key) {
+            if starts_over(self.path_key, &key, resized, scene_changed) {
                 self.path_samples = 0;
                 self.path_key = Some(key);
                 self.path_band.0 = 0;
@@ -278,7 +289,7 @@ impl Renderer {
             let rows = end_row - first_row;
             let kernel = self.path.encode(gpu, &mut encoder, effects, rows, self.timer.pass_writes())?;
             self.timer.resolve(&mut encoder);
-            self.path_band_ms += submit(&mut self.timer, gpu, self.wait_for_frames, encoder)?;
+            self.path_band_ms += submit(&mut self.timer, gpu, true, encoder)?;
             self.path_band.0 = (band + 1) % bands;
             let added = self.path_band.0 == 0;
             self.path_samples += u32::from(added);
@@ -304,7 +315,7 @@ impl Renderer {
         scene_changed: bool,
     ) -> bool {
         let resized = self.path.size() != (size.0.max(1), size.1.max(1));
-        scene_changed || resized || self.path_key != Some(path_key(tree, palette, camera, size, settings))
+        starts_over(self.path_key, &path_key(tree, palette, camera, size, settings), resized, scene_changed)
     }
 
     /// Compiles the path kernel a scene needs with `settings` now, so that the
