@@ -16,7 +16,7 @@ use glam::Vec3;
 use super::context::compute_pipeline;
 use super::prelude::with_prelude;
 use super::readback::{read_storage, read_texture_rgba8};
-use super::trace_pass::{FrameUniforms, buffer_entry, constants_entry, output_entry, output_texture};
+use super::trace_pass::{FrameUniforms, buffer_entry, constants_buffer, constants_entry, output_entry, output_texture};
 use super::{GpuContext, GpuError, SceneBuffers};
 use crate::trace::path::lights::Emitter;
 use crate::trace::path::materials::{Effects, GpuMaterial};
@@ -121,15 +121,6 @@ fn make_bind_group(
     })
 }
 
-fn uniform_buffer(device: &wgpu::Device, label: &str, size: usize) -> wgpu::Buffer {
-    device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some(label),
-        size: size as u64,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    })
-}
-
 fn storage(device: &wgpu::Device, label: &str, size: u64, extra: wgpu::BufferUsages) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {
         label: Some(label),
@@ -161,8 +152,8 @@ impl PathPass {
             immediate_size: 0,
         });
         let module = gpu.shader("path.wgsl", &with_prelude(&[COMMON_WGSL, SVO_WGSL, PATH_WGSL]))?;
-        let frame_buf = uniform_buffer(device, "path frame uniforms", std::mem::size_of::<FrameUniforms>());
-        let path_buf = uniform_buffer(device, "path uniforms", std::mem::size_of::<PathUniforms>());
+        let frame_buf = constants_buffer(device, "path frame uniforms", std::mem::size_of::<FrameUniforms>());
+        let path_buf = constants_buffer(device, "path uniforms", std::mem::size_of::<PathUniforms>());
         let materials_buf =
             storage(device, "materials", 256 * std::mem::size_of::<GpuMaterial>() as u64, wgpu::BufferUsages::empty());
         // A binding holds at least one element, even when there are no lights.

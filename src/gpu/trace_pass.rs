@@ -157,6 +157,16 @@ pub(super) fn constants_entry(binding: u32, size: usize) -> wgpu::BindGroupLayou
     }
 }
 
+/// The buffer behind a `constants_entry` binding, written each frame.
+pub(super) fn constants_buffer(device: &wgpu::Device, label: &str, size: usize) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: size as u64,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
 /// The binding of the RGBA8 output texture a kernel writes.
 pub(super) fn output_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
@@ -243,12 +253,7 @@ impl TracePass {
         let beam = pipeline(&svo, "beam", &[tile], "beam prepass")?;
         let floor_module = gpu.shader("floor.wgsl", &with_prelude(&[COMMON_WGSL, FLOOR_WGSL]))?;
         let floor = pipeline(&floor_module, "main", &[], "floor")?;
-        let uniform_buf = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("frame uniforms"),
-            size: std::mem::size_of::<FrameUniforms>() as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let uniform_buf = constants_buffer(device, "frame uniforms", std::mem::size_of::<FrameUniforms>());
         let target = Self::make_target(device, 1, 1, false);
         let bind_group = Self::make_bind_group(device, &layout, &uniform_buf, buffers, &target);
         let bound_generation = buffers.generation;
