@@ -33,7 +33,16 @@ struct FrameUniforms {
 }
 
 // Read-only storage, not uniform: see `constants_entry` in src/gpu/trace_pass.rs.
-@group(0) @binding(0) var<storage, read> u: FrameUniforms;
+@group(0) @binding(0) var<storage, read> frame_constants: FrameUniforms;
+// The invocation's copy of the frame constants, read once by `load_constants`
+// at the start of every entry point. CPU-emulated GPUs (lavapipe of Mesa 22)
+// read a storage buffer lane by lane, even where every lane reads the same
+// word: a read in the traversal loop cost a scalar loop per iteration.
+var<private> u: FrameUniforms;
+
+fn load_constants() {
+    u = frame_constants;
+}
 // Nodes (NODE_WORDS words each) and then bricks (2 words each) of the node pool.
 @group(0) @binding(1) var<storage, read> pool: array<u32>;
 @group(0) @binding(3) var<storage, read> palette: array<u32>;

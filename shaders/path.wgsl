@@ -53,7 +53,9 @@ struct Emitter {
     _pad1: u32,
 }
 
-@group(0) @binding(8) var<storage, read> pu: PathUniforms;
+@group(0) @binding(8) var<storage, read> path_constants: PathUniforms;
+// Read once per invocation, like `u` (common.wgsl, `load_constants`).
+var<private> pu: PathUniforms;
 @group(0) @binding(9) var<storage, read> materials: array<Material>;
 @group(0) @binding(10) var<storage, read> emitters: array<Emitter>;
 @group(0) @binding(11) var<storage, read_write> accum: array<vec4<f32>>;
@@ -478,6 +480,8 @@ fn clamp_sample(v: vec3<f32>) -> vec3<f32> {
 
 @compute @workgroup_size(8, 8)
 fn path(@builtin(global_invocation_id) gid: vec3<u32>) {
+    load_constants();
+    pu = path_constants;
     let px = vec2<u32>(gid.x, gid.y + pu.first_row);
     if (px.x >= u.width || px.y >= pu.end_row) {
         return;

@@ -55,6 +55,7 @@ fn trace_grid(r: Ray) -> Hit {
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    load_constants();
     if (gid.x >= u.width || gid.y >= u.height) {
         return;
     }

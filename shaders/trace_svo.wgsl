@@ -205,6 +205,7 @@ fn inward(n: vec3<f32>, center: vec3<f32>) -> vec3<f32> {
 // far; its stack is the child taken at every level, 3 bits a level.
 @compute @workgroup_size(8, 8)
 fn beam(@builtin(global_invocation_id) gid: vec3<u32>) {
+    load_constants();
     let tiles = beam_tiles();
     if (gid.x >= tiles.x || gid.y >= tiles.y) {
         return;
@@ -311,6 +312,7 @@ fn beam_start(px: vec2<u32>, r: Ray) -> f32 {
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    load_constants();
     if (gid.x >= u.width || gid.y >= u.height) {
         return;
     }
