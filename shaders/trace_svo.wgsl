@@ -9,6 +9,21 @@
 // costs more than the selects.
 
 @group(0) @binding(7) var<storage, read_write> beam_distance: array<f32>;
+// The tiles the beam prepass found something in; `main` runs on these only
+// (an indirect dispatch), after the floor kernel has drawn every pixel as
+// sky. CPU-emulated GPUs run a branch that any lane takes on every lane,
+// masked, so an empty tile in the trace kernel cost about what a traced one
+// did. `count` is zeroed before every frame.
+struct TracedTiles {
+    count: atomic<u32>,
+    // x | y << 16 of each tile, in no particular order.
+    list: array<u32>,
+}
+@group(0) @binding(12) var<storage, read_write> traced: TracedTiles;
+// The indirect dispatch arguments of `main`, written by `tile_dispatch`; in a
+// group of its own, since a dispatch may not read its own arguments buffer
+// as storage.
+@group(1) @binding(0) var<storage, read_write> dispatch_args: array<u32, 3>;
 
 // Side of the square tile of pixels that shares one beam: set from
 // `BEAM_TILE` in src/gpu/trace_pass.rs, which also sizes the beam buffer.
@@ -203,15 +218,9 @@ fn inward(n: vec3<f32>, center: vec3<f32>) -> vec3<f32> {
 // that pyramid, so none can meet a solid voxel closer than this distance.
 // A depth-first search, near children first, pruned by the best distance so
 // far; its stack is the child taken at every level, 3 bits a level.
-@compute @workgroup_size(8, 8)
-fn beam(@builtin(global_invocation_id) gid: vec3<u32>) {
-    load_constants();
-    let tiles = beam_tiles();
-    if (gid.x >= tiles.x || gid.y >= tiles.y) {
-        return;
-    }
-    let p0 = vec2<f32>(gid.xy * BEAM_TILE);
-    let p1 = vec2<f32>(min((gid.xy + vec2<u32>(1u)) * BEAM_TILE, vec2<u32>(u.width, u.height)));
+fn beam_search(tile: vec2<u32>) -> f32 {
+    let p0 = vec2<f32>(tile * BEAM_TILE);
+    let p1 = vec2<f32>(min((tile + vec2<u32>(1u)) * BEAM_TILE, vec2<u32>(u.width, u.height)));
     let c00 = image_direction(p0);
     let c10 = image_direction(vec2<f32>(p1.x, p0.y));
     let c11 = image_direction(p1);
@@ -225,8 +234,7 @@ fn beam(@builtin(global_invocation_id) gid: vec3<u32>) {
     let depth = u.depth;
     if ((u.root & POINTER_BIT) == 0u || depth <= BEAM_LEVEL) {
         // Too small to search: start every ray at the eye.
-        beam_distance[gid.y * tiles.x + gid.x] = select(0.0, BEAM_NONE, u.root == 0u);
-        return;
+        return select(0.0, BEAM_NONE, u.root == 0u);
     }
     var node = u.root;
     var level = depth;
@@ -297,31 +305,77 @@ fn beam(@builtin(global_invocation_id) gid: vec3<u32>) {
         mn = child_min;
         next = 0u;
     }
-    beam_distance[gid.y * tiles.x + gid.x] = best;
+    return best;
 }
 
-// Where the pixel's ray may start: one voxel before its tile's beam distance
-// (t measures distance in units of |d|), or BEAM_NONE when the tile is empty.
-fn beam_start(px: vec2<u32>, r: Ray) -> f32 {
-    let distance = beam_distance[(px.y / BEAM_TILE) * beam_tiles().x + px.x / BEAM_TILE];
-    if (distance >= BEAM_NONE) {
-        return BEAM_NONE;
-    }
-    return max(distance - 1.0, 0.0) / length(r.d);
-}
+// The lists are dispatched in rows of ROW_TILES tiles (dispatch sizes are
+// limited to 65535 per axis; ROW_TILES comes from src/gpu/trace_pass.rs,
+// which sizes the lists); the entry that pads the last row.
+const NO_TILE: u32 = 0xffffffffu;
 
 @compute @workgroup_size(8, 8)
-fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
+fn beam(@builtin(global_invocation_id) gid: vec3<u32>) {
     load_constants();
-    if (gid.x >= u.width || gid.y >= u.height) {
+    let tiles = beam_tiles();
+    if (gid.x >= tiles.x || gid.y >= tiles.y) {
         return;
     }
-    let r = pixel_ray(gid.xy);
-    var hit: Hit;
-    let t_start = beam_start(gid.xy, r);
-    if (t_start < BEAM_NONE) {
-        hit = trace_svo(r, t_start, 0u, vec2<f32>(0.0, u.lod_per_t));
+    let best = beam_search(gid.xy);
+    beam_distance[gid.y * tiles.x + gid.x] = best;
+    if (best < BEAM_NONE) {
+        traced.list[atomicAdd(&traced.count, 1u)] = gid.x | (gid.y << 16u);
     }
+}
+
+// 8×8 workgroups per tile (BEAM_TILE is a multiple of 8).
+fn tile_groups() -> u32 {
+    return (BEAM_TILE / 8u) * (BEAM_TILE / 8u);
+}
+
+// The indirect dispatch arguments of `main`: rows of ROW_TILES tiles, the
+// last one padded with NO_TILE.
+@compute @workgroup_size(1)
+fn tile_dispatch() {
+    let count = atomicLoad(&traced.count);
+    let rows = (count + ROW_TILES - 1u) / ROW_TILES;
+    for (var k = count; k < rows * ROW_TILES; k++) {
+        traced.list[k] = NO_TILE;
+    }
+    dispatch_args[0] = tile_groups() * ROW_TILES;
+    dispatch_args[1] = rows;
+    dispatch_args[2] = 1u;
+}
+
+// The pixel of this invocation in its workgroup's traced tile, or none
+// (x = NO_TILE) past the list or the image. Divisions by constants only:
+// integer division is a scalar loop over the lanes on CPU-emulated GPUs.
+fn traced_pixel(wid: vec3<u32>, lid: vec3<u32>) -> vec2<u32> {
+    let none = vec2<u32>(NO_TILE);
+    let tile = traced.list[wid.y * ROW_TILES + wid.x / tile_groups()];
+    if (tile == NO_TILE) {
+        return none;
+    }
+    let block = wid.x % tile_groups();
+    let side = BEAM_TILE / 8u;
+    let corner = vec2<u32>(tile & 0xffffu, tile >> 16u) * BEAM_TILE + vec2<u32>(block % side, block / side) * 8u;
+    let px = corner + lid.xy;
+    return select(none, px, px.x < u.width && px.y < u.height);
+}
+
+// Traces the pixels of the tiles the beam found something in, each ray
+// starting one voxel before its tile's beam distance (t measures distance in
+// units of |d|).
+@compute @workgroup_size(8, 8)
+fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>) {
+    load_constants();
+    let px = traced_pixel(wid, lid);
+    if (px.x == NO_TILE) {
+        return;
+    }
+    let r = pixel_ray(px);
+    let distance = beam_distance[(px.y / BEAM_TILE) * beam_tiles().x + px.x / BEAM_TILE];
+    let t_start = max(distance - 1.0, 0.0) / length(r.d);
+    let hit = trace_svo(r, t_start, 0u, vec2<f32>(0.0, u.lod_per_t));
     var in_shadow = false;
     if (SHADOWS && u.view == VIEW_SHADED && hit.value != 0u && hit.normal_code != 0u) {
         // The shadow ray keeps the footprint the camera ray had at the hit
@@ -329,5 +383,5 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let depth = dot(vec3<f32>(hit.voxel) + vec3<f32>(0.5) - u.eye, u.forward);
         in_shadow = trace_svo(shadow_ray(hit), 0.0, 0u, vec2<f32>(u.lod_per_t * depth, 0.0)).value != 0u;
     }
-    write_pixel(gid.xy, hit, r.d, in_shadow);
+    write_pixel(px, hit, r.d, in_shadow);
 }

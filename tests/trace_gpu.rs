@@ -65,6 +65,23 @@ fn gpu_matches_cpu_on_sculpture() {
     check_scene(&mut tree, &cameras_for(lo, hi), (96, 72));
 }
 
+/// The trace runs only on the tiles the beam lists, in rows of 64 tiles: an
+/// image with several rows of listed tiles, and partial tiles on its right
+/// and bottom edges, is still traced on every pixel.
+#[test]
+fn gpu_traces_every_listed_tile() {
+    let mut tree = sculpture();
+    let camera = Camera { eye: DVec3::new(-10.0, 25.0, -30.0), target: DVec3::ZERO, fov_y_deg: 60.0 };
+    let size = (333, 211);
+    let cpu = trace_image(Tracer::Svo(&tree), &camera.basis(size.0, size.1, tree.origin()), Footprint::EXACT);
+    let tiles_with_hits: std::collections::HashSet<(usize, usize)> = (0..cpu.len())
+        .filter(|&i| cpu[i].is_hit())
+        .map(|i| (i % size.0 as usize / 16, i / size.0 as usize / 16))
+        .collect();
+    assert!(tiles_with_hits.len() > 2 * 64, "only {} tiles to trace", tiles_with_hits.len());
+    check_scene(&mut tree, &[camera], size);
+}
+
 #[test]
 fn gpu_matches_cpu_on_a_voxelized_scan() {
     let path = common::assets().join("meshes/nefertiti.obj");

@@ -107,6 +107,11 @@ struct Target {
     hits_buf: wgpu::Buffer,
     /// One f32 per tile of BEAM_TILE² pixels, written by the beam prepass.
     beam_buf: wgpu::Buffer,
+    /// The tiles the beam found something in (`TracedTiles`: a count,
+    /// zeroed each frame, then a u32 per tile) and the indirect dispatch
+    /// arguments of the trace made from it (three u32).
+    traced_tiles: wgpu::Buffer,
+    dispatch_args: wgpu::Buffer,
     width: u32,
     height: u32,
     /// Whether `hits_buf` holds a record per pixel.
@@ -116,17 +121,30 @@ struct Target {
 /// Side of the pixel tile that shares one beam; it sizes the beam buffer and
 /// sets the shader's `BEAM_TILE` override.
 const BEAM_TILE: u32 = 16;
+// The per-pixel kernels cover a tile with 8×8 workgroups.
+const _: () = assert!(BEAM_TILE.is_multiple_of(8));
+
+/// The beam's list of traced tiles is dispatched in rows of this many tiles
+/// (a dispatch is at most 65535 workgroups per axis); it has room for every
+/// tile, rounded up to whole rows.
+pub(super) const ROW_TILES: u64 = 64;
 
 /// Pipelines are compiled per tracer and per shadow setting (an override
 /// constant), so a scene rendered without shadows pays nothing for them. The
-/// SVO tracer runs in two dispatches: the beam prepass (one thread per tile
-/// of pixels) and the per-pixel trace, which starts where the beam allows.
+/// SVO frame runs in four dispatches: the floor kernel draws every pixel as
+/// sky, the beam prepass (one thread per tile of pixels) lists the tiles with
+/// something in them, a one-thread kernel turns their count into a dispatch
+/// size, and the per-pixel trace (which starts where the beam allows) runs on
+/// those tiles only.
 pub struct TracePass {
     layout: wgpu::BindGroupLayout,
+    /// Group 1 of `tile_dispatch`: the indirect arguments it writes.
+    args_layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
     /// [svo without shadows, svo with, grid without, grid with].
     pipelines: [wgpu::ComputePipeline; 4],
     beam: wgpu::ComputePipeline,
+    tile_dispatch: wgpu::ComputePipeline,
     /// The SVO kernels with level of detail, compiled on first use from
     /// `svo`: [without shadows, with shadows, beam].
     lod_pipelines: Option<[wgpu::ComputePipeline; 3]>,
@@ -135,6 +153,7 @@ pub struct TracePass {
     uniform_buf: wgpu::Buffer,
     target: Target,
     bind_group: wgpu::BindGroup,
+    args_bind_group: wgpu::BindGroup,
     bound_generation: u64,
 }
 
@@ -231,11 +250,21 @@ impl TracePass {
                 output_entry(5),
                 buffer_entry(6, false),
                 buffer_entry(7, false),
+                buffer_entry(12, false),
             ],
+        });
+        let args_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("dispatch arguments layout"),
+            entries: &[buffer_entry(0, false)],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("trace pipeline layout"),
             bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let args_pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("tile dispatch pipeline layout"),
+            bind_group_layouts: &[Some(&layout), Some(&args_layout)],
             immediate_size: 0,
         });
         let svo = gpu.shader("trace_svo.wgsl", &with_prelude(&[COMMON_WGSL, SVO_WGSL]))?;
@@ -251,23 +280,29 @@ impl TracePass {
             pipeline(&grid, "main", &[("SHADOWS", 1.0)], "trace grid + shadows")?,
         ];
         let beam = pipeline(&svo, "beam", &[tile], "beam prepass")?;
+        let tile_dispatch =
+            compute_pipeline(&gpu.device, &args_pipeline_layout, &svo, "tile_dispatch", &[tile], "tile dispatch")?;
         let floor_module = gpu.shader("floor.wgsl", &with_prelude(&[COMMON_WGSL, FLOOR_WGSL]))?;
         let floor = pipeline(&floor_module, "main", &[], "floor")?;
         let uniform_buf = constants_buffer(device, "frame uniforms", std::mem::size_of::<FrameUniforms>());
         let target = Self::make_target(device, 1, 1, false);
         let bind_group = Self::make_bind_group(device, &layout, &uniform_buf, buffers, &target);
+        let args_bind_group = Self::make_args_bind_group(device, &args_layout, &target);
         let bound_generation = buffers.generation;
         Ok(TracePass {
             layout,
+            args_layout,
             pipeline_layout,
             pipelines,
             beam,
+            tile_dispatch,
             lod_pipelines: None,
             svo,
             floor,
             uniform_buf,
             target,
             bind_group,
+            args_bind_group,
             bound_generation,
         })
     }
@@ -311,7 +346,26 @@ impl TracePass {
             usage: wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
-        Target { texture, view, hits_buf, beam_buf, width, height, hit_records }
+        let buffer = |label, size, usage| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::STORAGE | usage,
+                mapped_at_creation: false,
+            })
+        };
+        let traced_tiles =
+            buffer("traced tiles", 4 + tiles.next_multiple_of(ROW_TILES) * 4, wgpu::BufferUsages::COPY_DST);
+        let dispatch_args = buffer("trace dispatch arguments", 12, wgpu::BufferUsages::INDIRECT);
+        Target { texture, view, hits_buf, beam_buf, traced_tiles, dispatch_args, width, height, hit_records }
+    }
+
+    fn make_args_bind_group(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, target: &Target) -> wgpu::BindGroup {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("dispatch arguments"),
+            layout,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: target.dispatch_args.as_entire_binding() }],
+        })
     }
 
     fn make_bind_group(
@@ -332,6 +386,7 @@ impl TracePass {
                 wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&target.view) },
                 wgpu::BindGroupEntry { binding: 6, resource: target.hits_buf.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 7, resource: target.beam_buf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 12, resource: target.traced_tiles.as_entire_binding() },
             ],
         })
     }
@@ -363,6 +418,7 @@ impl TracePass {
         let device = &gpu.device;
         self.target = Self::make_target(device, width, height, hit_records);
         self.bind_group = Self::make_bind_group(device, &self.layout, &self.uniform_buf, buffers, &self.target);
+        self.args_bind_group = Self::make_args_bind_group(device, &self.args_layout, &self.target);
         self.bound_generation = buffers.generation;
         Ok(())
     }
@@ -389,6 +445,7 @@ impl TracePass {
             self.bound_generation = buffers.generation;
         }
         queue.write_buffer(&self.uniform_buf, 0, bytemuck::bytes_of(uniforms));
+        queue.write_buffer(&self.target.traced_tiles, 0, bytemuck::bytes_of(&0u32));
     }
 
     /// Records the dispatches: the beam prepass (SVO only), then the
@@ -405,8 +462,7 @@ impl TracePass {
         let (mode, shadows, lod) = match kernel {
             Kernel::Trace { mode, shadows, lod } => (mode, shadows, lod),
             Kernel::Floor => {
-                pass.set_pipeline(&self.floor);
-                pass.dispatch_workgroups(self.target.width.div_ceil(8), self.target.height.div_ceil(8), 1);
+                self.encode_floor(&mut pass);
                 return;
             }
         };
@@ -416,12 +472,27 @@ impl TracePass {
         } + usize::from(shadows);
         // `ensure_kernel` compiled these; without them the exact kernels run.
         let lod_pipelines = self.lod_pipelines.as_ref().filter(|_| lod);
-        if mode == TraceMode::Svo {
-            let (tiles_x, tiles_y) = (self.target.width.div_ceil(BEAM_TILE), self.target.height.div_ceil(BEAM_TILE));
-            pass.set_pipeline(lod_pipelines.map_or(&self.beam, |p| &p[2]));
-            pass.dispatch_workgroups(tiles_x.div_ceil(8), tiles_y.div_ceil(8), 1);
+        let trace = lod_pipelines.map_or(&self.pipelines[index], |p| &p[usize::from(shadows)]);
+        if mode == TraceMode::Grid {
+            pass.set_pipeline(trace);
+            pass.dispatch_workgroups(self.target.width.div_ceil(8), self.target.height.div_ceil(8), 1);
+            return;
         }
-        pass.set_pipeline(lod_pipelines.map_or(&self.pipelines[index], |p| &p[usize::from(shadows)]));
+        self.encode_floor(&mut pass);
+        let (tiles_x, tiles_y) = (self.target.width.div_ceil(BEAM_TILE), self.target.height.div_ceil(BEAM_TILE));
+        pass.set_pipeline(lod_pipelines.map_or(&self.beam, |p| &p[2]));
+        pass.dispatch_workgroups(tiles_x.div_ceil(8), tiles_y.div_ceil(8), 1);
+        pass.set_pipeline(&self.tile_dispatch);
+        pass.set_bind_group(1, &self.args_bind_group, &[]);
+        pass.dispatch_workgroups(1, 1, 1);
+        pass.set_pipeline(trace);
+        pass.dispatch_workgroups_indirect(&self.target.dispatch_args, 0);
+    }
+
+    /// Every pixel as a miss: the floor of a frame, and the sky of an SVO
+    /// frame under the tiles the trace then draws over.
+    fn encode_floor(&self, pass: &mut wgpu::ComputePass<'_>) {
+        pass.set_pipeline(&self.floor);
         pass.dispatch_workgroups(self.target.width.div_ceil(8), self.target.height.div_ceil(8), 1);
     }
 
