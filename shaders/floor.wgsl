@@ -1,7 +1,8 @@
 // The floor of a frame on this adapter: everything the trace pass does per
 // pixel except the traversal (the pixel's ray, shading a miss, one store),
-// in the same dispatch shape. `octovox bench render` reports each model's
-// SVO time as a multiple of it.
+// a thread per pixel. `octovox bench render` reports each model's SVO time
+// as a multiple of it. An SVO frame runs it first as its sky: the trace then
+// draws over the tiles the beam prepass lists (trace_svo.wgsl).
 
 @compute @workgroup_size(8, 8)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {

@@ -448,8 +448,9 @@ impl TracePass {
         queue.write_buffer(&self.target.traced_tiles, 0, bytemuck::bytes_of(&0u32));
     }
 
-    /// Records the dispatches: the beam prepass (SVO only), then the
-    /// per-pixel kernel.
+    /// Records the dispatches: for the SVO the sky (the floor kernel), the
+    /// beam prepass, the trace's size and the trace of the listed tiles; for
+    /// the grid its per-pixel kernel; or the floor alone.
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
