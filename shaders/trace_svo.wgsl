@@ -308,9 +308,9 @@ fn beam_search(tile: vec2<u32>) -> f32 {
     return best;
 }
 
-// The lists are dispatched in rows of ROW_TILES tiles (dispatch sizes are
-// limited to 65535 per axis; ROW_TILES comes from src/gpu/trace_pass.rs,
-// which sizes the lists); the entry that pads the last row.
+// The traced tiles are dispatched in rows of ROW_TILES tiles (a dispatch is
+// at most 65535 workgroups per axis; ROW_TILES comes from
+// src/gpu/trace_pass.rs, which sizes the list). NO_TILE pads the last row.
 const NO_TILE: u32 = 0xffffffffu;
 
 @compute @workgroup_size(8, 8)
