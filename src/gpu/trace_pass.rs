@@ -333,19 +333,6 @@ impl TracePass {
     fn make_target(device: &wgpu::Device, width: u32, height: u32, hit_records: bool) -> Target {
         let (width, height) = (width.max(1), height.max(1));
         let (texture, view) = output_texture(device, "trace output", width, height);
-        let hits_buf = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("hit records"),
-            size: Self::hits_bytes(width, height, hit_records),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let tiles = u64::from(width.div_ceil(BEAM_TILE)) * u64::from(height.div_ceil(BEAM_TILE));
-        let beam_buf = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("beam distances"),
-            size: tiles * 4,
-            usage: wgpu::BufferUsages::STORAGE,
-            mapped_at_creation: false,
-        });
         let buffer = |label, size, usage| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -354,6 +341,10 @@ impl TracePass {
                 mapped_at_creation: false,
             })
         };
+        let hits_buf =
+            buffer("hit records", Self::hits_bytes(width, height, hit_records), wgpu::BufferUsages::COPY_SRC);
+        let tiles = u64::from(width.div_ceil(BEAM_TILE)) * u64::from(height.div_ceil(BEAM_TILE));
+        let beam_buf = buffer("beam distances", tiles * 4, wgpu::BufferUsages::empty());
         let traced_tiles =
             buffer("traced tiles", 4 + tiles.next_multiple_of(ROW_TILES) * 4, wgpu::BufferUsages::COPY_DST);
         let dispatch_args = buffer("trace dispatch arguments", 12, wgpu::BufferUsages::INDIRECT);
