@@ -107,10 +107,7 @@ fn click_attach_save_erase_save_in_a_real_window() {
     xdotool(&display, &["key", "r"]);
     std::thread::sleep(Duration::from_millis(700));
     let tools_after = screenshot_x(&display, &dir.path().join("tools-after.png"));
-    let changed = (0..230)
-        .flat_map(|x| (50..72).map(move |y| (x, y)))
-        .filter(|&(x, y)| tools_before.get_pixel(x, y) != tools_after.get_pixel(x, y))
-        .count();
+    let changed = pixels_changed(&tools_before, &tools_after, 0..230, 50..72);
     assert!(changed > 200, "the tool buttons did not follow the R key ({changed} pixels changed)");
     let bytes = click(&display, &window, &mut lines, x, y);
     assert!(bytes <= 1024, "a one-voxel erase wrote {bytes} bytes to the GPU");
@@ -204,10 +201,7 @@ fn slow_load_keeps_the_window_live() {
     xdotool(&display, &["mouseup", "3"]);
     std::thread::sleep(Duration::from_millis(1500));
     let after = screenshot_x(&display, &dir.path().join("after.png"));
-    let changed = (260..640)
-        .flat_map(|x| (40..480).map(move |y| (x, y)))
-        .filter(|&(x, y)| before.get_pixel(x, y) != after.get_pixel(x, y))
-        .count();
+    let changed = pixels_changed(&before, &after, 260..640, 40..480);
     assert!(changed > 5000, "the view did not follow the mouse during the load ({changed} pixels changed)");
     assert!(lines.rx.try_recv().map_or(true, |l| !l.starts_with("loaded:")), "the load finished too early");
 
@@ -410,4 +404,16 @@ fn floor_scene(dir: &std::path::Path) -> (PathBuf, octovox::scene::Scene, Camera
     let camera =
         Camera { eye: glam::DVec3::new(8.0, 20.0, 24.0), target: glam::DVec3::new(8.0, 0.0, 8.0), fov_y_deg: 50.0 };
     (file, scene, camera)
+}
+
+/// How many pixels of the rectangle `xs` × `ys` differ between two screenshots.
+fn pixels_changed(
+    before: &image::RgbImage,
+    after: &image::RgbImage,
+    xs: std::ops::Range<u32>,
+    ys: std::ops::Range<u32>,
+) -> usize {
+    xs.flat_map(|x| ys.clone().map(move |y| (x, y)))
+        .filter(|&(x, y)| before.get_pixel(x, y) != after.get_pixel(x, y))
+        .count()
 }
