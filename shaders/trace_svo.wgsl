@@ -346,20 +346,23 @@ fn tile_dispatch() {
     dispatch_args[2] = 1u;
 }
 
-// The pixel of this invocation in its workgroup's traced tile, or none
-// (x = NO_TILE) past the list or the image. Divisions by constants only:
-// integer division is a scalar loop over the lanes on CPU-emulated GPUs.
-fn traced_pixel(wid: vec3<u32>, lid: vec3<u32>) -> vec2<u32> {
-    let none = vec2<u32>(NO_TILE);
-    let tile = traced.list[wid.y * ROW_TILES + wid.x / tile_groups()];
-    if (tile == NO_TILE) {
+// The pixel of this invocation in its workgroup's traced tile, and the tile's
+// index in the beam buffer; or none (x = NO_TILE) past the list or the
+// image. Divisions by constants only: integer division is a scalar loop over
+// the lanes on CPU-emulated GPUs.
+fn traced_pixel(wid: vec3<u32>, lid: vec3<u32>) -> vec3<u32> {
+    let none = vec3<u32>(NO_TILE);
+    let packed = traced.list[wid.y * ROW_TILES + wid.x / tile_groups()];
+    if (packed == NO_TILE) {
         return none;
     }
+    let tile = vec2<u32>(packed & 0xffffu, packed >> 16u);
     let block = wid.x % tile_groups();
     let side = BEAM_TILE / 8u;
-    let corner = vec2<u32>(tile & 0xffffu, tile >> 16u) * BEAM_TILE + vec2<u32>(block % side, block / side) * 8u;
+    let corner = tile * BEAM_TILE + vec2<u32>(block % side, block / side) * 8u;
     let px = corner + lid.xy;
-    return select(none, px, px.x < u.width && px.y < u.height);
+    let inside = px.x < u.width && px.y < u.height;
+    return select(none, vec3<u32>(px, tile.y * beam_tiles().x + tile.x), inside);
 }
 
 // Traces the pixels of the tiles the beam found something in, each ray
@@ -368,12 +371,13 @@ fn traced_pixel(wid: vec3<u32>, lid: vec3<u32>) -> vec2<u32> {
 @compute @workgroup_size(8, 8)
 fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_id) lid: vec3<u32>) {
     load_constants();
-    let px = traced_pixel(wid, lid);
-    if (px.x == NO_TILE) {
+    let pixel = traced_pixel(wid, lid);
+    if (pixel.x == NO_TILE) {
         return;
     }
+    let px = pixel.xy;
     let r = pixel_ray(px);
-    let distance = beam_distance[(px.y / BEAM_TILE) * beam_tiles().x + px.x / BEAM_TILE];
+    let distance = beam_distance[pixel.z];
     let t_start = max(distance - 1.0, 0.0) / length(r.d);
     let hit = trace_svo(r, t_start, 0u, vec2<f32>(0.0, u.lod_per_t));
     var in_shadow = false;
