@@ -7,7 +7,7 @@
 use image::RgbaImage;
 
 use crate::camera::Camera;
-use crate::gpu::Renderer;
+use crate::gpu::{PathView, Renderer};
 use crate::io::png::upscale;
 use crate::scene::Scene;
 use crate::settings::{PathSettings, RenderSettings, TraceMode, View, scaled_size};
@@ -76,8 +76,10 @@ pub fn render_setting(
             let traced = scaled_size(size, render_scale);
             renderer.compile_path_kernel(&scene.tree, &scene.palette, &settings)?;
             let start = std::time::Instant::now();
+            let view =
+                PathView { tree: &scene.tree, palette: &scene.palette, camera, size: traced, settings: &settings };
             for sample in 0..spp {
-                renderer.render_path(&scene.tree, &scene.palette, camera, traced, &settings, sample == 0)?;
+                renderer.render_path(&view, sample == 0)?;
             }
             let ms = start.elapsed().as_secs_f64() * 1e3;
             Ok((ms, upscale(renderer.read_image()?, size)))

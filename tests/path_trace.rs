@@ -9,7 +9,7 @@ mod common;
 
 use glam::{DVec3, IVec3, Vec3};
 use octovox::camera::Camera;
-use octovox::gpu::Renderer;
+use octovox::gpu::{PathView, Renderer};
 use octovox::scene::{Material, MaterialKind, Octree, Op, Palette, Shape};
 use octovox::settings::{PathSettings, Sky};
 use octovox::trace::path::{CpuRender, render_cpu};
@@ -207,8 +207,9 @@ fn render_gpu(
     let mut renderer = Renderer::headless().expect("a GPU adapter (lavapipe on CI)");
     renderer.sync(tree, palette);
     let mut effects = None;
+    let view = PathView { tree, palette, camera, size, settings };
     for i in 0..spp {
-        let frame = renderer.render_path(tree, palette, camera, size, settings, i == 0).unwrap();
+        let frame = renderer.render_path(&view, i == 0).unwrap();
         assert_eq!(frame.samples, i + 1);
         effects = Some(frame.effects);
     }
@@ -292,8 +293,9 @@ fn no_nan_or_infinity_from_the_hard_case_cameras() {
     for (i, camera) in cameras.iter().enumerate() {
         let CpuRender { pixels: cpu, .. } = render_cpu(&tree, &palette, camera, (24, 18), &settings, 2);
         assert!(all_finite(&cpu), "camera {i}: the CPU's accumulation holds NaN, infinity or a negative");
+        let view = PathView { tree: &tree, palette: &palette, camera, size: (24, 18), settings: &settings };
         for sample in 0..2 {
-            renderer.render_path(&tree, &palette, camera, (24, 18), &settings, sample == 0).unwrap();
+            renderer.render_path(&view, sample == 0).unwrap();
         }
         let gpu = renderer.read_radiance().unwrap();
         assert!(all_finite(&gpu), "camera {i}: the GPU's accumulation holds NaN, infinity or a negative");
@@ -332,17 +334,24 @@ fn a_new_effect_set_is_compiled_off_the_frame_path() {
     let settings = PathSettings::default();
     let mut renderer = Renderer::headless().unwrap();
     renderer.sync(&mut tree, &palette);
-    let frame = renderer.render_path(&tree, &palette, &camera, (16, 12), &settings, true).unwrap();
+    let size = (16, 12);
+    let frame = renderer
+        .render_path(&PathView { tree: &tree, palette: &palette, camera: &camera, size, settings: &settings }, true)
+        .unwrap();
     assert_eq!((frame.effects.names(), frame.kernel), (vec!["sun", "sky"], frame.effects));
     let all = PathSettings { effects: octovox::settings::EffectsChoice::All, ..settings };
     renderer.compile_path_kernel(&tree, &palette, &all).unwrap();
     tree.apply_brush(&Shape::Voxel(IVec3::new(3, 8, 3)), Op::Place(SPECIAL)).unwrap();
     renderer.sync(&mut tree, &palette);
-    let frame = renderer.render_path(&tree, &palette, &camera, (16, 12), &settings, true).unwrap();
+    let frame = renderer
+        .render_path(&PathView { tree: &tree, palette: &palette, camera: &camera, size, settings: &settings }, true)
+        .unwrap();
     assert_eq!(frame.effects.names(), ["sun", "sky", "glass"]);
     assert_eq!(frame.kernel, octovox::trace::path::materials::Effects::ALL, "the stand-in runs while glass compiles");
     renderer.compile_path_kernel(&tree, &palette, &settings).unwrap();
-    let frame = renderer.render_path(&tree, &palette, &camera, (16, 12), &settings, false).unwrap();
+    let frame = renderer
+        .render_path(&PathView { tree: &tree, palette: &palette, camera: &camera, size, settings: &settings }, false)
+        .unwrap();
     assert_eq!(frame.kernel, frame.effects);
 }
 
@@ -362,22 +371,20 @@ fn a_sample_split_in_bands_equals_a_whole_one() {
     let mut renderer = Renderer::headless().expect("a GPU adapter (lavapipe on CI)");
     renderer.sync(&mut tree, &palette);
     // The window traces the preview first when an accumulation would start over.
-    let restarts = |r: &Renderer, camera: &Camera, changed: bool| {
-        r.path_restarts(&tree, &palette, camera, size, &settings, changed)
-    };
-    assert!(restarts(&renderer, &camera, false), "nothing accumulated yet");
-    renderer.render_path(&tree, &palette, &camera, size, &settings, true).unwrap();
-    assert!(!restarts(&renderer, &camera, false), "the same accumulation goes on");
-    assert!(restarts(&renderer, &camera, true), "the scene changed");
+    let view = PathView { tree: &tree, palette: &palette, camera: &camera, size, settings: &settings };
+    assert!(renderer.path_restarts(&view, false), "nothing accumulated yet");
+    renderer.render_path(&view, true).unwrap();
+    assert!(!renderer.path_restarts(&view, false), "the same accumulation goes on");
+    assert!(renderer.path_restarts(&view, true), "the scene changed");
     let moved = look(DVec3::new(3.5, 8.0, 14.0), DVec3::new(0.0, 1.0, 0.0));
-    assert!(restarts(&renderer, &moved, false), "the camera moved");
+    assert!(renderer.path_restarts(&PathView { camera: &moved, ..view }, false), "the camera moved");
     for bands in [4, 37, 100] {
         renderer.path_bands = bands;
         let used = bands.min(size.1);
         for sample in 0..3 {
             for band in 0..used {
                 let first = sample == 0 && band == 0;
-                let frame = renderer.render_path(&tree, &palette, &camera, size, &settings, first).unwrap();
+                let frame = renderer.render_path(&view, first).unwrap();
                 assert_eq!(frame.added, band == used - 1, "{bands} bands: band {band} of sample {sample}");
                 assert_eq!(frame.samples, sample + u32::from(frame.added));
             }

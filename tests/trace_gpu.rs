@@ -7,7 +7,7 @@ mod common;
 use common::{Agreement, cameras_for, sculpture};
 use glam::{DVec3, IVec3};
 use octovox::camera::Camera;
-use octovox::gpu::Renderer;
+use octovox::gpu::{PathView, Renderer};
 use octovox::io::mesh::{MESH_COLOR, UpAxis, voxelize_obj};
 use octovox::scene::{Octree, Op, Palette, Scene, Shape};
 use octovox::settings::{RenderSettings, TraceMode, View};
@@ -281,9 +281,9 @@ fn frame_times_stay_plausible_after_path_traced_frames() {
     let settings = RenderSettings { mode: TraceMode::Grid, ..RenderSettings::default() };
     let size = (480, 270);
     renderer.render(&scene.tree, &camera, size, &settings, None).unwrap();
-    renderer
-        .render_path(&scene.tree, &scene.palette, &camera, size, &octovox::settings::PathSettings::default(), true)
-        .unwrap();
+    let path_settings = octovox::settings::PathSettings::default();
+    let view = PathView { tree: &scene.tree, palette: &scene.palette, camera: &camera, size, settings: &path_settings };
+    renderer.render_path(&view, true).unwrap();
     for _ in 0..3 {
         let start = std::time::Instant::now();
         let ms = renderer.render(&scene.tree, &camera, size, &settings, None).unwrap();

@@ -7,6 +7,7 @@ use std::time::{Duration, Instant};
 
 use winit::event_loop::ActiveEventLoop;
 
+use octovox::gpu::PathView;
 use octovox::settings::{Shading, TraceMode, View};
 use octovox::trace::grid::DenseGrid;
 
@@ -182,25 +183,21 @@ impl App {
         // accumulation that starts over is preceded by a preview frame, shown
         // until its first sample (which may come in bands) is complete.
         let wants_path = path_traced(&self.state, self.motion.moving());
-        let restarts = wants_path && {
-            let (scene, state) = (&self.editor.scene, &self.state);
-            let (camera, settings) = (&state.camera, &state.path_settings);
-            gfx.renderer.path_restarts(&scene.tree, &scene.palette, camera, trace_size, settings, self.path_stale)
+        let (scene, state) = (&self.editor.scene, &self.state);
+        let view = PathView {
+            tree: &scene.tree,
+            palette: &scene.palette,
+            camera: &state.camera,
+            size: trace_size,
+            settings: &state.path_settings,
         };
+        let restarts = wants_path && gfx.renderer.path_restarts(&view, self.path_stale);
         let path = wants_path && (!restarts || self.preview_before_path);
         self.preview_before_path = wants_path && !path;
         if path {
             let changed = std::mem::take(&mut self.path_stale);
             gfx.renderer.sample_target = self.state.sample_target.max(1);
-            let (scene, state) = (&self.editor.scene, &self.state);
-            let frame = gfx.renderer.render_path(
-                &scene.tree,
-                &scene.palette,
-                &state.camera,
-                trace_size,
-                &state.path_settings,
-                changed,
-            );
+            let frame = gfx.renderer.render_path(&view, changed);
             match frame {
                 Ok(frame) => {
                     if frame.added {

@@ -10,7 +10,7 @@ use octovox::trace::render::display_rgba;
 use serde::Serialize;
 
 use octovox::camera::Camera;
-use octovox::gpu::Renderer;
+use octovox::gpu::{PathView, Renderer};
 use octovox::scene::Scene;
 use octovox::scene::demo::BuiltIn;
 use octovox::settings::{EffectsChoice, PathSettings};
@@ -52,8 +52,9 @@ fn run(
     samples: u32,
 ) -> anyhow::Result<(Vec<f64>, Vec<Vec3>)> {
     let mut times = Vec::new();
+    let view = PathView { tree: &scene.tree, palette: &scene.palette, camera, size, settings };
     for sample in 0..samples {
-        let frame = renderer.render_path(&scene.tree, &scene.palette, camera, size, settings, sample == 0)?;
+        let frame = renderer.render_path(&view, sample == 0)?;
         anyhow::ensure!(
             frame.kernel == frame.effects || settings.effects == EffectsChoice::All,
             "timed the stand-in kernel"

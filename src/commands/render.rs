@@ -7,7 +7,7 @@ use anyhow::Context;
 
 use crate::cli::{RenderArgs, camera_or_framing};
 use octovox::camera::Camera;
-use octovox::gpu::Renderer;
+use octovox::gpu::{PathView, Renderer};
 use octovox::io::atomic::WriteOptions;
 use octovox::io::output::{OutputKind, check_output};
 use octovox::io::png::save_png;
@@ -139,8 +139,9 @@ fn path_traced(
     renderer.sync(&mut scene.tree, &scene.palette);
     let mut total_ms = 0.0;
     let mut last = None;
+    let view = PathView { tree: &scene.tree, palette: &scene.palette, camera, size, settings: &settings };
     for sample in 0..spp {
-        let frame = renderer.render_path(&scene.tree, &scene.palette, camera, size, &settings, sample == 0)?;
+        let frame = renderer.render_path(&view, sample == 0)?;
         total_ms += frame.ms;
         last = Some(frame);
     }

@@ -14,6 +14,6 @@ pub mod trace_pass;
 pub use blit_pass::{BlitMode, BlitPass};
 pub use context::{GpuContext, GpuError};
 pub use path_pass::{PathPass, PathUniforms};
-pub use renderer::{PathFrame, Renderer};
+pub use renderer::{PathFrame, PathView, Renderer};
 pub use scene_buffers::SceneBuffers;
 pub use trace_pass::{FrameUniforms, Kernel, TracePass};

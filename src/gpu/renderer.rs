@@ -40,7 +40,19 @@ pub struct PathFrame {
     pub added: bool,
 }
 
-fn path_key(tree: &Octree, palette: &Palette, camera: &Camera, size: (u32, u32), settings: &PathSettings) -> PathKey {
+/// What a path-traced accumulation is of: the scene, the camera, the
+/// traced size and the settings. A change to any of them starts it over.
+#[derive(Clone, Copy)]
+pub struct PathView<'a> {
+    pub tree: &'a Octree,
+    pub palette: &'a Palette,
+    pub camera: &'a Camera,
+    pub size: (u32, u32),
+    pub settings: &'a PathSettings,
+}
+
+fn path_key(view: &PathView) -> PathKey {
+    let PathView { tree, palette, camera, size, settings } = *view;
     let basis = camera.basis(size.0.max(1), size.1.max(1), tree.origin());
     PathKey { basis, settings: *settings, effects: effects_for(tree, palette, settings) }
 }
@@ -232,20 +244,13 @@ impl Renderer {
     ///
     /// # Errors
     /// As [`Renderer::render`].
-    pub fn render_path(
-        &mut self,
-        tree: &Octree,
-        palette: &Palette,
-        camera: &Camera,
-        size: (u32, u32),
-        settings: &PathSettings,
-        scene_changed: bool,
-    ) -> Result<PathFrame, GpuError> {
+    pub fn render_path(&mut self, view: &PathView, scene_changed: bool) -> Result<PathFrame, GpuError> {
         self.check_pool()?;
+        let PathView { tree, palette, size, settings, .. } = *view;
         let gpu = &self.gpu;
         gpu.checked(|| {
             let resized = self.path.resize(gpu, &self.buffers, size)?;
-            let key = path_key(tree, palette, camera, size, settings);
+            let key = path_key(view);
             let effects = key.effects;
             // The materials and lights go up again when the scene or the effect set changed.
             let send_scene = scene_changed || resized || self.path_key.is_none_or(|k| k.effects != effects);
@@ -305,17 +310,9 @@ impl Renderer {
     /// the accumulation over. The window then traces the preview first: it
     /// is shown until the new accumulation's first sample, which may come
     /// in bands, is complete.
-    pub fn path_restarts(
-        &self,
-        tree: &Octree,
-        palette: &Palette,
-        camera: &Camera,
-        size: (u32, u32),
-        settings: &PathSettings,
-        scene_changed: bool,
-    ) -> bool {
-        let resized = self.path.size() != (size.0.max(1), size.1.max(1));
-        starts_over(self.path_key, &path_key(tree, palette, camera, size, settings), resized, scene_changed)
+    pub fn path_restarts(&self, view: &PathView, scene_changed: bool) -> bool {
+        let resized = self.path.size() != (view.size.0.max(1), view.size.1.max(1));
+        starts_over(self.path_key, &path_key(view), resized, scene_changed)
     }
 
     /// Compiles the path kernel a scene needs with `settings` now, so that the
