@@ -4,7 +4,9 @@
 // as a multiple of it. An SVO frame runs it first as its sky: the trace then
 // draws over the tiles the beam prepass lists (trace_svo.wgsl).
 
-@compute @workgroup_size(8, 8)
+// Rows of FLOOR_ROW pixels: whole cache lines of the output per workgroup
+// (src/gpu/trace_pass.rs says why).
+@compute @workgroup_size(FLOOR_ROW, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     load_constants();
     if (gid.x >= u.width || gid.y >= u.height) {

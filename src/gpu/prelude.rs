@@ -4,7 +4,7 @@
 
 use std::fmt::Write as _;
 
-use super::trace_pass::ROW_TILES;
+use super::trace_pass::{FLOOR_ROW, ROW_TILES};
 use crate::gpu_pool::{LOD_WORD, NODE_WORDS, POINTER_BIT};
 use crate::settings::{SUN_DIR, View};
 use crate::trace::path::{self, materials};
@@ -26,6 +26,7 @@ pub fn shared_constants() -> String {
     line("NODE_WORDS", "u32", format!("{NODE_WORDS}u"));
     line("LOD_WORD", "u32", format!("{LOD_WORD}u"));
     line("ROW_TILES", "u32", format!("{ROW_TILES}u"));
+    line("FLOOR_ROW", "u32", format!("{FLOOR_ROW}u"));
     line("SUN_DIR", "vec3<f32>", vec3(SUN_DIR));
     line("GAVE_UP_COLOR", "vec3<f32>", vec3(GAVE_UP_COLOR.to_array()));
     line("SUN_COS", "f32", format!("{:?}", path::sun_cos()));

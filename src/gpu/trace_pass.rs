@@ -129,6 +129,14 @@ const _: () = assert!(BEAM_TILE.is_multiple_of(8));
 /// tile, rounded up to whole rows.
 pub(super) const ROW_TILES: u64 = 64;
 
+/// The floor kernel's workgroups are rows of this many pixels: 256 bytes of
+/// the output, four cache lines, each shared with another workgroup only at
+/// the row's ends. An 8×8 workgroup wrote half a line per row and left the
+/// other half to a neighbour that lavapipe runs on another thread: with
+/// rows, the floor takes 22 % less time and an SVO frame 6–12 % less (A/B,
+/// docs/traversal.md).
+pub(super) const FLOOR_ROW: u32 = 64;
+
 /// Pipelines are compiled per tracer and per shadow setting (an override
 /// constant), so a scene rendered without shadows pays nothing for them. The
 /// SVO frame runs in four dispatches: the floor kernel draws every pixel as
@@ -485,7 +493,7 @@ impl TracePass {
     /// frame under the tiles the trace then draws over.
     fn encode_floor(&self, pass: &mut wgpu::ComputePass<'_>) {
         pass.set_pipeline(&self.floor);
-        pass.dispatch_workgroups(self.target.width.div_ceil(8), self.target.height.div_ceil(8), 1);
+        pass.dispatch_workgroups(self.target.width.div_ceil(FLOOR_ROW), self.target.height, 1);
     }
 
     /// Reads back the hit record of every pixel.
