@@ -4,8 +4,8 @@
 // as a multiple of it. An SVO frame runs it first as its sky: the trace then
 // draws over the tiles the beam prepass lists (trace_svo.wgsl).
 
-// Rows of FLOOR_ROW pixels: whole cache lines of the output per workgroup
-// (src/gpu/trace_pass.rs says why).
+// Workgroups are rows of FLOOR_ROW pixels, not 8×8 squares, so that two
+// threads rarely write one cache line of the output (src/gpu/trace_pass.rs).
 @compute @workgroup_size(FLOOR_ROW, 1)
 fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
     load_constants();
