@@ -13,7 +13,7 @@
 // (an indirect dispatch), after the floor kernel has drawn every pixel as
 // sky. CPU-emulated GPUs run a branch that any lane takes on every lane,
 // masked, so an empty tile in the trace kernel cost about what a traced one
-// did. `count` is zeroed before every frame.
+// did. `count` is zeroed before every SVO frame (`TracePass::encode`).
 struct TracedTiles {
     count: atomic<u32>,
     // x | y << 16 of each tile, in no particular order.

@@ -343,15 +343,12 @@ fn a_new_effect_set_is_compiled_off_the_frame_path() {
     renderer.compile_path_kernel(&tree, &palette, &all).unwrap();
     tree.apply_brush(&Shape::Voxel(IVec3::new(3, 8, 3)), Op::Place(SPECIAL)).unwrap();
     renderer.sync(&mut tree, &palette);
-    let frame = renderer
-        .render_path(&PathView { tree: &tree, palette: &palette, camera: &camera, size, settings: &settings }, true)
-        .unwrap();
+    let view = PathView { tree: &tree, palette: &palette, camera: &camera, size, settings: &settings };
+    let frame = renderer.render_path(&view, true).unwrap();
     assert_eq!(frame.effects.names(), ["sun", "sky", "glass"]);
     assert_eq!(frame.kernel, octovox::trace::path::materials::Effects::ALL, "the stand-in runs while glass compiles");
     renderer.compile_path_kernel(&tree, &palette, &settings).unwrap();
-    let frame = renderer
-        .render_path(&PathView { tree: &tree, palette: &palette, camera: &camera, size, settings: &settings }, false)
-        .unwrap();
+    let frame = renderer.render_path(&view, false).unwrap();
     assert_eq!(frame.kernel, frame.effects);
 }
 

@@ -444,7 +444,6 @@ impl TracePass {
             self.bound_generation = buffers.generation;
         }
         queue.write_buffer(&self.uniform_buf, 0, bytemuck::bytes_of(uniforms));
-        queue.write_buffer(&self.target.traced_tiles, 0, bytemuck::bytes_of(&0u32));
     }
 
     /// Records the dispatches: for the SVO the sky (the floor kernel), the
@@ -456,6 +455,10 @@ impl TracePass {
         kernel: Kernel,
         timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) {
+        if matches!(kernel, Kernel::Trace { mode: TraceMode::Svo, .. }) {
+            // The beam prepass appends to the list of traced tiles from zero.
+            encoder.clear_buffer(&self.target.traced_tiles, 0, Some(4));
+        }
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("trace"), timestamp_writes: timestamps });
         pass.set_bind_group(0, &self.bind_group, &[]);
