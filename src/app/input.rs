@@ -16,6 +16,16 @@ const CLICK_SLOP_PIXELS: f64 = 4.0;
 /// Pixels per wheel "line" for touchpads that report pixels.
 const PIXELS_PER_LINE: f64 = 40.0;
 
+/// One keyboard event, as [`Input::on_key`] needs it.
+#[derive(Clone, Copy, Debug)]
+struct Press {
+    code: KeyCode,
+    state: ElementState,
+    repeat: bool,
+    /// Sent by winit, not typed: see [`Input::on_key`].
+    synthetic: bool,
+}
+
 #[derive(Debug, Default)]
 pub struct Input {
     cursor: Option<(f64, f64)>,
@@ -170,29 +180,40 @@ impl Input {
                 };
                 out.push(Command::Zoom { steps });
             }
-            WindowEvent::KeyboardInput { event, .. } => {
+            WindowEvent::KeyboardInput { event, is_synthetic, .. } => {
                 log::debug!(
-                    "key {:?} {:?} consumed={consumed} modifiers={:?}",
+                    "key {:?} {:?} consumed={consumed} synthetic={is_synthetic} modifiers={:?}",
                     event.physical_key,
                     event.state,
                     self.modifiers
                 );
-                let PhysicalKey::Code(code) = event.physical_key else { return out };
-                if event.state == ElementState::Released {
-                    self.keys.remove(&code);
-                    return out;
-                }
-                if consumed {
-                    return out;
-                }
-                self.keys.insert(code);
-                if let Some(command) = self.shortcut(code, event.repeat) {
-                    out.push(command);
+                if let PhysicalKey::Code(code) = event.physical_key {
+                    let press = Press { code, state: event.state, repeat: event.repeat, synthetic: *is_synthetic };
+                    out.extend(self.on_key(press, consumed));
                 }
             }
             _ => {}
         }
         out
+    }
+
+    /// A key went down or up. A synthetic press (winit sends one for every
+    /// key held when the window gains focus) counts as held but fires no
+    /// shortcut: the real press, when the key was pressed just as the focus
+    /// came, follows it, and a toggle would fire twice.
+    fn on_key(&mut self, key: Press, consumed: bool) -> Option<Command> {
+        if key.state == ElementState::Released {
+            self.keys.remove(&key.code);
+            return None;
+        }
+        if consumed {
+            return None;
+        }
+        self.keys.insert(key.code);
+        if key.synthetic {
+            return None;
+        }
+        self.shortcut(key.code, key.repeat)
     }
 
     /// Keyboard shortcuts (physical keys, so they work on any layout), from
@@ -204,5 +225,37 @@ impl Input {
             return None;
         }
         Some(action.command.clone())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn press(code: KeyCode, synthetic: bool) -> Press {
+        Press { code, state: ElementState::Pressed, repeat: false, synthetic }
+    }
+
+    #[test]
+    fn a_key_held_as_the_focus_comes_toggles_once() {
+        let mut input = Input::default();
+        // The focus arrives while B is down: winit's synthetic press, then the real one.
+        assert_eq!(input.on_key(press(KeyCode::KeyB, true), false), None);
+        assert_eq!(input.on_key(press(KeyCode::KeyB, false), false), Some(Command::ToggleSelect));
+        let release = Press { state: ElementState::Released, ..press(KeyCode::KeyB, false) };
+        assert_eq!(input.on_key(release, false), None);
+    }
+
+    #[test]
+    fn a_synthetic_press_still_counts_as_held() {
+        let mut input = Input { right: Some(((0.0, 0.0), true)), ..Input::default() };
+        assert_eq!(input.on_key(press(KeyCode::KeyW, true), false), None);
+        assert_eq!(input.fly_direction(), Some(DVec3::Z));
+    }
+
+    #[test]
+    fn a_press_egui_consumed_fires_nothing() {
+        let mut input = Input::default();
+        assert_eq!(input.on_key(press(KeyCode::KeyB, false), true), None);
     }
 }
