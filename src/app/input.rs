@@ -16,9 +16,9 @@ const CLICK_SLOP_PIXELS: f64 = 4.0;
 /// Pixels per wheel "line" for touchpads that report pixels.
 const PIXELS_PER_LINE: f64 = 40.0;
 
-/// One keyboard event, as [`Input::on_key`] needs it.
+/// One key going down or up, as [`Input::on_key`] needs it.
 #[derive(Clone, Copy, Debug)]
-struct Press {
+struct KeyInput {
     code: KeyCode,
     state: ElementState,
     repeat: bool,
@@ -188,8 +188,8 @@ impl Input {
                     self.modifiers
                 );
                 if let PhysicalKey::Code(code) = event.physical_key {
-                    let press = Press { code, state: event.state, repeat: event.repeat, synthetic: *is_synthetic };
-                    out.extend(self.on_key(press, consumed));
+                    let key = KeyInput { code, state: event.state, repeat: event.repeat, synthetic: *is_synthetic };
+                    out.extend(self.on_key(key, consumed));
                 }
             }
             _ => {}
@@ -201,7 +201,7 @@ impl Input {
     /// key held when the window gains focus) counts as held but fires no
     /// shortcut: the real press, when the key was pressed just as the focus
     /// came, follows it, and a toggle would fire twice.
-    fn on_key(&mut self, key: Press, consumed: bool) -> Option<Command> {
+    fn on_key(&mut self, key: KeyInput, consumed: bool) -> Option<Command> {
         if key.state == ElementState::Released {
             self.keys.remove(&key.code);
             return None;
@@ -232,8 +232,8 @@ impl Input {
 mod tests {
     use super::*;
 
-    fn press(code: KeyCode, synthetic: bool) -> Press {
-        Press { code, state: ElementState::Pressed, repeat: false, synthetic }
+    fn press(code: KeyCode, synthetic: bool) -> KeyInput {
+        KeyInput { code, state: ElementState::Pressed, repeat: false, synthetic }
     }
 
     #[test]
@@ -242,7 +242,7 @@ mod tests {
         // The focus arrives while B is down: winit's synthetic press, then the real one.
         assert_eq!(input.on_key(press(KeyCode::KeyB, true), false), None);
         assert_eq!(input.on_key(press(KeyCode::KeyB, false), false), Some(Command::ToggleSelect));
-        let release = Press { state: ElementState::Released, ..press(KeyCode::KeyB, false) };
+        let release = KeyInput { state: ElementState::Released, ..press(KeyCode::KeyB, false) };
         assert_eq!(input.on_key(release, false), None);
     }
 
