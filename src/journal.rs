@@ -11,7 +11,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::replay::{Command, Runner, RunnerMode, Script, load_script};
+use crate::replay::{Command, Runner, RunnerMode, Script};
 use crate::scene::Scene;
 
 /// The journal of `document`: `.NAME.octovox-journal.ovr` beside it.
@@ -65,6 +65,93 @@ pub fn find(document: &Path) -> Option<PathBuf> {
     path.is_file().then_some(path)
 }
 
+/// What a journal noted of a file when it started: the file its `load`
+/// line loads, as the window read it. Recovery compares the file as it is
+/// now by its hash; size and time only make the message readable.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FileStamp {
+    pub size: u64,
+    /// Modification time, in seconds since the Unix epoch (0: unknown).
+    pub modified: u64,
+    pub sha256: String,
+}
+
+impl FileStamp {
+    /// The stamp of `path` as it is now.
+    ///
+    /// # Errors
+    /// The file cannot be read.
+    pub fn of(path: &Path) -> std::io::Result<FileStamp> {
+        let meta = std::fs::metadata(path)?;
+        let modified = meta.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
+        Ok(FileStamp {
+            size: meta.len(),
+            modified: modified.map_or(0, |d| d.as_secs()),
+            sha256: crate::io::atomic::sha256_of(path)?,
+        })
+    }
+
+    /// The journal's note of the file it edits: `source size=N modified=S sha256=HEX`.
+    pub fn note(&self) -> String {
+        format!("source size={} modified={} sha256={}", self.size, self.modified, self.sha256)
+    }
+
+    fn parse(words: &[String]) -> Option<FileStamp> {
+        let value = |key: &str| words.iter().find_map(|w| w.strip_prefix(key)?.strip_prefix('='));
+        Some(FileStamp {
+            size: value("size")?.parse().ok()?,
+            modified: value("modified")?.parse().ok()?,
+            sha256: value("sha256")?.to_owned(),
+        })
+    }
+}
+
+impl std::fmt::Display for FileStamp {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let short = self.sha256.get(..12).unwrap_or(&self.sha256);
+        write!(f, "{} bytes, modified at {} s after 1970, SHA-256 {short}…", self.size, self.modified)
+    }
+}
+
+/// The journal's note written just before a save replaces `path` with a
+/// file of hash `sha256`: if a kill comes between that save's rename and
+/// the journal's removal, recovery finds the journal's edits in `path`.
+pub fn saved_note(sha256: &str, path: &Path) -> String {
+    format!("saved sha256={sha256} {}", crate::replay::quoted(path))
+}
+
+/// The notes (`#@ …` lines) of a journal's text.
+#[derive(Default)]
+struct Notes {
+    /// The file the `load` line loads, as it was when the journal started.
+    source: Option<FileStamp>,
+    /// The last save the journal saw begin: its line, hash and file.
+    saved: Option<(usize, String, PathBuf)>,
+}
+
+impl Notes {
+    fn read(text: &str) -> Notes {
+        let mut notes = Notes::default();
+        for (number, line) in (1..).zip(text.lines()) {
+            let Some(words) = line.strip_prefix("#@").and_then(|rest| crate::replay::split_words(rest).ok()) else {
+                continue;
+            };
+            match words.first().map(String::as_str) {
+                Some("source") if notes.source.is_none() => notes.source = FileStamp::parse(&words[1..]),
+                Some("saved") => {
+                    if let [_, hash, path] = words.as_slice()
+                        && let Some(hash) = hash.strip_prefix("sha256=")
+                    {
+                        notes.saved = Some((number, hash.to_owned(), PathBuf::from(path)));
+                    }
+                }
+                _ => {}
+            }
+        }
+        notes
+    }
+}
+
 /// Why a journal could not be applied. The journal is never changed.
 #[derive(Debug, thiserror::Error)]
 pub enum RecoverError {
@@ -76,50 +163,118 @@ pub enum RecoverError {
     Foreign { path: PathBuf, owner: String, document: PathBuf },
     #[error("journal {}: {message}; nothing was applied", path.display())]
     Failed { path: PathBuf, message: String },
+    #[error(
+        "journal {} is live: another octovox window is editing with it and holds its lock; nothing was applied",
+        path.display()
+    )]
+    Live { path: PathBuf },
+    #[error(
+        "journal {} is stale: a save put all its edits in {} (the file still holds that save); nothing to recover",
+        path.display(),
+        saved_to.display()
+    )]
+    Saved { path: PathBuf, saved_to: PathBuf },
+    #[error(
+        "journal {} was started on {} as it was then ({then}); it is now {now}: its edits were made on other \
+         content, so nothing was applied",
+        path.display(),
+        document.display()
+    )]
+    Changed { path: PathBuf, document: PathBuf, then: FileStamp, now: String },
 }
 
-/// Reads a journal. Its first scene line must load `document` (or the
-/// journal's own snapshot) when one is given (the journal found beside
-/// it); a journal named directly (an untitled one) must start with a scene
-/// line (`load`, `new`, `demo`).
+/// Whether another process holds `journal`'s lock (a window editing with it).
+pub fn is_live(journal: &Path) -> bool {
+    std::fs::File::open(journal).is_ok_and(|file| matches!(file.try_lock(), Err(std::fs::TryLockError::WouldBlock)))
+}
+
+/// What [`read`] checks beyond the journal's own lines.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Checks {
+    /// Apply the journal even though the file it loads changed since it
+    /// started (the window asks the user first).
+    pub allow_changed_source: bool,
+}
+
+/// Reads a journal. It must make its scene once, on its first line: `load`
+/// of `document` (or of the journal's own snapshot) when one is given (the
+/// journal found beside it); a journal named directly (an untitled one)
+/// may also start with `new` or `demo`. The file it loads must be as the
+/// journal noted it when it started, unless `checks` allows otherwise; a
+/// journal whose edits a finished save holds, or that a running window
+/// holds, is refused.
 ///
 /// # Errors
-/// A journal that does not parse, or one written for another file.
-pub fn read(journal: &Path, document: Option<&Path>) -> Result<Script, RecoverError> {
-    let script = load_script(journal).map_err(|errors| RecoverError::Unreadable {
-        path: journal.to_path_buf(),
-        errors: errors.iter().map(ToString::to_string).collect(),
-    })?;
+/// A journal that does not parse, is written for another file, is live,
+/// stale, or was started on other content than its file holds now.
+pub fn read(journal: &Path, document: Option<&Path>, checks: Checks) -> Result<Script, RecoverError> {
+    if is_live(journal) {
+        return Err(RecoverError::Live { path: journal.to_path_buf() });
+    }
+    let unreadable = |errors: Vec<String>| RecoverError::Unreadable { path: journal.to_path_buf(), errors };
+    let bytes = crate::io::input::read_limited(journal, crate::replay::MAX_SCRIPT_BYTES)
+        .map_err(|e| unreadable(vec![format!("cannot read it: {e}")]))?;
+    let text = String::from_utf8(bytes).map_err(|_| unreadable(vec!["it is not UTF-8 text".into()]))?;
+    let script = crate::replay::parse_script(journal, &text)
+        .map_err(|errors| unreadable(errors.iter().map(ToString::to_string).collect()))?;
+    let first = check_lines(journal, &script, document)?;
+    let notes = Notes::read(&text);
+    if let Some((line, hash, saved_to)) = notes.saved
+        && script.lines.last().is_none_or(|last| last.number < line)
+        && crate::io::atomic::sha256_of(&saved_to).is_ok_and(|now| now == hash)
+    {
+        return Err(RecoverError::Saved { path: journal.to_path_buf(), saved_to });
+    }
+    if let (Some(then), Command::Load(source)) = (notes.source, first)
+        && !checks.allow_changed_source
+    {
+        let now = FileStamp::of(source);
+        if now.as_ref().is_ok_and(|now| now.sha256 != then.sha256) || now.is_err() {
+            let now = now.map_or_else(|err| format!("unreadable ({err})"), |now| now.to_string());
+            return Err(RecoverError::Changed { path: journal.to_path_buf(), document: source.clone(), then, now });
+        }
+    }
+    Ok(script)
+}
+
+/// The journal's own lines: one scene line, first, that makes the scene
+/// the journal edits, and no line that writes a file. Returns the scene line.
+fn check_lines<'a>(journal: &Path, script: &'a Script, document: Option<&Path>) -> Result<&'a Command, RecoverError> {
+    let failed = |message: String| RecoverError::Failed { path: journal.to_path_buf(), message };
+    let is_scene = |c: &Command| matches!(c, Command::Load(_) | Command::New | Command::Demo(_));
     let first = script.lines.iter().find(|l| !matches!(l.command, Command::Viewport(..))).map(|l| &l.command);
+    // A journal only edits: one that writes files (planted, or damaged) is refused.
+    if let Some(line) = script.lines.iter().find(|l| matches!(l.command, Command::Save(_) | Command::Render(_))) {
+        return Err(failed(format!("line {} writes a file ('{}'), which no journal does", line.number, line.command)));
+    }
+    // It makes its scene once: a second scene line would edit another file.
+    if let Some(line) = script.lines.iter().filter(|l| is_scene(&l.command)).nth(1) {
+        return Err(failed(format!(
+            "line {} makes a second scene ('{}'): a journal makes its scene once, on its first line",
+            line.number, line.command
+        )));
+    }
     let owned = match (first, document) {
         (Some(Command::Load(owner)), Some(document)) => {
             let id = |p: &Path| std::fs::canonicalize(p).ok();
             let owner = id(owner);
             owner.is_some() && (owner == id(document) || owner == id(&snapshot_path(journal)))
         }
-        (Some(Command::Load(_) | Command::New | Command::Demo(_)), None) => true,
+        (Some(first), None) => is_scene(first),
         _ => false,
     };
-    // A journal only edits: one that writes files (planted, or damaged) is refused.
-    if let Some(line) = script.lines.iter().find(|l| matches!(l.command, Command::Save(_) | Command::Render(_))) {
-        return Err(RecoverError::Failed {
-            path: journal.to_path_buf(),
-            message: format!("line {} writes a file ('{}'), which no journal does", line.number, line.command),
-        });
-    }
-    if owned {
-        return Ok(script);
-    }
-    let owner = first.map_or_else(|| "nothing".into(), ToString::to_string);
-    Err(match document {
-        Some(document) => {
-            RecoverError::Foreign { path: journal.to_path_buf(), owner, document: document.to_path_buf() }
+    match first {
+        Some(first) if owned => Ok(first),
+        _ => {
+            let owner = first.map_or_else(|| "nothing".into(), ToString::to_string);
+            Err(match document {
+                Some(document) => {
+                    RecoverError::Foreign { path: journal.to_path_buf(), owner, document: document.to_path_buf() }
+                }
+                None => failed(format!("it starts with '{owner}', not with the scene it edits (load, new or demo)")),
+            })
         }
-        None => RecoverError::Failed {
-            path: journal.to_path_buf(),
-            message: format!("it starts with '{owner}', not with the scene it edits (load, new or demo)"),
-        },
-    })
+    }
 }
 
 /// The scene as it was after the journal's last edit: the journal
@@ -127,8 +282,8 @@ pub fn read(journal: &Path, document: Option<&Path>) -> Result<Script, RecoverEr
 ///
 /// # Errors
 /// As [`read`], or a line that does not apply.
-pub fn recover_from(journal: &Path, document: Option<&Path>) -> Result<Scene, RecoverError> {
-    let script = read(journal, document)?;
+pub fn recover_from(journal: &Path, document: Option<&Path>, checks: Checks) -> Result<Scene, RecoverError> {
+    let script = read(journal, document, checks)?;
     let mut runner = Runner::new(RunnerMode::Cpu);
     let report = runner.run(&script);
     if let Some(failure) = report.failures.first() {
@@ -141,7 +296,7 @@ pub fn recover_from(journal: &Path, document: Option<&Path>) -> Result<Scene, Re
 ///
 /// # Errors
 /// No journal beside it, or as [`recover_from`].
-pub fn recover(document: &Path) -> Result<Scene, RecoverError> {
+pub fn recover(document: &Path, checks: Checks) -> Result<Scene, RecoverError> {
     let journal = find(document).ok_or_else(|| RecoverError::NoJournal(document.to_path_buf()))?;
-    recover_from(&journal, Some(document))
+    recover_from(&journal, Some(document), checks)
 }

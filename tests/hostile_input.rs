@@ -158,7 +158,7 @@ fn saves_follow_links_and_refuse_devices_fifos_and_read_only_files() {
     let err = write_bytes(&locked, b"x", WriteOptions::default()).unwrap_err();
     assert!(err.to_string().contains("read-only"), "{err}");
     assert_eq!(std::fs::read(&locked).unwrap(), b"mine");
-    write_bytes(&locked, b"forced", WriteOptions { overwrite_read_only: true }).unwrap();
+    write_bytes(&locked, b"forced", WriteOptions::forced(true)).unwrap();
     assert_eq!(std::fs::read(&locked).unwrap(), b"forced");
     assert_eq!(std::fs::metadata(&locked).unwrap().permissions().mode() & 0o777, 0o444, "still read-only");
     // The CLI: refused, and --force overwrites.

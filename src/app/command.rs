@@ -140,7 +140,8 @@ pub enum Command {
     /// Answer to the unsaved-changes prompt.
     Resolve(Choice),
     /// Answers to the crash-recovery prompt: apply the open document's
-    /// journal, or delete it.
-    RecoverJournal(PathBuf),
+    /// journal (to a document changed since, if the checks say so), or
+    /// delete it.
+    RecoverJournal(PathBuf, octovox::journal::Checks),
     DiscardJournal(PathBuf),
 }

@@ -12,6 +12,10 @@ use octovox::camera::Camera;
 use octovox::io::atomic::WriteOptions;
 use octovox::scene::Scene;
 
+use octovox::journal::{Checks, FileStamp};
+use octovox::replay::Command::Load;
+
+use super::journal::{Found, JournalStart, classify};
 use super::ui::DialogKind;
 use super::{App, Choice, Loading, Pending, camera_control, first_used_color};
 
@@ -19,7 +23,8 @@ impl App {
     /// Puts a new scene in place (load, New, a built-in scene) and uploads
     /// it whole; `source` is the script line that makes it (`load`, `new`,
     /// `demo`), which the recorder writes.
-    pub(super) fn replace_scene(&mut self, scene: Scene, source: octovox::replay::Command) {
+    /// `stamp` is the loaded file's as it was read (`JournalStart`).
+    pub(super) fn replace_scene(&mut self, scene: Scene, source: octovox::replay::Command, stamp: Option<FileStamp>) {
         let (path, line) = match source {
             octovox::replay::Command::Load(path) => {
                 let absolute = std::fs::canonicalize(&path).unwrap_or_else(|_| path.clone());
@@ -31,7 +36,10 @@ impl App {
         // The old document's edits were saved or discarded before this.
         self.close_journal();
         // The line that makes the scene starts its journal (untitled ones too).
-        self.journal_source = vec![line];
+        self.journal_start = match line {
+            octovox::replay::Command::Load(path) => JournalStart { lines: vec![Load(path)], stamp },
+            line => JournalStart::of(vec![line]),
+        };
         self.editor.set_scene(scene);
         self.stroke = None;
         // An imported mesh has no .vox to save back to: Save asks for one
@@ -84,7 +92,7 @@ impl App {
     pub(super) fn perform(&mut self, action: Pending, event_loop: &ActiveEventLoop) {
         match action {
             Pending::New => {
-                self.replace_scene(Scene::default(), octovox::replay::Command::New);
+                self.replace_scene(Scene::default(), octovox::replay::Command::New, None);
                 self.state.camera = Camera { fov_y_deg: self.state.camera.fov_y_deg, ..Camera::default() };
                 // A lone voxel to attach to: an empty scene gives the mouse nothing to hit.
                 let color = self.editor.tools.color.max(1);
@@ -98,7 +106,7 @@ impl App {
                 }
                 self.record(|r| r.seed(color, IVec3::ZERO));
                 // The journal starts from the seeded scene too.
-                self.journal_source.extend([
+                self.journal_start.lines.extend([
                     octovox::replay::Command::Brush(octovox::tool::Brush::Voxel),
                     octovox::replay::Command::Color(color),
                     octovox::replay::Command::Place(IVec3::ZERO),
@@ -118,19 +126,20 @@ impl App {
 
     /// Applies a crash-recovery journal (what `octovox recover` does): the
     /// open document's, and journaling goes on at its end; or an untitled
-    /// scene's, which this session's own journal then replaces.
-    pub(super) fn recover_journal(&mut self, journal: &Path) {
+    /// scene's, which this session's own journal then replaces. `checks`
+    /// says whether the user chose to apply it to a changed document.
+    pub(super) fn recover_journal(&mut self, journal: &Path, checks: Checks) {
         let document = self.state.path.clone().filter(|d| octovox::journal::journal_path(d) == journal);
         let recovered = match &document {
-            Some(document) => octovox::journal::recover(document),
-            None => octovox::journal::recover_from(journal, None),
+            Some(document) => octovox::journal::recover(document, checks),
+            None => octovox::journal::recover_from(journal, None, checks),
         };
         let scene = match recovered {
             Ok(scene) => scene,
             Err(err) => return self.ui.error(format!("cannot recover: {err}")),
         };
         let source = document.clone().map_or(octovox::replay::Command::New, octovox::replay::Command::Load);
-        self.replace_scene(scene, source);
+        self.replace_scene(scene, source, None);
         // What is shown is the scene plus its journal, not yet saved.
         self.state.dirty = true;
         if document.is_some() {
@@ -151,6 +160,26 @@ impl App {
         report!("recovered: {what}");
         self.ui.info(format!("recovered the unsaved edits of {what}"));
         self.update_title();
+    }
+
+    /// A journal found beside the document just opened (or an untitled
+    /// one a dead session left): offered, or said to be another window's,
+    /// or removed when a finished save holds its edits.
+    pub(super) fn found_journal(&mut self, journal: PathBuf, document: Option<&Path>) {
+        match classify(&journal, document) {
+            Found::Offer(doubt) => {
+                report!("asking: recover {}", journal.display());
+                self.ui.recover = Some((journal, doubt));
+            }
+            Found::Live(text) => {
+                report!("journal live: {}", journal.display());
+                self.journal_failed(format!("{text}; this window's edits are not journaled"));
+            }
+            Found::Stale(text) => {
+                report!("journal stale: {}", journal.display());
+                self.ui.info(text);
+            }
+        }
     }
 
     /// Where this session journals a scene that has no file.
@@ -178,15 +207,31 @@ impl App {
             self.ui.read_only = Some(path.to_path_buf());
             return false;
         }
-        match octovox::io::save_scene(path, &self.editor.scene, options) {
+        // Just before the rename, the journal notes which file will hold its
+        // edits: a kill before the journal's removal leaves it stale, not
+        // replayed a second time.
+        let target = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+        let journal = std::cell::RefCell::new(self.journal.take());
+        let note = |sha256: &str| {
+            if let Some(journal) = journal.borrow_mut().as_mut()
+                && let Err(err) = journal.note(&octovox::journal::saved_note(sha256, &target))
+            {
+                log::warn!("cannot note the save in the crash-recovery journal: {err}");
+            }
+        };
+        let result =
+            octovox::io::save_scene(path, &self.editor.scene, WriteOptions { before_replace: Some(&note), ..options });
+        self.journal = journal.into_inner();
+        match result {
             Ok(()) => {
+                hold_for_tests_after_rename();
                 self.recent.add(path);
                 report!("saved: {}", path.display());
                 self.state.dirty = false;
                 // The file now holds every edit: the journal starts again from it.
                 self.close_journal();
                 let absolute = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
-                self.journal_source = vec![octovox::replay::Command::Load(absolute)];
+                self.journal_start = JournalStart::load(absolute);
                 self.ui.info(format!("saved {}", path.display()));
                 self.update_title();
                 true
@@ -224,7 +269,12 @@ impl App {
         let progress = octovox::io::progress::Progress::default();
         let reporter = progress.clone();
         let spawned = std::thread::Builder::new().name("vox loader".into()).spawn(move || {
-            let result = octovox::io::load_scene_with(&thread_path, 0, &reporter).map_err(|e| e.to_string());
+            // The stamp before the read: a change on disk after it is one the
+            // journal's recovery then notices.
+            let stamp = FileStamp::of(&thread_path).ok();
+            let result = octovox::io::load_scene_with(&thread_path, 0, &reporter)
+                .map(|scene| (scene, stamp))
+                .map_err(|e| e.to_string());
             // The window may have closed meanwhile; then nobody wants the scene.
             let _ = tx.send(result);
         });
@@ -244,23 +294,37 @@ impl App {
         };
         let Some(loading) = self.loading.take() else { return };
         match result {
-            Ok(scene) => {
+            Ok((scene, stamp)) => {
                 self.recent.add(&loading.path);
                 let seconds = loading.started.elapsed().as_secs_f64();
                 report!("loaded: {} ({} voxels, {seconds:.2} s)", loading.path.display(), scene.tree.solid_voxels());
-                self.replace_scene(scene, octovox::replay::Command::Load(loading.path.clone()));
+                self.replace_scene(scene, Load(loading.path.clone()), stamp);
                 // A camera from the command line wins for the file it came with.
                 let keep_camera = self.args.camera.is_some() && self.args.file.as_ref() == Some(&loading.path);
                 if !keep_camera {
                     self.frame_model();
                 }
                 self.ui.info(format!("opened {}", loading.path.display()));
-                if let Some(journal) = self.state.path.as_deref().and_then(octovox::journal::find) {
-                    report!("asking: recover {}", journal.display());
-                    self.ui.recover = Some(journal);
+                if let Some(document) = self.state.path.clone()
+                    && let Some(journal) = octovox::journal::find(&document)
+                {
+                    self.found_journal(journal, Some(&document));
                 }
             }
             Err(err) => self.ui.error(format!("cannot open {}: {err}", loading.path.display())),
+        }
+    }
+}
+
+/// With `OCTOVOX_TEST_HOLD_AFTER_SAVE` set, a save stops between its rename
+/// and the journal's removal, says so, and waits to be killed: the moment a
+/// crash would leave a journal whose edits the file already holds, which a
+/// test cannot otherwise reach (tests/window_recovery.rs).
+fn hold_for_tests_after_rename() {
+    if std::env::var_os("OCTOVOX_TEST_HOLD_AFTER_SAVE").is_some() {
+        report!("test hold: saved, the journal not yet removed");
+        loop {
+            std::thread::sleep(std::time::Duration::from_secs(3600));
         }
     }
 }

@@ -5,25 +5,91 @@
 //! before it started, a paste of a block copied before it started) starts
 //! it again from a snapshot of the scene.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
+use octovox::journal::{FileStamp, RecoverError};
 use octovox::replay::{Command as Line, Recorder};
 
 use super::App;
 
+/// What starts the open scene's journal: the lines that make the scene as
+/// it is on disk (or as it started, for an untitled one), and the stamp of
+/// the file its `load` line loads, taken when the window read it (so a
+/// file changed on disk after that is caught at recovery, not hidden).
+#[derive(Debug, Default)]
+pub(super) struct JournalStart {
+    pub lines: Vec<Line>,
+    pub stamp: Option<FileStamp>,
+}
+
+impl JournalStart {
+    /// The journal starts from `lines`; no file stamp (a built-in or new scene).
+    pub fn of(lines: Vec<Line>) -> JournalStart {
+        JournalStart { lines, stamp: None }
+    }
+
+    /// The journal starts by loading `path` (absolute), as it is on disk now.
+    pub fn load(path: PathBuf) -> JournalStart {
+        let stamp = FileStamp::of(&path).ok();
+        JournalStart { lines: vec![Line::Load(path)], stamp }
+    }
+
+    fn clear(&mut self) {
+        self.lines.clear();
+        self.stamp = None;
+    }
+}
+
+/// What the window does with a journal found beside a document it opened
+/// (or an untitled one of a session that is gone).
+pub(super) enum Found {
+    /// Offer to apply it; with the reason to think twice, if there is one.
+    Offer(Option<String>),
+    /// Another window edits with it: leave it alone and say so.
+    Live(String),
+    /// A finished save holds its edits: it was removed.
+    Stale(String),
+}
+
+/// Looks at a journal before the window offers it.
+pub(super) fn classify(journal: &Path, document: Option<&Path>) -> Found {
+    match octovox::journal::read(journal, document, octovox::journal::Checks::default()) {
+        Err(err @ RecoverError::Live { .. }) => Found::Live(err.to_string()),
+        Err(err @ RecoverError::Saved { .. }) => {
+            let _ = std::fs::remove_file(octovox::journal::snapshot_path(journal));
+            let _ = std::fs::remove_file(journal);
+            Found::Stale(format!("{err}: removed it"))
+        }
+        Err(err @ RecoverError::Changed { .. }) => Found::Offer(Some(err.to_string())),
+        // Other faults are reported when the user asks to recover.
+        Ok(_) | Err(_) => Found::Offer(None),
+    }
+}
+
 impl App {
     /// Runs `f` on the recorder and on the scene's journal (started at the
-    /// first unsaved change); an I/O error stops that one with a message.
+    /// first unsaved change); an I/O error stops that one, and the status
+    /// bar says the edits are not protected until a journal starts again
+    /// (the next save, or another document).
     pub(super) fn record(&mut self, f: impl Fn(&mut Recorder) -> std::io::Result<()>) {
         self.record_to_recording(&f);
-        self.open_journal();
+        self.open_journal(self.editor.selection);
         if let Some(journal) = &mut self.journal
             && let Err(err) = f(journal)
         {
-            self.ui.error(format!("the crash-recovery journal {} stopped: {err}", journal.path().display()));
-            self.journal = None;
-            self.journal_source.clear();
+            let text = format!("the crash-recovery journal {} stopped: {err}", journal.path().display());
+            self.journal_failed(text);
         }
+    }
+
+    /// The journal cannot go on: it is dropped (its lock with it), and the
+    /// status bar says so until a journal starts again.
+    pub(super) fn journal_failed(&mut self, text: String) {
+        log::warn!("{text}");
+        report!("journal failed: {text}");
+        self.ui.journal_warning = Some(format!("unsaved edits are not protected: {text}"));
+        self.journal = None;
+        self.journal_start.clear();
     }
 
     /// Records an undo (or redo) the history just made. The journal gets
@@ -60,9 +126,11 @@ impl App {
 
     /// Starts the journal of the open scene once it has unsaved changes:
     /// its first lines make the scene as it is on disk (or as it started,
-    /// for an untitled one), then the selection in force.
-    fn open_journal(&mut self) {
-        if self.journal.is_some() || !self.state.dirty || self.journal_source.is_empty() {
+    /// for an untitled one), with the stamp of the file it loads, then
+    /// `selection`: the selection in force before the change (a `move` as
+    /// the first edit moves it).
+    pub(super) fn open_journal(&mut self, selection: Option<octovox::scene::selection::Region>) {
+        if self.journal.is_some() || !self.state.dirty || self.journal_start.lines.is_empty() {
             return;
         }
         let path = self.journal_file();
@@ -74,28 +142,37 @@ impl App {
         if let Some(dir) = path.parent() {
             let _ = std::fs::create_dir_all(dir);
         }
-        let selection = self.editor.selection.map(|r| Line::Select(Some((r.min, r.max))));
-        let start: Vec<Line> = self.journal_source.iter().cloned().chain(selection).collect();
-        match Recorder::with_header(&path, &header).and_then(|mut journal| {
-            start.into_iter().try_for_each(|line| journal.scene(line))?;
+        let selection = selection.map(|r| Line::Select(Some((r.min, r.max))));
+        let (lines, stamp) = (&self.journal_start.lines, &self.journal_start.stamp);
+        let started = Recorder::journal(&path, &header).and_then(|mut journal| {
+            let write = |journal: &mut Recorder| -> std::io::Result<()> {
+                if let Some(stamp) = stamp {
+                    journal.note(&stamp.note())?;
+                }
+                lines.iter().cloned().chain(selection).try_for_each(|line| journal.scene(line))
+            };
+            if let Err(err) = write(&mut journal) {
+                // No journal that holds only part of its start is left behind.
+                let _ = std::fs::remove_file(journal.path());
+                return Err(err);
+            }
             Ok(journal)
-        }) {
+        });
+        match started {
             Ok(journal) => {
                 self.journal = Some(journal);
+                self.ui.journal_warning = None;
                 // What the clipboard holds was copied before this journal.
                 self.clipboard_journaled = false;
             }
-            Err(err) => {
-                self.ui.error(format!("cannot write the crash-recovery journal {}: {err}", path.display()));
-                self.journal_source.clear();
-            }
+            Err(err) => self.journal_failed(format!("cannot write the crash-recovery journal {}: {err}", path.display())),
         }
     }
 
     /// Starts the journal again from a snapshot of the scene as it is now,
     /// saved beside it (`octovox::journal::snapshot_path`).
     pub(super) fn restart_journal_from_snapshot(&mut self) {
-        if self.journal_source.is_empty() {
+        if self.journal_start.lines.is_empty() {
             return;
         }
         let journal = self.journal_file();
@@ -107,22 +184,21 @@ impl App {
         match octovox::io::save_scene(&snapshot, &self.editor.scene, octovox::io::atomic::WriteOptions::default()) {
             Ok(()) => {
                 let absolute = std::fs::canonicalize(&snapshot).unwrap_or(snapshot);
-                self.journal_source = vec![Line::Load(absolute)];
-                self.open_journal();
+                self.journal_start = JournalStart::load(absolute);
+                self.open_journal(self.editor.selection);
             }
-            Err(err) => {
-                self.ui.error(format!("cannot snapshot the scene for the crash-recovery journal: {err}"));
-                self.journal_source.clear();
-            }
+            Err(err) => self.journal_failed(format!("cannot snapshot the scene for the crash-recovery journal: {err}")),
         }
     }
 
-    /// Removes the journal and its snapshot: the scene was saved, or its
-    /// edits discarded.
+    /// Removes the journal and its snapshot (the lock goes with the
+    /// recorder, after the file): the scene was saved, or its edits
+    /// discarded.
     pub(super) fn close_journal(&mut self) {
         if let Some(journal) = self.journal.take() {
             let _ = std::fs::remove_file(octovox::journal::snapshot_path(journal.path()));
             let _ = std::fs::remove_file(journal.path());
         }
+        self.ui.journal_warning = None;
     }
 }

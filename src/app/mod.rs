@@ -106,7 +106,7 @@ struct Loading {
     path: PathBuf,
     started: Instant,
     progress: octovox::io::progress::Progress,
-    result: Receiver<Result<Scene, String>>,
+    result: Receiver<Result<(Scene, Option<octovox::journal::FileStamp>), String>>,
 }
 
 /// An open mouse stroke: its tool, the face (normal and layer) it started
@@ -168,9 +168,9 @@ struct App {
     /// `--record`: where the session is written as a script.
     recorder: Option<octovox::replay::Recorder>,
     /// The crash-recovery journal of the open document (`octovox::journal`),
-    /// and the line that loads the document as saved, which starts it.
+    /// and what starts it (the document as saved).
     journal: Option<octovox::replay::Recorder>,
-    journal_source: Vec<octovox::replay::Command>,
+    journal_start: journal::JournalStart,
     /// The clipboard was filled by a `copy` or `cut` the open journal holds
     /// (else a paste starts the journal again from a snapshot).
     clipboard_journaled: bool,
@@ -223,7 +223,7 @@ impl App {
             player: None,
             recorder: None,
             journal: None,
-            journal_source: Vec::new(),
+            journal_start: journal::JournalStart::default(),
             clipboard_journaled: false,
             file_dialog: None,
             recent: recent::Recent::load(),
@@ -247,14 +247,13 @@ impl App {
             Some(path) => app.start_loading(path),
             None => {
                 let built_in = app.args.demo.unwrap_or_default();
-                app.replace_scene(built_in.scene(), octovox::replay::Command::Demo(built_in));
+                app.replace_scene(built_in.scene(), octovox::replay::Command::Demo(built_in), None);
                 if app.args.camera.is_none() {
                     app.frame_model();
                 }
                 // An untitled scene of a session that died: offer it back.
                 if let Some(journal) = octovox::journal::orphaned_untitled(std::path::Path::new(SAVES_DIR)).first() {
-                    report!("asking: recover {}", journal.display());
-                    app.ui.recover = Some(journal.clone());
+                    app.found_journal(journal.clone(), None);
                 }
             }
         }
@@ -351,13 +350,19 @@ impl App {
     /// and the journal. New and demo lines replace the scene as Open does.
     pub(super) fn run_line(&mut self, line: &octovox::replay::Command) -> Result<Outcome, String> {
         if let Some(scene) = octovox::editor::built_scene(line) {
-            self.replace_scene(scene, line.clone());
+            self.replace_scene(scene, line.clone(), None);
             return Ok(Outcome::Replaced);
         }
         // A key action during a drag ends the drag's undo step first: the
         // history and the recording count steps alike.
         self.close_strokes();
+        // A journal that the line starts begins with the selection before it.
+        let selection = self.editor.selection;
         let outcome = self.editor.run(line)?;
+        if matches!(outcome, Outcome::Changed) {
+            self.state.dirty = true;
+            self.open_journal(selection);
+        }
         let (tools, camera) = (self.editor.tools, self.state.camera);
         let ran = |r: &mut Recorder| r.ran(line, &tools, &camera);
         match (&outcome, line) {
@@ -525,7 +530,7 @@ impl App {
                 None => self.ask_path(DialogKind::SaveAs, "saves/untitled.vox".into()),
             },
             Command::SaveAs(path) => self.save_as(path, WriteOptions::default(), event_loop),
-            Command::SaveOver(path) => self.save_as(path, WriteOptions { overwrite_read_only: true }, event_loop),
+            Command::SaveOver(path) => self.save_as(path, WriteOptions::forced(true), event_loop),
             Command::AskOpen => {
                 let start = self.state.path.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
                 self.ask_path(DialogKind::Open, start);
@@ -541,7 +546,7 @@ impl App {
             Command::Export(path) => self.export(&path),
             Command::Screenshot => self.screenshot_requested = true,
             Command::Resolve(choice) => self.resolve(choice, event_loop),
-            Command::RecoverJournal(journal) => self.recover_journal(&journal),
+            Command::RecoverJournal(journal, checks) => self.recover_journal(&journal, checks),
             Command::DiscardJournal(journal) => {
                 let _ = std::fs::remove_file(journal);
             }

@@ -125,8 +125,12 @@ pub struct UiState {
     pub prompt_open: bool,
     /// A read-only file the user is asked about overwriting.
     pub read_only: Option<PathBuf>,
-    /// A crash-recovery journal found beside the document just opened.
-    pub recover: Option<PathBuf>,
+    /// A crash-recovery journal found beside the document just opened, and
+    /// why applying it needs a second thought (its document changed since).
+    pub recover: Option<(PathBuf, Option<String>)>,
+    /// The open scene's edits are not journaled, and why: shown until a
+    /// journal starts again.
+    pub journal_warning: Option<String>,
     /// Last message for the user, and whether it is an error.
     pub message: Option<(String, bool)>,
 }
@@ -530,6 +534,10 @@ fn stats(ui: &mut egui::Ui, info: &Info) {
 
 /// The last message (errors in red), on the menu bar where it is always seen.
 fn message(ui: &mut egui::Ui, ui_state: &mut UiState) {
+    if let Some(warning) = &ui_state.journal_warning {
+        ui.separator();
+        ui.colored_label(Color32::from_rgb(255, 170, 60), format!("⚠ {warning}"));
+    }
     let mut clear = false;
     if let Some((text, is_error)) = &ui_state.message {
         ui.separator();
@@ -638,16 +646,23 @@ fn prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
     });
 }
 
-/// Offers to apply a crash-recovery journal found beside the document.
+/// Offers to apply a crash-recovery journal found beside the document;
+/// one started on other content than the document holds now is offered
+/// only with that said, as "Apply anyway".
 fn recover_prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
-    let Some(journal) = ui_state.recover.clone() else { return };
+    let Some((journal, doubt)) = ui_state.recover.clone() else { return };
     egui::Modal::new(egui::Id::unique("recover")).show(ctx, |ui| {
         ui.heading("Recover unsaved edits?");
         ui.label(format!("A session that ended without saving left its edits in {}. Apply them?", journal.display()));
+        if let Some(doubt) = &doubt {
+            ui.colored_label(Color32::from_rgb(255, 110, 100), doubt);
+        }
         ui.horizontal(|ui| {
-            if ui.button("Recover").clicked() {
+            let apply = if doubt.is_some() { "Apply anyway" } else { "Recover" };
+            if ui.button(apply).clicked() {
                 ui_state.recover = None;
-                out.push(Command::RecoverJournal(journal.clone()));
+                let checks = octovox::journal::Checks { allow_changed_source: doubt.is_some() };
+                out.push(Command::RecoverJournal(journal.clone(), checks));
             }
             if ui.button("Discard").clicked() {
                 ui_state.recover = None;

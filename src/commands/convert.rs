@@ -15,7 +15,7 @@ pub fn run(input: &Path, output: &Path, frame: usize, force: bool) -> anyhow::Re
     let scene =
         super::progress_bar::with_bar("loading", |progress| octovox::io::load_scene_with(input, frame, progress))
             .with_context(|| format!("loading {}", input.display()))?;
-    let options = WriteOptions { overwrite_read_only: force };
+    let options = WriteOptions::forced(force);
     octovox::io::save_scene(output, &scene, options).with_context(|| format!("saving {}", output.display()))?;
     say!("wrote {} voxels to {}", scene.tree.solid_voxels(), output.display())?;
     Ok(ExitCode::SUCCESS)

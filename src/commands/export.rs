@@ -9,7 +9,7 @@ use octovox::io::atomic::WriteOptions;
 pub fn run(file: &Path, output: &Path, scale: f32, frame: usize, force: bool) -> anyhow::Result<ExitCode> {
     octovox::io::export::check_outputs(output, &[file], force)?;
     let scene = octovox::io::load_scene(file, frame).with_context(|| format!("loading {}", file.display()))?;
-    let options = WriteOptions { overwrite_read_only: force };
+    let options = WriteOptions::forced(force);
     let stats = octovox::io::export::export_mesh(output, &scene, scale, options)?;
     say!(
         "wrote {}: {} triangles, {} vertices ({} triangles as one quad per face)",

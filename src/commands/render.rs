@@ -62,7 +62,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<ExitCode> {
         None => preview(&mut scene, &camera, args, traced)?,
     };
     let image = octovox::io::png::upscale(image, args.size);
-    save_png(&image, &args.output, WriteOptions { overwrite_read_only: args.force })?;
+    save_png(&image, &args.output, WriteOptions::forced(args.force))?;
     if args.stats {
         say!("{}", serde_json::to_string(&stats)?)?;
     } else {

@@ -15,10 +15,42 @@ use std::io;
 use std::path::{Path, PathBuf};
 
 /// How far a save may go.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct WriteOptions {
+#[derive(Clone, Copy, Default)]
+pub struct WriteOptions<'a> {
     /// Replace a file whose permissions say it is read-only.
     pub overwrite_read_only: bool,
+    /// Told the SHA-256 (lowercase hex) of the complete new file just before
+    /// it replaces the target: the crash journal notes which save holds its
+    /// edits, so a kill between the rename and the journal's removal leaves
+    /// a journal recovery knows to be stale.
+    pub before_replace: Option<&'a dyn Fn(&str)>,
+}
+
+impl WriteOptions<'_> {
+    /// The default options, replacing a read-only file when `force` says so.
+    pub fn forced(force: bool) -> WriteOptions<'static> {
+        WriteOptions { overwrite_read_only: force, before_replace: None }
+    }
+}
+
+impl std::fmt::Debug for WriteOptions<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("WriteOptions")
+            .field("overwrite_read_only", &self.overwrite_read_only)
+            .field("before_replace", &self.before_replace.is_some())
+            .finish()
+    }
+}
+
+/// The SHA-256 of a file's bytes, in lowercase hex.
+///
+/// # Errors
+/// The file cannot be read.
+pub fn sha256_of(path: &Path) -> io::Result<String> {
+    use sha2::Digest as _;
+    let mut hasher = sha2::Sha256::new();
+    io::copy(&mut File::open(path)?, &mut hasher)?;
+    Ok(hasher.finalize().iter().map(|b| format!("{b:02x}")).collect())
 }
 
 /// Why the target cannot be written; `io::Error`s keep their own text.
@@ -125,6 +157,9 @@ pub fn write_atomically<E: From<io::Error>>(
     temp.as_file().sync_all()?;
     if let Some(permissions) = existing {
         temp.as_file().set_permissions(permissions)?;
+    }
+    if let Some(before_replace) = options.before_replace {
+        before_replace(&sha256_of(temp.path())?);
     }
     temp.persist(&target).map_err(|e| e.error)?;
     Ok(())

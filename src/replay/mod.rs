@@ -13,7 +13,7 @@ use glam::{DVec3, IVec3};
 
 use crate::tool::{Brush, Tool};
 
-pub use parse::{ScriptError, load_script, parse_script};
+pub use parse::{MAX_SCRIPT_BYTES, ScriptError, load_script, parse_script, split_words};
 pub use record::Recorder;
 pub use run::{Failure, Runner, RunnerMode, ScriptReport, StepResult};
 
@@ -158,21 +158,30 @@ impl fmt::Display for Command {
     }
 }
 
-/// A path as a script word: as it is, or in quotes (with `\"` and `\\`
-/// escaped) when it holds spaces, `#`, quotes or backslashes.
+/// A path as a script word: as it is, or in quotes when it holds spaces,
+/// `#`, quotes, backslashes or control characters: `\"` and `\\` for
+/// quotes and backslashes, `\n`, `\r`, `\t` and `\u{HEX}` for control
+/// characters (a name with a newline would otherwise end the line).
 pub fn quoted(path: &std::path::Path) -> String {
     let text = path.to_string_lossy();
-    let plain = !text.is_empty() && !text.chars().any(|c| c.is_whitespace() || matches!(c, '#' | '"' | '\\'));
-    if plain {
+    let special = |c: char| c.is_whitespace() || c.is_control() || matches!(c, '#' | '"' | '\\');
+    if !text.is_empty() && !text.chars().any(special) {
         return text.into_owned();
     }
     let mut out = String::with_capacity(text.len() + 2);
     out.push('"');
     for c in text.chars() {
-        if matches!(c, '"' | '\\') {
-            out.push('\\');
+        match c {
+            '"' | '\\' => {
+                out.push('\\');
+                out.push(c);
+            }
+            '\n' => out.push_str("\\n"),
+            '\r' => out.push_str("\\r"),
+            '\t' => out.push_str("\\t"),
+            c if c.is_control() => out.push_str(&format!("\\u{{{:x}}}", u32::from(c))),
+            c => out.push(c),
         }
-        out.push(c);
     }
     out.push('"');
     out

@@ -40,6 +40,43 @@ struct Cursor {
 
 type Fail = (usize, String);
 
+/// The words of `line` as a script line's are split (quotes removed,
+/// escapes resolved, `#` starting a comment); the journal's notes use it.
+///
+/// # Errors
+/// A quote that is not closed, or a bad escape.
+pub fn split_words(line: &str) -> Result<Vec<String>, String> {
+    Cursor::new(line).map(|cursor| cursor.tokens.into_iter().map(|t| t.text).collect()).map_err(|(_, message)| message)
+}
+
+/// The character an escape inside quotes stands for, the backslash read:
+/// `\"`, `\\`, `\n`, `\r`, `\t` or `\u{HEX}` (what [`super::quoted`]
+/// writes).
+fn unescape(chars: &mut std::iter::Peekable<impl Iterator<Item = (char, usize)>>) -> Result<char, String> {
+    let Some((c, _)) = chars.next() else { return Err("an escape at the end of the line".to_owned()) };
+    Ok(match c {
+        'n' => '\n',
+        'r' => '\r',
+        't' => '\t',
+        'u' => {
+            let bad = || "expected \\u{HEX} (a character's code in hexadecimal)".to_owned();
+            if chars.next().map(|(c, _)| c) != Some('{') {
+                return Err(bad());
+            }
+            let mut hex = String::new();
+            loop {
+                match chars.next() {
+                    Some(('}', _)) => break,
+                    Some((c, _)) if c.is_ascii_hexdigit() && hex.len() < 6 => hex.push(c),
+                    _ => return Err(bad()),
+                }
+            }
+            u32::from_str_radix(&hex, 16).ok().and_then(char::from_u32).ok_or_else(bad)?
+        }
+        other => other,
+    })
+}
+
 impl Cursor {
     /// Splits a line into words: whitespace separates them, `"…"` quotes a
     /// word that holds spaces or `#` (with `\"` and `\\` inside), and `#`
@@ -55,8 +92,9 @@ impl Cursor {
             if quote_column.is_some() {
                 match c {
                     '"' => quote_column = None,
-                    '\\' if matches!(chars.peek(), Some(('"' | '\\', _))) => {
-                        if let (Some(token), Some((escaped, _))) = (current.as_mut(), chars.next()) {
+                    '\\' if matches!(chars.peek(), Some(('"' | '\\' | 'n' | 'r' | 't' | 'u', _))) => {
+                        let escaped = unescape(&mut chars).map_err(|message| (column, message))?;
+                        if let Some(token) = current.as_mut() {
                             token.text.push(escaped);
                         }
                     }
@@ -482,6 +520,24 @@ mod tests {
         assert_eq!(errors("save \"open"), vec!["a quote that is not closed on this line at build.ovr:1:6"]);
         assert_eq!(errors("save \"\""), vec!["an empty path at build.ovr:1:6"]);
         assert_eq!(errors("\u{feff}nwe"), vec!["unknown command 'nwe' at build.ovr:1:1"]);
+    }
+
+    /// A recorded name with a newline ended the `load` line there, and the
+    /// journal or `--record` script no longer parsed (issue 24, item 4).
+    #[test]
+    fn control_characters_in_names_round_trip() {
+        for name in ["two\nlines.vox", "tab\there.vox", "bell\u{7}\r\u{1b}.vox", "mixed \"q\" \\ \n#.vox"] {
+            let command = Command::Load(PathBuf::from(name));
+            let printed = command.to_string();
+            assert!(!printed.contains('\n') && !printed.chars().any(char::is_control), "{printed:?}");
+            let again = parse_script(Path::new("q.ovr"), &printed).unwrap();
+            assert_eq!(again.lines.len(), 1, "{printed:?}");
+            assert_eq!(again.lines[0].command, command, "{printed:?}");
+        }
+        assert_eq!(
+            errors("load \"a\\u{zz}.vox\""),
+            vec!["expected \\u{HEX} (a character's code in hexadecimal) at build.ovr:1:8"]
+        );
     }
 
     /// A 2 MB line took 31 s to reject when columns were counted from the

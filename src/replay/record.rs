@@ -43,11 +43,37 @@ impl Recorder {
         Ok(recorder)
     }
 
+    /// A crash journal at `path`, locked (an advisory lock, held until the
+    /// recorder is dropped) so that a second window on the same document
+    /// finds it live and leaves it alone; started with the comment
+    /// `# HEADER`. A journal another process holds is refused untouched;
+    /// one whose first line cannot be written is removed, not left empty.
+    ///
+    /// # Errors
+    /// The file cannot be opened, is locked by another process
+    /// (`WouldBlock`), or cannot be written.
+    pub fn journal(path: &Path, header: &str) -> std::io::Result<Recorder> {
+        let file = std::fs::OpenOptions::new().read(true).write(true).create(true).truncate(false).open(path)?;
+        lock(&file, path)?;
+        let started = file.set_len(0).and_then(|()| {
+            let mut recorder = Recorder::on(path, file);
+            recorder.line(&format!("# {header}"))?;
+            Ok(recorder)
+        });
+        if started.is_err() {
+            let _ = std::fs::remove_file(path);
+        }
+        started
+    }
+
     /// A recorder that goes on at the end of an existing script (a recovered
-    /// journal): the camera, brush and colour are written again before the
-    /// next edit, and undo does not reach before this point.
+    /// journal, locked as [`Recorder::journal`] locks it): the camera, brush
+    /// and colour are written again before the next edit, and undo does not
+    /// reach before this point.
     pub fn append(path: &Path) -> std::io::Result<Recorder> {
-        let mut recorder = Recorder::on(path, std::fs::OpenOptions::new().append(true).open(path)?);
+        let file = std::fs::OpenOptions::new().append(true).open(path)?;
+        lock(&file, path)?;
+        let mut recorder = Recorder::on(path, file);
         // The script may end with mirror planes on; this recorder starts with none.
         recorder.command(&Command::Mirror(None))?;
         Ok(recorder)
@@ -74,6 +100,12 @@ impl Recorder {
     fn line(&mut self, text: &str) -> std::io::Result<()> {
         writeln!(self.out, "{text}")?;
         self.out.flush()
+    }
+
+    /// A journal's note on the file it edits or saves to: `#@ TEXT`, a
+    /// comment to scripts (`crate::journal` reads it).
+    pub fn note(&mut self, text: &str) -> std::io::Result<()> {
+        self.line(&format!("#@ {text}"))
     }
 
     fn command(&mut self, command: &Command) -> std::io::Result<()> {
@@ -249,4 +281,15 @@ impl Recorder {
             None => Ok(()),
         }
     }
+}
+
+/// Takes the advisory lock of a journal, or says who holds it.
+fn lock(file: &std::fs::File, path: &Path) -> std::io::Result<()> {
+    file.try_lock().map_err(|err| match err {
+        std::fs::TryLockError::WouldBlock => std::io::Error::new(
+            std::io::ErrorKind::WouldBlock,
+            format!("{} is held by another octovox window", path.display()),
+        ),
+        std::fs::TryLockError::Error(err) => err,
+    })
 }

@@ -164,7 +164,7 @@ impl Runner {
             Command::Save(path) => {
                 let path = resolve(path);
                 self.check_output(&path, OutputKind::Scene)?;
-                let options = WriteOptions { overwrite_read_only: self.force };
+                let options = WriteOptions::forced(self.force);
                 crate::io::save_scene(&path, scene, options).map_err(|e| e.to_string())?;
                 self.written.push(path);
             }
@@ -172,7 +172,7 @@ impl Runner {
                 let path = resolve(path);
                 self.check_output(&path, OutputKind::Image)?;
                 let image = self.render()?;
-                save_png(&image, &path, WriteOptions { overwrite_read_only: self.force }).map_err(|e| e.to_string())?;
+                save_png(&image, &path, WriteOptions::forced(self.force)).map_err(|e| e.to_string())?;
                 self.written.push(path);
                 self.last_render = Some(image);
             }
