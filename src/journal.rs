@@ -300,3 +300,97 @@ pub fn recover(document: &Path, checks: Checks) -> Result<Scene, RecoverError> {
     let journal = find(document).ok_or_else(|| RecoverError::NoJournal(document.to_path_buf()))?;
     recover_from(&journal, Some(document), checks)
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)] // in tests a panic is the failure report
+
+    use super::*;
+
+    /// A document of one voxel and its journal path, in a fresh folder.
+    fn document() -> (tempfile::TempDir, PathBuf, PathBuf) {
+        let dir = tempfile::tempdir().unwrap();
+        let document = dir.path().join("doc.vox");
+        let mut scene = Scene::default();
+        scene.tree.apply_brush(&crate::scene::Shape::Voxel(glam::IVec3::ZERO), crate::scene::Op::Place(3)).unwrap();
+        crate::io::save_scene(&document, &scene, Default::default()).unwrap();
+        let journal = journal_path(&document);
+        (dir, std::fs::canonicalize(&document).unwrap(), journal)
+    }
+
+    fn journal_text(document: &Path, notes: &str, edits: &str) -> String {
+        format!("# test journal\n{notes}load {}\n{edits}", crate::replay::quoted(document))
+    }
+
+    #[test]
+    fn a_journal_loads_its_document_once_and_first() {
+        let (dir, document, journal) = document();
+        let other = dir.path().join("other.vox");
+        std::fs::copy(&document, &other).unwrap();
+        let second = format!("place 0 1 0\nload {}\nplace 0 2 0\n", other.display());
+        std::fs::write(&journal, journal_text(&document, "", &second)).unwrap();
+        let err = recover(&document, Checks::default()).unwrap_err().to_string();
+        assert!(err.contains("line 4 makes a second scene") && err.contains("nothing was applied"), "{err}");
+        std::fs::write(&journal, format!("new\n{}", journal_text(&document, "", "place 0 1 0\n"))).unwrap();
+        assert!(recover(&document, Checks::default()).is_err(), "a scene line before the load is refused too");
+        std::fs::write(&journal, journal_text(&document, "", "place 0 1 0\n")).unwrap();
+        assert_eq!(recover(&document, Checks::default()).unwrap().tree.solid_voxels(), 2);
+    }
+
+    #[test]
+    fn a_journal_started_on_other_content_is_refused_unless_allowed() {
+        let (_dir, document, journal) = document();
+        let stamp = FileStamp::of(&document).unwrap();
+        let text = journal_text(&document, &format!("#@ {}\n", stamp.note()), "place 0 1 0\n");
+        std::fs::write(&journal, &text).unwrap();
+        assert_eq!(recover(&document, Checks::default()).unwrap().tree.solid_voxels(), 2, "the same content");
+        // Another program rewrites the document after the journal started.
+        let mut scene = crate::io::load_scene(&document, 0).unwrap();
+        scene.tree.apply_brush(&crate::scene::Shape::Voxel(glam::IVec3::X), crate::scene::Op::Place(4)).unwrap();
+        crate::io::save_scene(&document, &scene, Default::default()).unwrap();
+        let err = recover(&document, Checks::default()).unwrap_err();
+        assert!(matches!(err, RecoverError::Changed { .. }), "{err}");
+        let message = err.to_string();
+        assert!(message.contains(&format!("{} bytes", stamp.size)) && message.contains("nothing was applied"));
+        let checks = Checks { allow_changed_source: true };
+        assert_eq!(recover(&document, checks).unwrap().tree.solid_voxels(), 3, "applied when the user says so");
+        assert_eq!(std::fs::read_to_string(&journal).unwrap(), text, "the journal is left as it was");
+    }
+
+    #[test]
+    fn a_journal_whose_save_finished_is_stale() {
+        let (_dir, document, journal) = document();
+        let stamp = FileStamp::of(&document).unwrap();
+        // The save noted itself, then renamed its file over the document.
+        let mut scene = crate::io::load_scene(&document, 0).unwrap();
+        scene.tree.apply_brush(&crate::scene::Shape::Voxel(glam::IVec3::Y), crate::scene::Op::Place(3)).unwrap();
+        crate::io::save_scene(&document, &scene, Default::default()).unwrap();
+        let saved = crate::io::atomic::sha256_of(&document).unwrap();
+        let edits = format!("place 0 1 0\n#@ {}\n", saved_note(&saved, &document));
+        std::fs::write(&journal, journal_text(&document, &format!("#@ {}\n", stamp.note()), &edits)).unwrap();
+        let err = recover(&document, Checks::default()).unwrap_err();
+        assert!(matches!(err, RecoverError::Saved { .. }), "{err}");
+        // A save that did not finish (the file is not what it noted) changes nothing.
+        let mut unfinished = saved.clone();
+        unfinished.replace_range(..1, if saved.starts_with('0') { "1" } else { "0" });
+        let edits = format!("place 0 1 0\n#@ {}\n", saved_note(&unfinished, &document));
+        std::fs::write(&journal, journal_text(&document, "", &edits)).unwrap();
+        assert_eq!(recover(&document, Checks::default()).unwrap().tree.solid_voxels(), 2);
+    }
+
+    #[test]
+    fn a_journal_a_window_holds_is_live() {
+        let (_dir, document, journal) = document();
+        let mut recorder = crate::replay::Recorder::journal(&journal, "test").unwrap();
+        recorder.scene(Command::Load(document.clone())).unwrap();
+        assert!(is_live(&journal));
+        let err = recover(&document, Checks::default()).unwrap_err();
+        assert!(matches!(err, RecoverError::Live { .. }), "{err}");
+        let again = crate::replay::Recorder::journal(&journal, "second window").map(|_| ()).unwrap_err();
+        assert_eq!(again.kind(), std::io::ErrorKind::WouldBlock);
+        assert!(std::fs::read_to_string(&journal).unwrap().contains("# test\nload"), "left as the first wrote it");
+        drop(recorder);
+        assert!(!is_live(&journal));
+        assert!(recover(&document, Checks::default()).is_ok());
+    }
+}

@@ -234,3 +234,170 @@ fn undo_past_a_save_selections_and_old_clipboards_survive_a_kill() {
     };
     assert_eq!(voxels(&recovered), voxels(&headless_dir.path().join("expected.vox")));
 }
+
+/// A writable torus16.vox as `doc.vox` in a new folder.
+fn small_document() -> (tempfile::TempDir, PathBuf) {
+    require_window_tools();
+    let dir = tempfile::tempdir().unwrap();
+    let source = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/vox/seed/torus16.vox");
+    let file = dir.path().join("doc.vox");
+    common::copy_writable(&source, &file);
+    (dir, file)
+}
+
+/// The window on `doc.vox` in `dir`, playing `script` (written as
+/// `play.ovr` there) with `env` set; returns once the script has run.
+fn play_in_window(display: &str, dir: &Path, script: &str, env: &[(&str, &str)]) -> (KillOnDrop, Lines) {
+    std::fs::write(dir.join("play.ovr"), script).unwrap();
+    let args = ["doc.vox".to_string(), "--size".into(), "640x480".into(), "--replay".into(), "play.ovr".into()];
+    let env: Vec<(&str, &str)> = [("OCTOVOX_NO_NATIVE_DIALOGS", "1")].into_iter().chain(env.iter().copied()).collect();
+    let (mut app, lines, stderr_path) = spawn_app_with(display, dir, &args, &env);
+    find_window(display, &mut app, &stderr_path);
+    (app, lines)
+}
+
+/// What `script` makes of `document` headless (`octovox replay --cpu`).
+fn replayed(document: &Path, script: &str) -> HashSet<(IVec3, u8)> {
+    let dir = tempfile::tempdir().unwrap();
+    common::copy_writable(document, &dir.path().join("doc.vox"));
+    let text = format!("load doc.vox\n{script}save expected.vox\n");
+    std::fs::write(dir.path().join("expected.ovr"), text).unwrap();
+    let run = octovox(&["replay", "--cpu", "--force", s(&dir.path().join("expected.ovr"))]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stdout));
+    voxel_colors(&dir.path().join("expected.vox"))
+}
+
+fn voxel_colors(path: &Path) -> HashSet<(IVec3, u8)> {
+    octovox::io::load_scene(path, 0).unwrap().tree.voxels().into_iter().collect()
+}
+
+/// Issue 24, items 1 and 5: the journal of a `move` made as the first edit
+/// began with the selection *after* the move, so recovery moved nothing;
+/// and a journal replayed onto a document changed since it started gave
+/// exit 0 and the old edits on new content.
+#[test]
+fn a_move_as_the_first_edit_is_recovered_and_a_changed_document_refused() {
+    let (dir, file) = small_document();
+    let script = "select -8 -2 -7 7 2 8\nmove 0 10 0\n";
+    let expected = replayed(&file, script);
+    let (_xvfb, display) = start_xvfb(13);
+    let (mut app, mut lines) = play_in_window(&display, dir.path(), script, &[]);
+    assert_eq!(lines.wait_for("replay:", Duration::from_secs(90)), "replay: 0 passed, 0 failed");
+    app.0.kill().unwrap();
+    app.0.wait().unwrap();
+
+    let recovered = dir.path().join("recovered.vox");
+    let run = octovox(&["recover", s(&file), "-o", s(&recovered)]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let got = voxel_colors(&recovered);
+    assert_eq!(got, expected, "the move is recovered");
+    let (min_y, max_y) = (got.iter().map(|v| v.0.y).min().unwrap(), got.iter().map(|v| v.0.y).max().unwrap());
+    assert!(min_y >= 8, "the torus moved up 10 (y {min_y}..{max_y})");
+
+    // The document changes on disk after the session died.
+    std::fs::remove_file(&recovered).unwrap();
+    let journal = octovox::journal::journal_path(&file);
+    let journal_text = std::fs::read_to_string(&journal).unwrap();
+    let mut scene = octovox::io::load_scene(&file, 0).unwrap();
+    scene.tree.apply_brush(&octovox::scene::Shape::Voxel(IVec3::new(0, 40, 0)), octovox::scene::Op::Place(9)).unwrap();
+    octovox::io::save_scene(&file, &scene, Default::default()).unwrap();
+    let run = octovox(&["recover", s(&file), "-o", s(&recovered)]);
+    let message = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success() && message.contains("was started on"), "{message}");
+    assert!(!recovered.exists(), "nothing is written");
+    assert_eq!(std::fs::read_to_string(&journal).unwrap(), journal_text, "the journal is left as it was");
+}
+
+/// Issue 24, item 2: a kill after the save's rename but before the
+/// journal's removal left a journal that recovery replayed onto the saved
+/// file, moving the torus twice (y 18..22). The journal notes the save
+/// before the rename; the test hook holds the window at that point.
+#[test]
+fn a_kill_between_the_save_and_the_journal_removal_replays_nothing_twice() {
+    let (dir, file) = small_document();
+    let script = "select -8 -2 -7 7 2 8\nmove 0 10 0\nsave doc.vox\n";
+    let expected = replayed(&file, script);
+    let (_xvfb, display) = start_xvfb(14);
+    let (mut app, mut lines) = play_in_window(&display, dir.path(), script, &[("OCTOVOX_TEST_HOLD_AFTER_SAVE", "1")]);
+    lines.wait_for("test hold:", Duration::from_secs(90));
+    app.0.kill().unwrap();
+    app.0.wait().unwrap();
+    let journal = octovox::journal::journal_path(&file);
+    assert!(journal.is_file(), "the kill came before the journal's removal");
+    assert_eq!(voxel_colors(&file), expected, "the save holds the move once");
+
+    let recovered = dir.path().join("recovered.vox");
+    let run = octovox(&["recover", s(&file), "-o", s(&recovered)]);
+    let message = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success() && message.contains("is stale"), "{message}");
+    assert!(!recovered.exists(), "nothing is written");
+
+    // The window opening the document removes the stale journal, asking nothing.
+    let (mut app, mut lines) = play_in_window(&display, dir.path(), "", &[]);
+    lines.wait_for("journal stale:", Duration::from_secs(90));
+    lines.wait_for("replay:", Duration::from_secs(30));
+    assert!(!lines.seen.iter().any(|l| l.starts_with("asking:")), "{:?}", lines.seen);
+    assert!(!journal.exists(), "the stale journal is gone");
+    app.0.kill().unwrap();
+    assert_eq!(voxel_colors(&file), expected);
+}
+
+/// Issue 24, item 3: a second window on the same document offered to
+/// recover the live window's journal and then replaced it with its own, so
+/// the first window's edits were no longer protected.
+#[test]
+fn a_second_window_leaves_the_live_journal_alone() {
+    let (dir, file) = small_document();
+    let first = "color 5\nplace 0 20 0\n";
+    let expected = replayed(&file, first);
+    let (_xvfb, display) = start_xvfb(15);
+    let (mut app, mut lines) = play_in_window(&display, dir.path(), first, &[]);
+    lines.wait_for("replay:", Duration::from_secs(90));
+    let journal = octovox::journal::journal_path(&file);
+    let held = std::fs::read_to_string(&journal).unwrap();
+
+    let (mut second, mut second_lines) = play_in_window(&display, dir.path(), "color 6\nplace 0 30 0\n", &[]);
+    assert!(second_lines.wait_for("journal live:", Duration::from_secs(90)).ends_with(".doc.vox.octovox-journal.ovr"));
+    second_lines.wait_for("replay:", Duration::from_secs(30));
+    assert!(!second_lines.seen.iter().any(|l| l.starts_with("asking:")), "{:?}", second_lines.seen);
+    assert_eq!(std::fs::read_to_string(&journal).unwrap(), held, "the first window's journal is untouched");
+
+    app.0.kill().unwrap();
+    app.0.wait().unwrap();
+    second.0.kill().unwrap();
+    second.0.wait().unwrap();
+    let recovered = dir.path().join("recovered.vox");
+    let run = octovox(&["recover", s(&file), "-o", s(&recovered)]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert_eq!(voxel_colors(&recovered), expected, "the first window's edits are recovered");
+}
+
+/// Issue 24, item 6: a journal that cannot be written (here a name too
+/// long for the file system) was one log line; the status bar now says the
+/// edits are not protected, and no empty journal is left.
+#[test]
+fn a_journal_that_cannot_be_written_is_shown_and_leaves_nothing() {
+    let (dir, file) = small_document();
+    // 240 characters: the document fits in a name, its journal does not.
+    let long = dir.path().join(format!("{}.vox", "d".repeat(236)));
+    std::fs::rename(&file, &long).unwrap();
+    std::fs::write(dir.path().join("play.ovr"), "color 5\nplace 0 20 0\nplace 0 21 0\n").unwrap();
+    let (_xvfb, display) = start_xvfb(16);
+    let args = [s(&long).to_string(), "--size".into(), "640x480".into(), "--replay".into(), "play.ovr".into()];
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
+    find_window(&display, &mut app, &stderr_path);
+    let failed = lines.wait_for("journal failed:", Duration::from_secs(90));
+    assert!(failed.contains("File name too long"), "{failed}");
+    lines.wait_for("replay:", Duration::from_secs(30));
+    let failures = lines.seen.iter().filter(|l| l.starts_with("journal failed:")).count();
+    assert_eq!(failures, 1, "reported once, then shown: {:?}", lines.seen);
+    let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert!(!left.iter().any(|n| n.to_string_lossy().contains("journal")), "no journal is left: {left:?}");
+    // The warning stays in the menu bar: its orange text is on screen.
+    std::thread::sleep(Duration::from_millis(500));
+    let shot = screenshot_x(&display, &dir.path().join("shot.png"));
+    let is_orange = |p: &&image::Rgb<u8>| p[0] > 200 && (120..200).contains(&p[1]) && p[2] < 100;
+    let orange = shot.pixels().take(shot.width() as usize * 30).filter(is_orange).count();
+    assert!(orange > 20, "the menu bar shows the warning ({orange} orange pixels)");
+    app.0.kill().unwrap();
+}

@@ -165,7 +165,9 @@ impl App {
                 // What the clipboard holds was copied before this journal.
                 self.clipboard_journaled = false;
             }
-            Err(err) => self.journal_failed(format!("cannot write the crash-recovery journal {}: {err}", path.display())),
+            Err(err) => {
+                self.journal_failed(format!("cannot write the crash-recovery journal {}: {err}", path.display()))
+            }
         }
     }
 

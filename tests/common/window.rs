@@ -148,17 +148,19 @@ impl Lines {
 
     /// Waits for a line starting with `prefix`; returns it.
     pub fn wait_for(&mut self, prefix: &str, timeout: Duration) -> String {
+        self.try_wait_for(prefix, timeout)
+            .unwrap_or_else(|| panic!("no `{prefix}` line from the app within {timeout:?}; saw {:?}", self.seen))
+    }
+
+    /// Waits for a line starting with `prefix`, or `None` after `timeout`.
+    pub fn try_wait_for(&mut self, prefix: &str, timeout: Duration) -> Option<String> {
         let deadline = Instant::now() + timeout;
         loop {
             let left = deadline.saturating_duration_since(Instant::now());
-            match self.rx.recv_timeout(left) {
-                Ok(line) => {
-                    self.seen.push(line.clone());
-                    if line.starts_with(prefix) {
-                        return line;
-                    }
-                }
-                Err(_) => panic!("no `{prefix}` line from the app within {timeout:?}; saw {:?}", self.seen),
+            let line = self.rx.recv_timeout(left).ok()?;
+            self.seen.push(line.clone());
+            if line.starts_with(prefix) {
+                return Some(line);
             }
         }
     }
@@ -269,9 +271,20 @@ pub fn click(display: &str, window: &str, lines: &mut Lines, x: u32, y: u32) -> 
     line.split_whitespace().nth(1).and_then(|n| n.parse().ok()).expect("edit line: `edit: N bytes written …`")
 }
 
+/// Ctrl+S, until the app says it saved `file`. Sent again after a while:
+/// on a loaded machine an Escape that takes the keyboard focus from a panel
+/// widget and the Ctrl+S after it can reach the window before egui's next
+/// frame has seen the Escape, and egui then takes the Ctrl+S as its own.
 pub fn save(display: &str, lines: &mut Lines, file: &Path) {
-    xdotool(display, &["key", "ctrl+s"]);
-    let line = lines.wait_for("saved:", Duration::from_secs(30));
+    let mut line = None;
+    for _ in 0..6 {
+        xdotool(display, &["key", "ctrl+s"]);
+        line = lines.try_wait_for("saved:", Duration::from_secs(5));
+        if line.is_some() {
+            break;
+        }
+    }
+    let line = line.unwrap_or_else(|| panic!("no `saved:` line after six Ctrl+S; saw {:?}", lines.seen));
     assert!(line.ends_with(&*file.file_name().unwrap().to_string_lossy()), "{line}");
 }
 
