@@ -58,13 +58,16 @@ pub fn parse_bytes(text: &str) -> Result<u64, String> {
     let split = text.find(|c: char| !c.is_ascii_digit()).unwrap_or(text.len());
     let (digits, unit) = text.split_at(split);
     let number: u64 = digits.parse().map_err(|_| format!("'{text}' is not a size such as 4G, 512M or 1000000"))?;
-    let shift = match unit.to_ascii_lowercase().trim_end_matches("ib").trim_end_matches('b') {
-        "" => 0,
+    // One unit, spelled K, KB or KiB (any case): `4GiBiBiB` is not one.
+    let lower = unit.to_ascii_lowercase();
+    let prefix = lower.strip_suffix("ib").or_else(|| lower.strip_suffix('b')).unwrap_or(&lower);
+    let shift = match prefix {
+        "" if lower.is_empty() || lower == "b" => 0,
         "k" => 10,
         "m" => 20,
         "g" => 30,
         "t" => 40,
-        _ => return Err(format!("'{text}': unknown unit '{unit}' (use K, M, G or T)")),
+        _ => return Err(format!("'{text}': unknown unit '{unit}' (use K, M, G or T, as in 4G, 4GB or 4GiB)")),
     };
     number.checked_mul(1 << shift).filter(|b| *b > 0).ok_or_else(|| format!("'{text}' is not a usable size"))
 }
@@ -82,6 +85,13 @@ mod tests {
         assert!(parse_bytes("-1G").is_err());
         assert!(parse_bytes("12 parsecs").is_err());
         assert!(parse_bytes("99999999999T").is_err());
+        // Issue 24, item 16: a malformed unit was read as its first one.
+        for bad in ["4GiBiBiB", "4GBB", "4ibib", "4iB", "4bb", "4KMG"] {
+            assert!(parse_bytes(bad).is_err(), "{bad}");
+        }
+        assert_eq!(parse_bytes("4gb"), Ok(4 << 30));
+        assert_eq!(parse_bytes("4kib"), Ok(4 << 10));
+        assert_eq!(parse_bytes("100b"), Ok(100));
         assert_eq!(human(3 << 29), "1.5 GiB");
         assert_eq!(human(10), "10 B");
     }

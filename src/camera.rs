@@ -13,6 +13,28 @@ pub fn clamp_fov(fov: f32) -> f32 {
     if fov.is_nan() { *FOV_RANGE_DEG.start() } else { fov.clamp(*FOV_RANGE_DEG.start(), *FOV_RANGE_DEG.end()) }
 }
 
+/// How far from the origin a camera's eye and target may be, per axis:
+/// 2^28, sixteen times the coordinate limit. Past it the ray basis loses
+/// the precision of f32 on the GPU (1e39 is infinite there and drew sky).
+pub const CAMERA_LIMIT: f64 = (1 << 28) as f64;
+
+/// Checks a camera given by the user: eye and target finite, within
+/// [`CAMERA_LIMIT`], and apart.
+///
+/// # Errors
+/// Which of these fails, in words.
+pub fn check_camera(eye: DVec3, target: DVec3) -> Result<(), String> {
+    for (what, v) in [("eye", eye), ("target", target)] {
+        if !v.is_finite() || v.abs().max_element() > CAMERA_LIMIT {
+            return Err(format!("camera {what} {v} is outside ±2^28 (±{CAMERA_LIMIT}) on some axis"));
+        }
+    }
+    if eye == target {
+        return Err("camera eye and target are the same point".into());
+    }
+    Ok(())
+}
+
 /// Checks a field of view given by the user.
 pub fn check_fov(fov: f32) -> Result<f32, String> {
     if FOV_RANGE_DEG.contains(&fov) {

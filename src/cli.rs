@@ -340,9 +340,7 @@ pub fn parse_camera(s: &str) -> Result<(DVec3, DVec3), String> {
         }
     };
     let (eye, target) = (vec(eye)?, vec(target)?);
-    if eye == target {
-        return Err(format!("camera '{s}': eye and target are the same point"));
-    }
+    octovox::camera::check_camera(eye, target).map_err(|message| format!("camera '{s}': {message}"))?;
     Ok((eye, target))
 }
 

@@ -41,6 +41,21 @@ impl Edit {
         }
     }
 
+    /// Peak bytes applying it may take: a brush as `Octree::apply_brush`
+    /// estimates it (24 bytes per voxel of its surface), a restore twice its
+    /// saved cells (they and the cells it replaces), plus the edit and its
+    /// undo record themselves.
+    pub fn estimated_bytes(&self) -> u64 {
+        let own = 2 * std::mem::size_of::<Edit>() as u64;
+        own.saturating_add(match self {
+            Edit::Brush { shape, .. } => {
+                shape.surface_voxels().saturating_mul(crate::scene::apply::EDIT_BYTES_PER_SURFACE_VOXEL)
+            }
+            Edit::Restore(patch) => 2 * patch.heap_bytes() as u64,
+            Edit::Palette { .. } => 0,
+        })
+    }
+
     /// Whether applying it changes the palette (which then goes to the GPU).
     pub fn changes_palette(&self) -> bool {
         matches!(self, Edit::Palette { .. })
@@ -98,6 +113,12 @@ impl History {
     /// open stroke. If one is refused, those before it are undone: the
     /// scene is as it was and the error is returned.
     pub fn apply_group(&mut self, scene: &mut Scene, edits: Vec<Edit>) -> Result<(), EditError> {
+        // The whole step against the budget before any of it (an extrude
+        // of a million faces is a million brushes, each under the budget).
+        if edits.len() > 1 {
+            let bytes = edits.iter().map(Edit::estimated_bytes).fold(0, u64::saturating_add);
+            crate::budget::check(|| format!("a step of {} edits", edits.len()), bytes)?;
+        }
         let mut step = Step::default();
         for edit in edits {
             match edit.apply(scene) {

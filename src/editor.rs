@@ -92,7 +92,8 @@ impl Editor {
                 self.apply_mirrored(vec![brush_edit(&tools, *p, Op::Paint(tools.color))]).map_err(text)?
             }
             Command::Line(a, b) => {
-                self.apply_mirrored(crate::tool::line_edits(&tools.brush, tools.color, *a, *b)).map_err(text)?
+                let edits = crate::tool::line_edits(&tools.brush, tools.color, *a, *b).map_err(text)?;
+                self.apply_mirrored(edits).map_err(text)?
             }
             // Fills and extrudes are not mirrored: their regions follow the
             // colours and faces, not the brush.

@@ -4,7 +4,8 @@
 use glam::IVec3;
 
 use crate::edit::Edit;
-use crate::scene::{Op, Shape};
+use crate::scene::octree::{MAX_DEPTH, WORLD_LIMIT};
+use crate::scene::{EditError, Op, Shape};
 
 /// What a click does (MagicaVoxel's names and keys: T, R, G).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -107,8 +108,27 @@ pub fn line_points(a: IVec3, b: IVec3) -> Vec<IVec3> {
 }
 
 /// The edits of a line: the brush placed with `color` at every cell of it.
-pub fn line_edits(brush: &Brush, color: u8, a: IVec3, b: IVec3) -> Vec<Edit> {
-    line_points(a, b).into_iter().map(|p| Edit::Brush { shape: brush.shape_at(p), op: Op::Place(color) }).collect()
+/// Its extent and memory are checked before any cell is built (a line
+/// across the whole coordinate range is 33 million cells).
+///
+/// # Errors
+/// The line and brush reach past the coordinate limit, are wider than the
+/// world, or their edits' estimate is over the memory budget.
+pub fn line_edits(brush: &Brush, color: u8, a: IVec3, b: IVec3) -> Result<Vec<Edit>, EditError> {
+    let (lo_a, hi_a) = brush.shape_at(a).bounds();
+    let (lo_b, hi_b) = brush.shape_at(b).bounds();
+    let (min, max) = (lo_a.min(lo_b), hi_a.max(hi_b));
+    if min.min_element() <= -WORLD_LIMIT || max.max_element() >= WORLD_LIMIT {
+        return Err(EditError::OutsideWorld { min, max });
+    }
+    if (max.as_i64vec3() - min.as_i64vec3()).max_element() >= 1 << MAX_DEPTH {
+        return Err(EditError::TooWide { min, max });
+    }
+    let cells = (b.as_i64vec3() - a.as_i64vec3()).abs().max_element().unsigned_abs() + 1;
+    let each = Edit::Brush { shape: brush.shape_at(a), op: Op::Place(color) }.estimated_bytes();
+    crate::budget::check(|| format!("a line of {cells} brushes"), cells.saturating_mul(each))?;
+    let edits = line_points(a, b).into_iter().map(|p| Edit::Brush { shape: brush.shape_at(p), op: Op::Place(color) });
+    Ok(edits.collect())
 }
 
 #[cfg(test)]

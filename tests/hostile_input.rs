@@ -558,3 +558,68 @@ fn a_closed_pipe_is_a_normal_end() {
     assert!(out.status.success(), "{stderr}");
     assert!(!stderr.contains("panicked"), "{stderr}");
 }
+
+/// Issue 24, item 11: an extrude of a million faces by 4096 layers (within
+/// the documented limits) had no estimate and aborted at 4 GB after 25 s;
+/// the whole step is now estimated before any of it is applied.
+#[test]
+fn an_extrude_is_estimated_against_the_budget_before_it_is_built() {
+    let dir = tempfile::tempdir().unwrap();
+    let script = dir.path().join("extrude.ovr");
+    std::fs::write(&script, "new\nbrush box 1024 1 1024\nplace 0 0 0\nextrude 0 0 0 0 1 0 4096\n").unwrap();
+    let out = octovox(&["--memory-budget", "1G", "replay", "--cpu", s(&script)]);
+    assert_refused(&out, "a step of 1048576 edits would need about");
+    assert_refused(&out, "over the 1.0 GiB budget");
+}
+
+/// Issue 24, item 12: a line across the whole coordinate range built its
+/// 33 million cells (4.1 GB) before the world-width check refused it. Run
+/// under a 1.5 GiB address-space limit, the old code aborted.
+#[test]
+fn a_line_wider_than_the_world_is_refused_before_its_cells_are_built() {
+    let dir = tempfile::tempdir().unwrap();
+    let script = dir.path().join("line.ovr");
+    std::fs::write(&script, "new\nline -16777215 0 0 16777215 0 0\n").unwrap();
+    let out = Command::new("prlimit")
+        .args(["--as=1610612736", "--", env!("CARGO_BIN_EXE_octovox"), "replay", "--cpu", s(&script)])
+        .output()
+        .expect("prlimit (util-linux) runs octovox");
+    assert_refused(&out, "would make the world wider than 2^20 voxels");
+    // Within the world but over the budget: refused by the estimate, with nothing built.
+    std::fs::write(&script, "new\nbrush box 4096 4096 1\nline 0 0 0 0 0 1000000\n").unwrap();
+    assert_refused(&octovox(&["--memory-budget", "1G", "replay", "--cpu", s(&script)]), "a line of 1000001 brushes");
+}
+
+/// A closed cube of side `side` with its min corner at (`at`, 0, 0), as .obj text.
+fn cube_obj(at: f32, side: f32) -> String {
+    let mut text = String::new();
+    for i in 0..8 {
+        let corner = |bit: i32| if i & bit != 0 { side } else { 0.0 };
+        text += &format!("v {:e} {:e} {:e}\n", at + corner(1), corner(2), corner(4));
+    }
+    // Six faces as quads, wound outward.
+    for face in ["1 3 4 2", "5 6 8 7", "1 2 6 5", "3 7 8 4", "1 5 7 3", "2 4 8 6"] {
+        text += &format!("f {face}\n");
+    }
+    text
+}
+
+/// Issue 24, item 18: a closed mesh too small, or too far from the origin
+/// for its size, was "encloses no voxel centre (is it closed?)"; the
+/// message now says what is wrong with its coordinates.
+#[test]
+fn meshes_too_small_or_too_far_to_voxelize_say_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.ovx");
+    for (at, side, why) in [(0.0, 1e-38, "too small"), (1e30, 1.0, "too far from the origin"), (0.0, 1.0, "")] {
+        let mesh = dir.path().join("cube.obj");
+        std::fs::write(&mesh, cube_obj(at, side)).unwrap();
+        let run = octovox(&["import", s(&mesh), "-o", s(&out), "--size", "16", "--force"]);
+        if why.is_empty() {
+            assert!(run.status.success(), "a unit cube imports: {}", text(&run));
+        } else {
+            assert_refused(&run, why);
+            assert!(!text(&run).contains("is it closed"), "{}", text(&run));
+        }
+    }
+}

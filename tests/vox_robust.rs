@@ -128,6 +128,24 @@ fn hand_built_files_load() {
     assert_eq!(model.voxels[0].0.to_array(), [5, 7, -6]);
 }
 
+/// Issue 24, item 8: a model translated past ±2^24 loaded, rendered and
+/// converted (docs/limits.md says it is refused at load), and edits there
+/// reported wrapped coordinates. Both ends of the limit, and just inside it.
+#[test]
+fn voxels_past_the_coordinate_limit_are_refused_at_load() {
+    let placed_at = |t: &str| {
+        let mut scene = one_voxel_model();
+        scene.extend([transform(0, 1, &[]), group(1, &[2]), transform(2, 3, &[("_t", t)])]);
+        scene.push(shape(3, 0));
+        load_vox(&vox_file(&scene), 0)
+    };
+    for t in ["16777216 0 0", "0 0 -16777216", "0 -20000000 0", "2000000000 0 0"] {
+        let message = placed_at(t).map(|m| m.voxels.len()).unwrap_err().to_string();
+        assert!(message.contains("past the coordinate limit ±16777216"), "{t}: {message}");
+    }
+    assert_eq!(placed_at("16777215 0 -16777215").unwrap().voxels[0].0.to_array(), [16777215, -16777215, -0]);
+}
+
 /// `--frame` picks the last keyframe at or before it (no interpolation).
 #[test]
 fn keyframes_follow_the_requested_frame() {

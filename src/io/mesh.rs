@@ -54,6 +54,12 @@ pub enum MeshError {
     BadIndex { path: PathBuf, index: u32, vertices: usize },
     #[error("{}: at {size} voxels the mesh encloses no voxel centre (is it closed?)", path.display())]
     NothingInside { path: PathBuf, size: u32 },
+    #[error(
+        "{}: the mesh is {extent:e} units wide, {distance:e} from the origin: {why} for {size} voxels across it \
+         (32-bit floats cannot place them); scale or move it in its file",
+        path.display()
+    )]
+    Unplaceable { path: PathBuf, extent: f32, distance: f32, size: u32, why: &'static str },
     #[error("voxel size {0} is outside 1..={MAX_MESH_SIZE}")]
     Size(u32),
     #[error("{}: {source}", path.display())]
@@ -199,6 +205,13 @@ pub fn voxelize_obj_with(
         return Err(MeshError::Size(size));
     }
     let triangles = load_obj_triangles(path, up)?;
+    check_placeable(&triangles, size).map_err(|(extent, distance, why)| MeshError::Unplaceable {
+        path: path.to_path_buf(),
+        extent,
+        distance,
+        size,
+        why,
+    })?;
     crate::budget::check(
         || format!("voxelizing {} at {size} voxels", path.display()),
         voxelize_bytes(&triangles, size),
@@ -210,6 +223,24 @@ pub fn voxelize_obj_with(
         return Err(MeshError::NothingInside { path: path.to_path_buf(), size });
     }
     Ok(tree)
+}
+
+/// Whether f32 can place `size` voxels across the mesh: its extent must be
+/// a normal number whose scale to voxels is finite, and a voxel must be
+/// wider than a unit in the last place of the coordinates (a mesh of side
+/// 1 at 1e30 has all its vertices at one float). Else (extent, distance, why).
+fn check_placeable(triangles: &[[Vec3; 3]], size: u32) -> Result<(), (f32, f32, &'static str)> {
+    let (lo, hi) = bounds(triangles);
+    let extent = (hi - lo).max_element();
+    let distance = lo.abs().max(hi.abs()).max_element();
+    let voxel = extent / size as f32;
+    if !extent.is_normal() || !voxel.is_normal() || !(size as f32 / extent).is_finite() {
+        return Err((extent, distance, "too small"));
+    }
+    if voxel <= distance * f32::EPSILON {
+        return Err((extent, distance, "too far from the origin for its size"));
+    }
+    Ok(())
 }
 
 /// The min and max corners of the triangles' vertices.

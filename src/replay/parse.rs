@@ -235,6 +235,19 @@ pub fn load_script(path: &Path) -> Result<Script, Vec<ScriptError>> {
 /// Largest script file read: 64 MiB, about a million edit lines.
 pub const MAX_SCRIPT_BYTES: u64 = 64 << 20;
 
+/// The count of `undo N` / `redo N`: a whole number 1..=u32::MAX.
+fn parse_count(text: &str) -> Result<u32, String> {
+    let digits = !text.is_empty() && text.bytes().all(|b| b.is_ascii_digit());
+    match text.parse::<u32>() {
+        Ok(n) if n >= 1 => Ok(n),
+        // A number past u32 is a count, only too large (not "not ≥ 1").
+        Err(_) if digits && text.trim_start_matches('0').len() >= 10 => {
+            Err(format!("count {text} is too large (at most {})", u32::MAX))
+        }
+        _ => Err(format!("expected a count ≥ 1, found '{text}'")),
+    }
+}
+
 fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
     let name = c.word("a command")?;
     Ok(match name.text.as_str() {
@@ -259,9 +272,7 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
                 None => None,
             };
             let (eye, target) = (DVec3::new(v[0], v[1], v[2]), DVec3::new(v[3], v[4], v[5]));
-            if eye == target {
-                return Err((name.column, "camera eye and target are the same point".into()));
-            }
+            crate::camera::check_camera(eye, target).map_err(|message| (name.column, message))?;
             Command::Camera { eye, target, fov }
         }
         "viewport" => Command::Viewport(c.int_in("width", 1..=8192)? as u32, c.int_in("height", 1..=8192)? as u32),
@@ -329,12 +340,7 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
         }
         "undo" | "redo" => {
             let n = match c.optional() {
-                Some(t) => t
-                    .text
-                    .parse::<u32>()
-                    .ok()
-                    .filter(|n| *n >= 1)
-                    .ok_or((t.column, format!("expected a count ≥ 1, found '{}'", t.text)))?,
+                Some(t) => parse_count(&t.text).map_err(|message| (t.column, message))?,
                 None => 1,
             };
             if name.text == "undo" { Command::Undo(n) } else { Command::Redo(n) }
@@ -417,6 +423,12 @@ fn parse_material(c: &mut Cursor) -> Result<Command, Fail> {
             ));
         }
         let value = c.float(&format!("a number for {}", key.text))?;
+        if let Some(range) = crate::scene::palette::param_range(&key.text)
+            && !range.contains(&(value as f32))
+        {
+            let (lo, hi) = (range.start(), range.end());
+            return Err((key.column, format!("{} {value} is outside {lo}..={hi}", key.text)));
+        }
         material.params.insert(key.text, value.to_string());
     }
     Ok(Command::Material(index, Box::new(material)))
@@ -458,6 +470,23 @@ mod tests {
         let text = "new\n\n# comment\nbrush sphere 3\n\n\n\n\n\n\n\nplcae 1 2 3\n";
         assert_eq!(errors(text), vec!["unknown command 'plcae' at build.ovr:12:1"]);
         assert_eq!(errors("place 1 2"), vec!["missing Z at build.ovr:1:10"]);
+        // Issue 24, item 17: a count past u32 was "expected a count ≥ 1".
+        assert_eq!(
+            errors("undo 4294967296"),
+            vec!["count 4294967296 is too large (at most 4294967295) at build.ovr:1:6"]
+        );
+        // Issue 24, item 10: non-finite cameras and out-of-range materials were accepted.
+        assert_eq!(
+            errors("camera 1e39 0 0 0 0 0"),
+            vec![
+                "camera eye [1000000000000000000000000000000000000000, 0, 0] is outside ±2^28 (±268435456) on some axis at build.ovr:1:1"
+            ]
+        );
+        assert_eq!(errors("material 1 glass _ri -1"), vec!["_ri -1 is outside 1..=3 at build.ovr:1:18"]);
+        assert_eq!(errors("material 1 glass _trans -3"), vec!["_trans -3 is outside 0..=1 at build.ovr:1:18"]);
+        assert_eq!(errors("material 1 glass _ri 1.5 _trans 0.5"), Vec::<String>::new());
+        assert_eq!(errors("redo 0"), vec!["expected a count ≥ 1, found '0' at build.ovr:1:6"]);
+        assert_eq!(errors("undo -3"), vec!["expected a count ≥ 1, found '-3' at build.ovr:1:6"]);
         assert_eq!(errors("color 0"), vec!["palette index 0 is outside 1..=255 at build.ovr:1:7"]);
         assert_eq!(errors("color 300"), vec!["palette index 300 is outside 1..=255 at build.ovr:1:7"]);
         assert_eq!(errors("brush sphere -1"), vec!["sphere radius -1 is outside 0..=4096 at build.ovr:1:14"]);

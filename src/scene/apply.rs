@@ -29,7 +29,7 @@ pub enum EditError {
 /// Peak bytes an edit takes per surface voxel of its shape: bricks and
 /// nodes, the undo patch and the dirty lists (a radius-4096 sphere, 2·10^8
 /// surface voxels, took 3.8 GB).
-const EDIT_BYTES_PER_SURFACE_VOXEL: u64 = 24;
+pub const EDIT_BYTES_PER_SURFACE_VOXEL: u64 = 24;
 
 /// Serialized-subtree tag for a node: eight child subtrees follow.
 const NODE_TAG: u32 = 0x8000_0000;

@@ -359,6 +359,14 @@ impl Octree {
         bricks: Vec<Brick>,
     ) -> Result<Octree, String> {
         check_tree_shape(root, depth, &nodes, bricks.len())?;
+        // The root cube may pass the coordinate limit by at most one world
+        // width (a grown root is aligned), never so far that i32 wraps.
+        let reach = i64::from(WORLD_LIMIT) + (1 << MAX_DEPTH);
+        let far = origin.as_i64vec3().min_element() <= -reach
+            || origin.as_i64vec3().max_element() + (1_i64 << depth.min(MAX_DEPTH)) >= reach;
+        if far {
+            return Err(format!("its root cube at {origin} reaches past the coordinate limit ±{WORLD_LIMIT} (±2^24)"));
+        }
         let mut tree = Octree::empty(origin, depth);
         if tree.depth != depth {
             return Err(format!("root depth {depth} is outside {MIN_DEPTH}..={MAX_DEPTH}"));
@@ -368,6 +376,14 @@ impl Octree {
         tree.root = root;
         tree.counts.add_word(&tree.pool, root, depth);
         tree.check_invariants()?;
+        if let Some((lo, hi)) = tree.solid_bounds()
+            && (lo.min_element() <= -WORLD_LIMIT || hi.max_element() >= WORLD_LIMIT)
+        {
+            return Err(format!(
+                "it holds voxels at {lo}..{hi}, past the coordinate limit ±{WORLD_LIMIT} (±2^24) that edits and \
+                 rendering keep exact"
+            ));
+        }
         Ok(tree)
     }
 
@@ -483,4 +499,25 @@ pub fn decode_from_bytes(nodes: &[u8], bricks: &[u8], root: u32, origin: IVec3, 
         level -= 1;
     }
     word as u8
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 24, item 8: an .ovx whose root sits past ±2^24 loaded (and one
+    /// near i32's end made child positions wrap). `from_parts` is what the
+    /// .ovx reader builds its tree with.
+    #[test]
+    fn a_tree_past_the_coordinate_limit_is_refused() {
+        let solid = |origin: IVec3| Octree::from_parts(origin, MIN_DEPTH, 7, Vec::new(), Vec::new());
+        let inside = IVec3::new(WORLD_LIMIT - 4, -WORLD_LIMIT + 1, 0);
+        assert_eq!(solid(inside).map(|t| t.solid_voxels()), Ok(64));
+        for origin in
+            [IVec3::new(WORLD_LIMIT - 3, 0, 0), IVec3::new(0, -WORLD_LIMIT, 0), IVec3::new(i32::MAX - 1, 0, 0)]
+        {
+            let err = solid(origin).map(|t| t.solid_voxels()).unwrap_err();
+            assert!(err.contains("past the coordinate limit"), "{origin}: {err}");
+        }
+    }
 }

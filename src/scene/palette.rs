@@ -61,6 +61,13 @@ const NUMERIC_PARAMS: [(&str, std::ops::RangeInclusive<f32>, f32); 11] = [
     ("_d", 0.0..=1.0, 0.0),
 ];
 
+/// The range MagicaVoxel's UI allows a numeric MATL parameter (scripts and
+/// the window refuse values outside it; files keep theirs, and rendering
+/// clamps them).
+pub fn param_range(key: &str) -> Option<std::ops::RangeInclusive<f32>> {
+    NUMERIC_PARAMS.iter().find(|(k, _, _)| *k == key).map(|(_, range, _)| range.clone())
+}
+
 /// Whether `key` is a MATL parameter octovox reads as a number.
 pub fn is_numeric_key(key: &str) -> bool {
     NUMERIC_PARAMS.iter().any(|(k, _, _)| *k == key)

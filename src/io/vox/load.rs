@@ -12,6 +12,7 @@ use super::validate::{self, Layout};
 use super::{MAX_FILE_BYTES, VoxError};
 use crate::io::guard::catch_quietly;
 use crate::io::input::{InputError, read_limited};
+use crate::scene::octree::WORLD_LIMIT;
 use crate::scene::{Material, MaterialKind, Octree, Palette, Scene, Voxel, VoxelModel};
 
 /// Reads and loads the `.vox` file at `path`; see [`load_vox`].
@@ -141,7 +142,8 @@ impl Parsed {
                 let [x, y, z] = placement.place([v.x, v.y, v.z], size);
                 let world = to_world([x, z, -y]).ok_or_else(|| {
                     VoxError::BadSceneGraph(format!(
-                        "a voxel of model {} lands at ({x}, {y}, {z}), outside the 32-bit range",
+                        "a voxel of model {} lands at ({x}, {y}, {z}) (MagicaVoxel's axes), past the coordinate \
+                         limit ±{WORLD_LIMIT} (±2^24) that edits and rendering keep exact",
                         placement.model
                     ))
                 })?;
@@ -228,8 +230,11 @@ fn place_voxels(parsed: &Parsed) -> Result<Vec<Voxel>, VoxError> {
     Ok(voxels)
 }
 
+/// A position in world axes, if it is inside the coordinate limit
+/// (what an edit may reach: docs/limits.md).
 fn to_world(p: [i64; 3]) -> Option<IVec3> {
-    Some(IVec3::new(p[0].try_into().ok()?, p[1].try_into().ok()?, p[2].try_into().ok()?))
+    let limit = i64::from(WORLD_LIMIT);
+    p.iter().all(|c| -limit < *c && *c < limit).then(|| IVec3::new(p[0] as i32, p[1] as i32, p[2] as i32))
 }
 
 /// Sorts by position (x, then y, then z) and keeps the last of equal positions.
