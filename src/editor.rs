@@ -57,7 +57,10 @@ pub struct Editor {
 impl Editor {
     /// Puts `scene` in place with an empty history and no selection; the
     /// tools and the clipboard stay (pasting between documents works).
-    pub fn set_scene(&mut self, scene: Scene) {
+    /// Puts `scene` in place; the next flush uploads all of it (what it was
+    /// flushed to before, if anything, is not this editor's GPU buffer).
+    pub fn set_scene(&mut self, mut scene: Scene) {
+        scene.tree.pool_mut().forget_uploads();
         self.scene = scene;
         self.history.clear();
         self.selection = None;
@@ -256,6 +259,24 @@ mod tests {
         assert_eq!(editor.history.usage().0, 2);
         assert!(run(&mut editor, &format!("move {limit} 0 0")).is_err());
         assert_eq!((editor.scene.tree.get(IVec3::ZERO), editor.scene.tree.get(IVec3::X)), (1, 1));
+    }
+
+    /// Issue 27, bug 1: a scene recovered from a journal (replayed on the
+    /// CPU, whose runner flushed the pool as it went) uploaded 0 bytes in
+    /// the window, which went on showing the scene from before recovery.
+    #[test]
+    fn a_scene_put_in_place_is_uploaded_whole() {
+        let mut replayed = Editor::default();
+        for line in ["new", "brush sphere 6", "place 0 0 0", "place 9 0 0"] {
+            run(&mut replayed, line).unwrap();
+        }
+        // A flush elsewhere (the CPU runner counts its flushes so).
+        let _ = replayed.scene.tree.pool_mut().flush();
+        let live = replayed.scene.tree.pool().live_bytes();
+        let mut window = Editor::default();
+        window.set_scene(replayed.scene);
+        let upload = window.scene.tree.pool_mut().flush();
+        assert!(upload.byte_count() >= live, "{} of {live} bytes uploaded", upload.byte_count());
     }
 
     #[test]

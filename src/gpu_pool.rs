@@ -160,6 +160,19 @@ impl<T: bytemuck::Pod> SlotArena<T> {
     /// The slots the GPU buffer should be re-created with, when it cannot
     /// hold the arena: half again as many as are in use, so a long session
     /// does not grow on every edit.
+    /// Forgets what any GPU buffer holds: every slot in use is dirty and
+    /// the next flush sizes a buffer afresh.
+    fn forget_uploads(&mut self) {
+        self.dirty.clear();
+        for (slot, state) in (0..).zip(self.state.iter_mut()) {
+            if *state != SlotState::Free {
+                *state = SlotState::Dirty;
+                self.dirty.push(slot);
+            }
+        }
+        self.gpu_capacity = None;
+    }
+
     fn wanted_capacity(&self) -> Option<usize> {
         match self.gpu_capacity {
             Some(cap) if cap >= self.items.len() => None,
@@ -268,6 +281,14 @@ pub struct PoolTooLarge {
 }
 
 impl NodePool {
+    /// The pool is going to a GPU buffer that holds none of it (a scene put
+    /// in place of another, which may have been flushed elsewhere: a journal
+    /// recovered headless): the next flush uploads every slot in use.
+    pub fn forget_uploads(&mut self) {
+        self.nodes.forget_uploads();
+        self.bricks.forget_uploads();
+    }
+
     /// Takes every change since the last flush. The caller writes each range
     /// (after re-creating a buffer that must grow) and nothing else.
     pub fn flush(&mut self) -> Upload {
