@@ -293,3 +293,23 @@ fn lock(file: &std::fs::File, path: &Path) -> std::io::Result<()> {
         std::fs::TryLockError::Error(err) => err,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)] // in tests a panic is the failure report
+
+    use super::*;
+
+    /// Issue 24, item 6: a journal whose first line could not be written
+    /// (a full disk) was left behind empty. `/dev/full` is such a disk.
+    #[cfg(unix)]
+    #[test]
+    fn a_journal_that_cannot_be_written_leaves_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let journal = dir.path().join(".doc.vox.octovox-journal.ovr");
+        std::os::unix::fs::symlink("/dev/full", &journal).unwrap();
+        assert!(Recorder::journal(&journal, "test").is_err());
+        assert!(std::fs::symlink_metadata(&journal).is_err(), "nothing is left at the journal's path");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
+}
