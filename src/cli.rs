@@ -130,7 +130,7 @@ pub enum Command {
     /// Ray-trace a scene to a PNG (GPU, or the CPU reference with --cpu).
     #[command(allow_negative_numbers = true)]
     Render(RenderArgs),
-    /// Measure build, edit and render speed and memory; writes docs/bench/.
+    /// Measure build, edit and render speed and memory; writes target/bench/ (or --out).
     Bench(BenchArgs),
     /// Run edit scripts headless and check their expectations (docs/replay.md).
     Replay {
@@ -255,8 +255,10 @@ pub struct BenchArgs {
     /// What to measure.
     #[arg(value_enum)]
     pub what: BenchKind,
-    /// Folder for the markdown and JSON results.
-    #[arg(long, default_value = "docs/bench")]
+    /// Folder for the markdown and JSON results. The default is a build
+    /// folder, not the checkout's committed tables: `--out docs/bench`
+    /// updates those.
+    #[arg(long, default_value = "target/bench")]
     pub out: PathBuf,
     /// Fewer repetitions and smaller images (a smoke run).
     #[arg(long)]

@@ -102,3 +102,21 @@ fn the_quality_bench_measures_every_knob_and_plots_them() {
     let coloured = png.pixels().filter(|p| p[0] != p[1] || p[1] != p[2]).count();
     assert!(coloured > 500, "the plot has hardly any coloured pixels: {coloured}");
 }
+
+/// Issue 27, bug 5: `octovox bench` run from a checkout, as the README
+/// says, rewrote the committed docs/bench/; its default is a build folder.
+#[test]
+fn bench_without_out_leaves_the_committed_tables_alone() {
+    let checkout = tempfile::tempdir().unwrap();
+    let committed = checkout.path().join("docs/bench/edit.md");
+    std::fs::create_dir_all(committed.parent().unwrap()).unwrap();
+    std::fs::write(&committed, "the committed table\n").unwrap();
+    let run = Command::new(env!("CARGO_BIN_EXE_octovox"))
+        .args(["bench", "edit", "--quick"])
+        .current_dir(checkout.path())
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert_eq!(std::fs::read_to_string(&committed).unwrap(), "the committed table\n");
+    assert!(checkout.path().join("target/bench/edit.md").is_file());
+}

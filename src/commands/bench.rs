@@ -1,5 +1,6 @@
 //! `octovox bench build|edit|render` (and `effects`, in `bench_effects`): the numbers the issues ask for,
-//! printed and written to docs/bench/ as markdown and JSON.
+//! printed and written to `--out` (target/bench/ unless told; the committed
+//! tables are docs/bench/) as markdown and JSON.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
