@@ -392,3 +392,20 @@ fn a_sample_split_in_bands_equals_a_whole_one() {
         assert_eq!(differing, 0, "{bands} bands: {differing} of {} pixels differ", whole.len());
     }
 }
+
+/// Issue 27, bug 6: a long path-traced render said nothing until it was
+/// done. On a terminal (a pty from `script`) it shows a bar; in a pipe it
+/// stays quiet.
+#[test]
+fn a_path_traced_render_shows_progress_on_a_terminal_only() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r.png");
+    let args = ["render", "--demo", "showroom", "--spp", "8", "--size", "64x36", "-o"];
+    let piped = std::process::Command::new(env!("CARGO_BIN_EXE_octovox")).args(args).arg(&out).output().unwrap();
+    assert!(piped.status.success(), "{}", String::from_utf8_lossy(&piped.stderr));
+    assert!(!String::from_utf8_lossy(&piped.stderr).contains("path tracing"), "no bar in a pipe");
+    let command = format!("{} {} {} --force", env!("CARGO_BIN_EXE_octovox"), args.join(" "), out.display());
+    let tty = std::process::Command::new("script").args(["-qec", &command, "/dev/null"]).output().unwrap();
+    assert!(tty.status.success(), "{}", String::from_utf8_lossy(&tty.stdout));
+    assert!(String::from_utf8_lossy(&tty.stdout).contains("path tracing ["), "a bar on a terminal");
+}

@@ -7,13 +7,20 @@ use std::time::Duration;
 use indicatif::{ProgressBar, ProgressStyle};
 use octovox::io::progress::Progress;
 
-/// Runs `work` with a progress it reports to, showing a bar named `what`.
-pub fn with_bar<T: Send>(what: &str, work: impl FnOnce(&Progress) -> T + Send) -> T {
-    let progress = Progress::default();
-    let bar = ProgressBar::new(0).with_message(what.to_string());
+/// A bar named `what` over `total` steps, on stderr (indicatif draws
+/// nothing where stderr is not a terminal).
+pub fn bar(what: &str, total: u64) -> ProgressBar {
+    let bar = ProgressBar::new(total).with_message(what.to_string());
     bar.set_style(
         ProgressStyle::with_template("{msg} [{bar:30}] {percent}% {elapsed}").unwrap_or(ProgressStyle::default_bar()),
     );
+    bar
+}
+
+/// Runs `work` with a progress it reports to, showing a bar named `what`.
+pub fn with_bar<T: Send>(what: &str, work: impl FnOnce(&Progress) -> T + Send) -> T {
+    let progress = Progress::default();
+    let bar = bar(what, 0);
     let result = std::thread::scope(|scope| {
         let worker = scope.spawn(|| work(&progress));
         while !worker.is_finished() {

@@ -140,11 +140,14 @@ fn path_traced(
     let mut total_ms = 0.0;
     let mut last = None;
     let view = PathView { tree: &scene.tree, palette: &scene.palette, camera, size, settings: &settings };
+    let bar = super::progress_bar::bar("path tracing", u64::from(spp));
     for sample in 0..spp {
         let frame = renderer.render_path(&view, sample == 0)?;
         total_ms += frame.ms;
         last = Some(frame);
+        bar.inc(1);
     }
+    bar.finish_and_clear();
     let frame = last.context("no samples")?;
     let stats = Stats {
         effects: frame.effects.names(),
