@@ -42,6 +42,8 @@ impl App {
         };
         self.editor.set_scene(scene);
         self.stroke = None;
+        // What the presets cost was measured on the scene before.
+        self.presets_measured = None;
         // An imported mesh has no .vox to save back to: Save asks for one
         // rather than writing .vox bytes over the .obj.
         self.state.path = path.filter(|p| !octovox::io::is_mesh_path(p));

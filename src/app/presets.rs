@@ -74,9 +74,8 @@ pub const PRESETS: [Preset; 5] = [
     },
 ];
 
-/// Pixels of the measurement's images, and the reference's samples.
+/// Pixels of the measurement's images.
 pub const MEASURE_SIZE: (u32, u32) = (256, 144);
-pub const MEASURE_REFERENCE_SPP: u32 = 64;
 
 impl Preset {
     pub fn apply(&self, state: &mut EditorState) {
@@ -101,11 +100,6 @@ impl Preset {
                 render_scale: self.render_scale,
             },
         }
-    }
-
-    /// The reference the measurement compares against.
-    pub fn reference() -> Setting {
-        Setting::Path { spp: MEASURE_REFERENCE_SPP, bounces: 8, shadow_samples: 4, render_scale: 1.0 }
     }
 }
 
@@ -142,14 +136,20 @@ fn measure_all(
     window: (u32, u32),
 ) -> Result<Vec<Measured>, GpuError> {
     let ratio = f64::from(window.0) * f64::from(window.1) / f64::from(MEASURE_SIZE.0 * MEASURE_SIZE.1);
-    let (_, reference) = render_setting(renderer, scene, camera, MEASURE_SIZE, Preset::reference())?;
-    PRESETS
+    // The last preset is the reference: the others' error is measured
+    // against its image, and its own is 0 by definition (it once was a
+    // separate 64-sample render, and "reference" scored worse than "good").
+    let Some((reference_preset, others)) = PRESETS.split_last() else { return Ok(Vec::new()) };
+    let (reference_ms, reference) = render_setting(renderer, scene, camera, MEASURE_SIZE, reference_preset.setting())?;
+    let mut measured = others
         .iter()
         .map(|preset| {
             let (ms, image) = render_setting(renderer, scene, camera, MEASURE_SIZE, preset.setting())?;
             Ok(Measured { ms: ms * ratio, flip: flip(&reference, &image) })
         })
-        .collect()
+        .collect::<Result<Vec<_>, GpuError>>()?;
+    measured.push(Measured { ms: reference_ms * ratio, flip: 0.0 });
+    Ok(measured)
 }
 
 #[cfg(test)]
@@ -168,6 +168,9 @@ mod tests {
         let (draft, reference) = (measured[0], measured[PRESETS.len() - 1]);
         assert!(draft.ms < reference.ms, "{measured:?}");
         assert!(draft.flip > reference.flip, "{measured:?}");
+        // Issue 27, bug 3: the reference scored FLIP 0.003, "path: good" 0.000.
+        assert_eq!(reference.flip, 0.0, "the reference is what the others are measured against");
+        assert!(measured[..PRESETS.len() - 1].iter().all(|m| m.flip > 0.0), "{measured:?}");
         assert!(measured.iter().all(|m| m.ms > 0.0 && (0.0..=1.0).contains(&m.flip)), "{measured:?}");
         assert!(renderer.wait_for_frames && renderer.sample_target == u32::MAX, "settings restored");
     }
