@@ -80,9 +80,14 @@ impl FileStamp {
     /// The stamp of `path` as it is now.
     ///
     /// # Errors
-    /// The file cannot be read.
+    /// The file cannot be read, or is not a regular file: a FIFO would be
+    /// drained by the hash before the loader could read it.
     pub fn of(path: &Path) -> std::io::Result<FileStamp> {
         let meta = std::fs::metadata(path)?;
+        if !meta.is_file() {
+            let text = format!("{} is not a regular file", path.display());
+            return Err(std::io::Error::new(std::io::ErrorKind::InvalidInput, text));
+        }
         let modified = meta.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
         Ok(FileStamp {
             size: meta.len(),

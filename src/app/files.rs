@@ -321,7 +321,7 @@ impl App {
 /// With `OCTOVOX_TEST_HOLD_AFTER_SAVE` set, a save stops between its rename
 /// and the journal's removal, says so, and waits to be killed: the moment a
 /// crash would leave a journal whose edits the file already holds, which a
-/// test cannot otherwise reach (tests/window_recovery.rs).
+/// test cannot otherwise reach (tests/window/recovery.rs).
 fn hold_for_tests_after_rename() {
     if std::env::var_os("OCTOVOX_TEST_HOLD_AFTER_SAVE").is_some() {
         report!("test hold: saved, the journal not yet removed");

@@ -4,7 +4,7 @@
 //! test's own), and Ctrl+Z takes them back in one step.
 #![allow(clippy::unwrap_used)] // in tests a panic is the failure report
 
-mod common;
+use crate::common;
 
 use std::collections::{HashSet, VecDeque};
 use std::time::Duration;

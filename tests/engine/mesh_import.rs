@@ -3,7 +3,7 @@
 //! import` writes a .vox that reads back the same.
 #![allow(clippy::unwrap_used)] // in tests a panic is the failure report
 
-mod common;
+use crate::common;
 
 use std::f32::consts::PI;
 use std::path::{Path, PathBuf};

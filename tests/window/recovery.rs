@@ -6,7 +6,7 @@
 //! Needs `Xvfb` and `xdotool`, like tests/window_e2e.rs.
 #![allow(clippy::unwrap_used)] // in tests a panic is the failure report
 
-mod common;
+use crate::common;
 
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};

@@ -6,7 +6,7 @@
 //! test works out itself.
 #![allow(clippy::unwrap_used)] // in tests a panic is the failure report
 
-mod common;
+use crate::common;
 
 use std::collections::HashSet;
 use std::time::Duration;

@@ -19,7 +19,7 @@
 // A test: a failed unwrap is a failed test, with its message.
 #![allow(clippy::unwrap_used)]
 
-mod common;
+use crate::common;
 
 use std::collections::HashSet;
 use std::path::PathBuf;

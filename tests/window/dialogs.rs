@@ -4,7 +4,7 @@
 //! window to its own path field, where typing the path still works.
 #![allow(clippy::unwrap_used)] // in tests a panic is the failure report
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 use std::time::Duration;

@@ -2,7 +2,7 @@
 //! references: same hit records, same hard cases.
 #![allow(clippy::unwrap_used)] // in tests a panic is the failure report
 
-mod common;
+use crate::common;
 
 use common::{Agreement, cameras_for, sculpture};
 use glam::{DVec3, IVec3};

@@ -5,7 +5,7 @@
 
 #![allow(clippy::unwrap_used)] // in tests a panic is the failure report
 
-mod common;
+use crate::common;
 
 use glam::{DVec3, IVec3, Vec3};
 use octovox::camera::Camera;

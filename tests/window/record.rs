@@ -3,7 +3,7 @@
 //! the window through the same edit path.
 #![allow(clippy::unwrap_used)] // in tests a panic is the failure report
 
-mod common;
+use crate::common;
 
 use std::process::Command;
 use std::time::Duration;
@@ -20,7 +20,7 @@ fn recorded_window_session_replays_to_the_same_voxels() {
     let (dir, file, original, camera) = torus_document();
     let (x, y, _, _) = stable_pixel(&original.tree, &camera, |_, _| true);
 
-    let (_xvfb, display) = start_xvfb(0);
+    let (_xvfb, display) = start_xvfb(17);
     let script = dir.path().join("session.ovr");
     let args = document_args(&file, &camera, &["--record", &script.display().to_string()]);
     let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
@@ -69,7 +69,7 @@ fn window_plays_a_script_through_the_edit_path() {
          rgb 9 200 100 50\nmaterial 9 emit _emit 1\nundo\nexpect effects sun sky metal\nsave out.vox\n",
     )
     .unwrap();
-    let (_xvfb, display) = start_xvfb(1);
+    let (_xvfb, display) = start_xvfb(18);
     let recording = dir.path().join("rec.ovr");
     let args = [
         "--size".to_string(),

@@ -6,7 +6,7 @@
 //! that give up. docs/traversal.md states the guarantee.
 #![allow(clippy::unwrap_used)] // in tests a panic is the failure report
 
-mod common;
+use crate::common;
 
 use common::exact::{ExactRay, first_hit, gap_to_voxel};
 use glam::{IVec3, Vec3};

@@ -1,0 +1,19 @@
+//! The engine's integration tests, one binary (each test binary links
+//! wgpu, naga and egui: one link instead of one per file): loading and
+//! saving, editing and replay scripts, the CPU tracers, meshes, hostile
+//! input and the bench's smoke run, each in the module named for it.
+#![allow(clippy::unwrap_used)] // in tests a panic is the failure report
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod bench_cli;
+mod hostile_input;
+mod mesh_import;
+mod octree_props;
+mod replay_cli;
+mod trace_cpu;
+mod trace_exact;
+mod vox_info;
+mod vox_robust;
+mod vox_roundtrip;
