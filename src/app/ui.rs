@@ -363,7 +363,10 @@ fn material_editor(ui: &mut egui::Ui, index: u8, palette: &Palette, out: &mut Ve
             .show_ui(ui, |ui| {
                 for kind in MaterialKind::ALL {
                     let label = kind.vox_name().trim_start_matches('_');
-                    changed |= ui.selectable_value(&mut material.kind, kind, label).changed();
+                    if ui.selectable_label(material.kind == kind, label).clicked() && material.kind != kind {
+                        material = material.switched_to(kind);
+                        changed = true;
+                    }
                 }
             });
     });

@@ -131,6 +131,17 @@ impl Material {
             0.0
         }
     }
+    /// This material as `kind`, its parameters kept; an emitter whose
+    /// emission is 0 gets 1, so that choosing "emit" changes what is seen
+    /// (the panel's kind menu).
+    pub fn switched_to(&self, kind: MaterialKind) -> Material {
+        let mut material = Material { kind, params: self.params.clone() };
+        if kind == MaterialKind::Emit && material.emission() == 0.0 {
+            material.params.insert("_emit".to_string(), "1".to_string());
+        }
+        material
+    }
+
     pub fn emission(&self) -> f32 {
         self.param("_emit")
     }
@@ -203,6 +214,17 @@ mod tests {
         let mut m = Material::new(kind);
         m.params.extend(params.iter().map(|(k, v)| ((*k).to_string(), (*v).to_string())));
         m
+    }
+
+    /// Issue 27, bug 7: "emit" started at emission 0, so choosing it
+    /// changed nothing on screen.
+    #[test]
+    fn switching_to_emit_gives_a_visible_emission() {
+        let emitter = with(MaterialKind::Diffuse, &[("_rough", "0.3")]).switched_to(MaterialKind::Emit);
+        assert_eq!((emitter.kind, emitter.emission(), emitter.roughness()), (MaterialKind::Emit, 1.0, 0.3));
+        let dim = with(MaterialKind::Metal, &[("_emit", "0.25")]).switched_to(MaterialKind::Emit);
+        assert_eq!(dim.emission(), 0.25, "a set emission is kept");
+        assert_eq!(emitter.switched_to(MaterialKind::Glass).kind, MaterialKind::Glass);
     }
 
     #[test]
