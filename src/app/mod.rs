@@ -423,6 +423,7 @@ impl App {
     /// bytes written` (the tests read it).
     fn after_change(&mut self, what: &str, record: impl Fn(&mut Recorder) -> std::io::Result<()>) {
         self.state.dirty = true;
+        self.ui.change_made();
         self.record(record);
         let upload = self.upload();
         self.stats.last_edit_bytes = upload.bytes;

@@ -116,6 +116,9 @@ pub enum DialogKind {
     Export,
 }
 
+/// How long an info message (`saved …`, `copied 6 voxels`) stays.
+pub const INFO_LIFETIME: std::time::Duration = std::time::Duration::from_secs(4);
+
 /// UI-only state: open dialogs, the prompt, the message line.
 #[derive(Debug, Default)]
 pub struct UiState {
@@ -131,19 +134,41 @@ pub struct UiState {
     /// The open scene's edits are not journaled, and why: shown until a
     /// journal starts again.
     pub journal_warning: Option<String>,
-    /// Last message for the user, and whether it is an error.
-    pub message: Option<(String, bool)>,
+    /// Last message for the user, whether it is an error, and when it came.
+    pub message: Option<(String, bool, std::time::Instant)>,
 }
 
 impl UiState {
     pub fn error(&mut self, text: impl Into<String>) {
         let text = text.into();
         log::warn!("{text}");
-        self.message = Some((text, true));
+        self.message = Some((text, true, std::time::Instant::now()));
     }
 
+    /// A message that says what just happened: it goes after
+    /// [`INFO_LIFETIME`], or at the next change (`saved …` no longer holds
+    /// once the scene is edited again).
     pub fn info(&mut self, text: impl Into<String>) {
-        self.message = Some((text.into(), false));
+        self.message = Some((text.into(), false, std::time::Instant::now()));
+    }
+
+    /// The scene changed: a message about what was before goes. Errors stay
+    /// until dismissed or replaced.
+    pub fn change_made(&mut self) {
+        self.message = self.message.take().filter(|(_, is_error, _)| *is_error);
+    }
+
+    /// The message to show `now`, if any: an info message past its lifetime
+    /// is dropped.
+    pub fn current_message(&mut self, now: std::time::Instant) -> Option<(&str, bool, std::time::Duration)> {
+        let expired = |(_, is_error, at): &(String, bool, std::time::Instant)| {
+            !is_error && now.saturating_duration_since(*at) >= INFO_LIFETIME
+        };
+        if self.message.as_ref().is_some_and(expired) {
+            self.message = None;
+        }
+        let (text, is_error, at) = self.message.as_ref()?;
+        Some((text, *is_error, INFO_LIFETIME.saturating_sub(now.saturating_duration_since(*at))))
     }
 }
 
@@ -542,11 +567,15 @@ fn message(ui: &mut egui::Ui, ui_state: &mut UiState) {
         ui.colored_label(Color32::from_rgb(255, 170, 60), format!("⚠ {warning}"));
     }
     let mut clear = false;
-    if let Some((text, is_error)) = &ui_state.message {
+    if let Some((text, is_error, left)) = ui_state.current_message(std::time::Instant::now()) {
         ui.separator();
-        let color = if *is_error { Color32::from_rgb(255, 110, 100) } else { Color32::LIGHT_GREEN };
+        let color = if is_error { Color32::from_rgb(255, 110, 100) } else { Color32::LIGHT_GREEN };
         ui.colored_label(color, text);
         clear = ui.small_button("×").on_hover_text("dismiss").clicked();
+        if !is_error {
+            // A frame when it goes, though nothing else moves.
+            ui.ctx().request_repaint_after(left);
+        }
     }
     if clear {
         ui_state.message = None;
@@ -866,5 +895,29 @@ fn outline_box(
                 painter.circle_filled(p, 4.0, color);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::{Duration, Instant};
+
+    /// Issue 27, bug 4: "saved …" and "copied 6 voxels" stayed on screen
+    /// long after they described anything.
+    #[test]
+    fn info_messages_go_with_time_or_the_next_change_and_errors_stay() {
+        let mut ui = UiState::default();
+        let now = Instant::now();
+        ui.info("saved a.vox");
+        assert_eq!(ui.current_message(now).map(|m| m.0), Some("saved a.vox"));
+        assert!(ui.current_message(now + INFO_LIFETIME + Duration::from_millis(1)).is_none(), "gone after its time");
+        ui.info("copied 6 voxels");
+        ui.change_made();
+        assert!(ui.current_message(now).is_none(), "gone at the next change");
+        ui.error("save failed: disk full");
+        ui.change_made();
+        let later = now + INFO_LIFETIME * 10;
+        assert_eq!(ui.current_message(later).map(|m| (m.0, m.1)), Some(("save failed: disk full", true)));
     }
 }
