@@ -863,8 +863,16 @@ impl ApplicationHandler for App {
             }
             _ => {}
         }
-        // The prompt is modal: while it is open the scene gets no input.
-        let consumed = response.consumed || self.ui.prompt_open;
+        // The prompt is modal: while it is open the scene gets no input. A
+        // wheel over the side panel is the panel's even where egui lets it
+        // go (at the end of its scroll range), never a zoom of the view.
+        let wheel_on_panel = matches!(event, WindowEvent::MouseWheel { .. })
+            && (self.pointer_over_ui
+                || self
+                    .input
+                    .cursor()
+                    .is_some_and(|(x, _)| x < f64::from(ui::PANEL_WIDTH) * gfx.window.scale_factor()));
+        let consumed = response.consumed || self.ui.prompt_open || wheel_on_panel;
         for command in self.input.on_event(&event, consumed, self.state.tool) {
             self.execute(command, event_loop);
         }

@@ -417,3 +417,34 @@ fn pixels_changed(
         .filter(|&(x, y)| before.get_pixel(x, y) != after.get_pixel(x, y))
         .count()
 }
+
+/// Issue 27, bug 2: once the side panel was at the end of its scroll range,
+/// egui let the wheel go and the 3D view zoomed. Fast notches over the
+/// panel, past both ends, must leave every pixel of the view as it was.
+#[test]
+fn the_wheel_over_the_panel_never_zooms_the_view() {
+    require_window_tools();
+    let dir = tempfile::tempdir().unwrap();
+    let (_xvfb, display) = start_xvfb(19);
+    let args = ["--size", "800x600", "--spp", "1"].map(String::from);
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
+    let window = find_window(&display, &mut app, &stderr_path);
+    lines.wait_for("octovox: ready", Duration::from_secs(90));
+    xdotool(&display, &["mousemove", "--window", &window, "100", "400"]);
+    // The path tracer at rest, its one sample done: the view is still.
+    lines.wait_for("path: 1 samples", Duration::from_secs(60));
+    std::thread::sleep(Duration::from_millis(500));
+    let before = screenshot_x(&display, &dir.path().join("before.png"));
+    // Down past the panel's end, then up past its top: 5 (down) and 4 (up).
+    for button in ["5", "4"] {
+        xdotool(&display, &["click", "--repeat", "40", "--delay", "1", button]);
+        std::thread::sleep(Duration::from_millis(300));
+    }
+    xdotool(&display, &["mousemove", "--window", &window, "100", "420"]);
+    std::thread::sleep(Duration::from_millis(800));
+    let after = screenshot_x(&display, &dir.path().join("after.png"));
+    let (panel, width, height) = (300, before.width().min(800), before.height().min(600));
+    let changed = pixels_changed(&before, &after, panel..width, 40..height);
+    assert_eq!(changed, 0, "the 3D view changed under a wheel over the panel");
+    app.0.kill().unwrap();
+}
