@@ -81,9 +81,7 @@ fn a_killed_window_loses_no_finished_edit() {
     let recovered = dir.path().join("recovered.vox");
     let run = octovox(&["recover", s(&file), "-o", s(&recovered)]);
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
-    let voxels = |p: &Path| -> HashSet<(IVec3, u8)> {
-        octovox::io::load_scene(p, 0).unwrap().tree.voxels().into_iter().collect()
-    };
+    let voxels = voxel_colors;
     assert_eq!(voxels(&recovered), voxels(&expected_file), "recover gives the session's voxels");
     assert_eq!(voxels(&recovered).len(), original.tree.voxels().len() + 3);
     assert!(journal.is_file(), "recover leaves the journal in place");
@@ -162,9 +160,7 @@ fn an_untitled_scene_is_recovered_after_a_kill() {
     let recovered = dir.path().join("recovered.vox");
     let run = octovox(&["recover", s(&journal), "-o", s(&recovered)]);
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
-    let voxels = |p: &Path| -> HashSet<(IVec3, u8)> {
-        octovox::io::load_scene(p, 0).unwrap().tree.voxels().into_iter().collect()
-    };
+    let voxels = voxel_colors;
     assert_eq!(voxels(&recovered), expected, "the demo plus the three edits");
 
     // A window started without a file offers the orphaned journal.
@@ -229,9 +225,7 @@ fn undo_past_a_save_selections_and_old_clipboards_survive_a_kill() {
     let (doc, recovered) = (window_dir.path().join("doc.vox"), window_dir.path().join("recovered.vox"));
     let run = octovox(&["recover", s(&doc), "-o", s(&recovered)]);
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
-    let voxels = |p: &Path| -> HashSet<(IVec3, u8)> {
-        octovox::io::load_scene(p, 0).unwrap().tree.voxels().into_iter().collect()
-    };
+    let voxels = voxel_colors;
     assert_eq!(voxels(&recovered), voxels(&headless_dir.path().join("expected.vox")));
 }
 
