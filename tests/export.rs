@@ -341,3 +341,71 @@ fn bad_export_targets_are_refused() {
     std::fs::write(&mtl, b"my materials").unwrap();
     refused(&["export", v, "-o", dir.path().join("other.obj").to_str().unwrap()], "other.mtl already exists");
 }
+
+/// Issue 24, item 9: a scale that makes a vertex coordinate infinite or
+/// denormal (or zero) is refused, naming the scale and the range this scene
+/// allows, and nothing is written; before, `--scale 3e38` wrote `inf`
+/// vertices and `--scale 1e-45` collapsed them, both with exit 0.
+#[test]
+fn scales_past_what_a_float_holds_are_refused_and_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let script = dir.path().join("box.ovr");
+    std::fs::write(&script, "new\ncolor 7\nbrush box 5 3 4\nplace 0 0 0\nsave box.vox\n").unwrap();
+    assert!(octovox(&["replay", "--cpu", script.to_str().unwrap()]).status.success());
+    let vox = dir.path().join("box.vox");
+    for name in ["big.obj", "big.ply", "big.glb"] {
+        let out_path = dir.path().join(name);
+        for scale in ["3e38", "1e-45", "1e-39"] {
+            let out = octovox(&["export", vox.to_str().unwrap(), "-o", out_path.to_str().unwrap(), "--scale", scale]);
+            assert!(!out.status.success(), "{name} --scale {scale}: {}", text(&out));
+            assert!(text(&out).contains(&format!("--scale {scale} puts")), "{}", text(&out));
+            assert!(text(&out).contains("this scene allows --scale 2.3509887e-38 to "), "{}", text(&out));
+            assert!(!out_path.exists() && !dir.path().join("big.mtl").exists(), "{name}: something was written");
+        }
+    }
+    // The ends of the range work, and every coordinate is finite.
+    for scale in ["1e30", "3e-38"] {
+        let obj = dir.path().join(format!("ok{scale}.obj"));
+        let out = octovox(&["export", vox.to_str().unwrap(), "-o", obj.to_str().unwrap(), "--scale", scale]);
+        assert!(out.status.success(), "{}", text(&out));
+        let (positions, _) = read_obj(&obj);
+        assert!(positions.iter().flatten().all(|c| c.is_finite()), "{positions:?}");
+        let nonzero: Vec<f64> = positions.iter().flatten().copied().filter(|c| *c != 0.0).collect();
+        assert!(nonzero.iter().all(|c| (*c as f32).is_normal()), "{positions:?}");
+        assert!(!nonzero.is_empty());
+    }
+}
+
+/// Issue 24, item 19: when the .obj cannot be written after its .mtl was,
+/// the export removes the .mtl it created, so the rerun is not refused; a
+/// file that was there before is never removed.
+#[test]
+fn a_failed_export_leaves_no_partial_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let (vox, _) = sculpture_file(dir.path());
+    let v = vox.to_str().unwrap();
+    // The .obj refused by the atomic writer: a link to a device, a folder.
+    let full = dir.path().join("full.obj");
+    std::os::unix::fs::symlink("/dev/full", &full).unwrap();
+    let folder = dir.path().join("folder.obj");
+    std::fs::create_dir(&folder).unwrap();
+    for (obj, needle) in [(&full, "not a regular file"), (&folder, "is a folder")] {
+        let out = octovox(&["export", v, "-o", obj.to_str().unwrap(), "--force"]);
+        assert!(!out.status.success() && text(&out).contains(needle), "{}", text(&out));
+        assert!(!obj.with_extension("mtl").exists(), "{}: the .mtl was left behind", obj.display());
+    }
+    assert!(std::fs::symlink_metadata(&full).unwrap().file_type().is_symlink(), "the link stays");
+    assert!(folder.is_dir(), "the folder stays");
+    // The rerun, once the cause is gone, is not refused by a stale .mtl.
+    std::fs::remove_file(&full).unwrap();
+    let out = octovox(&["export", v, "-o", full.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(full.is_file() && full.with_extension("mtl").is_file());
+    // An .mtl that existed before the failed export is not removed.
+    let mine = dir.path().join("mine.obj");
+    std::os::unix::fs::symlink("/dev/full", &mine).unwrap();
+    std::fs::write(mine.with_extension("mtl"), b"my materials").unwrap();
+    let out = octovox(&["export", v, "-o", mine.to_str().unwrap(), "--force"]);
+    assert!(!out.status.success(), "{}", text(&out));
+    assert!(mine.with_extension("mtl").is_file(), "an existing .mtl was removed");
+}

@@ -47,3 +47,13 @@ fn obj_corpus() {
 fn script_corpus() {
     replay("script", 10, checks::script);
 }
+
+#[test]
+fn journal_corpus() {
+    replay("journal", 10, checks::journal);
+}
+
+#[test]
+fn ovx_corpus() {
+    replay("ovx", 10, checks::ovx);
+}

@@ -70,6 +70,11 @@ pub fn save_ovx(path: &Path, scene: &Scene, options: WriteOptions) -> Result<(),
     let write_error = |source| OvxError::Write { path: path.to_path_buf(), source };
     let compact = Compact::of(&scene.tree);
     let materials = encode_materials(&scene.palette);
+    if materials.len() as u64 > MAX_MATERIALS_BYTES {
+        let text =
+            format!("the materials take {} bytes, past the {MAX_MATERIALS_BYTES} an .ovx holds", materials.len());
+        return Err(write_error(io::Error::new(io::ErrorKind::InvalidInput, text)));
+    }
     let payload_len = FIXED_PAYLOAD_BYTES
         + compact.nodes.len() as u64 * NODE_BYTES
         + compact.bricks.len() as u64 * BRICK_BYTES
@@ -223,47 +228,191 @@ pub fn decode_ovx(bytes: &[u8], progress: &Progress) -> Result<Scene, OvxError> 
     if stored != computed {
         return Err(OvxError::BadChecksum { stored, computed });
     }
+    let flags = le_u32(bytes, 12);
+    if flags != 0 {
+        return Err(corrupt(format!("header flags {flags:#x} are set, but version {VERSION} defines none")));
+    }
     crate::budget::check(|| format!("an .ovx pool of {payload_len} bytes"), payload_len)?;
     progress.start(payload_len);
-    let decoder = zstd::Decoder::new(&body[HEADER_BYTES as usize..]).map_err(|e| corrupt(format!("zstd: {e}")))?;
-    let mut decoder = Reporting { inner: decoder, progress }.take(payload_len);
-    let scene = read_payload(&mut decoder, payload_len)?;
-    if decoder.limit() != 0 {
-        return Err(corrupt(format!("{} payload bytes left unread", decoder.limit())));
-    }
+    let decoder =
+        zstd::Decoder::with_buffer(&body[HEADER_BYTES as usize..]).map_err(|e| corrupt(format!("zstd: {e}")))?;
+    let mut payload = Payload { decoder: decoder.single_frame(), progress, produced: 0, expected: payload_len };
+    let scene = read_payload(&mut payload)?;
+    payload.finish()?;
     Ok(scene)
 }
 
-fn read_payload(input: &mut impl Read, payload_len: u64) -> Result<Scene, OvxError> {
-    let fixed: Vec<u8> = read_items(input, FIXED_PAYLOAD_BYTES as usize)?;
+/// Largest materials section read: 256 entries of up to 64 KiB of MATL
+/// keys and values each (MagicaVoxel writes a few dozen bytes).
+pub const MAX_MATERIALS_BYTES: u64 = 256 << 16;
+/// Smallest materials section: 256 entries without parameters.
+const MIN_MATERIALS_BYTES: u64 = 256 * 5;
+/// Items read and checked at a time: memory follows what the zstd frame
+/// really holds, not the counts it claims.
+const CHUNK_BYTES: usize = 1 << 20;
+
+/// The decompressed payload, read in bounded steps: never more than the
+/// header's payload length plus the one byte that shows the frame holds
+/// more, and from one zstd frame only.
+struct Payload<'a> {
+    decoder: zstd::Decoder<'a, &'a [u8]>,
+    progress: &'a Progress,
+    /// Bytes the decoder has handed out.
+    produced: u64,
+    /// The header's payload length.
+    expected: u64,
+}
+
+impl Payload<'_> {
+    /// Fills `out`, or says why the payload ends before it.
+    fn fill(&mut self, out: &mut [u8]) -> Result<(), OvxError> {
+        let mut at = 0;
+        while at < out.len() {
+            let room = self.expected.saturating_sub(self.produced).min((out.len() - at) as u64) as usize;
+            if room == 0 {
+                return Err(corrupt(format!("the payload passes the header's {} bytes", self.expected)));
+            }
+            let n = match self.decoder.read(&mut out[at..at + room]) {
+                Ok(n) => n,
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+                Err(e) => return Err(corrupt(format!("zstd: {e}"))),
+            };
+            if n == 0 {
+                return Err(self.ended_early());
+            }
+            at += n;
+            self.produced += n as u64;
+            self.progress.advance(n as u64);
+        }
+        Ok(())
+    }
+
+    /// The frame ended before the payload did: a second frame after it is
+    /// its own error (the format has one).
+    fn ended_early(&self) -> OvxError {
+        if self.decoder.get_ref().is_empty() {
+            corrupt(format!("the payload ends early ({} of its {} bytes)", self.produced, self.expected))
+        } else {
+            corrupt(format!(
+                "the payload is split over more than one zstd frame (the first ends after {} of its {} bytes)",
+                self.produced, self.expected
+            ))
+        }
+    }
+
+    /// `n` items, read and checked `check(index, item)` a chunk at a time.
+    fn items<T: bytemuck::Pod>(
+        &mut self,
+        n: u64,
+        mut check: impl FnMut(usize, &T) -> Result<(), String>,
+    ) -> Result<Vec<T>, OvxError> {
+        let n = usize::try_from(n).map_err(|_| corrupt(format!("{n} items do not fit in memory")))?;
+        let per_chunk = (CHUNK_BYTES / size_of::<T>().max(1)).max(1);
+        let mut items: Vec<T> = Vec::new();
+        while items.len() < n {
+            let start = items.len();
+            let take = per_chunk.min(n - start);
+            items.resize(start + take, T::zeroed());
+            self.fill(bytemuck::cast_slice_mut(&mut items[start..]))?;
+            for (k, item) in items[start..].iter().enumerate() {
+                check(start + k, item).map_err(corrupt)?;
+            }
+        }
+        Ok(items)
+    }
+
+    /// After the payload: the frame must end there (one more byte would be
+    /// past the header's length), and no bytes, another frame included,
+    /// may follow it.
+    fn finish(mut self) -> Result<(), OvxError> {
+        let mut one = [0u8; 1];
+        let extra = loop {
+            match self.decoder.read(&mut one) {
+                Err(e) if e.kind() == io::ErrorKind::Interrupted => {}
+                Err(e) => return Err(corrupt(format!("zstd: {e}"))),
+                Ok(n) => break n,
+            }
+        };
+        self.produced += extra as u64;
+        if extra > 0 {
+            return Err(corrupt(format!(
+                "the zstd frame holds more than the header's {} payload bytes",
+                self.expected
+            )));
+        }
+        let after = self.decoder.get_ref().len();
+        if after > 0 {
+            return Err(corrupt(format!(
+                "{after} bytes follow the payload's zstd frame (a second frame?); the format has one frame"
+            )));
+        }
+        Ok(())
+    }
+}
+
+fn read_payload(input: &mut Payload) -> Result<Scene, OvxError> {
+    let payload_len = input.expected;
+    let mut fixed = vec![0u8; FIXED_PAYLOAD_BYTES as usize];
+    input.fill(&mut fixed)?;
     let word = |at: usize| le_u32(&fixed, at);
     let origin = IVec3::new(word(0) as i32, word(4) as i32, word(8) as i32);
     let (depth, root, node_count, brick_count) = (word(12), word(16), le_u64(&fixed, 20), le_u64(&fixed, 28));
     if !(MIN_DEPTH..=MAX_DEPTH).contains(&depth) {
         return Err(corrupt(format!("root depth {depth} is outside {MIN_DEPTH}..={MAX_DEPTH}")));
     }
-    let arrays = node_count.checked_mul(NODE_BYTES).zip(brick_count.checked_mul(BRICK_BYTES));
-    let Some(materials_len) =
-        arrays.and_then(|(n, b)| payload_len.checked_sub(FIXED_PAYLOAD_BYTES)?.checked_sub(n)?.checked_sub(b))
+    // What the counts can need: the arrays, and materials between the
+    // smallest and the largest section read.
+    let arrays = node_count
+        .checked_mul(NODE_BYTES)
+        .zip(brick_count.checked_mul(BRICK_BYTES))
+        .and_then(|(n, b)| n.checked_add(b)?.checked_add(FIXED_PAYLOAD_BYTES));
+    let Some(materials_len) = arrays.and_then(|a| payload_len.checked_sub(a)).filter(|m| *m >= MIN_MATERIALS_BYTES)
     else {
         return Err(corrupt(format!("{node_count} nodes and {brick_count} bricks do not fit its {payload_len} bytes")));
     };
+    if materials_len > MAX_MATERIALS_BYTES {
+        return Err(corrupt(format!(
+            "a payload of {payload_len} bytes is more than {node_count} nodes and {brick_count} bricks can need \
+             (their arrays and at most {MAX_MATERIALS_BYTES} bytes of materials)"
+        )));
+    }
     let mut palette = Palette { colors: bytemuck::pod_read_unaligned(&fixed[36..36 + 256 * 4]), ..Palette::default() };
-    let nodes: Vec<NodeSlot> = read_items(input, node_count as usize)?;
-    let bricks: Vec<Brick> = read_items(input, brick_count as usize)?;
-    palette.materials = decode_materials(&read_items::<u8>(input, materials_len as usize)?)?;
+    let slots = node_count.max(brick_count);
+    let nodes: Vec<NodeSlot> = input.items(node_count, |index, slot: &NodeSlot| check_node(index, slot, slots))?;
+    let bricks: Vec<Brick> = input.items(brick_count, |index, brick: &Brick| {
+        if brick.iter().all(|v| *v == brick[0]) {
+            Err(format!("brick {index} is uncollapsed: {brick:?}"))
+        } else {
+            Ok(())
+        }
+    })?;
+    palette.materials = decode_materials(&input.items::<u8>(materials_len, |_, _| Ok(()))?)?;
     let tree = Octree::from_parts(origin, depth, root, nodes, bricks).map_err(corrupt)?;
     Ok(Scene { palette, tree })
 }
 
-/// `n` items read straight into their vector (the counts were checked
-/// against the payload's length, itself against the memory budget).
-fn read_items<T: bytemuck::Pod>(input: &mut impl Read, n: usize) -> Result<Vec<T>, OvxError> {
-    let mut items = vec![T::zeroed(); n];
-    input
-        .read_exact(bytemuck::cast_slice_mut(&mut items))
-        .map_err(|e| corrupt(format!("the payload ends early ({e})")))?;
-    Ok(items)
+/// What one stored node can be told wrong by on its own, as it is read (a
+/// forged payload of repeated bytes fails on its first node): a uniform
+/// word that is no palette index, a pointer past every array, the same
+/// slot twice, or eight equal uniform children. [`Octree::from_parts`]
+/// checks the rest once the pool is read.
+fn check_node(index: usize, slot: &NodeSlot, slots: u64) -> Result<(), String> {
+    let children = &slot.children;
+    for (k, &child) in children.iter().enumerate() {
+        if !is_pointer(child) && child > 255 {
+            return Err(format!("node {index}: bad cell word {child:#x}"));
+        }
+        if is_pointer(child) && u64::from(slot_of(child)) >= slots {
+            return Err(format!("node {index}: child {k} points past the {slots} slots stored"));
+        }
+        if is_pointer(child) && children[..k].contains(&child) {
+            return Err(format!("node {index}: slot {} is used twice", slot_of(child)));
+        }
+    }
+    if !is_pointer(children[0]) && children.iter().all(|c| *c == children[0]) {
+        return Err(format!("node {index} is uncollapsed: eight children of value {}", children[0]));
+    }
+    Ok(())
 }
 
 fn le_u32(bytes: &[u8], at: usize) -> u32 {
@@ -300,6 +449,9 @@ fn decode_materials(bytes: &[u8]) -> Result<Vec<Material>, OvxError> {
         }
         materials.push(material);
     }
+    if at < bytes.len() {
+        return Err(corrupt(format!("{} bytes of junk follow the 256 materials", bytes.len() - at)));
+    }
     Ok(materials)
 }
 
@@ -314,20 +466,6 @@ fn crc_of(input: &mut impl Read, len: u64) -> io::Result<u32> {
             return Ok(hasher.finalize());
         }
         hasher.update(&buf[..n]);
-    }
-}
-
-/// A reader that reports the bytes it hands out.
-struct Reporting<'a, R: Read> {
-    inner: R,
-    progress: &'a Progress,
-}
-
-impl<R: Read> Read for Reporting<'_, R> {
-    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
-        let n = self.inner.read(buf)?;
-        self.progress.advance(n as u64);
-        Ok(n)
     }
 }
 
@@ -417,6 +555,125 @@ mod tests {
         let mut longer = bytes.clone();
         longer.push(0);
         assert!(message(&longer).contains("corrupted"));
+    }
+
+    /// The decompressed payload of a saved file.
+    fn payload_of(bytes: &[u8]) -> Vec<u8> {
+        zstd::decode_all(&bytes[HEADER_BYTES as usize..bytes.len() - FOOTER_BYTES as usize]).unwrap()
+    }
+
+    /// A file of `frames` (already compressed) under a header claiming
+    /// `payload_len`, with the right length and CRC-32, so that only the
+    /// check under test can refuse it.
+    fn forge(frames: &[Vec<u8>], payload_len: u64, flags: u32) -> Vec<u8> {
+        let body: Vec<u8> = frames.concat();
+        let file_len = HEADER_BYTES + body.len() as u64 + FOOTER_BYTES;
+        let mut bytes = header(file_len, payload_len).to_vec();
+        bytes[12..16].copy_from_slice(&flags.to_le_bytes());
+        bytes.extend(body);
+        let crc = crc32fast::hash(&bytes);
+        bytes.extend(crc.to_le_bytes());
+        bytes
+    }
+
+    fn frame(parts: &[&[u8]], zeros: usize) -> Vec<u8> {
+        let mut encoder = zstd::Encoder::new(Vec::new(), ZSTD_LEVEL).unwrap();
+        for part in parts {
+            encoder.write_all(part).unwrap();
+        }
+        let block = vec![0u8; 1 << 20];
+        for start in (0..zeros).step_by(block.len()) {
+            encoder.write_all(&block[..block.len().min(zeros - start)]).unwrap();
+        }
+        encoder.finish().unwrap()
+    }
+
+    fn refusal(bytes: &[u8]) -> (String, u64) {
+        let progress = Progress::default();
+        let Err(error) = decode_ovx(bytes, &progress) else { panic!("the forged file loads") };
+        (error.to_string(), progress.get().0)
+    }
+
+    /// Issue 24, item 15: docs/ovx.md says flags are 0 in version 1.
+    #[test]
+    fn header_flags_are_refused() {
+        let payload = payload_of(&saved(&scene()));
+        let good = forge(&[frame(&[&payload], 0)], payload.len() as u64, 0);
+        assert!(decode_ovx(&good, &Progress::default()).is_ok(), "the forger makes loadable files");
+        let (message, _) = refusal(&forge(&[frame(&[&payload], 0)], payload.len() as u64, 1));
+        assert!(message.contains("header flags 0x1 are set"), "{message}");
+    }
+
+    /// Issue 24, item 15: bytes after the 256 materials, inside the payload.
+    #[test]
+    fn junk_after_the_materials_is_refused() {
+        let payload = payload_of(&saved(&scene()));
+        let forged = forge(&[frame(&[&payload, b"junk"], 0)], payload.len() as u64 + 4, 0);
+        let (message, _) = refusal(&forged);
+        assert!(message.contains("4 bytes of junk follow the 256 materials"), "{message}");
+    }
+
+    /// Issue 24, item 15: the payload is one zstd frame.
+    #[test]
+    fn a_payload_in_two_frames_is_refused() {
+        let payload = payload_of(&saved(&scene()));
+        let half = payload.len() / 2;
+        let split = forge(&[frame(&[&payload[..half]], 0), frame(&[&payload[half..]], 0)], payload.len() as u64, 0);
+        let (message, _) = refusal(&split);
+        assert!(message.contains("split over more than one zstd frame"), "{message}");
+        let second = forge(&[frame(&[&payload], 0), frame(&[b"more"], 0)], payload.len() as u64, 0);
+        let (message, _) = refusal(&second);
+        assert!(message.contains("follow the payload's zstd frame"), "{message}");
+    }
+
+    /// Issue 24, item 13: a frame that decompresses to far more than the
+    /// header's payload length is refused one byte past it.
+    #[test]
+    fn a_frame_longer_than_its_header_stops_one_byte_past_it() {
+        let payload = payload_of(&saved(&scene()));
+        let bomb = forge(&[frame(&[&payload], 256 << 20)], payload.len() as u64, 0);
+        assert!(bomb.len() < 64 << 10, "{} bytes", bomb.len());
+        let (message, produced) = refusal(&bomb);
+        assert!(message.contains("holds more than the header's"), "{message}");
+        assert!(produced <= payload.len() as u64 + 1, "the decoder produced {produced} bytes");
+    }
+
+    /// The fixed part of a payload: an empty palette, `nodes` and `bricks`.
+    fn fixed_part(nodes: u64, bricks: u64) -> Vec<u8> {
+        let mut fixed = Vec::new();
+        for word in [0u32, 0, 0, MAX_DEPTH, pointer_to(0)] {
+            fixed.extend(word.to_le_bytes());
+        }
+        fixed.extend(nodes.to_le_bytes());
+        fixed.extend(bricks.to_le_bytes());
+        fixed.resize(FIXED_PAYLOAD_BYTES as usize, 0);
+        fixed
+    }
+
+    /// Issue 24, item 13: a small file whose counts claim gigabytes, and
+    /// whose frame expands to tens of megabytes of zeros, is refused at its
+    /// first node, having decompressed one step; before, `info` allocated
+    /// what the counts claimed and decompressed all of it first.
+    #[test]
+    fn a_forged_pool_claiming_gigabytes_is_refused_at_its_first_node() {
+        let nodes = 100_000_000u64;
+        let payload_len = FIXED_PAYLOAD_BYTES + nodes * NODE_BYTES + MIN_MATERIALS_BYTES;
+        assert!(payload_len > 3 << 30 && payload_len < crate::budget::DEFAULT_BUDGET_BYTES);
+        let forged = forge(&[frame(&[&fixed_part(nodes, 0)], 64 << 20)], payload_len, 0);
+        assert!(forged.len() < 128 << 10, "{} bytes", forged.len());
+        let (message, produced) = refusal(&forged);
+        assert!(message.contains("node 0 is uncollapsed"), "{message}");
+        assert!(produced <= FIXED_PAYLOAD_BYTES + CHUNK_BYTES as u64, "the decoder produced {produced} bytes");
+    }
+
+    /// Issue 24, item 13: a header's payload length is capped by what the
+    /// counts can need: their arrays and at most MAX_MATERIALS_BYTES.
+    #[test]
+    fn a_payload_longer_than_its_counts_need_is_refused_before_decompressing_it() {
+        let forged = forge(&[frame(&[&fixed_part(0, 0)], 64 << 20)], 3 << 30, 0);
+        let (message, produced) = refusal(&forged);
+        assert!(message.contains("is more than 0 nodes and 0 bricks can need"), "{message}");
+        assert_eq!(produced, FIXED_PAYLOAD_BYTES, "only the counts were decompressed");
     }
 
     #[test]

@@ -57,3 +57,74 @@ pub fn script(data: &[u8]) {
         assert_eq!(again.lines[0].command, line.command, "'{printed}'");
     }
 }
+
+/// The folder of the journal check's document, the same for every process
+/// so that the corpus can name it: `load /tmp/octovox-fuzz-journal/doc.vox`.
+pub const JOURNAL_DOCUMENT: &str = "/tmp/octovox-fuzz-journal/doc.vox";
+
+/// A folder of this process's own (fuzz jobs run side by side).
+fn own_dir(what: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("octovox-fuzz-{what}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a folder for the check");
+    dir
+}
+
+/// A crash journal: reading it never panics, and a journal read as good
+/// only edits: no line that writes a file (`save`, `render`) and one scene
+/// line at most (`load`, `new`, `demo`), with and without its document.
+pub fn journal(data: &[u8]) {
+    use octovox::replay::Command;
+    static DOCUMENT: std::sync::Once = std::sync::Once::new();
+    let document = Path::new(JOURNAL_DOCUMENT);
+    DOCUMENT.call_once(|| {
+        std::fs::create_dir_all(document.parent().expect("a folder")).expect("the document's folder");
+        let mut scene = octovox::scene::Scene::default();
+        let shape = octovox::scene::Shape::Box { min: glam::IVec3::ZERO, max: glam::IVec3::new(1, 2, 1) };
+        scene.tree.apply_brush(&shape, octovox::scene::Op::Place(3)).expect("a small box");
+        // Every process writes the same bytes; the write is atomic.
+        let options = octovox::io::atomic::WriteOptions::forced(true);
+        octovox::io::save_scene(document, &scene, options).expect("the journal's document saves");
+    });
+    let journal = own_dir("journal").join(".doc.vox.octovox-journal.ovr");
+    std::fs::write(&journal, data).expect("the journal is written");
+    for owner in [Some(document), None] {
+        let Ok(script) = octovox::journal::read(&journal, owner, Default::default()) else { continue };
+        let writes = script.lines.iter().find(|l| matches!(l.command, Command::Save(_) | Command::Render(_)));
+        assert!(writes.is_none(), "a journal read as good writes a file: '{}'", writes.map(|l| &l.command).unwrap());
+        let scenes =
+            script.lines.iter().filter(|l| matches!(l.command, Command::Load(_) | Command::New | Command::Demo(_)));
+        assert!(scenes.count() <= 1, "a journal read as good makes more than one scene");
+    }
+}
+
+/// Bytes an .ovx decoder may produce for an input of `input` bytes: a step
+/// of its chunked reading, and a generous compression ratio.
+const OVX_DECODED_PER_INPUT_BYTE: u64 = 1024;
+
+/// An .ovx file: decoding never panics, never decompresses far more than
+/// the input could honestly hold, and what loads saves and loads back the same.
+pub fn ovx(data: &[u8]) {
+    let progress = octovox::io::progress::Progress::default();
+    let loaded = octovox::io::ovx::decode_ovx(data, &progress);
+    let (decoded, _) = progress.get();
+    let allowed = (2 << 20) + OVX_DECODED_PER_INPUT_BYTE * data.len() as u64;
+    assert!(decoded <= allowed, "{} input bytes decoded to {decoded}", data.len());
+    let Ok(scene) = loaded else { return };
+    if let Err(broken) = scene.tree.check_invariants() {
+        panic!("a loaded .ovx is a broken octree: {broken}");
+    }
+    let path = own_dir("ovx").join("again.ovx");
+    octovox::io::ovx::save_ovx(&path, &scene, octovox::io::atomic::WriteOptions::forced(true))
+        .expect("a loaded .ovx saves");
+    let again = octovox::io::ovx::load_ovx(&path, &Default::default()).expect("a saved .ovx loads");
+    // Cells, not voxels: a tiny file can hold one uniform 2^20-wide cube.
+    let cells = |tree: &octovox::scene::Octree| {
+        let mut cells = Vec::new();
+        tree.for_each_solid_cell(|min, size, value| cells.push((min, size, value)));
+        cells
+    };
+    assert_eq!(cells(&again.tree), cells(&scene.tree), "the voxels changed in a save and load");
+    assert_eq!(again.tree.counts(), scene.tree.counts());
+    assert_eq!((again.tree.origin(), again.tree.depth()), (scene.tree.origin(), scene.tree.depth()));
+    assert_eq!(again.palette, scene.palette, "the palette or materials changed in a save and load");
+}
