@@ -83,17 +83,26 @@ impl FileStamp {
     /// The file cannot be read, or is not a regular file: a FIFO would be
     /// drained by the hash before the loader could read it.
     pub fn of(path: &Path) -> std::io::Result<FileStamp> {
+        FileStamp::with_hash(path, None)
+    }
+
+    /// [`FileStamp::of`], with the file's SHA-256 when the caller knows it
+    /// already (a save just hashed what it wrote) rather than reading it again.
+    ///
+    /// # Errors
+    /// As [`FileStamp::of`].
+    pub fn with_hash(path: &Path, sha256: Option<String>) -> std::io::Result<FileStamp> {
         let meta = std::fs::metadata(path)?;
         if !meta.is_file() {
             let text = format!("{} is not a regular file", path.display());
             return Err(std::io::Error::new(std::io::ErrorKind::InvalidInput, text));
         }
         let modified = meta.modified().ok().and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
-        Ok(FileStamp {
-            size: meta.len(),
-            modified: modified.map_or(0, |d| d.as_secs()),
-            sha256: crate::io::atomic::sha256_of(path)?,
-        })
+        let sha256 = match sha256 {
+            Some(known) => known,
+            None => crate::io::atomic::sha256_of(path)?,
+        };
+        Ok(FileStamp { size: meta.len(), modified: modified.map_or(0, |d| d.as_secs()), sha256 })
     }
 
     /// The journal's note of the file it edits: `source size=N modified=S sha256=HEX`.
@@ -234,7 +243,7 @@ pub fn read(journal: &Path, document: Option<&Path>, checks: Checks) -> Result<S
         && !checks.allow_changed_source
     {
         let now = FileStamp::of(source);
-        if now.as_ref().is_ok_and(|now| now.sha256 != then.sha256) || now.is_err() {
+        if !now.as_ref().is_ok_and(|now| now.sha256 == then.sha256) {
             let now = now.map_or_else(|err| format!("unreadable ({err})"), |now| now.to_string());
             return Err(RecoverError::Changed { path: journal.to_path_buf(), document: source.clone(), then, now });
         }

@@ -214,7 +214,9 @@ impl App {
         // replayed a second time.
         let target = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
         let journal = std::cell::RefCell::new(self.journal.take());
+        let saved_hash = std::cell::RefCell::new(None);
         let note = |sha256: &str| {
+            *saved_hash.borrow_mut() = Some(sha256.to_owned());
             if let Some(journal) = journal.borrow_mut().as_mut()
                 && let Err(err) = journal.note(&octovox::journal::saved_note(sha256, &target))
             {
@@ -233,7 +235,8 @@ impl App {
                 // The file now holds every edit: the journal starts again from it.
                 self.close_journal();
                 let absolute = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
-                self.journal_start = JournalStart::load(absolute);
+                // The hash the save computed: the file is not read again.
+                self.journal_start = JournalStart::load(absolute, saved_hash.into_inner());
                 self.ui.info(format!("saved {}", path.display()));
                 self.update_title();
                 true

@@ -28,9 +28,10 @@ impl JournalStart {
         JournalStart { lines, stamp: None }
     }
 
-    /// The journal starts by loading `path` (absolute), as it is on disk now.
-    pub fn load(path: PathBuf) -> JournalStart {
-        let stamp = FileStamp::of(&path).ok();
+    /// The journal starts by loading `path` (absolute), as it is on disk
+    /// now; `sha256` is its hash where the caller just computed it.
+    pub fn load(path: PathBuf, sha256: Option<String>) -> JournalStart {
+        let stamp = FileStamp::with_hash(&path, sha256).ok();
         JournalStart { lines: vec![Line::Load(path)], stamp }
     }
 
@@ -183,10 +184,14 @@ impl App {
         if let Some(dir) = snapshot.parent() {
             let _ = std::fs::create_dir_all(dir);
         }
-        match octovox::io::save_scene(&snapshot, &self.editor.scene, octovox::io::atomic::WriteOptions::default()) {
+        // The save hashes what it writes: the snapshot is not read again for its stamp.
+        let hash = std::cell::RefCell::new(None);
+        let keep = |sha256: &str| *hash.borrow_mut() = Some(sha256.to_owned());
+        let options = octovox::io::atomic::WriteOptions { before_replace: Some(&keep), ..Default::default() };
+        match octovox::io::save_scene(&snapshot, &self.editor.scene, options) {
             Ok(()) => {
                 let absolute = std::fs::canonicalize(&snapshot).unwrap_or(snapshot);
-                self.journal_start = JournalStart::load(absolute);
+                self.journal_start = JournalStart::load(absolute, hash.into_inner());
                 self.open_journal(self.editor.selection);
             }
             Err(err) => self.journal_failed(format!("cannot snapshot the scene for the crash-recovery journal: {err}")),
