@@ -6,12 +6,30 @@
 
 use glam::IVec3;
 
+use crate::edit::brush::Brush;
+use crate::edit::mirror::Mirror;
+use crate::edit::selection::{self, Block, Region};
 use crate::edit::{Edit, History};
-use crate::mirror::Mirror;
-use crate::replay::Command;
-use crate::scene::selection::{self, Block, Region};
-use crate::scene::{EditError, Op, Scene};
-use crate::tool::Brush;
+use crate::scene::{EditError, Op, Palette, Scene};
+use crate::script::Command;
+use crate::settings::PathSettings;
+
+/// Why a line could not run. A refused line changes nothing.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum EditorError {
+    #[error(transparent)]
+    Edit(#[from] EditError),
+    #[error("nothing is selected: select a box first")]
+    NothingSelected,
+    #[error("nothing to paste: copy or cut a selection first")]
+    NothingToPaste,
+    #[error("no voxel at {0} to pick a colour from")]
+    NothingToPick(IVec3),
+    #[error("nothing to {0}")]
+    NoSteps(&'static str),
+    #[error("only {available} step(s) to {what}, not {wanted}")]
+    TooFewSteps { what: &'static str, available: usize, wanted: u32 },
+}
 
 /// What brush edits use: the brush, the colour and the mirror planes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -72,8 +90,7 @@ impl Editor {
 
     /// Carries out one line. `Err` is a line that could not run (a refused
     /// edit changes nothing).
-    pub fn run(&mut self, command: &Command) -> Result<Outcome, String> {
-        let text = |e: EditError| e.to_string();
+    pub fn run(&mut self, command: &Command) -> Result<Outcome, EditorError> {
         let tools = self.tools;
         let changed = match command {
             Command::New | Command::Demo(_) => {
@@ -84,59 +101,53 @@ impl Editor {
             Command::Color(c) => self.set(|e| e.tools.color = *c),
             Command::Mirror(plane) => self.set(|e| e.tools.mirror.apply_line(*plane)),
             Command::Pick(p) => {
-                let color = crate::replay::picked_color(&self.scene, *p)?;
+                let color = picked_color(&self.scene, *p)?;
                 self.set(|e| e.tools.color = color)
             }
-            Command::Place(p) => {
-                self.apply_mirrored(vec![brush_edit(&tools, *p, Op::Place(tools.color))]).map_err(text)?
-            }
-            Command::Remove(p) => self.apply_mirrored(vec![brush_edit(&tools, *p, Op::Remove)]).map_err(text)?,
-            Command::Paint(p) => {
-                self.apply_mirrored(vec![brush_edit(&tools, *p, Op::Paint(tools.color))]).map_err(text)?
-            }
+            Command::Place(p) => self.apply_mirrored(vec![brush_edit(&tools, *p, Op::Place(tools.color))])?,
+            Command::Remove(p) => self.apply_mirrored(vec![brush_edit(&tools, *p, Op::Remove)])?,
+            Command::Paint(p) => self.apply_mirrored(vec![brush_edit(&tools, *p, Op::Paint(tools.color))])?,
             Command::Line(a, b) => {
-                let edits = crate::tool::line_edits(&tools.brush, tools.color, *a, *b).map_err(text)?;
-                self.apply_mirrored(edits).map_err(text)?
+                let edits = crate::edit::brush::line_edits(&tools.brush, tools.color, *a, *b)?;
+                self.apply_mirrored(edits)?
             }
             // Fills and extrudes are not mirrored: their regions follow the
             // colours and faces, not the brush.
             Command::Fill(p) => {
-                let edits = crate::scene::fill::fill_edits(&self.scene.tree, *p, tools.color).map_err(text)?;
-                self.commit(edits).map_err(text)?
+                let edits = crate::edit::fill::fill_edits(&self.scene.tree, *p, tools.color)?;
+                self.commit(edits)?
             }
             Command::Extrude(p, normal, layers) => {
-                let edits =
-                    crate::scene::extrude::extrude_edits(&self.scene.tree, *p, *normal, *layers).map_err(text)?;
-                self.commit(edits).map_err(text)?
+                let edits = crate::edit::extrude::extrude_edits(&self.scene.tree, *p, *normal, *layers)?;
+                self.commit(edits)?
             }
-            Command::Rgb(..) | Command::Material(..) => match crate::replay::palette_edit(command, &self.scene.palette)
-            {
-                Some(edit) => self.commit(vec![edit]).map_err(text)?,
+            Command::Rgb(..) | Command::Material(..) => match palette_edit(command, &self.scene.palette) {
+                Some(edit) => self.commit(vec![edit])?,
                 None => false,
             },
             Command::Undo(n) => self.repeat(*n, true)?,
             Command::Redo(n) => self.repeat(*n, false)?,
             Command::Select(None) => self.set(|e| e.selection = None),
             Command::Select(Some((a, b))) => {
-                let region = Region::new(*a, *b).map_err(text)?;
+                let region = Region::new(*a, *b)?;
                 self.set(|e| e.selection = Some(region))
             }
             Command::Copy => {
-                let block = selection::copy(&self.scene.tree, self.selected()?).map_err(text)?;
+                let block = selection::copy(&self.scene.tree, self.selected()?)?;
                 self.set(|e| e.clipboard = Some(block))
             }
             Command::Cut => {
                 let region = self.selected()?;
-                let block = selection::copy(&self.scene.tree, region).map_err(text)?;
-                let changed = self.commit(vec![region.clear_edit()]).map_err(text)?;
+                let block = selection::copy(&self.scene.tree, region)?;
+                let changed = self.commit(vec![region.clear_edit()])?;
                 self.clipboard = Some(block);
                 changed
             }
-            Command::Delete => self.commit(vec![self.selected()?.clear_edit()]).map_err(text)?,
+            Command::Delete => self.commit(vec![self.selected()?.clear_edit()])?,
             Command::Paste(at) => {
-                let block = self.clipboard.as_ref().ok_or("nothing to paste: copy or cut a selection first")?;
-                let region = block.region_at(*at).inside_world().map_err(text)?;
-                let changed = self.commit(block.place_edits(*at)).map_err(text)?;
+                let block = self.clipboard.as_ref().ok_or(EditorError::NothingToPaste)?;
+                let region = block.region_at(*at).inside_world()?;
+                let changed = self.commit(block.place_edits(*at))?;
                 self.selection = Some(region);
                 changed
             }
@@ -149,7 +160,18 @@ impl Editor {
                 let got = self.scene.tree.solid_voxels();
                 return Ok(checked(got == *want, format!("{want} voxels"), got));
             }
-            _ => return Ok(Outcome::Host),
+            Command::ExpectEffects(want) => {
+                let (ok, got) = effects_match(&self.scene, want);
+                return Ok(checked(ok, format!("effects [{}]", want.join(" ")), format!("[{}]", got.join(" "))));
+            }
+            Command::Load(_)
+            | Command::Camera { .. }
+            | Command::Viewport(..)
+            | Command::Click { .. }
+            | Command::Save(_)
+            | Command::Render(_)
+            | Command::ExpectWritten(_)
+            | Command::ExpectImage(..) => return Ok(Outcome::Host),
         };
         Ok(if changed { Outcome::Changed } else { Outcome::State })
     }
@@ -161,21 +183,20 @@ impl Editor {
     }
 
     /// The selected box, or why a line that needs one cannot run.
-    fn selected(&self) -> Result<Region, String> {
-        self.selection.ok_or_else(|| "nothing is selected: select a box first".to_string())
+    fn selected(&self) -> Result<Region, EditorError> {
+        self.selection.ok_or(EditorError::NothingSelected)
     }
 
     /// `move`: the selected voxels leave their box and land `by` away, as
     /// one undo step; the selection follows. Refused as a whole when the
     /// new place is outside the world. Whether the voxels changed.
-    fn move_selection(&mut self, by: IVec3) -> Result<bool, String> {
-        let text = |e: EditError| e.to_string();
+    fn move_selection(&mut self, by: IVec3) -> Result<bool, EditorError> {
         let region = self.selected()?;
-        let moved = region.shifted(by).inside_world().map_err(text)?;
-        let block = selection::copy(&self.scene.tree, region).map_err(text)?;
+        let moved = region.shifted(by).inside_world()?;
+        let block = selection::copy(&self.scene.tree, region)?;
         let mut edits = vec![region.clear_edit()];
         edits.extend(block.place_edits(moved.min));
-        let changed = self.commit(edits).map_err(text)?;
+        let changed = self.commit(edits)?;
         self.selection = Some(moved);
         Ok(changed)
     }
@@ -202,30 +223,61 @@ impl Editor {
     }
 
     /// `undo N` / `redo N`: all N steps, or (fewer there) none.
-    fn repeat(&mut self, n: u32, undo: bool) -> Result<bool, String> {
+    fn repeat(&mut self, n: u32, undo: bool) -> Result<bool, EditorError> {
         let (undoable, redoable) = self.history.steps();
         let (what, available) = if undo { ("undo", undoable) } else { ("redo", redoable) };
         if available == 0 {
-            return Err(format!("nothing to {what}"));
+            return Err(EditorError::NoSteps(what));
         }
         if usize::try_from(n).map_or(true, |n| n > available) {
-            return Err(format!("only {available} step(s) to {what}, not {n}"));
+            return Err(EditorError::TooFewSteps { what, available, wanted: n });
         }
         for _ in 0..n {
             let scene = &mut self.scene;
-            if undo { self.history.undo(scene) } else { self.history.redo(scene) }.map_err(|e| e.to_string())?;
+            if undo { self.history.undo(scene) } else { self.history.redo(scene) }?;
         }
         Ok(true)
     }
 }
 
 /// The scene a `new` or `demo` line makes; `None` for other lines.
-pub fn built_scene(command: &Command) -> Option<Scene> {
+fn built_scene(command: &Command) -> Option<Scene> {
     match command {
         Command::New => Some(Scene::default()),
         Command::Demo(built_in) => Some(built_in.scene()),
         _ => None,
     }
+}
+
+/// The edit a palette line (`rgb`, `material`) makes on `palette`; `None`
+/// for other lines.
+fn palette_edit(command: &Command, palette: &Palette) -> Option<Edit> {
+    let (index, color, material) = match command {
+        Command::Rgb(index, [r, g, b]) => (*index, [*r, *g, *b, 255], palette.material(*index).clone()),
+        Command::Material(index, material) => (*index, palette.color(*index), (**material).clone()),
+        _ => return None,
+    };
+    Some(Edit::Palette { index, color, material: Box::new(material) })
+}
+
+/// `pick X Y Z`: the colour of the voxel there, or why there is none.
+fn picked_color(scene: &Scene, at: IVec3) -> Result<u8, EditorError> {
+    match scene.tree.get(at) {
+        0 => Err(EditorError::NothingToPick(at)),
+        value => Ok(value),
+    }
+}
+
+/// `expect effects`: whether the effect set the scene calls for (with the
+/// default path settings, so a script means one thing in every host) is
+/// exactly `want` (in any order), and the set's names.
+pub fn effects_match(scene: &Scene, want: &[String]) -> (bool, Vec<&'static str>) {
+    let names = crate::trace::path::effects_for(&scene.tree, &scene.palette, &PathSettings::default()).names();
+    let mut got = names.clone();
+    let mut expected: Vec<&str> = want.iter().map(String::as_str).collect();
+    got.sort_unstable();
+    expected.sort_unstable();
+    (got == expected, names)
 }
 
 fn brush_edit(tools: &Tools, at: IVec3, op: Op) -> Edit {
@@ -240,8 +292,8 @@ fn checked(ok: bool, expected: String, got: impl ToString) -> Outcome {
 mod tests {
     use super::*;
 
-    fn run(editor: &mut Editor, line: &str) -> Result<Outcome, String> {
-        let script = crate::replay::parse_script(std::path::Path::new("t.ovr"), line).unwrap();
+    fn run(editor: &mut Editor, line: &str) -> Result<Outcome, EditorError> {
+        let script = crate::script::parse_script(std::path::Path::new("t.ovr"), line).unwrap();
         editor.run(&script.lines[0].command)
     }
 
@@ -252,7 +304,7 @@ mod tests {
             run(&mut editor, line).unwrap();
         }
         let limit = crate::scene::octree::WORLD_LIMIT - 1;
-        let err = run(&mut editor, &format!("paste {limit} 0 0")).unwrap_err();
+        let err = run(&mut editor, &format!("paste {limit} 0 0")).unwrap_err().to_string();
         assert!(err.contains("outside the world"), "{err}");
         assert_eq!(editor.scene.tree.solid_voxels(), 2);
         assert_eq!(editor.selection, Some(Region { min: IVec3::ZERO, max: IVec3::X }));
@@ -283,9 +335,9 @@ mod tests {
     fn lines_that_need_a_selection_or_clipboard_say_so() {
         let mut editor = Editor::default();
         for line in ["copy", "cut", "delete", "move 1 0 0"] {
-            assert!(run(&mut editor, line).unwrap_err().contains("nothing is selected"), "{line}");
+            assert!(run(&mut editor, line).unwrap_err().to_string().contains("nothing is selected"), "{line}");
         }
-        assert!(run(&mut editor, "paste 0 0 0").unwrap_err().contains("nothing to paste"));
+        assert!(run(&mut editor, "paste 0 0 0").unwrap_err().to_string().contains("nothing to paste"));
     }
 
     #[test]
@@ -297,7 +349,7 @@ mod tests {
         assert_eq!(run(&mut editor, "paste 10 0 0"), Ok(Outcome::State), "nothing to place: no step");
         assert_eq!(editor.history.steps(), (1, 0));
         let far = crate::scene::octree::WORLD_LIMIT - 1;
-        assert!(run(&mut editor, &format!("move {far} 0 0")).unwrap_err().contains("outside the world"));
+        assert!(run(&mut editor, &format!("move {far} 0 0")).unwrap_err().to_string().contains("outside the world"));
         assert_eq!(editor.selection, Some(Region { min: IVec3::new(10, 0, 0), max: IVec3::new(11, 1, 1) }));
     }
 
@@ -307,7 +359,7 @@ mod tests {
         for line in ["place 0 0 0", "place 1 0 0"] {
             run(&mut editor, line).unwrap();
         }
-        assert!(run(&mut editor, "undo 3").unwrap_err().contains("only 2 step(s) to undo"));
+        assert!(run(&mut editor, "undo 3").unwrap_err().to_string().contains("only 2 step(s) to undo"));
         assert_eq!(editor.scene.tree.solid_voxels(), 2, "nothing was undone");
         assert_eq!(run(&mut editor, "undo 2"), Ok(Outcome::Changed));
         assert_eq!(editor.scene.tree.solid_voxels(), 0);

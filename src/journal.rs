@@ -11,8 +11,9 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::replay::{Command, Runner, RunnerMode, Script};
+use crate::replay::{Runner, RunnerMode};
 use crate::scene::Scene;
+use crate::script::{Command, Script};
 
 /// The journal of `document`: `.NAME.octovox-journal.ovr` beside it.
 pub fn journal_path(document: &Path) -> PathBuf {
@@ -131,7 +132,7 @@ impl std::fmt::Display for FileStamp {
 /// file of hash `sha256`: if a kill comes between that save's rename and
 /// the journal's removal, recovery finds the journal's edits in `path`.
 pub fn saved_note(sha256: &str, path: &Path) -> String {
-    format!("saved sha256={sha256} {}", crate::replay::quoted(path))
+    format!("saved sha256={sha256} {}", crate::script::quoted(path))
 }
 
 /// The notes (`#@ …` lines) of a journal's text.
@@ -147,7 +148,7 @@ impl Notes {
     fn read(text: &str) -> Notes {
         let mut notes = Notes::default();
         for (number, line) in (1..).zip(text.lines()) {
-            let Some(words) = line.strip_prefix("#@").and_then(|rest| crate::replay::split_words(rest).ok()) else {
+            let Some(words) = line.strip_prefix("#@").and_then(|rest| crate::script::split_words(rest).ok()) else {
                 continue;
             };
             match words.first().map(String::as_str) {
@@ -226,10 +227,10 @@ pub fn read(journal: &Path, document: Option<&Path>, checks: Checks) -> Result<S
         return Err(RecoverError::Live { path: journal.to_path_buf() });
     }
     let unreadable = |errors: Vec<String>| RecoverError::Unreadable { path: journal.to_path_buf(), errors };
-    let bytes = crate::io::input::read_limited(journal, crate::replay::MAX_SCRIPT_BYTES)
+    let bytes = crate::io::input::read_limited(journal, crate::script::MAX_SCRIPT_BYTES)
         .map_err(|e| unreadable(vec![format!("cannot read it: {e}")]))?;
     let text = String::from_utf8(bytes).map_err(|_| unreadable(vec!["it is not UTF-8 text".into()]))?;
-    let script = crate::replay::parse_script(journal, &text)
+    let script = crate::script::parse_script(journal, &text)
         .map_err(|errors| unreadable(errors.iter().map(ToString::to_string).collect()))?;
     let first = check_lines(journal, &script, document)?;
     let notes = Notes::read(&text);
@@ -333,7 +334,7 @@ mod tests {
     }
 
     fn journal_text(document: &Path, notes: &str, edits: &str) -> String {
-        format!("# test journal\n{notes}load {}\n{edits}", crate::replay::quoted(document))
+        format!("# test journal\n{notes}load {}\n{edits}", crate::script::quoted(document))
     }
 
     #[test]

@@ -21,14 +21,10 @@ impl App {
     pub(super) fn save_screenshot(&mut self, window_copy: Option<WindowCopy>) {
         let Some(gfx) = &self.gfx else { return };
         let stamp = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_millis());
-        // A script's `render PATH` names the file; otherwise a stamped name in saves/.
-        let view_path = self.screenshot_path.take().unwrap_or_else(|| {
-            // The screenshot folder is ours to make; a path a script names is not.
-            if let Err(err) = std::fs::create_dir_all(SAVES_DIR) {
-                log::warn!("cannot create {SAVES_DIR}: {err}");
-            }
-            Path::new(SAVES_DIR).join(format!("octovox-{stamp}.png"))
-        });
+        if let Err(err) = std::fs::create_dir_all(SAVES_DIR) {
+            log::warn!("cannot create {SAVES_DIR}: {err}");
+        }
+        let view_path = Path::new(SAVES_DIR).join(format!("octovox-{stamp}.png"));
         let base = view_path.with_extension("");
         let result = gfx.renderer.read_image().map_err(anyhow::Error::from).and_then(|image| {
             octovox::io::png::save_png(&image, &view_path, Default::default()).map_err(anyhow::Error::from)

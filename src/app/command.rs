@@ -4,7 +4,6 @@
 
 use std::path::PathBuf;
 
-use octovox::camera::Camera;
 use octovox::edit::Edit;
 
 use super::state::Tool;
@@ -106,7 +105,6 @@ pub enum Command {
     /// Measure what each preset costs and how far it is from the reference.
     MeasurePresets,
     SetTool(Tool),
-    SetCamera(Camera),
     Orbit {
         dx: f64,
         dy: f64,

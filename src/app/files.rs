@@ -13,7 +13,7 @@ use octovox::io::atomic::WriteOptions;
 use octovox::scene::Scene;
 
 use octovox::journal::{Checks, FileStamp};
-use octovox::replay::Command::Load;
+use octovox::script::Command::Load;
 
 use super::journal::{Found, JournalStart, classify};
 use super::ui::DialogKind;
@@ -24,11 +24,19 @@ impl App {
     /// it whole; `source` is the script line that makes it (`load`, `new`,
     /// `demo`), which the recorder writes.
     /// `stamp` is the loaded file's as it was read (`JournalStart`).
-    pub(super) fn replace_scene(&mut self, scene: Scene, source: octovox::replay::Command, stamp: Option<FileStamp>) {
+    pub(super) fn replace_scene(&mut self, scene: Scene, source: octovox::script::Command, stamp: Option<FileStamp>) {
+        self.editor.set_scene(scene);
+        self.scene_replaced(source, stamp);
+    }
+
+    /// Follows up a scene the editor just put in place (opened, or made by a
+    /// `new` or `demo` line): the recording, a fresh journal, the title, and
+    /// all of it to the GPU.
+    pub(super) fn scene_replaced(&mut self, source: octovox::script::Command, stamp: Option<FileStamp>) {
         let (path, line) = match source {
-            octovox::replay::Command::Load(path) => {
+            octovox::script::Command::Load(path) => {
                 let absolute = std::fs::canonicalize(&path).unwrap_or_else(|_| path.clone());
-                (Some(path), octovox::replay::Command::Load(absolute))
+                (Some(path), octovox::script::Command::Load(absolute))
             }
             line => (None, line),
         };
@@ -37,11 +45,11 @@ impl App {
         self.close_journal();
         // The line that makes the scene starts its journal (untitled ones too).
         self.journal_start = match line {
-            octovox::replay::Command::Load(path) => JournalStart { lines: vec![Load(path)], stamp },
+            octovox::script::Command::Load(path) => JournalStart { lines: vec![Load(path)], stamp },
             line => JournalStart::of(vec![line]),
         };
-        self.editor.set_scene(scene);
         self.stroke = None;
+        self.stats.last_edit_bytes = None;
         // What the presets cost was measured on the scene before.
         self.presets_measured = None;
         // An imported mesh has no .vox to save back to: Save asks for one
@@ -75,7 +83,7 @@ impl App {
             Choice::Discard => self.perform(pending, event_loop),
             Choice::Save => match self.state.path.clone() {
                 Some(path) => {
-                    if self.save(&path, WriteOptions::default()) {
+                    if self.save_document(&path, WriteOptions::default()) {
                         self.perform(pending, event_loop);
                     } else if self.ui.read_only.is_some() {
                         // Overwriting from the read-only prompt carries on with it.
@@ -94,7 +102,7 @@ impl App {
     pub(super) fn perform(&mut self, action: Pending, event_loop: &ActiveEventLoop) {
         match action {
             Pending::New => {
-                self.replace_scene(Scene::default(), octovox::replay::Command::New, None);
+                self.replace_scene(Scene::default(), octovox::script::Command::New, None);
                 self.state.camera = Camera { fov_y_deg: self.state.camera.fov_y_deg, ..Camera::default() };
                 // A lone voxel to attach to: an empty scene gives the mouse nothing to hit.
                 let color = self.editor.tools.color.max(1);
@@ -109,9 +117,9 @@ impl App {
                 self.record(|r| r.seed(color, IVec3::ZERO));
                 // The journal starts from the seeded scene too.
                 self.journal_start.lines.extend([
-                    octovox::replay::Command::Brush(octovox::tool::Brush::Voxel),
-                    octovox::replay::Command::Color(color),
-                    octovox::replay::Command::Place(IVec3::ZERO),
+                    octovox::script::Command::Brush(octovox::edit::brush::Brush::Voxel),
+                    octovox::script::Command::Color(color),
+                    octovox::script::Command::Place(IVec3::ZERO),
                 ]);
                 self.upload();
                 self.state.dirty = false;
@@ -140,7 +148,7 @@ impl App {
             Ok(scene) => scene,
             Err(err) => return self.ui.error(format!("cannot recover: {err}")),
         };
-        let source = document.clone().map_or(octovox::replay::Command::New, octovox::replay::Command::Load);
+        let source = document.clone().map_or(octovox::script::Command::New, octovox::script::Command::Load);
         self.replace_scene(scene, source, None);
         // What is shown is the scene plus its journal, not yet saved.
         self.state.dirty = true;
@@ -192,7 +200,7 @@ impl App {
     /// Saves, then makes `path` the document and carries on with an action
     /// that waited for a path to save to.
     pub(super) fn save_as(&mut self, path: PathBuf, options: WriteOptions, event_loop: &ActiveEventLoop) {
-        if self.save(&path, options) {
+        if self.save_document(&path, options) {
             self.state.path = Some(path);
             self.update_title();
             if let Some(pending) = self.ui.pending.take() {
@@ -203,7 +211,7 @@ impl App {
 
     /// Saves atomically; reports the outcome in the UI and on stdout. A
     /// read-only file is not replaced: the user is asked first.
-    pub(super) fn save(&mut self, path: &Path, options: WriteOptions) -> bool {
+    pub(super) fn save_document(&mut self, path: &Path, options: WriteOptions) -> bool {
         if !options.overwrite_read_only && octovox::io::atomic::is_read_only(path) {
             report!("asking: {} is read-only", path.display());
             self.ui.read_only = Some(path.to_path_buf());

@@ -27,7 +27,7 @@ impl App {
         self.poll_loading();
         self.poll_file_dialog(event_loop);
         if self.ready {
-            self.play_step(event_loop);
+            self.play_step();
         }
         if let Some(dir) = self.input.fly_direction() {
             camera_control::fly(&mut self.state.camera, dir, seconds);
@@ -37,7 +37,7 @@ impl App {
         let Some((ctx, full, overlays)) = self.run_panels(event_loop) else { return };
         self.stats.panels_ms = panels_started.elapsed().as_secs_f64() * 1e3;
         // The camera is final for this frame: pick how many pixels to trace.
-        let screenshot = self.screenshot_requested || self.screenshot_path.is_some();
+        let screenshot = self.screenshot_requested;
         let last = motion::FrameTimes { frame_ms: self.stats.frame_ms, trace_ms: self.stats.trace_ms };
         self.motion.update(&self.state.camera, started, last, self.state.frame_target_ms, screenshot);
         self.stats.scale = self.render_scale();

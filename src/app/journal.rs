@@ -8,7 +8,8 @@
 use std::path::{Path, PathBuf};
 
 use octovox::journal::{FileStamp, RecoverError};
-use octovox::replay::{Command as Line, Recorder};
+use octovox::replay::Recorder;
+use octovox::script::Command as Line;
 
 use super::App;
 
@@ -130,7 +131,7 @@ impl App {
     /// for an untitled one), with the stamp of the file it loads, then
     /// `selection`: the selection in force before the change (a `move` as
     /// the first edit moves it).
-    pub(super) fn open_journal(&mut self, selection: Option<octovox::scene::selection::Region>) {
+    pub(super) fn open_journal(&mut self, selection: Option<octovox::edit::selection::Region>) {
         if self.journal.is_some() || !self.state.dirty || self.journal_start.lines.is_empty() {
             return;
         }

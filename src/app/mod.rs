@@ -20,6 +20,7 @@ mod egui_layers;
 mod file_dialog;
 mod files;
 mod frame;
+mod host;
 mod input;
 mod journal;
 mod motion;
@@ -47,7 +48,7 @@ use winit::window::{Window, WindowId};
 
 use octovox::camera::Camera;
 use octovox::edit::Edit;
-use octovox::editor::{Editor, Outcome};
+use octovox::editor::Editor;
 use octovox::gpu::scene_buffers::UploadStats;
 use octovox::gpu::{BlitMode, BlitPass, GpuContext, Renderer};
 use octovox::io::atomic::WriteOptions;
@@ -110,11 +111,13 @@ struct Loading {
 }
 
 /// An open mouse stroke: its tool, the face (normal and layer) it started
-/// on, and the last brush centre applied.
+/// on, the last brush centre applied, and whether the line being run is
+/// the stroke's own (a step of it, not a key action that ends it).
 struct Stroke {
     tool: Tool,
     plane: Option<(IVec3, i32)>,
     last_center: Option<IVec3>,
+    applying: bool,
 }
 
 /// `--bench-frames`: frames left and the measurements so far.
@@ -187,8 +190,6 @@ struct App {
     fill_preview: Option<preview::FillPreview>,
     /// The face a Ctrl+drag extrude started on and where the drag began.
     extrude_from: Option<(Pick, (f64, f64))>,
-    /// Where the next screenshot goes (a script's `render PATH`), else `saves/`.
-    screenshot_path: Option<PathBuf>,
 }
 
 impl App {
@@ -231,7 +232,6 @@ impl App {
             extrude_preview: None,
             fill_preview: None,
             extrude_from: None,
-            screenshot_path: None,
             args,
         };
         app.open_script_files();
@@ -247,7 +247,7 @@ impl App {
             Some(path) => app.start_loading(path),
             None => {
                 let built_in = app.args.demo.unwrap_or_default();
-                app.replace_scene(built_in.scene(), octovox::replay::Command::Demo(built_in), None);
+                app.replace_scene(built_in.scene(), octovox::script::Command::Demo(built_in), None);
                 if app.args.camera.is_none() {
                     app.frame_model();
                 }
@@ -328,76 +328,6 @@ impl App {
 
     // ----- the one path for changes: edit → history → octree → upload ------------
 
-    /// Applies an edit and its mirror images (a stroke step, a palette
-    /// change) the way every edit is applied: through the editor's history
-    /// onto the octree, `record` to the recording and the journal, then the
-    /// pool's dirty ranges go to the GPU.
-    fn apply_edit(&mut self, edit: Edit, record: impl Fn(&mut Recorder) -> std::io::Result<()>) -> bool {
-        match self.editor.apply_mirrored(vec![edit]) {
-            Ok(_) => {
-                self.after_change("edit", record);
-                true
-            }
-            Err(err) => {
-                self.ui.error(format!("edit refused: {err}"));
-                false
-            }
-        }
-    }
-
-    /// Runs one editor line (a played script line, or what a mouse action
-    /// became) and follows it up: an edit goes to the GPU, the recording
-    /// and the journal. New and demo lines replace the scene as Open does.
-    pub(super) fn run_line(&mut self, line: &octovox::replay::Command) -> Result<Outcome, String> {
-        if let Some(scene) = octovox::editor::built_scene(line) {
-            self.replace_scene(scene, line.clone(), None);
-            return Ok(Outcome::Replaced);
-        }
-        // A key action during a drag ends the drag's undo step first: the
-        // history and the recording count steps alike.
-        self.close_strokes();
-        // A journal that the line starts begins with the selection before it.
-        let selection = self.editor.selection;
-        let outcome = self.editor.run(line)?;
-        if matches!(outcome, Outcome::Changed) {
-            self.state.dirty = true;
-            self.open_journal(selection);
-        }
-        let (tools, camera) = (self.editor.tools, self.state.camera);
-        let ran = |r: &mut Recorder| r.ran(line, &tools, &camera);
-        match (&outcome, line) {
-            // Undo and redo: the journal gets them as lines only if it holds the steps.
-            (Outcome::Changed, octovox::replay::Command::Undo(n) | octovox::replay::Command::Redo(n)) => {
-                let undo = matches!(line, octovox::replay::Command::Undo(_));
-                self.state.dirty = true;
-                (0..*n).for_each(|_| self.record_undo(undo));
-                self.after_change(if undo { "undo" } else { "redo" }, |_| Ok(()));
-            }
-            // A block copied before the journal started: the journal starts again after the paste.
-            (Outcome::Changed, octovox::replay::Command::Paste(_)) if !self.clipboard_journaled => {
-                self.state.dirty = true;
-                self.record_to_recording(ran);
-                self.restart_journal_from_snapshot();
-                self.after_change("paste", |_| Ok(()));
-            }
-            (Outcome::Changed, _) => {
-                // The line's command word names it in the printed line (`fill: N bytes written`).
-                let text = line.to_string();
-                self.after_change(text.split(' ').next().unwrap_or("edit"), ran);
-            }
-            (Outcome::State, _) => {
-                self.record(ran);
-                report!("ran: {line}");
-                self.request_redraw();
-            }
-            (Outcome::Replaced | Outcome::Checked { .. } | Outcome::Host, _) => return Ok(outcome),
-        }
-        if matches!(line, octovox::replay::Command::Copy | octovox::replay::Command::Cut) {
-            self.clipboard_journaled = self.journal.is_some();
-        }
-        Ok(outcome)
-    }
-
     /// Ctrl+Z / Ctrl+Shift+Z: one step, if there is one.
     fn undo_redo(&mut self, undo: bool) {
         let what = if undo { "undo" } else { "redo" };
@@ -405,12 +335,12 @@ impl App {
         if (if undo { undoable } else { redoable }) == 0 {
             return self.ui.info(format!("nothing to {what}"));
         }
-        self.act(if undo { octovox::replay::Command::Undo(1) } else { octovox::replay::Command::Redo(1) }, what);
+        self.act(if undo { octovox::script::Command::Undo(1) } else { octovox::script::Command::Redo(1) }, what);
     }
 
     /// A mouse or key action as an editor line; a refusal goes to the
     /// message line as `what refused: …`.
-    fn act(&mut self, line: octovox::replay::Command, what: &str) {
+    fn act(&mut self, line: octovox::script::Command, what: &str) {
         if let Err(err) = self.run_line(&line) {
             self.ui.error(format!("{what} refused: {err}"));
         }
@@ -426,7 +356,7 @@ impl App {
         self.ui.change_made();
         self.record(record);
         let upload = self.upload();
-        self.stats.last_edit_bytes = upload.bytes;
+        self.stats.last_edit_bytes = Some(upload.bytes);
         self.stats.last_edit_ranges = upload.ranges;
         report!(
             "{what}: {} bytes written in {} ranges{}",
@@ -468,8 +398,8 @@ impl App {
             Command::PointerEdit { phase, tool, x, y } if !busy_loading => self.pointer_edit(phase, tool, x, y),
             Command::ExtrudeDrag { phase, x, y } if !busy_loading => self.extrude_drag(phase, x, y),
             Command::EditPalette { edit, dragging } if !busy_loading => self.palette_edit(edit, dragging),
-            Command::Cut if !busy_loading => self.act(octovox::replay::Command::Cut, "cut"),
-            Command::DeleteSelection if !busy_loading => self.act(octovox::replay::Command::Delete, "delete"),
+            Command::Cut if !busy_loading => self.act(octovox::script::Command::Cut, "cut"),
+            Command::DeleteSelection if !busy_loading => self.act(octovox::script::Command::Delete, "delete"),
             Command::PasteAtCursor if !busy_loading => self.paste_at_cursor(),
             Command::Nudge(nudge) if !busy_loading => self.nudge(nudge),
             Command::Undo if !busy_loading => self.undo_redo(true),
@@ -493,27 +423,26 @@ impl App {
             Command::MeasurePresets => self.measure_presets(),
             Command::ToggleLine => self.state.toggle_line_mode(),
             Command::ToggleSelect => self.state.toggle_select_mode(),
-            Command::Copy => match self.run_line(&octovox::replay::Command::Copy) {
+            Command::Copy => match self.run_line(&octovox::script::Command::Copy) {
                 Ok(_) => {
-                    let voxels = self.editor.clipboard().map_or(0, octovox::scene::selection::Block::voxels);
+                    let voxels = self.editor.clipboard().map_or(0, octovox::edit::selection::Block::voxels);
                     self.ui.info(format!("copied {voxels} voxels"));
                 }
                 Err(err) => self.ui.error(format!("copy refused: {err}")),
             },
-            Command::SelectNone => self.act(octovox::replay::Command::Select(None), "select"),
+            Command::SelectNone => self.act(octovox::script::Command::Select(None), "select"),
             Command::FillAt { x, y } => {
                 if let Some(pick) = self.pick_or_say(x, y, "no voxel there to fill") {
-                    self.act(octovox::replay::Command::Fill(pick.voxel), "fill");
+                    self.act(octovox::script::Command::Fill(pick.voxel), "fill");
                 }
             }
             Command::PickColor { x, y } => {
                 if let Some(pick) = self.pick_or_say(x, y, "no voxel there to pick a colour from") {
-                    self.act(octovox::replay::Command::Pick(pick.voxel), "pick");
+                    self.act(octovox::script::Command::Pick(pick.voxel), "pick");
                     report!("picked colour {}", self.editor.tools.color);
                 }
             }
             Command::SetTool(tool) => self.state.tool = tool,
-            Command::SetCamera(camera) => self.state.camera = camera,
             Command::Orbit { dx, dy } => camera_control::orbit(&mut self.state.camera, dx, dy),
             Command::Pan { dx, dy } => {
                 let height = self.gfx.as_ref().map_or(1, |g| g.config.height);
@@ -526,7 +455,7 @@ impl App {
             Command::Quit => self.guard_unsaved(Pending::Quit, event_loop),
             Command::Save => match self.state.path.clone() {
                 Some(path) => {
-                    self.save(&path, WriteOptions::default());
+                    self.save_document(&path, WriteOptions::default());
                 }
                 None => self.ask_path(DialogKind::SaveAs, "saves/untitled.vox".into()),
             },
@@ -633,7 +562,7 @@ impl App {
             StrokePhase::End | StrokePhase::Click => {
                 let start = self.state.line_start.take().or(target);
                 if let (Some(a), Some(b)) = (start, target) {
-                    self.act(octovox::replay::Command::Line(a, b), "line");
+                    self.act(octovox::script::Command::Line(a, b), "line");
                 }
             }
         }
@@ -661,7 +590,7 @@ impl App {
                 let layers = self.extrude_layers(x, y);
                 let Some((pick, _)) = self.extrude_from.take() else { return };
                 let Some(layers) = layers.filter(|l| *l != 0) else { return };
-                self.act(octovox::replay::Command::Extrude(pick.voxel, pick.normal, layers), "extrude");
+                self.act(octovox::script::Command::Extrude(pick.voxel, pick.normal, layers), "extrude");
             }
             StrokePhase::Click => {}
         }
@@ -709,17 +638,29 @@ impl App {
         self.request_redraw();
     }
 
-    /// A palette change from the panel, recorded as `rgb`/`material` lines;
-    /// changes while a control is held form one undo step.
+    /// A palette change from the panel, as `rgb` and `material` lines (the
+    /// parts that changed); changes while a control is held form one undo
+    /// step, and so do the two lines of one change.
     fn palette_edit(&mut self, edit: Edit, dragging: bool) {
-        let Edit::Palette { index, color, material } = &edit else { return };
-        let (index, after) = (*index, (*color, (**material).clone()));
-        if dragging && !self.palette_stroke {
+        let Edit::Palette { index, color: [r, g, b, _], material } = edit else { return };
+        let palette = &self.editor.scene.palette;
+        let mut lines = Vec::new();
+        if palette.color(index)[..3] != [r, g, b] {
+            lines.push(octovox::script::Command::Rgb(index, [r, g, b]));
+        }
+        if *palette.material(index) != *material {
+            lines.push(octovox::script::Command::Material(index, material));
+        }
+        if !self.palette_stroke {
             self.editor.history.begin_stroke();
             self.palette_stroke = true;
         }
-        let before = (self.editor.scene.palette.color(index), self.editor.scene.palette.material(index).clone());
-        self.apply_edit(edit, |r| r.palette(index, &before, &after));
+        for line in &lines {
+            if let Err(err) = self.run_line(line) {
+                self.ui.error(format!("edit refused: {err}"));
+                break;
+            }
+        }
         if !dragging {
             self.close_strokes();
         }
@@ -747,7 +688,7 @@ impl App {
         match phase {
             StrokePhase::Begin => {
                 self.editor.history.begin_stroke();
-                self.stroke = Some(Stroke { tool, plane: None, last_center: None });
+                self.stroke = Some(Stroke { tool, plane: None, last_center: None, applying: false });
                 self.stroke_step(x, y);
             }
             StrokePhase::Move => self.stroke_step(x, y),
@@ -784,17 +725,39 @@ impl App {
         if stroke.tool != Tool::Paint && stroke.plane.is_some_and(off_layer) {
             return;
         }
-        let (center, edit) = self.state.edit_at(&self.editor.tools, stroke.tool, &pick);
+        let center = octovox::edit::brush::click_target(stroke.tool, pick.voxel, pick.normal);
         if stroke.last_center == Some(center) {
             return;
         }
-        let (tool, camera, tools) = (stroke.tool, self.state.camera, self.editor.tools);
-        let record = |r: &mut Recorder| r.edit(&camera, tools.brush, tools.color.max(1), (tool, &tools.mirror), center);
-        if self.apply_edit(edit, record)
-            && let Some(stroke) = &mut self.stroke
-        {
-            stroke.plane.get_or_insert(layer);
-            stroke.last_center = Some(center);
+        // The step is the script line a click there is: the same path as
+        // every line, recorded and journaled as one edit of the stroke.
+        let line = octovox::script::edit_command(stroke.tool, center);
+        self.with_stroke(|s| s.applying = true);
+        let ran = self.run_line(&line);
+        self.with_stroke(|s| s.applying = false);
+        match ran {
+            Ok(_) => self.with_stroke(|stroke| {
+                stroke.plane.get_or_insert(layer);
+                stroke.last_center = Some(center);
+            }),
+            Err(err) => self.ui.error(format!("edit refused: {err}")),
+        }
+    }
+
+    fn with_stroke(&mut self, f: impl FnOnce(&mut Stroke)) {
+        if let Some(stroke) = &mut self.stroke {
+            f(stroke);
+        }
+    }
+
+    /// Whether `line` is a step of the gesture under way (a mouse stroke,
+    /// a held palette control) rather than an action that ends it.
+    fn continues_gesture(&self, line: &octovox::script::Command) -> bool {
+        use octovox::script::Command as Line;
+        match line {
+            Line::Place(_) | Line::Remove(_) | Line::Paint(_) => self.stroke.as_ref().is_some_and(|s| s.applying),
+            Line::Rgb(..) | Line::Material(..) => self.palette_stroke,
+            _ => false,
         }
     }
 }

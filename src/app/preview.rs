@@ -6,7 +6,7 @@
 
 use glam::IVec3;
 
-use octovox::scene::selection::Region;
+use octovox::edit::selection::Region;
 
 use super::App;
 use super::state::Tool;
@@ -49,7 +49,7 @@ impl App {
         };
         if self.extrude_preview.as_ref().is_none_or(|p| p.face != face) {
             // A region too large to extrude previews nothing; the release says why.
-            let region = octovox::scene::extrude::face_region(&self.editor.scene.tree, face.0, face.1);
+            let region = octovox::edit::extrude::face_region(&self.editor.scene.tree, face.0, face.1);
             let voxels = region.map(|r| r.into_iter().map(|(p, _)| p).collect()).unwrap_or_default();
             self.extrude_preview = Some(ExtrudePreview { face, voxels, layers: 0 });
         }
@@ -74,7 +74,7 @@ impl App {
         if self.fill_preview.as_ref().is_some_and(|p| p.start == start) {
             return;
         }
-        let region = octovox::scene::fill::fill_region(&self.editor.scene.tree, start).ok().map(|voxels| {
+        let region = octovox::edit::fill::fill_region(&self.editor.scene.tree, start).ok().map(|voxels| {
             let lo = voxels.iter().copied().reduce(IVec3::min).unwrap_or(start);
             let hi = voxels.iter().copied().reduce(IVec3::max).unwrap_or(start);
             ((lo, hi), voxels.len())

@@ -8,8 +8,8 @@
 use glam::{DVec3, IVec3, Vec3};
 
 use octovox::camera::Camera;
-use octovox::replay::Command as Line;
-use octovox::scene::selection::Region;
+use octovox::edit::selection::Region;
+use octovox::script::Command as Line;
 
 use super::{App, Nudge, StrokePhase};
 

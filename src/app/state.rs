@@ -10,10 +10,10 @@ use glam::IVec3;
 
 use octovox::camera::Camera;
 use octovox::edit::Edit;
+pub use octovox::edit::brush::{Brush, Tool, click_edit};
+use octovox::edit::selection::Region;
 use octovox::editor::Tools;
-use octovox::scene::selection::Region;
 use octovox::settings::{PathSettings, RenderSettings, Shading};
-pub use octovox::tool::{Brush, Tool, click_edit};
 
 /// The voxel and face under the cursor, in world coordinates.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

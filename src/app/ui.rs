@@ -16,9 +16,9 @@ use octovox::settings::{EffectsChoice, Shading, Sky, TraceMode, View};
 use super::command::{Choice, Command, Pending};
 use super::state::{BrushKind, EditorState, Pick, Tool};
 use glam::{IVec3, Vec3};
+use octovox::edit::brush::Brush;
+use octovox::edit::selection::Region;
 use octovox::editor::Tools;
-use octovox::scene::selection::Region;
-use octovox::tool::Brush;
 
 /// Width of the left panel in points.
 pub const PANEL_WIDTH: f32 = 236.0;
@@ -43,8 +43,9 @@ pub struct Stats {
     pub scale: f32,
     /// Whether the camera moved since the frame before.
     pub moving: bool,
-    /// Bytes the last edit (or undo/redo) wrote to the GPU.
-    pub last_edit_bytes: u64,
+    /// Bytes the last edit (or undo/redo) of this scene wrote to the GPU;
+    /// `None` before its first.
+    pub last_edit_bytes: Option<u64>,
     /// Byte ranges of the last edit.
     pub last_edit_ranges: usize,
     /// The path tracer's last frame, when it drew it.
@@ -551,7 +552,10 @@ fn stats(ui: &mut egui::Ui, info: &Info) {
         row("voxels", format!("{}", tree.solid_voxels()));
         row("nodes", format!("{} + {} bricks", tree.node_count(), tree.brick_count()));
         row("pool", format!("{} bytes", pool.live_bytes()));
-        row("last edit", format!("{} bytes, {} ranges", s.last_edit_bytes, s.last_edit_ranges));
+        match s.last_edit_bytes {
+            Some(bytes) => row("last edit", format!("{bytes} bytes, {} ranges", s.last_edit_ranges)),
+            None => row("last edit", "none".to_string()),
+        }
         row("uploaded", format!("{} bytes total", pool.stats.total_bytes));
         let (steps, bytes, limit) = info.history;
         let human = |b: usize| octovox::budget::human(b as u64);

@@ -6,7 +6,8 @@ use std::process::ExitCode;
 use anyhow::Context;
 
 use octovox::gpu::Renderer;
-use octovox::replay::{Runner, RunnerMode, load_script};
+use octovox::replay::{Runner, RunnerMode};
+use octovox::script::load_script;
 
 pub fn run(scripts: &[PathBuf], cpu: bool, force: bool, update_images: bool) -> anyhow::Result<ExitCode> {
     let mut mode = if cpu {

@@ -7,12 +7,11 @@ use std::path::{Path, PathBuf};
 
 use glam::IVec3;
 
-use super::{Command, edit_command};
 use crate::camera::Camera;
+use crate::edit::brush::{Brush, Tool};
+use crate::edit::mirror::Mirror;
 use crate::editor::Tools;
-use crate::mirror::Mirror;
-use crate::scene::Material;
-use crate::tool::{Brush, Tool};
+use crate::script::{Command, edit_command};
 
 /// Writes script lines as the user works. Lines are flushed as they are
 /// written, so a crash loses nothing that was recorded.
@@ -132,28 +131,14 @@ impl Recorder {
         self.command(&edit_command(Tool::Attach, at))
     }
 
-    /// One edit made by a click: writes the state it depends on if it
-    /// changed, then the edit line.
-    pub fn edit(
-        &mut self,
-        camera: &Camera,
-        brush: Brush,
-        color: u8,
-        (tool, mirror): (Tool, &Mirror),
-        center: IVec3,
-    ) -> std::io::Result<()> {
-        self.edit_state(camera, brush, (tool != Tool::Erase).then_some(color), mirror)?;
-        self.undone.clear();
-        self.open_stroke += 1;
-        self.command(&edit_command(tool, center))
-    }
-
     /// A line the editor ran (`octovox::editor::Editor::run`) with `tools`
-    /// in force: edit lines as one undo step each, after the state they
-    /// depend on where it changed; `select` and `copy` as they are. Brush,
-    /// colour and mirror lines are written before the next edit that uses
-    /// them; expectations and file lines are not part of a recording.
-    pub fn ran(&mut self, command: &Command, tools: &Tools, camera: &Camera) -> std::io::Result<()> {
+    /// in force: edit lines after the state they depend on where it
+    /// changed, each one undo step or, `in_stroke`, one edit of the open
+    /// step (a mouse drag, a held palette control); `select` and `copy` as
+    /// they are. Brush, colour and mirror lines are written before the next
+    /// edit that uses them; expectations and file lines are not part of a
+    /// recording.
+    pub fn ran(&mut self, command: &Command, tools: &Tools, camera: &Camera, in_stroke: bool) -> std::io::Result<()> {
         let color = match command {
             Command::Place(_) | Command::Paint(_) | Command::Line(..) | Command::Fill(_) => Some(tools.color),
             Command::Remove(_)
@@ -169,37 +154,15 @@ impl Recorder {
             Command::Redo(n) => return (0..*n).try_for_each(|_| self.redo()),
             _ => return Ok(()),
         };
-        self.end_step();
+        if !in_stroke {
+            self.end_step();
+        }
         self.edit_state(camera, tools.brush, color, &tools.mirror)?;
-        self.one_step(command)
-    }
-
-    /// A line that is an undo step of its own.
-    fn one_step(&mut self, command: &Command) -> std::io::Result<()> {
         self.undone.clear();
         self.open_stroke += 1;
         self.command(command)?;
-        self.end_step();
-        Ok(())
-    }
-
-    /// A palette edit: an `rgb` line if the colour changed, a `material`
-    /// line if the material did (each one edit of the open step).
-    pub fn palette(
-        &mut self,
-        index: u8,
-        before: &([u8; 4], Material),
-        after: &([u8; 4], Material),
-    ) -> std::io::Result<()> {
-        self.undone.clear();
-        if before.0 != after.0 {
-            self.open_stroke += 1;
-            let [r, g, b, _] = after.0;
-            self.command(&Command::Rgb(index, [r, g, b]))?;
-        }
-        if before.1 != after.1 {
-            self.open_stroke += 1;
-            self.command(&Command::Material(index, Box::new(after.1.clone())))?;
+        if !in_stroke {
+            self.end_step();
         }
         Ok(())
     }

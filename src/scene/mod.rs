@@ -4,13 +4,10 @@ pub mod apply;
 pub mod build;
 pub mod counts;
 pub mod demo;
-pub mod extrude;
-pub mod fill;
 pub mod lod;
 pub mod octree;
 pub mod palette;
 pub mod sculpture;
-pub mod selection;
 pub mod shape;
 pub mod showroom;
 

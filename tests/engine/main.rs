@@ -1,16 +1,20 @@
 //! The engine's integration tests, one binary (each test binary links
 //! wgpu, naga and egui: one link instead of one per file): loading and
 //! saving, editing and replay scripts, the CPU tracers, meshes, hostile
-//! input and the bench's smoke run, each in the module named for it.
+//! input, exports, .ovx files, the fuzz corpus and the bench's smoke run,
+//! each in the module named for it.
 #![allow(clippy::unwrap_used)] // in tests a panic is the failure report
 
 #[path = "../common/mod.rs"]
 mod common;
 
 mod bench_cli;
+mod export;
+mod fuzz_corpus;
 mod hostile_input;
 mod mesh_import;
 mod octree_props;
+mod ovx;
 mod replay_cli;
 mod trace_cpu;
 mod trace_exact;

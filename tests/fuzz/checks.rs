@@ -1,6 +1,6 @@
 //! What each fuzz target checks for one input. The fuzz targets
 //! (`tests/fuzz/fuzz_targets/`) and the corpus replay that CI runs
-//! (`tests/fuzz_corpus.rs`) include this one file, so both check the same.
+//! (`tests/engine/fuzz_corpus.rs`) include this one file, so both check the same.
 //!
 //! A check panics when octovox misbehaves: a panic escaping the library, an
 //! accepted input whose result breaks an invariant, or a script line that
@@ -48,10 +48,10 @@ pub fn obj(data: &[u8]) {
 /// that parses to the same command (what `--record` relies on).
 pub fn script(data: &[u8]) {
     let Ok(text) = std::str::from_utf8(data) else { return };
-    let Ok(script) = octovox::replay::parse_script(Path::new("fuzz.ovr"), text) else { return };
+    let Ok(script) = octovox::script::parse_script(Path::new("fuzz.ovr"), text) else { return };
     for line in &script.lines {
         let printed = line.command.to_string();
-        let again = octovox::replay::parse_script(Path::new("fuzz.ovr"), &printed)
+        let again = octovox::script::parse_script(Path::new("fuzz.ovr"), &printed)
             .unwrap_or_else(|e| panic!("'{printed}' does not parse again: {e:?}"));
         assert_eq!(again.lines.len(), 1, "'{printed}'");
         assert_eq!(again.lines[0].command, line.command, "'{printed}'");
@@ -73,7 +73,7 @@ fn own_dir(what: &str) -> std::path::PathBuf {
 /// only edits: no line that writes a file (`save`, `render`) and one scene
 /// line at most (`load`, `new`, `demo`), with and without its document.
 pub fn journal(data: &[u8]) {
-    use octovox::replay::Command;
+    use octovox::script::Command;
     static DOCUMENT: std::sync::Once = std::sync::Once::new();
     let document = Path::new(JOURNAL_DOCUMENT);
     DOCUMENT.call_once(|| {

@@ -5,8 +5,8 @@ use std::collections::{HashSet, VecDeque};
 
 use glam::IVec3;
 
-use super::{EditError, Octree, Op, Shape};
 use crate::edit::Edit;
+use crate::scene::{EditError, Octree, Op, Shape};
 
 /// Most voxels one fill recolours; a larger region is refused before
 /// anything changes.

@@ -5,9 +5,9 @@
 
 use glam::IVec3;
 
-use super::shape::MAX_BRUSH_EXTENT;
-use super::{EditError, Octree, Op, Shape};
 use crate::edit::Edit;
+use crate::scene::shape::MAX_BRUSH_EXTENT;
+use crate::scene::{EditError, Octree, Op, Shape};
 
 /// Most voxels one copy holds (16 Mi).
 pub const MAX_CLIPBOARD_VOXELS: u64 = 1 << 24;
@@ -54,7 +54,7 @@ impl Region {
     /// # Errors
     /// [`EditError::OutsideWorld`], as an edit there would get.
     pub fn inside_world(self) -> Result<Region, EditError> {
-        let limit = super::octree::WORLD_LIMIT;
+        let limit = crate::scene::octree::WORLD_LIMIT;
         if self.min.min_element() <= -limit || self.max.max_element() >= limit {
             return Err(EditError::OutsideWorld { min: self.min, max: self.max });
         }

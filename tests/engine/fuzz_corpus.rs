@@ -1,10 +1,9 @@
 //! Replays the fuzz corpus (tests/fuzz/corpus/<target>/) through the same
 //! checks the fuzz targets run, so what fuzzing found stays fixed.
-#![allow(clippy::unwrap_used)] // in tests a panic is the failure report
 
 use std::path::PathBuf;
 
-#[path = "fuzz/checks.rs"]
+#[path = "../fuzz/checks.rs"]
 mod checks;
 
 /// Every file of one target's corpus; at least `min` of them.

@@ -1,8 +1,7 @@
 //! The native .ovx file through the real binary: `convert` both ways with
 //! .vox, `info`, `render`, and the errors of damaged files and budgets.
-#![allow(clippy::unwrap_used)] // in tests a panic is the failure report
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

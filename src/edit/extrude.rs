@@ -5,9 +5,9 @@
 use glam::IVec3;
 
 use super::fill::connected;
-use super::shape::MAX_BRUSH_EXTENT;
-use super::{EditError, Octree, Op, Shape};
 use crate::edit::Edit;
+use crate::scene::shape::MAX_BRUSH_EXTENT;
+use crate::scene::{EditError, Octree, Op, Shape};
 
 /// Most faces one extrude moves; a larger region is refused before anything
 /// changes.

@@ -1,8 +1,7 @@
 //! `octovox export`: greedy meshes that are small, closed and outward, read
 //! back from the files themselves (not through the code that wrote them).
-#![allow(clippy::unwrap_used)] // in tests a panic is the failure report
 
-mod common;
+use crate::common;
 
 use std::collections::HashMap;
 use std::path::Path;

@@ -7,9 +7,9 @@ use glam::{DVec3, IVec3};
 
 use super::{Command, Line, Script};
 use crate::camera::{FOV_RANGE_DEG, check_fov};
+use crate::edit::brush::{Brush, Tool};
 use crate::scene::demo::BuiltIn;
 use crate::scene::shape::MAX_BRUSH_EXTENT;
-use crate::tool::{Brush, Tool};
 use clap::ValueEnum as _;
 
 /// A script that cannot be read or parsed, or a line that failed to run.

@@ -1,0 +1,149 @@
+//! The window as a host of the one script interpreter
+//! (`octovox::replay::step`): played lines and what mouse and key actions
+//! become run through it, so a line means what it means in `octovox
+//! replay`. An edit goes to the GPU, the recording and the journal here.
+
+use std::path::Path;
+
+use glam::{DVec3, IVec3};
+
+use octovox::camera::Camera;
+use octovox::edit::selection::Region;
+use octovox::editor::{Editor, Outcome};
+use octovox::io::atomic::WriteOptions;
+use octovox::replay::{Host, HostError, Recorder, StepError, StepResult, step};
+use octovox::script::Command as Line;
+use octovox::settings::RenderSettings;
+use octovox::trace::svo;
+
+use super::App;
+
+impl App {
+    /// Runs one line that a mouse or key action became, as a script line.
+    pub(super) fn run_line(&mut self, line: &Line) -> Result<StepResult, StepError> {
+        step(self, Path::new("."), line)
+    }
+
+    /// Follows up an editor line: an edit goes to the GPU, the recording
+    /// and the journal; a new scene starts its journal as Open does.
+    fn followed_up(&mut self, line: &Line, outcome: &Outcome, selection: Option<Region>) {
+        if matches!(outcome, Outcome::Replaced) {
+            return self.scene_replaced(line.clone(), None);
+        }
+        if matches!(outcome, Outcome::Changed) {
+            self.state.dirty = true;
+            // A journal that the line starts begins with the selection before it.
+            self.open_journal(selection);
+        }
+        let (tools, camera) = (self.editor.tools, self.state.camera);
+        let gesture = self.continues_gesture(line);
+        let ran = |r: &mut Recorder| r.ran(line, &tools, &camera, gesture);
+        match (outcome, line) {
+            // Undo and redo: the journal gets them as lines only if it holds the steps.
+            (Outcome::Changed, Line::Undo(n) | Line::Redo(n)) => {
+                let undo = matches!(line, Line::Undo(_));
+                (0..*n).for_each(|_| self.record_undo(undo));
+                self.after_change(if undo { "undo" } else { "redo" }, |_| Ok(()));
+            }
+            // A block copied before the journal started: the journal starts again after the paste.
+            (Outcome::Changed, Line::Paste(_)) if !self.clipboard_journaled => {
+                self.record_to_recording(ran);
+                self.restart_journal_from_snapshot();
+                self.after_change("paste", |_| Ok(()));
+            }
+            // A step of a mouse stroke or a palette control prints `edit: …`.
+            (Outcome::Changed, _) if gesture => self.after_change("edit", ran),
+            (Outcome::Changed, _) => {
+                // The line's command word names it in the printed line (`fill: N bytes written`).
+                let text = line.to_string();
+                self.after_change(text.split(' ').next().unwrap_or("edit"), ran);
+            }
+            _ => {
+                self.record(ran);
+                report!("ran: {line}");
+                self.request_redraw();
+            }
+        }
+        if matches!(line, Line::Copy | Line::Cut) {
+            self.clipboard_journaled = self.journal.is_some();
+        }
+    }
+
+    /// `render PATH` in the window: the image `octovox replay` makes (the
+    /// script's viewport, the default settings), by the window's renderer.
+    fn render_for_script(&mut self, path: &Path) -> Result<image::RgbaImage, HostError> {
+        let gfx = self.gfx.as_mut().ok_or(HostError::NoGpuYet)?;
+        let viewport = self.player.as_ref().map_or(octovox::replay::DEFAULT_VIEWPORT, |p| p.viewport);
+        let settings = RenderSettings::default();
+        gfx.renderer.render(&self.editor.scene.tree, &self.state.camera, viewport, &settings, None)?;
+        let image = gfx.renderer.read_image()?;
+        octovox::io::png::save_png(&image, path, WriteOptions::default())?;
+        report!("screenshot: {}", path.display());
+        // The window's next frame traces its own view again.
+        self.path_stale = true;
+        self.request_redraw();
+        Ok(image)
+    }
+}
+
+impl Host for App {
+    fn editor(&mut self) -> &mut Editor {
+        &mut self.editor
+    }
+
+    /// A key action during a drag ends the drag's undo step first: the
+    /// history and the recording count steps alike.
+    fn before_line(&mut self, line: &Line) {
+        if !self.continues_gesture(line) {
+            self.close_strokes();
+        }
+    }
+
+    fn after_line(&mut self, line: &Line, outcome: &Outcome, selection: Option<Region>) -> Result<(), HostError> {
+        self.followed_up(line, outcome, selection);
+        Ok(())
+    }
+
+    /// Read in the background, as File ▸ Open does; the player waits for it.
+    fn load(&mut self, path: &Path) -> Result<(), HostError> {
+        self.start_loading(path.to_path_buf());
+        Ok(())
+    }
+
+    fn set_camera(&mut self, eye: DVec3, target: DVec3, fov_y_deg: Option<f32>) {
+        let fov_y_deg = fov_y_deg.unwrap_or(self.state.camera.fov_y_deg);
+        self.state.camera = Camera { eye, target, fov_y_deg };
+        self.request_redraw();
+    }
+
+    /// The size of the script's renders; clicks name pixels of the window.
+    fn set_viewport(&mut self, width: u32, height: u32) {
+        if let Some(player) = &mut self.player {
+            player.viewport = (width, height);
+        }
+    }
+
+    fn pick(&mut self, x: u32, y: u32) -> Result<Option<(IVec3, IVec3)>, svo::GaveUp> {
+        Ok(self.pick_at(f64::from(x) + 0.5, f64::from(y) + 0.5)?.map(|pick| (pick.voxel, pick.normal)))
+    }
+
+    fn save(&mut self, path: &Path) -> Result<(), HostError> {
+        if self.save_document(path, WriteOptions::default()) { Ok(()) } else { Err(HostError::NotSaved(path.into())) }
+    }
+
+    fn render(&mut self, path: &Path) -> Result<(), HostError> {
+        let image = self.render_for_script(path)?;
+        if let Some(player) = &mut self.player {
+            player.last_render = Some(image);
+        }
+        Ok(())
+    }
+
+    fn last_render(&self) -> Option<&image::RgbaImage> {
+        self.player.as_ref()?.last_render.as_ref()
+    }
+
+    fn last_written(&self) -> Option<u64> {
+        self.stats.last_edit_bytes
+    }
+}

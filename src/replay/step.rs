@@ -1,0 +1,194 @@
+//! The one interpreter of script lines. [`step`] gives every line to the
+//! [`Editor`] first; what the editor leaves (files, the camera, pixels) is
+//! the host's, through the [`Host`] trait, which `octovox replay` (the
+//! headless [`super::Runner`]) and the window both implement. So a line
+//! means one thing wherever it runs, and this is the only place the host
+//! lines are matched.
+
+use std::path::Path;
+
+use glam::{DVec3, IVec3};
+
+use crate::edit::selection::Region;
+use crate::editor::{Editor, EditorError, Outcome};
+use crate::io::png::{differing_fraction, load_png, save_png};
+use crate::script::{Command, edit_command};
+use crate::trace::svo;
+
+/// The size of renders (and of the pixels `click` names headless) before a
+/// `viewport` line.
+pub const DEFAULT_VIEWPORT: (u32, u32) = (640, 480);
+
+/// What a host does around the editor: files, the camera, the viewport,
+/// pixels, and the follow-up of edits (the pool flush to the GPU, the
+/// recording, the journal).
+pub trait Host {
+    fn editor(&mut self) -> &mut Editor;
+
+    /// Before an editor line runs.
+    fn before_line(&mut self, _line: &Command) {}
+
+    /// After an editor line that changed something (`State`, `Changed` or
+    /// `Replaced`): `selection` is the selection from before the line.
+    ///
+    /// # Errors
+    /// The follow-up failed; the script stops.
+    fn after_line(&mut self, line: &Command, outcome: &Outcome, selection: Option<Region>) -> Result<(), HostError>;
+
+    /// `load PATH`: the file's scene goes into the editor (the window reads
+    /// it in the background; the next line waits for it).
+    ///
+    /// # Errors
+    /// The file cannot be read.
+    fn load(&mut self, path: &Path) -> Result<(), HostError>;
+
+    /// `camera`: `None` keeps the field of view.
+    fn set_camera(&mut self, eye: DVec3, target: DVec3, fov_y_deg: Option<f32>);
+
+    /// `viewport W H`: the size of renders and of the pixels `click` names.
+    fn set_viewport(&mut self, width: u32, height: u32);
+
+    /// The world voxel and face normal under a pixel (what the mouse picks).
+    ///
+    /// # Errors
+    /// The traversal gave up.
+    fn pick(&mut self, x: u32, y: u32) -> Result<Option<(IVec3, IVec3)>, svo::GaveUp>;
+
+    /// `save PATH`.
+    ///
+    /// # Errors
+    /// The file cannot be written (or may not be).
+    fn save(&mut self, path: &Path) -> Result<(), HostError>;
+
+    /// `render PATH`: the view at the viewport's size with the default
+    /// render settings, as `octovox replay` makes it; kept for `expect image`.
+    ///
+    /// # Errors
+    /// The render failed or the file cannot be written.
+    fn render(&mut self, path: &Path) -> Result<(), HostError>;
+
+    /// The image of the last `render`.
+    fn last_render(&self) -> Option<&image::RgbaImage>;
+
+    /// Bytes the pool flush after the last edit line wrote; `None` before
+    /// any edit of this scene.
+    fn last_written(&self) -> Option<u64>;
+
+    /// Write missing or different reference images instead of failing.
+    fn update_images(&self) -> bool {
+        false
+    }
+}
+
+/// What one line did.
+#[derive(Debug, PartialEq)]
+pub enum StepResult {
+    Done,
+    Passed,
+    Failed { expected: String, got: String },
+}
+
+/// A line that could not run: the script stops there.
+#[derive(Debug, thiserror::Error)]
+pub enum StepError {
+    #[error(transparent)]
+    Editor(#[from] EditorError),
+    #[error(transparent)]
+    Host(#[from] HostError),
+    #[error("'{0}' needs {1} line before it")]
+    NeedsEarlier(&'static str, &'static str),
+    #[error("'{0}' is not a line octovox replay runs")]
+    NotAHostLine(String),
+}
+
+/// A host's failure: files and the GPU.
+#[derive(Debug, thiserror::Error)]
+pub enum HostError {
+    #[error(transparent)]
+    Load(#[from] crate::io::LoadError),
+    #[error(transparent)]
+    Save(#[from] crate::io::SaveError),
+    #[error(transparent)]
+    Output(#[from] crate::io::output::OutputError),
+    #[error(transparent)]
+    Png(#[from] crate::io::png::PngError),
+    #[error(transparent)]
+    Gpu(#[from] crate::gpu::GpuError),
+    #[error("{reference} ({hint})")]
+    Reference { reference: crate::io::png::PngError, hint: &'static str },
+    /// The window's device is not there yet.
+    #[error("no GPU device yet")]
+    NoGpuYet,
+    /// The window could not save (it says why on its message line).
+    #[error("could not save {0}")]
+    NotSaved(std::path::PathBuf),
+    #[error("cannot write the journal: {0}")]
+    Journal(std::io::Error),
+}
+
+/// Carries out one line for `host`; relative paths are taken from `base`
+/// (the script's folder).
+///
+/// # Errors
+/// A line that could not run; a refused edit changes nothing.
+pub fn step(host: &mut impl Host, base: &Path, line: &Command) -> Result<StepResult, StepError> {
+    host.before_line(line);
+    let selection = host.editor().selection;
+    let outcome = host.editor().run(line)?;
+    match outcome {
+        Outcome::Checked { ok, expected, got } => Ok(check(ok, expected, || got)),
+        Outcome::Host => host_line(host, base, line),
+        outcome => {
+            host.after_line(line, &outcome, selection)?;
+            Ok(StepResult::Done)
+        }
+    }
+}
+
+/// The lines that are the host's own: files, the camera and pixels.
+fn host_line(host: &mut impl Host, base: &Path, line: &Command) -> Result<StepResult, StepError> {
+    match line {
+        Command::Load(path) => host.load(&base.join(path))?,
+        Command::Camera { eye, target, fov } => host.set_camera(*eye, *target, *fov),
+        Command::Viewport(w, h) => host.set_viewport(*w, *h),
+        Command::Click { x, y, tool } => {
+            let expected = format!("pixel ({x}, {y}) to hit a voxel");
+            let (voxel, normal) = match host.pick(*x, *y) {
+                Ok(Some(hit)) => hit,
+                Ok(None) => return Ok(StepResult::Failed { expected, got: "no voxel under it".into() }),
+                Err(gave_up) => return Ok(StepResult::Failed { expected, got: gave_up.to_string() }),
+            };
+            // The place, remove or paint of the cell it picks, as the mouse does.
+            let center = crate::edit::brush::click_target(*tool, voxel, normal);
+            return step(host, base, &edit_command(*tool, center));
+        }
+        Command::Save(path) => host.save(&base.join(path))?,
+        Command::Render(path) => host.render(&base.join(path))?,
+        Command::ExpectWritten(limit) => {
+            let got = host.last_written().ok_or(StepError::NeedsEarlier("expect written", "an edit"))?;
+            return Ok(check(got <= *limit, format!("at most {limit} bytes written"), || format!("{got} bytes")));
+        }
+        Command::ExpectImage(path, tolerance) => return expect_image(host, &base.join(path), *tolerance),
+        // `Editor::run` answers every other line.
+        _ => return Err(StepError::NotAHostLine(line.to_string())),
+    }
+    Ok(StepResult::Done)
+}
+
+fn expect_image(host: &mut impl Host, path: &Path, tolerance: f64) -> Result<StepResult, StepError> {
+    let image = host.last_render().ok_or(StepError::NeedsEarlier("expect image", "a render"))?;
+    if host.update_images() {
+        save_png(image, path, crate::io::atomic::WriteOptions::default()).map_err(HostError::from)?;
+        return Ok(StepResult::Passed);
+    }
+    let reference = load_png(path)
+        .map_err(|reference| HostError::Reference { reference, hint: "OCTOVOX_UPDATE_IMAGES=1 writes it" })?;
+    let fraction = differing_fraction(image, &reference);
+    Ok(check(fraction <= tolerance, format!("at most {tolerance} of pixels differing from {}", path.display()), || {
+        format!("{fraction:.5}")
+    }))
+}
+
+fn check(ok: bool, expected: String, got: impl FnOnce() -> String) -> StepResult {
+    if ok { StepResult::Passed } else { StepResult::Failed { expected, got: got() } }
+}

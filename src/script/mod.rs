@@ -1,0 +1,110 @@
+//! The script language: its syntax tree ([`Command`], [`Line`],
+//! [`Script`]), the parser and the printer. Scripts are run headless by
+//! `octovox replay`, played and recorded by the window and written by the
+//! crash journal; `docs/replay.md` describes them. This room knows no
+//! editor, no GPU and no window: `crate::replay` runs what it parses.
+
+mod parse;
+mod print;
+
+use std::path::PathBuf;
+
+use glam::{DVec3, IVec3};
+
+use crate::edit::brush::{Brush, Tool};
+
+pub use parse::{MAX_SCRIPT_BYTES, ScriptError, load_script, parse_script, split_words};
+pub use print::quoted;
+
+/// One line of a script.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Command {
+    Load(PathBuf),
+    New,
+    /// The built-in demo scene (what the window opens without a file).
+    /// A built-in scene (`demo` alone: the terrain).
+    Demo(crate::scene::demo::BuiltIn),
+    Camera {
+        eye: DVec3,
+        target: DVec3,
+        fov: Option<f32>,
+    },
+    Viewport(u32, u32),
+    Brush(Brush),
+    Color(u8),
+    Place(IVec3),
+    Remove(IVec3),
+    Paint(IVec3),
+    Click {
+        x: u32,
+        y: u32,
+        tool: Tool,
+    },
+    Undo(u32),
+    Redo(u32),
+    Save(PathBuf),
+    Render(PathBuf),
+    ExpectVoxel(IVec3, u8),
+    ExpectCount(u64),
+    ExpectWritten(u64),
+    ExpectImage(PathBuf, f64),
+    /// The path tracer's effect set for the scene, as names (any order).
+    ExpectEffects(Vec<String>),
+    /// `line X1 Y1 Z1 X2 Y2 Z2`: the brush placed with the current colour at
+    /// every cell of the line, ends included (one undo step).
+    Line(IVec3, IVec3),
+    /// `mirror x|y|z C`: later brush edits are also applied mirrored across
+    /// the plane at C (a whole or half number); `mirror off` ends them all.
+    Mirror(Option<(usize, f64)>),
+    /// `fill X Y Z`: the 6-connected region of the voxel's colour takes the
+    /// current colour (one undo step).
+    Fill(IVec3),
+    /// `pick X Y Z`: the eyedropper; the voxel's colour becomes the current one.
+    Pick(IVec3),
+    /// `extrude X Y Z NX NY NZ N`: the connected coplanar faces facing
+    /// (NX, NY, NZ) around voxel (X, Y, Z)'s move out N layers (in, N < 0).
+    Extrude(IVec3, IVec3, i32),
+    /// `rgb INDEX R G B`: a palette entry's colour (an undoable edit).
+    Rgb(u8, [u8; 3]),
+    /// `material INDEX KIND [KEY VALUE]...`: a palette entry's material,
+    /// with exactly these parameters (an undoable edit).
+    Material(u8, Box<crate::scene::Material>),
+    /// `select X1 Y1 Z1 X2 Y2 Z2`: the inclusive box later `copy`, `cut`,
+    /// `delete` and `move` act on; `select off` clears it.
+    Select(Option<(IVec3, IVec3)>),
+    /// `copy`: the selected voxels go to the clipboard.
+    Copy,
+    /// `cut`: copy, then delete (one undo step).
+    Cut,
+    /// `delete`: empties the selected box (one undo step).
+    Delete,
+    /// `paste X Y Z`: the clipboard's voxels with its box's min corner at
+    /// (X, Y, Z), which becomes the selection (one undo step).
+    Paste(IVec3),
+    /// `move DX DY DZ`: the selected voxels move by (DX, DY, DZ), and the
+    /// selection with them (one undo step).
+    Move(IVec3),
+}
+
+/// A parsed command with its 1-based line number.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Line {
+    pub number: usize,
+    pub command: Command,
+}
+
+/// A parsed script: its file (for messages and relative paths) and lines.
+#[derive(Clone, Debug)]
+pub struct Script {
+    pub path: PathBuf,
+    pub lines: Vec<Line>,
+}
+
+/// The edit a `place`/`remove`/`paint` line (or a recorded click) becomes.
+pub fn edit_command(tool: Tool, at: IVec3) -> Command {
+    match tool {
+        Tool::Attach => Command::Place(at),
+        Tool::Erase => Command::Remove(at),
+        Tool::Paint => Command::Paint(at),
+    }
+}

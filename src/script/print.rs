@@ -1,0 +1,95 @@
+//! Writing commands back as script lines (what `--record` and the crash
+//! journal produce); the parser reads every line this writes.
+
+use std::fmt;
+
+use glam::IVec3;
+
+use super::Command;
+use crate::edit::brush::Brush;
+
+/// Writes a command back as a script line (what `--record` produces).
+impl fmt::Display for Command {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let v = |p: IVec3| format!("{} {} {}", p.x, p.y, p.z);
+        match self {
+            Command::Load(path) => write!(f, "load {}", quoted(path)),
+            Command::New => write!(f, "new"),
+            Command::Demo(crate::scene::demo::BuiltIn::Terrain) => write!(f, "demo"),
+            Command::Demo(built_in) => write!(f, "demo {}", built_in.name()),
+            Command::Camera { eye, target, fov } => {
+                write!(f, "camera {} {} {} {} {} {}", eye.x, eye.y, eye.z, target.x, target.y, target.z)?;
+                match fov {
+                    Some(fov) => write!(f, " {fov}"),
+                    None => Ok(()),
+                }
+            }
+            Command::Viewport(w, h) => write!(f, "viewport {w} {h}"),
+            Command::Brush(Brush::Voxel) => write!(f, "brush voxel"),
+            Command::Brush(Brush::Sphere(r)) => write!(f, "brush sphere {r}"),
+            Command::Brush(Brush::Box(s)) => write!(f, "brush box {}", v(*s)),
+            Command::Color(c) => write!(f, "color {c}"),
+            Command::Place(p) => write!(f, "place {}", v(*p)),
+            Command::Remove(p) => write!(f, "remove {}", v(*p)),
+            Command::Paint(p) => write!(f, "paint {}", v(*p)),
+            Command::Click { x, y, tool } => write!(f, "click {x} {y} {}", tool.name()),
+            Command::Undo(n) => write!(f, "undo {n}"),
+            Command::Redo(n) => write!(f, "redo {n}"),
+            Command::Save(path) => write!(f, "save {}", quoted(path)),
+            Command::Render(path) => write!(f, "render {}", quoted(path)),
+            Command::ExpectVoxel(p, n) => write!(f, "expect voxel {} {n}", v(*p)),
+            Command::ExpectCount(n) => write!(f, "expect count {n}"),
+            Command::ExpectWritten(n) => write!(f, "expect written <= {n}"),
+            Command::ExpectImage(path, tol) => write!(f, "expect image {} {tol}", quoted(path)),
+            Command::Fill(p) => write!(f, "fill {}", v(*p)),
+            Command::Extrude(p, n, layers) => write!(f, "extrude {} {} {layers}", v(*p), v(*n)),
+            Command::Line(a, b) => write!(f, "line {} {}", v(*a), v(*b)),
+            Command::Mirror(None) => write!(f, "mirror off"),
+            Command::Mirror(Some((axis, c))) => write!(f, "mirror {} {c}", ["x", "y", "z"][*axis]),
+            Command::Pick(p) => write!(f, "pick {}", v(*p)),
+            Command::Rgb(index, [r, g, b]) => write!(f, "rgb {index} {r} {g} {b}"),
+            Command::Material(index, material) => {
+                write!(f, "material {index} {}", &material.kind.vox_name()[1..])?;
+                material.params.iter().try_for_each(|(key, value)| write!(f, " {key} {value}"))
+            }
+            Command::Select(None) => write!(f, "select off"),
+            Command::Select(Some((a, b))) => write!(f, "select {} {}", v(*a), v(*b)),
+            Command::Copy => write!(f, "copy"),
+            Command::Cut => write!(f, "cut"),
+            Command::Delete => write!(f, "delete"),
+            Command::Paste(p) => write!(f, "paste {}", v(*p)),
+            Command::Move(d) => write!(f, "move {}", v(*d)),
+            Command::ExpectEffects(names) if names.is_empty() => write!(f, "expect effects none"),
+            Command::ExpectEffects(names) => write!(f, "expect effects {}", names.join(" ")),
+        }
+    }
+}
+
+/// A path as a script word: as it is, or in quotes when it holds spaces,
+/// `#`, quotes, backslashes or control characters: `\"` and `\\` for
+/// quotes and backslashes, `\n`, `\r`, `\t` and `\u{HEX}` for control
+/// characters (a name with a newline would otherwise end the line).
+pub fn quoted(path: &std::path::Path) -> String {
+    let text = path.to_string_lossy();
+    let special = |c: char| c.is_whitespace() || c.is_control() || matches!(c, '#' | '"' | '\\');
+    if !text.is_empty() && !text.chars().any(special) {
+        return text.into_owned();
+    }
+    let mut out = String::with_capacity(text.len() + 2);
+    out.push('"');
+    for c in text.chars() {
+        match c {
+            '"' | '\\' => {
+                out.push('\\');
+                out.push(c);
+            }
+            '\n' => out.push_str("\\n"),
+            '\r' => out.push_str("\\r"),
+            '\t' => out.push_str("\\t"),
+            c if c.is_control() => out.push_str(&format!("\\u{{{:x}}}", u32::from(c))),
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
