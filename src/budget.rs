@@ -52,12 +52,23 @@ pub fn human(bytes: u64) -> String {
         .map_or_else(|| format!("{bytes} B"), |(unit, size)| format!("{:.1} {unit}", bytes as f64 / *size as f64))
 }
 
+/// Why a size such as `--memory-budget`'s is refused.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum SizeError {
+    #[error("'{0}' is not a size such as 4G, 512M or 1000000")]
+    NotASize(String),
+    #[error("'{text}': unknown unit '{unit}' (use K, M, G or T, as in 4G, 4GB or 4GiB)")]
+    Unit { text: String, unit: String },
+    #[error("'{0}' is not a usable size")]
+    Unusable(String),
+}
+
 /// Parses "4G", "512M", "64k", "1000" (bytes; binary units, case-insensitive).
-pub fn parse_bytes(text: &str) -> Result<u64, String> {
+pub fn parse_bytes(text: &str) -> Result<u64, SizeError> {
     let text = text.trim();
     let split = text.find(|c: char| !c.is_ascii_digit()).unwrap_or(text.len());
     let (digits, unit) = text.split_at(split);
-    let number: u64 = digits.parse().map_err(|_| format!("'{text}' is not a size such as 4G, 512M or 1000000"))?;
+    let number: u64 = digits.parse().map_err(|_| SizeError::NotASize(text.to_owned()))?;
     // One unit, spelled K, KB or KiB (any case): `4GiBiBiB` is not one.
     let lower = unit.to_ascii_lowercase();
     let prefix = lower.strip_suffix("ib").or_else(|| lower.strip_suffix('b')).unwrap_or(&lower);
@@ -67,9 +78,9 @@ pub fn parse_bytes(text: &str) -> Result<u64, String> {
         "m" => 20,
         "g" => 30,
         "t" => 40,
-        _ => return Err(format!("'{text}': unknown unit '{unit}' (use K, M, G or T, as in 4G, 4GB or 4GiB)")),
+        _ => return Err(SizeError::Unit { text: text.to_owned(), unit: unit.to_owned() }),
     };
-    number.checked_mul(1 << shift).filter(|b| *b > 0).ok_or_else(|| format!("'{text}' is not a usable size"))
+    number.checked_mul(1 << shift).filter(|b| *b > 0).ok_or_else(|| SizeError::Unusable(text.to_owned()))
 }
 
 #[cfg(test)]

@@ -18,30 +18,37 @@ pub fn clamp_fov(fov: f32) -> f32 {
 /// the precision of f32 on the GPU (1e39 is infinite there and drew sky).
 pub const CAMERA_LIMIT: f64 = (1 << 28) as f64;
 
+/// Why a camera given by the user is refused.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum CameraError {
+    #[error("camera {what} {at} is outside ±2^28 (±{CAMERA_LIMIT}) on some axis")]
+    OutOfRange { what: &'static str, at: DVec3 },
+    #[error("camera eye and target are the same point")]
+    SamePoint,
+    #[error("field of view {0} must be {lo}..={hi} degrees", lo = FOV_RANGE_DEG.start(), hi = FOV_RANGE_DEG.end())]
+    Fov(f32),
+}
+
 /// Checks a camera given by the user: eye and target finite, within
 /// [`CAMERA_LIMIT`], and apart.
 ///
 /// # Errors
 /// Which of these fails, in words.
-pub fn check_camera(eye: DVec3, target: DVec3) -> Result<(), String> {
+pub fn check_camera(eye: DVec3, target: DVec3) -> Result<(), CameraError> {
     for (what, v) in [("eye", eye), ("target", target)] {
         if !v.is_finite() || v.abs().max_element() > CAMERA_LIMIT {
-            return Err(format!("camera {what} {v} is outside ±2^28 (±{CAMERA_LIMIT}) on some axis"));
+            return Err(CameraError::OutOfRange { what, at: v });
         }
     }
     if eye == target {
-        return Err("camera eye and target are the same point".into());
+        return Err(CameraError::SamePoint);
     }
     Ok(())
 }
 
 /// Checks a field of view given by the user.
-pub fn check_fov(fov: f32) -> Result<f32, String> {
-    if FOV_RANGE_DEG.contains(&fov) {
-        Ok(fov)
-    } else {
-        Err(format!("field of view {fov} must be {}..={} degrees", FOV_RANGE_DEG.start(), FOV_RANGE_DEG.end()))
-    }
+pub fn check_fov(fov: f32) -> Result<f32, CameraError> {
+    if FOV_RANGE_DEG.contains(&fov) { Ok(fov) } else { Err(CameraError::Fov(fov)) }
 }
 
 /// Eye, target and vertical field of view, in world coordinates (y up).

@@ -307,7 +307,7 @@ pub fn parse_scale(s: &str) -> Result<f32, String> {
 /// Parses a field of view in degrees, within [`octovox::camera::FOV_RANGE_DEG`].
 pub fn parse_fov(s: &str) -> Result<f32, String> {
     let fov: f32 = s.trim().parse().map_err(|_| format!("field of view '{s}' is not a number"))?;
-    octovox::camera::check_fov(fov)
+    octovox::camera::check_fov(fov).map_err(|e| e.to_string())
 }
 
 /// Parses a render scale in `MIN_RENDER_SCALE..=1`.

@@ -88,8 +88,8 @@ pub fn render_setting(
             let settings = RenderSettings { mode, view: View::Shaded, shadows: true, render_scale: 1.0, lod };
             let traced = scaled_size(size, render_scale);
             if mode == TraceMode::Grid {
-                let grid =
-                    crate::trace::grid::DenseGrid::from_octree(&scene.tree).map_err(crate::gpu::GpuError::TooLarge)?;
+                let grid = crate::trace::grid::DenseGrid::from_octree(&scene.tree)
+                    .map_err(|e| crate::gpu::GpuError::TooLarge(e.to_string()))?;
                 renderer.set_grid(&grid)?;
             }
             // The first frame compiles nothing but warms caches; time the second.

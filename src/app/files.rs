@@ -285,9 +285,7 @@ impl App {
             // The stamp before the read: a change on disk after it is one the
             // journal's recovery then notices.
             let stamp = FileStamp::of(&thread_path).ok();
-            let result = octovox::io::load_scene_with(&thread_path, 0, &reporter)
-                .map(|scene| (scene, stamp))
-                .map_err(|e| e.to_string());
+            let result = octovox::io::load_scene_with(&thread_path, 0, &reporter).map(|scene| (scene, stamp));
             // The window may have closed meanwhile; then nobody wants the scene.
             let _ = tx.send(result);
         });
@@ -301,9 +299,9 @@ impl App {
     pub(super) fn poll_loading(&mut self) {
         let Some(loading) = &self.loading else { return };
         let result = match loading.result.try_recv() {
-            Ok(result) => result,
+            Ok(result) => result.map_err(|err| err.to_string()),
             Err(TryRecvError::Empty) => return,
-            Err(TryRecvError::Disconnected) => Err("the loader thread stopped".to_string()),
+            Err(TryRecvError::Disconnected) => Err("the loader thread stopped".to_owned()),
         };
         let Some(loading) = self.loading.take() else { return };
         match result {

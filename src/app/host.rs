@@ -1,7 +1,8 @@
 //! The window as a host of the one script interpreter
 //! (`octovox::replay::step`): played lines and what mouse and key actions
 //! become run through it, so a line means what it means in `octovox
-//! replay`. An edit goes to the GPU, the recording and the journal here.
+//! replay`. Once it has run, an edit goes to the GPU, the recording and
+//! the journal here.
 
 use std::path::Path;
 
@@ -11,7 +12,7 @@ use octovox::camera::Camera;
 use octovox::edit::selection::Region;
 use octovox::editor::{Editor, Outcome};
 use octovox::io::atomic::WriteOptions;
-use octovox::replay::{Host, HostError, Recorder, StepError, StepResult, step};
+use octovox::replay::{Host, HostError, Ran, Recorder, StepError, StepResult, step};
 use octovox::script::Command as Line;
 use octovox::settings::RenderSettings;
 use octovox::trace::svo;
@@ -21,7 +22,21 @@ use super::App;
 impl App {
     /// Runs one line that a mouse or key action became, as a script line.
     pub(super) fn run_line(&mut self, line: &Line) -> Result<StepResult, StepError> {
-        step(self, Path::new("."), line)
+        self.run_script_line(Path::new("."), line)
+    }
+
+    /// Runs one line (paths relative to `base`) and follows it up. A key
+    /// action during a drag ends the drag's undo step first: the history
+    /// and the recording count steps alike.
+    pub(super) fn run_script_line(&mut self, base: &Path, line: &Line) -> Result<StepResult, StepError> {
+        if !self.continues_gesture(line) {
+            self.close_strokes();
+        }
+        let result = step(self, base, line)?;
+        if let StepResult::Ran(Ran { line, outcome, selection }) = &result {
+            self.followed_up(line, outcome, *selection);
+        }
+        Ok(result)
     }
 
     /// Follows up an editor line: an edit goes to the GPU, the recording
@@ -89,19 +104,6 @@ impl App {
 impl Host for App {
     fn editor(&mut self) -> &mut Editor {
         &mut self.editor
-    }
-
-    /// A key action during a drag ends the drag's undo step first: the
-    /// history and the recording count steps alike.
-    fn before_line(&mut self, line: &Line) {
-        if !self.continues_gesture(line) {
-            self.close_strokes();
-        }
-    }
-
-    fn after_line(&mut self, line: &Line, outcome: &Outcome, selection: Option<Region>) -> Result<(), HostError> {
-        self.followed_up(line, outcome, selection);
-        Ok(())
     }
 
     /// Read in the background, as File ▸ Open does; the player waits for it.

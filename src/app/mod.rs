@@ -107,7 +107,7 @@ struct Loading {
     path: PathBuf,
     started: Instant,
     progress: octovox::io::progress::Progress,
-    result: Receiver<Result<(Scene, Option<octovox::journal::FileStamp>), String>>,
+    result: Receiver<Result<(Scene, Option<octovox::journal::FileStamp>), octovox::io::LoadError>>,
 }
 
 /// An open mouse stroke: its tool, the face (normal and layer) it started

@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use octovox::replay::{DEFAULT_VIEWPORT, StepResult, step};
+use octovox::replay::{DEFAULT_VIEWPORT, StepResult};
 use octovox::script::Script;
 
 use super::App;
@@ -49,14 +49,18 @@ impl App {
         player.next += 1;
         let base = player.base.clone();
         let where_ = format!("{}:{}", player.script.path.display(), line.number);
-        let failure = match step(self, &base, &line.command) {
-            Ok(StepResult::Done) => None,
+        let failure = match self.run_script_line(&base, &line.command) {
+            Ok(StepResult::Done | StepResult::Ran(_)) => None,
             Ok(StepResult::Passed) => {
                 self.with_player(|p| p.passed += 1);
                 None
             }
             Ok(StepResult::Failed { expected, got }) => Some(format!("expected {expected}, got {got}")),
-            Err(err) => Some(err.to_string()),
+            Err(err) => {
+                // A line that cannot run stops the script, as in `octovox replay`.
+                self.with_player(|p| p.next = p.script.lines.len());
+                Some(err.to_string())
+            }
         };
         if let Some(message) = failure {
             self.with_player(|p| p.failed += 1);

@@ -146,7 +146,7 @@ fn bench_build(quick: bool) -> anyhow::Result<(String, String)> {
             tree = build(&source)?;
             times.push(start.elapsed().as_secs_f64() * 1e3);
         }
-        let grid = DenseGrid::from_octree(&tree).map_err(anyhow::Error::msg)?;
+        let grid = DenseGrid::from_octree(&tree)?;
         let solid = tree.solid_voxels();
         rows.push(BuildRow {
             model: model.name,
@@ -276,7 +276,7 @@ fn bench_render(quick: bool, lod: f32) -> anyhow::Result<(String, String)> {
     let mut rows = Vec::new();
     for model in &MODELS {
         let mut scene = Scene { palette: Palette::default(), tree: build(&source(model)?)? };
-        let grid = DenseGrid::from_octree(&scene.tree).map_err(anyhow::Error::msg)?;
+        let grid = DenseGrid::from_octree(&scene.tree)?;
         renderer.sync(&mut scene.tree, &scene.palette);
         renderer.set_grid(&grid)?;
         let (lo, hi) = scene.tree.solid_bounds().context("empty model")?;

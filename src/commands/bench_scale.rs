@@ -37,6 +37,14 @@ pub fn peak_resident_bytes() -> Option<u64> {
     Some(kib * 1024)
 }
 
+/// The .vox save of a row: seconds, or why .vox cannot hold it (written
+/// to the JSON as `{"Ok": s}` or `{"Err": why}`).
+#[derive(Serialize)]
+enum VoxSave {
+    Ok(f64),
+    Err(String),
+}
+
 #[derive(Serialize)]
 struct ScaleRow {
     height: u32,
@@ -48,7 +56,7 @@ struct ScaleRow {
     ovx_mb: f64,
     ovx_load_s: f64,
     /// Seconds, or why .vox cannot hold it.
-    vox_save: Result<f64, String>,
+    vox_save: VoxSave,
     frame_ms: f64,
     edit_ms: f64,
 }
@@ -76,8 +84,7 @@ fn measure(renderer: &mut Renderer, mesh: &Path, dir: &Path, height: u32) -> any
     let pool = scene.tree.pool().live_bytes();
     let start = Instant::now();
     let vox_save = octovox::io::save_scene(&dir.join("saved.vox"), &scene, WriteOptions::default())
-        .map(|()| start.elapsed().as_secs_f64())
-        .map_err(|e| e.to_string());
+        .map_or_else(|e| VoxSave::Err(e.to_string()), |()| VoxSave::Ok(start.elapsed().as_secs_f64()));
     let _ = std::fs::remove_file(dir.join("saved.vox"));
     renderer.sync(&mut scene.tree, &scene.palette);
     let (lo, hi) = scene.tree.solid_bounds().context("empty import")?;
@@ -132,8 +139,8 @@ fn markdown(rows: &[ScaleRow], adapter: &str) -> String {
     md += "| height | solid voxels | import s | import peak MB | pool MB | pool B / voxel | .ovx MB | .ovx load s | .vox save s | frame ms | r = 64 edit + upload ms |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
     for r in rows {
         let save = match &r.vox_save {
-            Ok(s) => format!("{s:.2}"),
-            Err(_) => "refused (> 2^26 voxels)".into(),
+            VoxSave::Ok(s) => format!("{s:.2}"),
+            VoxSave::Err(_) => "refused (> 2^26 voxels)".into(),
         };
         md += &format!(
             "| {} | {} | {:.2} | {} | {:.1} | {:.3} | {:.1} | {:.2} | {save} | {:.1} | {:.1} |\n",

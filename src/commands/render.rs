@@ -97,7 +97,7 @@ fn preview(
         lod: args.lod,
     };
     let grid = match args.mode {
-        TraceMode::Grid => Some(DenseGrid::from_octree(&scene.tree).map_err(anyhow::Error::msg)?),
+        TraceMode::Grid => Some(DenseGrid::from_octree(&scene.tree)?),
         TraceMode::Svo => None,
     };
     let stats = |ms, adapter| Stats { effects: Vec::new(), spp: 0, ms_per_sample: ms, adapter, lights: 0 };

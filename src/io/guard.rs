@@ -17,7 +17,7 @@ thread_local! {
 /// inside this function and passes every other panic to the hook it
 /// replaced, so the caught panic does not print while other threads' panics
 /// still do.
-pub(crate) fn catch_quietly<T>(f: impl FnOnce() -> T) -> Result<T, String> {
+pub(crate) fn catch_quietly<T>(f: impl FnOnce() -> T) -> Result<T, Panicked> {
     static INSTALL_HOOK: Once = Once::new();
     INSTALL_HOOK.call_once(|| {
         let previous = panic::take_hook();
@@ -32,13 +32,20 @@ pub(crate) fn catch_quietly<T>(f: impl FnOnce() -> T) -> Result<T, String> {
     let result = panic::catch_unwind(AssertUnwindSafe(f));
     QUIET_PANICS.set(was_quiet);
     result.map_err(|payload| {
-        payload
-            .downcast_ref::<&str>()
-            .map(|s| (*s).to_owned())
-            .or_else(|| payload.downcast_ref::<String>().cloned())
-            .unwrap_or_else(|| "unknown panic".to_owned())
+        Panicked(
+            payload
+                .downcast_ref::<&str>()
+                .map(|s| (*s).to_owned())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".to_owned()),
+        )
     })
 }
+
+/// A parser's panic, caught: its message.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct Panicked(pub String);
 
 #[cfg(test)]
 mod tests {
@@ -47,8 +54,8 @@ mod tests {
     #[test]
     fn panics_become_errors() {
         assert_eq!(catch_quietly(|| 7), Ok(7));
-        let boom: Result<(), String> = catch_quietly(|| panic!("boom {}", 1));
-        assert_eq!(boom, Err("boom 1".to_owned()));
+        let boom: Result<(), Panicked> = catch_quietly(|| panic!("boom {}", 1));
+        assert_eq!(boom, Err(Panicked("boom 1".to_owned())));
         // The thread is loud again afterwards.
         assert!(!QUIET_PANICS.get());
     }

@@ -95,7 +95,7 @@ pub fn parse_obj(bytes: &[u8], path: &Path, up: UpAxis) -> Result<Vec<[Vec3; 3]>
         tobj::load_obj_buf(&mut BufReader::new(bytes), &options, |_| Err(tobj::LoadError::OpenFileFailed))
     });
     let reason = |r: String| MeshError::Parse { path: path.to_path_buf(), reason: r };
-    let (models, _materials) = parsed.map_err(reason)?.map_err(|e| match bad_line(bytes) {
+    let (models, _materials) = parsed.map_err(|panicked| reason(panicked.0))?.map_err(|e| match bad_line(bytes) {
         Some((line, text)) => MeshError::BadVertex { path: path.to_path_buf(), line, reason: text },
         None => reason(e.to_string()),
     })?;

@@ -304,7 +304,7 @@ impl Payload<'_> {
     fn items<T: bytemuck::Pod>(
         &mut self,
         n: u64,
-        mut check: impl FnMut(usize, &T) -> Result<(), String>,
+        mut check: impl FnMut(usize, &T) -> Result<(), OvxError>,
     ) -> Result<Vec<T>, OvxError> {
         let n = usize::try_from(n).map_err(|_| corrupt(format!("{n} items do not fit in memory")))?;
         let per_chunk = (CHUNK_BYTES / size_of::<T>().max(1)).max(1);
@@ -315,7 +315,7 @@ impl Payload<'_> {
             items.resize(start + take, T::zeroed());
             self.fill(bytemuck::cast_slice_mut(&mut items[start..]))?;
             for (k, item) in items[start..].iter().enumerate() {
-                check(start + k, item).map_err(corrupt)?;
+                check(start + k, item)?;
             }
         }
         Ok(items)
@@ -381,13 +381,13 @@ fn read_payload(input: &mut Payload) -> Result<Scene, OvxError> {
     let nodes: Vec<NodeSlot> = input.items(node_count, |index, slot: &NodeSlot| check_node(index, slot, slots))?;
     let bricks: Vec<Brick> = input.items(brick_count, |index, brick: &Brick| {
         if brick.iter().all(|v| *v == brick[0]) {
-            Err(format!("brick {index} is uncollapsed: {brick:?}"))
+            Err(corrupt(format!("brick {index} is uncollapsed: {brick:?}")))
         } else {
             Ok(())
         }
     })?;
     palette.materials = decode_materials(&input.items::<u8>(materials_len, |_, _| Ok(()))?)?;
-    let tree = Octree::from_parts(origin, depth, root, nodes, bricks).map_err(corrupt)?;
+    let tree = Octree::from_parts(origin, depth, root, nodes, bricks).map_err(|e| corrupt(e.to_string()))?;
     Ok(Scene { palette, tree })
 }
 
@@ -396,21 +396,21 @@ fn read_payload(input: &mut Payload) -> Result<Scene, OvxError> {
 /// word that is no palette index, a pointer past every array, the same
 /// slot twice, or eight equal uniform children. [`Octree::from_parts`]
 /// checks the rest once the pool is read.
-fn check_node(index: usize, slot: &NodeSlot, slots: u64) -> Result<(), String> {
+fn check_node(index: usize, slot: &NodeSlot, slots: u64) -> Result<(), OvxError> {
     let children = &slot.children;
     for (k, &child) in children.iter().enumerate() {
         if !is_pointer(child) && child > 255 {
-            return Err(format!("node {index}: bad cell word {child:#x}"));
+            return Err(corrupt(format!("node {index}: bad cell word {child:#x}")));
         }
         if is_pointer(child) && u64::from(slot_of(child)) >= slots {
-            return Err(format!("node {index}: child {k} points past the {slots} slots stored"));
+            return Err(corrupt(format!("node {index}: child {k} points past the {slots} slots stored")));
         }
         if is_pointer(child) && children[..k].contains(&child) {
-            return Err(format!("node {index}: slot {} is used twice", slot_of(child)));
+            return Err(corrupt(format!("node {index}: slot {} is used twice", slot_of(child))));
         }
     }
     if !is_pointer(children[0]) && children.iter().all(|c| *c == children[0]) {
-        return Err(format!("node {index} is uncollapsed: eight children of value {}", children[0]));
+        return Err(corrupt(format!("node {index} is uncollapsed: eight children of value {}", children[0])));
     }
     Ok(())
 }
@@ -680,12 +680,32 @@ mod tests {
     fn a_pool_that_is_not_a_tree_is_refused() {
         let slot = |children: [u32; 8]| NodeSlot { children, lod: 0 };
         let shared = vec![slot([pointer_to(1), pointer_to(1), 0, 0, 0, 0, 0, 0]), slot([1, 2, 0, 0, 0, 0, 0, 0])];
-        assert!(Octree::from_parts(IVec3::ZERO, 3, pointer_to(0), shared, Vec::new()).unwrap_err().contains("twice"));
+        assert!(
+            Octree::from_parts(IVec3::ZERO, 3, pointer_to(0), shared, Vec::new())
+                .unwrap_err()
+                .to_string()
+                .contains("twice")
+        );
         let cycle = vec![slot([pointer_to(0), 1, 0, 0, 0, 0, 0, 0])];
-        assert!(Octree::from_parts(IVec3::ZERO, 4, pointer_to(0), cycle, Vec::new()).unwrap_err().contains("twice"));
+        assert!(
+            Octree::from_parts(IVec3::ZERO, 4, pointer_to(0), cycle, Vec::new())
+                .unwrap_err()
+                .to_string()
+                .contains("twice")
+        );
         let past = vec![slot([pointer_to(7), 1, 0, 0, 0, 0, 0, 0])];
-        assert!(Octree::from_parts(IVec3::ZERO, 3, pointer_to(0), past, Vec::new()).unwrap_err().contains("past"));
+        assert!(
+            Octree::from_parts(IVec3::ZERO, 3, pointer_to(0), past, Vec::new())
+                .unwrap_err()
+                .to_string()
+                .contains("past")
+        );
         let stale = vec![slot([1, 2, 0, 0, 0, 0, 0, 0])];
-        assert!(Octree::from_parts(IVec3::ZERO, 3, pointer_to(0), stale, Vec::new()).unwrap_err().contains("summary"));
+        assert!(
+            Octree::from_parts(IVec3::ZERO, 3, pointer_to(0), stale, Vec::new())
+                .unwrap_err()
+                .to_string()
+                .contains("summary")
+        );
     }
 }

@@ -8,4 +8,4 @@ mod step;
 
 pub use record::Recorder;
 pub use run::{Failure, Runner, RunnerMode, ScriptReport};
-pub use step::{DEFAULT_VIEWPORT, Host, HostError, StepError, StepResult, step};
+pub use step::{DEFAULT_VIEWPORT, Host, HostError, Ran, StepError, StepResult, step};

@@ -8,13 +8,12 @@ use glam::{DVec3, IVec3};
 
 use super::step::{Host, HostError, StepResult, step};
 use crate::camera::Camera;
-use crate::edit::selection::Region;
 use crate::editor::{Editor, Outcome};
 use crate::gpu::Renderer;
 use crate::io::atomic::WriteOptions;
 use crate::io::output::{OutputKind, check_output};
 use crate::io::png::save_png;
-use crate::script::{Command, Line, Script};
+use crate::script::{Line, Script};
 use crate::settings::RenderSettings;
 use crate::trace::render::render_scene_cpu;
 use crate::trace::svo;
@@ -102,7 +101,7 @@ impl Runner {
             let fail =
                 |expected: String, got: String| Failure { file: script.path.clone(), line: line.number, expected, got };
             match self.step(&base, line) {
-                Ok(StepResult::Done) => {}
+                Ok(StepResult::Done | StepResult::Ran(_)) => {}
                 Ok(StepResult::Passed) => report.passed += 1,
                 Ok(StepResult::Failed { expected, got }) => report.failures.push(fail(expected, got)),
                 Err(message) => {
@@ -119,7 +118,15 @@ impl Runner {
     /// # Errors
     /// As [`step`].
     pub fn step(&mut self, base: &Path, line: &Line) -> Result<StepResult, StepError> {
-        step(self, base, &line.command)
+        let result = step(self, base, &line.command)?;
+        if let StepResult::Ran(ran) = &result {
+            match ran.outcome {
+                Outcome::Changed => self.last_written = Some(self.flush()),
+                Outcome::Replaced => self.scene_replaced(),
+                _ => {}
+            }
+        }
+        Ok(result)
     }
 
     /// The rule of every command that writes (`crate::io::output`); a file
@@ -160,15 +167,6 @@ impl Runner {
 impl Host for Runner {
     fn editor(&mut self) -> &mut Editor {
         &mut self.editor
-    }
-
-    fn after_line(&mut self, _line: &Command, outcome: &Outcome, _: Option<Region>) -> Result<(), HostError> {
-        match outcome {
-            Outcome::Changed => self.last_written = Some(self.flush()),
-            Outcome::Replaced => self.scene_replaced(),
-            _ => {}
-        }
-        Ok(())
     }
 
     fn load(&mut self, path: &Path) -> Result<(), HostError> {

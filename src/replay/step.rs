@@ -3,7 +3,10 @@
 //! the host's, through the [`Host`] trait, which `octovox replay` (the
 //! headless [`super::Runner`]) and the window both implement. So a line
 //! means one thing wherever it runs, and this is the only place the host
-//! lines are matched.
+//! lines are matched. An editor line comes back as [`StepResult::Ran`]
+//! for the host to follow up (the pool flush, the recording, the journal)
+//! once `step` has returned: the engine never calls back into a host for
+//! an edit.
 
 use std::path::Path;
 
@@ -19,21 +22,10 @@ use crate::trace::svo;
 /// `viewport` line.
 pub const DEFAULT_VIEWPORT: (u32, u32) = (640, 480);
 
-/// What a host does around the editor: files, the camera, the viewport,
-/// pixels, and the follow-up of edits (the pool flush to the GPU, the
-/// recording, the journal).
+/// What a host does around the editor: files, the camera, the viewport
+/// and pixels.
 pub trait Host {
     fn editor(&mut self) -> &mut Editor;
-
-    /// Before an editor line runs.
-    fn before_line(&mut self, _line: &Command) {}
-
-    /// After an editor line that changed something (`State`, `Changed` or
-    /// `Replaced`): `selection` is the selection from before the line.
-    ///
-    /// # Errors
-    /// The follow-up failed; the script stops.
-    fn after_line(&mut self, line: &Command, outcome: &Outcome, selection: Option<Region>) -> Result<(), HostError>;
 
     /// `load PATH`: the file's scene goes into the editor (the window reads
     /// it in the background; the next line waits for it).
@@ -83,9 +75,26 @@ pub trait Host {
 /// What one line did.
 #[derive(Debug, PartialEq)]
 pub enum StepResult {
+    /// An editor line changed the tool state, the voxels or the scene: the
+    /// host follows it up.
+    Ran(Ran),
+    /// A host line was carried out.
     Done,
     Passed,
-    Failed { expected: String, got: String },
+    Failed {
+        expected: String,
+        got: String,
+    },
+}
+
+/// An editor line that ran: the line (a `click` gives the edit it became),
+/// what it changed, and the selection from before it (a journal that the
+/// line starts begins with that).
+#[derive(Debug, PartialEq)]
+pub struct Ran {
+    pub line: Command,
+    pub outcome: Outcome,
+    pub selection: Option<Region>,
 }
 
 /// A line that could not run: the script stops there.
@@ -132,16 +141,12 @@ pub enum HostError {
 /// # Errors
 /// A line that could not run; a refused edit changes nothing.
 pub fn step(host: &mut impl Host, base: &Path, line: &Command) -> Result<StepResult, StepError> {
-    host.before_line(line);
     let selection = host.editor().selection;
     let outcome = host.editor().run(line)?;
     match outcome {
         Outcome::Checked { ok, expected, got } => Ok(check(ok, expected, || got)),
         Outcome::Host => host_line(host, base, line),
-        outcome => {
-            host.after_line(line, &outcome, selection)?;
-            Ok(StepResult::Done)
-        }
+        outcome => Ok(StepResult::Ran(Ran { line: line.clone(), outcome, selection })),
     }
 }
 

@@ -19,6 +19,8 @@ pub enum EditError {
     #[error("edit at {min}..{max} would make the world wider than 2^{MAX_DEPTH} voxels")]
     TooWide { min: IVec3, max: IVec3 },
     #[error("invalid brush: {0}")]
+    Shape(#[from] crate::scene::shape::ShapeError),
+    #[error("invalid brush: {0}")]
     Brush(String),
     #[error("palette index 0 means empty; use remove, or a colour in 1..=255")]
     ZeroColor,
@@ -73,7 +75,7 @@ impl Octree {
     /// Applies a brush. Grows the root first if the shape reaches outside it.
     /// Returns the patch that undoes the edit.
     pub fn apply_brush(&mut self, shape: &Shape, op: Op) -> Result<Patch, EditError> {
-        shape.validate().map_err(EditError::Brush)?;
+        shape.validate()?;
         if op.color() == Some(0) {
             return Err(EditError::ZeroColor);
         }

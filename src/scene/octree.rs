@@ -14,6 +14,42 @@ use super::counts::VoxelCounts;
 use super::lod::{self, Summary};
 use crate::gpu_pool::{self, Brick, Node, NodePool, NodeSlot, is_pointer, pointer_to, slot_of};
 
+/// What is wrong with a tree put together from outside (a .ovx file's
+/// pool), or broken by a bug (the invariants tests check after every edit).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum TreeError {
+    #[error("its root cube at {0} reaches past the coordinate limit ±{WORLD_LIMIT} (±2^24)")]
+    RootTooFar(IVec3),
+    #[error("root depth {0} is outside {MIN_DEPTH}..={MAX_DEPTH}")]
+    Depth(u32),
+    #[error(
+        "it holds voxels at {lo}..{hi}, past the coordinate limit ±{WORLD_LIMIT} (±2^24) that edits and rendering keep exact"
+    )]
+    VoxelsTooFar { lo: IVec3, hi: IVec3 },
+    #[error("bad cell word {0:#x}")]
+    BadWord(u32),
+    #[error("pointer below level 1")]
+    PointerInBrick,
+    #[error("{what} {slot} is free but referenced")]
+    FreeReferenced { what: &'static str, slot: u32 },
+    #[error("{what} {slot} is past the {stored} stored")]
+    PastStored { what: &'static str, slot: u32, stored: usize },
+    #[error("{what} {slot} is used twice")]
+    UsedTwice { what: &'static str, slot: u32 },
+    #[error("{0} stored nodes or bricks are not in the tree")]
+    Unused(usize),
+    #[error("uncollapsed brick {0:?}")]
+    UncollapsedBrick(Brick),
+    #[error("uncollapsed node {node:?} at level {level}")]
+    UncollapsedNode { node: Node, level: u32 },
+    #[error("stale summary {summary:?} of node {slot} at level {level}")]
+    StaleSummary { summary: Summary, slot: u32, level: u32 },
+    #[error("reachable nodes/bricks {reached:?} != live {live:?}")]
+    Leaked { reached: (usize, usize), live: (usize, usize) },
+    #[error("cached voxel counts {cached} != counted {counted}")]
+    Counts { cached: u64, counted: u64 },
+}
+
 /// Smallest root: a 4³ cube (the root is then a node of bricks).
 pub const MIN_DEPTH: u32 = 2;
 /// Largest root: 2^20 voxels per side; edits beyond it are refused.
@@ -357,7 +393,7 @@ impl Octree {
         root: u32,
         nodes: Vec<NodeSlot>,
         bricks: Vec<Brick>,
-    ) -> Result<Octree, String> {
+    ) -> Result<Octree, TreeError> {
         check_tree_shape(root, depth, &nodes, bricks.len())?;
         // The root cube may pass the coordinate limit by at most one world
         // width (a grown root is aligned), never so far that i32 wraps.
@@ -365,11 +401,11 @@ impl Octree {
         let far = origin.as_i64vec3().min_element() <= -reach
             || origin.as_i64vec3().max_element() + (1_i64 << depth.min(MAX_DEPTH)) >= reach;
         if far {
-            return Err(format!("its root cube at {origin} reaches past the coordinate limit ±{WORLD_LIMIT} (±2^24)"));
+            return Err(TreeError::RootTooFar(origin));
         }
         let mut tree = Octree::empty(origin, depth);
         if tree.depth != depth {
-            return Err(format!("root depth {depth} is outside {MIN_DEPTH}..={MAX_DEPTH}"));
+            return Err(TreeError::Depth(depth));
         }
         tree.pool.nodes = gpu_pool::SlotArena::from_items(nodes);
         tree.pool.bricks = gpu_pool::SlotArena::from_items(bricks);
@@ -379,10 +415,7 @@ impl Octree {
         if let Some((lo, hi)) = tree.solid_bounds()
             && (lo.min_element() <= -WORLD_LIMIT || hi.max_element() >= WORLD_LIMIT)
         {
-            return Err(format!(
-                "it holds voxels at {lo}..{hi}, past the coordinate limit ±{WORLD_LIMIT} (±2^24) that edits and \
-                 rendering keep exact"
-            ));
+            return Err(TreeError::VoxelsTooFar { lo, hi });
         }
         Ok(tree)
     }
@@ -390,53 +423,46 @@ impl Octree {
     /// Checks the structural invariants: collapse, no dangling or leaked
     /// slots, and the cached voxel count. Returns a description of the first
     /// violation. Used by tests after every edit.
-    pub fn check_invariants(&self) -> Result<(), String> {
+    pub fn check_invariants(&self) -> Result<(), TreeError> {
         let mut reached = (0usize, 0usize);
         self.check_word(self.root, self.depth, &mut reached)?;
         if reached != (self.pool.nodes.live(), self.pool.bricks.live()) {
-            return Err(format!(
-                "reachable nodes/bricks {reached:?} != live {:?}",
-                (self.pool.nodes.live(), self.pool.bricks.live())
-            ));
+            return Err(TreeError::Leaked { reached, live: (self.pool.nodes.live(), self.pool.bricks.live()) });
         }
         let mut counted = VoxelCounts::default();
         counted.add_word(&self.pool, self.root, self.depth);
         if counted != self.counts {
-            return Err(format!("cached voxel counts {} != counted {}", self.solid_voxels(), counted.solid()));
+            return Err(TreeError::Counts { cached: self.solid_voxels(), counted: counted.solid() });
         }
         Ok(())
     }
 
-    fn check_word(&self, word: u32, level: u32, reached: &mut (usize, usize)) -> Result<(), String> {
+    fn check_word(&self, word: u32, level: u32, reached: &mut (usize, usize)) -> Result<(), TreeError> {
         if !is_pointer(word) {
-            return if word <= 255 { Ok(()) } else { Err(format!("bad uniform word {word:#x}")) };
+            return if word <= 255 { Ok(()) } else { Err(TreeError::BadWord(word)) };
         }
         if level == 0 {
-            return Err("pointer below level 1".into());
+            return Err(TreeError::PointerInBrick);
         }
         if level == 1 {
             if self.pool.bricks.is_free(slot_of(word)) {
-                return Err(format!("brick {} is free but referenced", slot_of(word)));
+                return Err(TreeError::FreeReferenced { what: "brick", slot: slot_of(word) });
             }
             reached.1 += 1;
             let b = self.brick(word);
-            return if b.iter().all(|v| *v == b[0]) { Err(format!("uncollapsed brick {b:?}")) } else { Ok(()) };
+            return if b.iter().all(|v| *v == b[0]) { Err(TreeError::UncollapsedBrick(*b)) } else { Ok(()) };
         }
         if self.pool.nodes.is_free(slot_of(word)) {
-            return Err(format!("node {} is free but referenced", slot_of(word)));
+            return Err(TreeError::FreeReferenced { what: "node", slot: slot_of(word) });
         }
         reached.0 += 1;
         let node = *self.node(word);
         let stored = self.pool.nodes.get(slot_of(word)).lod;
         if stored != self.node_slot(node, level).lod {
-            return Err(format!(
-                "stale summary {:?} of node {} at level {level}",
-                Summary::from_word(stored),
-                slot_of(word)
-            ));
+            return Err(TreeError::StaleSummary { summary: Summary::from_word(stored), slot: slot_of(word), level });
         }
         if !is_pointer(node[0]) && node.iter().all(|c| *c == node[0]) {
-            return Err(format!("uncollapsed node {node:?} at level {level}"));
+            return Err(TreeError::UncollapsedNode { node, level });
         }
         node.iter().try_for_each(|&c| self.check_word(c, level - 1, reached))
     }
@@ -445,21 +471,21 @@ impl Octree {
 /// Checks that the pointers under `root` form a tree over exactly the given
 /// slots: in range, each used once (so no cycle and no shared subtree), and
 /// uniform words that are palette indices.
-fn check_tree_shape(root: u32, depth: u32, nodes: &[NodeSlot], bricks: usize) -> Result<(), String> {
+fn check_tree_shape(root: u32, depth: u32, nodes: &[NodeSlot], bricks: usize) -> Result<(), TreeError> {
     let mut used = (vec![false; nodes.len()], vec![false; bricks]);
     let mut stack = vec![(root, depth)];
     while let Some((word, level)) = stack.pop() {
         if !is_pointer(word) {
             if word > 255 {
-                return Err(format!("bad cell word {word:#x}"));
+                return Err(TreeError::BadWord(word));
             }
             continue;
         }
         let slot = slot_of(word);
         let (seen, what) = if level == 1 { (&mut used.1, "brick") } else { (&mut used.0, "node") };
         match seen.get_mut(slot as usize) {
-            None => return Err(format!("{what} {slot} is past the {} stored", seen.len())),
-            Some(true) => return Err(format!("{what} {slot} is used twice")),
+            None => return Err(TreeError::PastStored { what, slot, stored: seen.len() }),
+            Some(true) => return Err(TreeError::UsedTwice { what, slot }),
             Some(flag) => *flag = true,
         }
         if level == 1 {
@@ -469,7 +495,7 @@ fn check_tree_shape(root: u32, depth: u32, nodes: &[NodeSlot], bricks: usize) ->
     }
     let unused = used.0.iter().chain(&used.1).filter(|u| !**u).count();
     if unused > 0 {
-        return Err(format!("{unused} stored nodes or bricks are not in the tree"));
+        return Err(TreeError::Unused(unused));
     }
     Ok(())
 }
@@ -517,7 +543,7 @@ mod tests {
             [IVec3::new(WORLD_LIMIT - 3, 0, 0), IVec3::new(0, -WORLD_LIMIT, 0), IVec3::new(i32::MAX - 1, 0, 0)]
         {
             let err = solid(origin).map(|t| t.solid_voxels()).unwrap_err();
-            assert!(err.contains("past the coordinate limit"), "{origin}: {err}");
+            assert!(err.to_string().contains("past the coordinate limit"), "{origin}: {err}");
         }
     }
 }

@@ -35,6 +35,17 @@ pub enum Overlap {
     Inside,
 }
 
+/// Why a brush shape is refused.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ShapeError {
+    #[error("sphere radius {0} is outside 0..={MAX_BRUSH_EXTENT}")]
+    Radius(i32),
+    #[error("box min {min} is above its max {max}")]
+    Inverted { min: IVec3, max: IVec3 },
+    #[error("box {min}..{max} is wider than {MAX_BRUSH_EXTENT}")]
+    TooWide { min: IVec3, max: IVec3 },
+}
+
 impl Shape {
     /// A box of `size` cells centred on `center` the way the replay language
     /// defines it: `center - size / 2 ..= center - size / 2 + size - 1`.
@@ -96,17 +107,15 @@ impl Shape {
         }
     }
 
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), ShapeError> {
         match *self {
             Shape::Voxel(_) => Ok(()),
             Shape::Sphere { radius, .. } if !(0..=MAX_BRUSH_EXTENT).contains(&radius) => {
-                Err(format!("sphere radius {radius} is outside 0..={MAX_BRUSH_EXTENT}"))
+                Err(ShapeError::Radius(radius))
             }
-            Shape::Box { min, max } if (max - min).cmplt(IVec3::ZERO).any() => {
-                Err(format!("box min {min} is above its max {max}"))
-            }
+            Shape::Box { min, max } if (max - min).cmplt(IVec3::ZERO).any() => Err(ShapeError::Inverted { min, max }),
             Shape::Box { min, max } if (max - min).max_element() >= MAX_BRUSH_EXTENT => {
-                Err(format!("box {min}..{max} is wider than {MAX_BRUSH_EXTENT}"))
+                Err(ShapeError::TooWide { min, max })
             }
             _ => Ok(()),
         }

@@ -45,21 +45,41 @@ type Fail = (usize, String);
 ///
 /// # Errors
 /// A quote that is not closed, or a bad escape.
-pub fn split_words(line: &str) -> Result<Vec<String>, String> {
-    Cursor::new(line).map(|cursor| cursor.tokens.into_iter().map(|t| t.text).collect()).map_err(|(_, message)| message)
+pub fn split_words(line: &str) -> Result<Vec<String>, WordError> {
+    Cursor::new(line).map(|cursor| cursor.tokens.into_iter().map(|t| t.text).collect()).map_err(|(_, error)| error)
+}
+
+/// Why the words of a line cannot be split.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum WordError {
+    #[error("an escape at the end of the line")]
+    EscapeAtEnd,
+    #[error("expected \\u{{HEX}} (a character's code in hexadecimal)")]
+    BadUnicodeEscape,
+    #[error("a quote that is not closed on this line")]
+    UnclosedQuote,
+}
+
+/// Why the count of `undo N` / `redo N` is refused.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+enum CountError {
+    #[error("count {0} is too large (at most {max})", max = u32::MAX)]
+    TooLarge(String),
+    #[error("expected a count ≥ 1, found '{0}'")]
+    NotACount(String),
 }
 
 /// The character an escape inside quotes stands for, the backslash read:
 /// `\"`, `\\`, `\n`, `\r`, `\t` or `\u{HEX}` (what [`super::quoted`]
 /// writes).
-fn unescape(chars: &mut std::iter::Peekable<impl Iterator<Item = (char, usize)>>) -> Result<char, String> {
-    let Some((c, _)) = chars.next() else { return Err("an escape at the end of the line".to_owned()) };
+fn unescape(chars: &mut std::iter::Peekable<impl Iterator<Item = (char, usize)>>) -> Result<char, WordError> {
+    let Some((c, _)) = chars.next() else { return Err(WordError::EscapeAtEnd) };
     Ok(match c {
         'n' => '\n',
         'r' => '\r',
         't' => '\t',
         'u' => {
-            let bad = || "expected \\u{HEX} (a character's code in hexadecimal)".to_owned();
+            let bad = || WordError::BadUnicodeEscape;
             if chars.next().map(|(c, _)| c) != Some('{') {
                 return Err(bad());
             }
@@ -82,7 +102,7 @@ impl Cursor {
     /// word that holds spaces or `#` (with `\"` and `\\` inside), and `#`
     /// outside quotes starts a comment. One pass, so a long line costs
     /// linear time.
-    fn new(line: &str) -> Result<Cursor, Fail> {
+    fn new(line: &str) -> Result<Cursor, (usize, WordError)> {
         let mut tokens = Vec::new();
         let mut current: Option<Token> = None;
         let mut quote_column = None;
@@ -93,7 +113,7 @@ impl Cursor {
                 match c {
                     '"' => quote_column = None,
                     '\\' if matches!(chars.peek(), Some(('"' | '\\' | 'n' | 'r' | 't' | 'u', _))) => {
-                        let escaped = unescape(&mut chars).map_err(|message| (column, message))?;
+                        let escaped = unescape(&mut chars).map_err(|error| (column, error))?;
                         if let Some(token) = current.as_mut() {
                             token.text.push(escaped);
                         }
@@ -117,7 +137,7 @@ impl Cursor {
             }
         }
         if let Some(column) = quote_column {
-            return Err((column, "a quote that is not closed on this line".to_owned()));
+            return Err((column, WordError::UnclosedQuote));
         }
         tokens.extend(current);
         Ok(Cursor { tokens, next: 0, end_column })
@@ -204,7 +224,7 @@ pub fn parse_script(file: &Path, text: &str) -> Result<Script, Vec<ScriptError>>
     // A byte-order mark (some Windows editors write one) is not a command.
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     for (index, raw) in text.lines().enumerate() {
-        let parsed = Cursor::new(raw).and_then(|mut cursor| {
+        let parsed = Cursor::new(raw).map_err(|(column, error)| (column, error.to_string())).and_then(|mut cursor| {
             if cursor.is_empty() {
                 return Ok(None);
             }
@@ -236,15 +256,13 @@ pub fn load_script(path: &Path) -> Result<Script, Vec<ScriptError>> {
 pub const MAX_SCRIPT_BYTES: u64 = 64 << 20;
 
 /// The count of `undo N` / `redo N`: a whole number 1..=u32::MAX.
-fn parse_count(text: &str) -> Result<u32, String> {
+fn parse_count(text: &str) -> Result<u32, CountError> {
     let digits = !text.is_empty() && text.bytes().all(|b| b.is_ascii_digit());
     match text.parse::<u32>() {
         Ok(n) if n >= 1 => Ok(n),
         // A number past u32 is a count, only too large (not "not ≥ 1").
-        Err(_) if digits && text.trim_start_matches('0').len() >= 10 => {
-            Err(format!("count {text} is too large (at most {})", u32::MAX))
-        }
-        _ => Err(format!("expected a count ≥ 1, found '{text}'")),
+        Err(_) if digits && text.trim_start_matches('0').len() >= 10 => Err(CountError::TooLarge(text.to_owned())),
+        _ => Err(CountError::NotACount(text.to_owned())),
     }
 }
 
@@ -272,7 +290,7 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
                 None => None,
             };
             let (eye, target) = (DVec3::new(v[0], v[1], v[2]), DVec3::new(v[3], v[4], v[5]));
-            crate::camera::check_camera(eye, target).map_err(|message| (name.column, message))?;
+            crate::camera::check_camera(eye, target).map_err(|error| (name.column, error.to_string()))?;
             Command::Camera { eye, target, fov }
         }
         "viewport" => Command::Viewport(c.int_in("width", 1..=8192)? as u32, c.int_in("height", 1..=8192)? as u32),
@@ -340,7 +358,7 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
         }
         "undo" | "redo" => {
             let n = match c.optional() {
-                Some(t) => parse_count(&t.text).map_err(|message| (t.column, message))?,
+                Some(t) => parse_count(&t.text).map_err(|error| (t.column, error.to_string()))?,
                 None => 1,
             };
             if name.text == "undo" { Command::Undo(n) } else { Command::Redo(n) }

@@ -21,11 +21,20 @@ pub struct DenseGrid {
     pub data: Vec<u8>,
 }
 
+/// Why a scene has no dense grid.
+#[derive(Clone, Debug, thiserror::Error)]
+pub enum GridError {
+    #[error("the scene's bounding cube of {0}³ voxels is larger than a dense grid may be ({MAX_GRID_CELLS} cells)")]
+    TooLarge(u32),
+    #[error(transparent)]
+    OverBudget(#[from] crate::budget::OverBudget),
+}
+
 impl DenseGrid {
     /// Rasterizes the tree's solid voxels (tree-local coordinates), or
     /// says why not: a bounding cube of more than [`MAX_GRID_CELLS`], or
     /// more bytes than the memory budget allows.
-    pub fn from_octree(tree: &Octree) -> Result<DenseGrid, String> {
+    pub fn from_octree(tree: &Octree) -> Result<DenseGrid, GridError> {
         let Some((lo, hi)) = tree.solid_bounds() else {
             return Ok(DenseGrid::default());
         };
@@ -33,12 +42,9 @@ impl DenseGrid {
         let dims = UVec3::splat((hi - lo + IVec3::ONE).max_element() as u32);
         let cells = dims.as_u64vec3().element_product();
         if cells > MAX_GRID_CELLS {
-            return Err(format!(
-                "the scene's bounding cube of {}³ voxels is larger than a dense grid may be ({MAX_GRID_CELLS} cells)",
-                dims.x
-            ));
+            return Err(GridError::TooLarge(dims.x));
         }
-        crate::budget::check(|| format!("a dense grid of {}³ voxels", dims.x), cells).map_err(|e| e.to_string())?;
+        crate::budget::check(|| format!("a dense grid of {}³ voxels", dims.x), cells)?;
         let mut data = vec![0u8; dims.x as usize * dims.y as usize * dims.z as usize];
         let index = |p: IVec3| (p.x as usize) + dims.x as usize * (p.y as usize + dims.y as usize * p.z as usize);
         tree.for_each_solid_cell(|cell_min, size, value| {

@@ -106,3 +106,51 @@ fn window_plays_a_script_through_the_edit_path() {
         (saved.palette.color(9), saved.palette.material(9))
     );
 }
+
+/// One interpreter: a played script's `render` makes the image `octovox
+/// replay` makes, so `expect image` is checked in the window (it was
+/// skipped there), and `expect written` needs an edit in both hosts.
+#[test]
+fn a_played_script_renders_and_checks_images_as_octovox_replay_does() {
+    require_tool("Xvfb");
+    let dir = tempfile::tempdir().unwrap();
+    let scene = "demo showroom\ncamera 30 22 34 8 4 8 50\nviewport 160 120\n";
+    // The reference, headless on the GPU (lavapipe here).
+    std::fs::write(dir.path().join("reference.ovr"), format!("{scene}render reference.png\n")).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_octovox"))
+        .arg("replay")
+        .arg(dir.path().join("reference.ovr"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stdout));
+    let reference = image::open(dir.path().join("reference.png")).unwrap().to_rgb8();
+    assert_eq!(reference.dimensions(), (160, 120));
+    let lit = reference.pixels().filter(|p| p.0.iter().any(|c| *c > 40)).count();
+    assert!(lit > 160 * 120 / 4, "the reference is a real picture ({lit} lit pixels)");
+
+    let script = dir.path().join("play.ovr");
+    std::fs::write(
+        &script,
+        format!(
+            "{scene}expect written <= 0\nrender window.png\nexpect image reference.png 0.002\nexpect effects none\n"
+        ),
+    )
+    .unwrap();
+    let (_xvfb, display) = start_xvfb(20);
+    let args = ["--size".to_string(), "640x480".into(), "--replay".into(), script.display().to_string()];
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
+    find_window(&display, &mut app, &stderr_path);
+    let summary = lines.wait_for("replay:", Duration::from_secs(120));
+    // `expect written` before any edit is an error that stops the script
+    // in both hosts; so the window runs the rest in a second script.
+    assert_eq!(summary, "replay: 0 passed, 1 failed", "{:?}", lines.seen);
+    drop(app);
+
+    std::fs::write(&script, format!("{scene}render window.png\nexpect image reference.png 0.002\n")).unwrap();
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
+    find_window(&display, &mut app, &stderr_path);
+    let summary = lines.wait_for("replay:", Duration::from_secs(120));
+    assert_eq!(summary, "replay: 1 passed, 0 failed", "{:?}", lines.seen);
+    let window = image::open(dir.path().join("window.png")).unwrap().to_rgb8();
+    assert_eq!(window.dimensions(), (160, 120), "the script's viewport, not the window's size");
+}

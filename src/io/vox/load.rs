@@ -167,7 +167,7 @@ impl Parsed {
 fn parse_guarded(bytes: &[u8]) -> Result<DotVoxData, VoxError> {
     match catch_quietly(|| dot_vox::load_bytes(bytes)) {
         Ok(parsed) => parsed.map_err(VoxError::Parser),
-        Err(message) => Err(VoxError::ParserPanic(message)),
+        Err(panicked) => Err(VoxError::ParserPanic(panicked.0)),
     }
 }
 
