@@ -70,18 +70,28 @@ pub struct Editor {
     /// The selected box, if any.
     pub selection: Option<Region>,
     clipboard: Option<Block>,
+    /// Counts the changes of the voxels and the palette, new scenes
+    /// included: a frame drawn from revision r is up to date while it is r.
+    revision: u64,
 }
 
 impl Editor {
     /// Puts `scene` in place with an empty history and no selection; the
-    /// tools and the clipboard stay (pasting between documents works).
-    /// Puts `scene` in place; the next flush uploads all of it (what it was
-    /// flushed to before, if anything, is not this editor's GPU buffer).
+    /// tools and the clipboard stay (pasting between documents works). The
+    /// next flush uploads all of it (what it was flushed to before, if
+    /// anything, is not this editor's GPU buffer).
     pub fn set_scene(&mut self, mut scene: Scene) {
         scene.tree.pool_mut().forget_uploads();
         self.scene = scene;
         self.history.clear();
         self.selection = None;
+        self.revision += 1;
+    }
+
+    /// The revision of the voxels and the palette (see `Editor::revision`'s
+    /// field): it changes with every edit, undo, redo and new scene.
+    pub fn revision(&self) -> u64 {
+        self.revision
     }
 
     pub fn clipboard(&self) -> Option<&Block> {
@@ -219,6 +229,7 @@ impl Editor {
     pub fn commit(&mut self, edits: Vec<Edit>) -> Result<bool, EditError> {
         let any = !edits.is_empty();
         self.history.apply_group(&mut self.scene, edits)?;
+        self.revision += u64::from(any);
         Ok(any)
     }
 
@@ -232,6 +243,8 @@ impl Editor {
         if usize::try_from(n).map_or(true, |n| n > available) {
             return Err(EditorError::TooFewSteps { what, available, wanted: n });
         }
+        // Counted first: a step that fails halfway has changed cells too.
+        self.revision += 1;
         for _ in 0..n {
             let scene = &mut self.scene;
             if undo { self.history.undo(scene) } else { self.history.redo(scene) }?;

@@ -59,17 +59,17 @@ impl App {
     }
 
     pub(super) fn bench_step(&mut self, event_loop: &ActiveEventLoop) {
-        if !self.ready {
+        if !self.frames.ready {
             return;
         }
         let (w, h) = self.trace_size();
         let clock = self.gfx.as_ref().map_or("", |g| if g.renderer.timed_by_gpu() { "GPU timestamps" } else { "wall" });
-        let Some(bench) = &mut self.bench else { return };
+        let Some(bench) = &mut self.frames.bench else { return };
         match bench.started {
             // The first ready frame warms up; timing starts after it.
             None => bench.started = Some(Instant::now()),
             Some(started) => {
-                bench.trace_ms += self.stats.trace_ms;
+                bench.trace_ms += self.readouts.stats.trace_ms;
                 bench.left -= 1;
                 if bench.left == 0 {
                     let seconds = started.elapsed().as_secs_f64();
@@ -81,7 +81,7 @@ impl App {
                         seconds * 1e3 / n,
                         bench.trace_ms / n,
                     );
-                    self.bench = None;
+                    self.frames.bench = None;
                     event_loop.exit();
                 }
             }

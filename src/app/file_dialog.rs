@@ -71,7 +71,7 @@ impl App {
     /// Asks for a path for `kind`: in a native dialog where there is one,
     /// else in the window's path field, starting at `start`.
     pub(super) fn ask_path(&mut self, kind: DialogKind, start: String) {
-        if self.file_dialog.is_some() {
+        if self.doc.file_dialog.is_some() {
             return self.ui.info("a file dialog is open");
         }
         if !available() {
@@ -88,7 +88,7 @@ impl App {
         match spawned {
             Ok(_) => {
                 report!("file dialog: native");
-                self.file_dialog = Some(NativeDialog { kind, start, answer: rx });
+                self.doc.file_dialog = Some(NativeDialog { kind, start, answer: rx });
             }
             Err(_) => self.ui.dialog = Some((kind, start)),
         }
@@ -96,13 +96,13 @@ impl App {
 
     /// Carries out the answer of the open native dialog, once it came.
     pub(super) fn poll_file_dialog(&mut self, event_loop: &ActiveEventLoop) {
-        let Some(open) = &self.file_dialog else { return };
+        let Some(open) = &self.doc.file_dialog else { return };
         let (answer, took) = match open.answer.try_recv() {
             Ok(answer) => answer,
             Err(TryRecvError::Empty) => return,
             Err(TryRecvError::Disconnected) => (None, Duration::ZERO),
         };
-        let Some(open) = self.file_dialog.take() else { return };
+        let Some(open) = self.doc.file_dialog.take() else { return };
         match answer {
             Some(path) => {
                 let command = match open.kind {

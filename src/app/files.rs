@@ -15,9 +15,11 @@ use octovox::scene::Scene;
 use octovox::journal::{Checks, FileStamp};
 use octovox::script::Command::Load;
 
+use super::document::Loading;
+use super::gesture::Gesture;
 use super::journal::{Found, JournalStart, classify};
 use super::ui::DialogKind;
-use super::{App, Choice, Loading, Pending, camera_control, first_used_color};
+use super::{App, Choice, Pending, camera_control, first_used_color};
 
 impl App {
     /// Puts a new scene in place (load, New, a built-in scene) and uploads
@@ -25,7 +27,7 @@ impl App {
     /// `demo`), which the recorder writes.
     /// `stamp` is the loaded file's as it was read (`JournalStart`).
     pub(super) fn replace_scene(&mut self, scene: Scene, source: octovox::script::Command, stamp: Option<FileStamp>) {
-        self.editor.set_scene(scene);
+        self.doc.editor.set_scene(scene);
         self.scene_replaced(source, stamp);
     }
 
@@ -44,21 +46,19 @@ impl App {
         // The old document's edits were saved or discarded before this.
         self.close_journal();
         // The line that makes the scene starts its journal (untitled ones too).
-        self.journal_start = match line {
+        self.doc.journal_start = match line {
             octovox::script::Command::Load(path) => JournalStart { lines: vec![Load(path)], stamp },
             line => JournalStart::of(vec![line]),
         };
-        self.stroke = None;
-        self.stats.last_edit_bytes = None;
+        self.gesture = Gesture::Idle;
+        self.readouts.stats.last_edit_bytes = None;
         // What the presets cost was measured on the scene before.
-        self.presets_measured = None;
+        self.readouts.presets_measured = None;
         // An imported mesh has no .vox to save back to: Save asks for one
         // rather than writing .vox bytes over the .obj.
         self.state.path = path.filter(|p| !octovox::io::is_mesh_path(p));
         self.state.dirty = false;
-        self.editor.tools.color = first_used_color(&self.editor.scene).unwrap_or(self.editor.tools.color);
-        self.grid_stale = true;
-        self.path_stale = true;
+        self.doc.editor.tools.color = first_used_color(&self.doc.editor.scene).unwrap_or(self.doc.editor.tools.color);
         let upload = self.upload();
         log::info!("scene uploaded: {} bytes", upload.bytes);
         self.update_title();
@@ -105,8 +105,9 @@ impl App {
                 self.replace_scene(Scene::default(), octovox::script::Command::New, None);
                 self.state.camera = Camera { fov_y_deg: self.state.camera.fov_y_deg, ..Camera::default() };
                 // A lone voxel to attach to: an empty scene gives the mouse nothing to hit.
-                let color = self.editor.tools.color.max(1);
+                let color = self.doc.editor.tools.color.max(1);
                 if let Err(err) = self
+                    .doc
                     .editor
                     .scene
                     .tree
@@ -116,7 +117,7 @@ impl App {
                 }
                 self.record(|r| r.seed(color, IVec3::ZERO));
                 // The journal starts from the seeded scene too.
-                self.journal_start.lines.extend([
+                self.doc.journal_start.lines.extend([
                     octovox::script::Command::Brush(octovox::edit::brush::Brush::Voxel),
                     octovox::script::Command::Color(color),
                     octovox::script::Command::Place(IVec3::ZERO),
@@ -154,14 +155,14 @@ impl App {
         self.state.dirty = true;
         if document.is_some() {
             match octovox::replay::Recorder::append(journal) {
-                Ok(recorder) => self.journal = Some(recorder),
+                Ok(recorder) => self.doc.journal = Some(recorder),
                 Err(err) => self.ui.error(format!("cannot go on with the journal {}: {err}", journal.display())),
             }
         } else {
             // This session's own journal starts from the recovered scene;
             // the dead session's journal and snapshot go.
             self.restart_journal_from_snapshot();
-            if self.journal.is_some() {
+            if self.doc.journal.is_some() {
                 let _ = std::fs::remove_file(octovox::journal::snapshot_path(journal));
                 let _ = std::fs::remove_file(journal);
             }
@@ -221,7 +222,7 @@ impl App {
         // edits: a kill before the journal's removal leaves it stale, not
         // replayed a second time.
         let target = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
-        let journal = std::cell::RefCell::new(self.journal.take());
+        let journal = std::cell::RefCell::new(self.doc.journal.take());
         let saved_hash = std::cell::RefCell::new(None);
         let note = |sha256: &str| {
             *saved_hash.borrow_mut() = Some(sha256.to_owned());
@@ -231,20 +232,23 @@ impl App {
                 log::warn!("cannot note the save in the crash-recovery journal: {err}");
             }
         };
-        let result =
-            octovox::io::save_scene(path, &self.editor.scene, WriteOptions { before_replace: Some(&note), ..options });
-        self.journal = journal.into_inner();
+        let result = octovox::io::save_scene(
+            path,
+            &self.doc.editor.scene,
+            WriteOptions { before_replace: Some(&note), ..options },
+        );
+        self.doc.journal = journal.into_inner();
         match result {
             Ok(()) => {
                 hold_for_tests_after_rename();
-                self.recent.add(path);
+                self.doc.recent.add(path);
                 report!("saved: {}", path.display());
                 self.state.dirty = false;
                 // The file now holds every edit: the journal starts again from it.
                 self.close_journal();
                 let absolute = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
                 // The hash the save computed: the file is not read again.
-                self.journal_start = JournalStart::load(absolute, saved_hash.into_inner());
+                self.doc.journal_start = JournalStart::load(absolute, saved_hash.into_inner());
                 self.ui.info(format!("saved {}", path.display()));
                 self.update_title();
                 true
@@ -262,7 +266,7 @@ impl App {
         let inputs: Vec<&Path> = self.state.path.iter().map(PathBuf::as_path).collect();
         let result =
             octovox::io::export::check_outputs(path, &inputs, false).map_err(|e| e.to_string()).and_then(|()| {
-                octovox::io::export::export_mesh(path, &self.editor.scene, 1.0, WriteOptions::default())
+                octovox::io::export::export_mesh(path, &self.doc.editor.scene, 1.0, WriteOptions::default())
                     .map_err(|e| e.to_string())
             });
         match result {
@@ -290,23 +294,23 @@ impl App {
             let _ = tx.send(result);
         });
         match spawned {
-            Ok(_) => self.loading = Some(Loading { path, started: Instant::now(), progress, result: rx }),
+            Ok(_) => self.doc.loading = Some(Loading { path, started: Instant::now(), progress, result: rx }),
             Err(err) => self.ui.error(format!("cannot start loading: {err}")),
         }
         self.request_redraw();
     }
 
     pub(super) fn poll_loading(&mut self) {
-        let Some(loading) = &self.loading else { return };
+        let Some(loading) = &self.doc.loading else { return };
         let result = match loading.result.try_recv() {
             Ok(result) => result.map_err(|err| err.to_string()),
             Err(TryRecvError::Empty) => return,
             Err(TryRecvError::Disconnected) => Err("the loader thread stopped".to_owned()),
         };
-        let Some(loading) = self.loading.take() else { return };
+        let Some(loading) = self.doc.loading.take() else { return };
         match result {
             Ok((scene, stamp)) => {
-                self.recent.add(&loading.path);
+                self.doc.recent.add(&loading.path);
                 let seconds = loading.started.elapsed().as_secs_f64();
                 report!("loaded: {} ({} voxels, {seconds:.2} s)", loading.path.display(), scene.tree.solid_voxels());
                 self.replace_scene(scene, Load(loading.path.clone()), stamp);

@@ -11,6 +11,7 @@ use octovox::gpu::PathView;
 use octovox::settings::{Shading, TraceMode, View};
 use octovox::trace::grid::DenseGrid;
 
+use super::gesture::Gesture;
 use super::{App, Gfx, camera_control, capture, motion, ui};
 
 /// Most bands a path-traced sample is split into.
@@ -22,11 +23,11 @@ type Overlays = Vec<egui::epaint::ClippedShape>;
 impl App {
     pub(super) fn frame(&mut self, event_loop: &ActiveEventLoop) {
         let started = Instant::now();
-        let interval_ms = self.last_frame.map(|last| started.duration_since(last).as_secs_f64() * 1e3);
+        let interval_ms = self.frames.last_frame.map(|last| started.duration_since(last).as_secs_f64() * 1e3);
         let seconds = self.measure_interval(started);
         self.poll_loading();
         self.poll_file_dialog(event_loop);
-        if self.ready {
+        if self.frames.ready {
             self.play_step();
         }
         if let Some(dir) = self.input.fly_direction() {
@@ -35,18 +36,20 @@ impl App {
         // Panels first: they may change settings and produce commands.
         let panels_started = Instant::now();
         let Some((ctx, full, overlays)) = self.run_panels(event_loop) else { return };
-        self.stats.panels_ms = panels_started.elapsed().as_secs_f64() * 1e3;
+        self.readouts.stats.panels_ms = panels_started.elapsed().as_secs_f64() * 1e3;
         // The camera is final for this frame: pick how many pixels to trace.
-        let screenshot = self.screenshot_requested;
-        let last = motion::FrameTimes { frame_ms: self.stats.frame_ms, trace_ms: self.stats.trace_ms };
-        self.motion.update(&self.state.camera, started, last, self.state.frame_target_ms, screenshot);
-        self.stats.scale = self.render_scale();
+        let screenshot = self.frames.screenshot_requested;
+        let last =
+            motion::FrameTimes { frame_ms: self.readouts.stats.frame_ms, trace_ms: self.readouts.stats.trace_ms };
+        self.frames.motion.update(&self.state.camera, started, last, self.state.frame_target_ms, screenshot);
+        self.readouts.stats.scale = self.render_scale();
         // The interval since the last frame is a moving frame's time when
         // that one moved too: before a motion it also holds the time the
         // window sat idle (the wait for work in flight shows in the next).
-        let counted = std::mem::replace(&mut self.stats.moving, self.motion.moving()) && self.motion.moving();
-        if let (Some(frames), Some(interval_ms), true) = (&mut self.moving_frames, interval_ms, counted) {
-            let s = &self.stats;
+        let counted = std::mem::replace(&mut self.readouts.stats.moving, self.frames.motion.moving())
+            && self.frames.motion.moving();
+        if let (Some(frames), Some(interval_ms), true) = (&mut self.frames.moving_frames, interval_ms, counted) {
+            let s = &self.readouts.stats;
             frames.push(motion::FrameParts {
                 interval_ms,
                 trace_ms: s.trace_ms,
@@ -58,21 +61,23 @@ impl App {
             });
         }
         // Hover pick: what a click would edit, highlighted before any click.
-        self.pick = match self.input.cursor() {
+        self.hover.pick = match self.input.cursor() {
             // A hover over a ray that gave up highlights nothing; a click says why.
-            Some((x, y)) if !self.pointer_over_ui && self.loading.is_none() => self.pick_at(x, y).ok().flatten(),
+            Some((x, y)) if !self.hover.pointer_over_ui && self.doc.loading.is_none() => {
+                self.pick_at(x, y).ok().flatten()
+            }
             _ => None,
         };
         self.update_previews();
         self.sync_grid();
         let repaint_delay = full.viewport_output.get(&egui::ViewportId::ROOT).map(|v| v.repaint_delay);
         let Some(window_copy) = self.trace_and_present(&ctx, full, overlays) else { return };
-        if std::mem::take(&mut self.screenshot_requested) {
+        if std::mem::take(&mut self.frames.screenshot_requested) {
             self.save_screenshot(window_copy);
         }
-        self.stats.frame_ms = started.elapsed().as_secs_f64() * 1e3;
-        if !self.ready && self.loading.is_none() {
-            self.ready = true;
+        self.readouts.stats.frame_ms = started.elapsed().as_secs_f64() * 1e3;
+        if !self.frames.ready && self.doc.loading.is_none() {
+            self.frames.ready = true;
             let (w, h) = self.gfx.as_ref().map_or((0, 0), |g| (g.config.width, g.config.height));
             report!("octovox: ready {w}x{h}");
         }
@@ -83,15 +88,16 @@ impl App {
     /// Updates the smoothed frame rate; returns the seconds since the last
     /// frame (at most 0.1, so a stall does not fling the flying camera).
     fn measure_interval(&mut self, started: Instant) -> f64 {
-        let seconds = self.last_frame.map_or(0.0, |t| started.duration_since(t).as_secs_f64().min(0.1));
-        if let Some(last) = self.last_frame {
+        let seconds = self.frames.last_frame.map_or(0.0, |t| started.duration_since(t).as_secs_f64().min(0.1));
+        if let Some(last) = self.frames.last_frame {
             let interval = started.duration_since(last).as_secs_f64();
             if interval < 1.0 {
                 let fps = 1.0 / interval.max(1e-6);
-                self.stats.fps = if self.stats.fps == 0.0 { fps } else { self.stats.fps * 0.9 + fps * 0.1 };
+                self.readouts.stats.fps =
+                    if self.readouts.stats.fps == 0.0 { fps } else { self.readouts.stats.fps * 0.9 + fps * 0.1 };
             }
         }
-        self.last_frame = Some(started);
+        self.frames.last_frame = Some(started);
         seconds
     }
 
@@ -102,35 +108,38 @@ impl App {
         let gfx = self.gfx.as_mut()?;
         let raw_input = gfx.egui_state.take_egui_input(&gfx.window);
         let ctx = gfx.egui_state.egui_ctx().clone();
-        let loading =
-            self.loading.as_ref().map(|l| (l.path.clone(), l.started.elapsed().as_secs_f64(), l.progress.fraction()));
+        let loading = self
+            .doc
+            .loading
+            .as_ref()
+            .map(|l| (l.path.clone(), l.started.elapsed().as_secs_f64(), l.progress.fraction()));
         let mut commands = Vec::new();
         let mut overlays = Vec::new();
         let mut full = {
             let info = ui::Info {
-                palette: &self.editor.scene.palette,
-                tree: &self.editor.scene.tree,
-                stats: self.shown_stats.take(&ctx, &self.stats),
+                palette: &self.doc.editor.scene.palette,
+                tree: &self.doc.editor.scene.tree,
+                stats: self.readouts.shown_stats.take(&ctx, &self.readouts.stats),
                 adapter: &gfx.renderer.gpu.adapter_name,
                 timestamps: gfx.renderer.timed_by_gpu(),
                 loading: loading.as_ref().map(|(p, s, f)| (p.as_path(), *s, *f)),
-                can_undo: self.editor.history.can_undo(),
-                can_redo: self.editor.history.can_redo(),
+                can_undo: self.doc.editor.history.can_undo(),
+                can_redo: self.doc.editor.history.can_redo(),
                 history: {
-                    let (steps, bytes) = self.editor.history.usage();
-                    (steps, bytes, self.editor.history.memory_limit_bytes)
+                    let (steps, bytes) = self.doc.editor.history.usage();
+                    (steps, bytes, self.doc.editor.history.memory_limit_bytes)
                 },
-                presets: self.presets_measured.as_deref(),
+                presets: self.readouts.presets_measured.as_deref(),
                 selection,
-                has_clipboard: self.editor.clipboard().is_some(),
-                recent: self.recent.files().cloned().collect(),
-                extrude: self.extrude_preview.as_ref().map(|p| (p.voxels.as_slice(), p.face.1, p.layers)),
-                fill: self.fill_preview.as_ref().map(|p| p.region),
+                has_clipboard: self.doc.editor.clipboard().is_some(),
+                recent: self.doc.recent.files().cloned().collect(),
+                extrude: self.hover.extrude_preview.as_ref().map(|p| (p.voxels.as_slice(), p.face.1, p.layers)),
+                fill: self.hover.fill_preview.as_ref().map(|p| p.region),
                 paste,
                 eyedropper,
             };
-            let (state, ui_state, tools) = (&mut self.state, &mut self.ui, &mut self.editor.tools);
-            let pick = self.pick;
+            let (state, ui_state, tools) = (&mut self.state, &mut self.ui, &mut self.doc.editor.tools);
+            let pick = self.hover.pick;
             ctx.run_ui(raw_input, |ui| {
                 commands = ui::show(ui, state, tools, ui_state, &info);
                 ui::draw_selection(ui, state, &info);
@@ -143,7 +152,7 @@ impl App {
                 overlays = ui::take_scene_overlays(ui.ctx());
             })
         };
-        self.pointer_over_ui = ctx.is_pointer_over_egui();
+        self.hover.pointer_over_ui = ctx.is_pointer_over_egui();
         gfx.egui_state.handle_platform_output(&gfx.window, std::mem::take(&mut full.platform_output));
         if !commands.is_empty() {
             log::debug!("panel commands {commands:?}");
@@ -152,7 +161,7 @@ impl App {
             self.execute(command, event_loop);
         }
         // A palette control let go without a last change still ends its step.
-        if self.palette_stroke && !ctx.input(|i| i.pointer.any_down()) {
+        if matches!(self.gesture, Gesture::Palette) && !ctx.input(|i| i.pointer.any_down()) {
             self.close_strokes();
         }
         Some((ctx, full, overlays))
@@ -172,7 +181,7 @@ impl App {
         let tessellate_started = Instant::now();
         let panels = ctx.tessellate(full.shapes, full.pixels_per_point);
         let overlays = ctx.tessellate(overlays, full.pixels_per_point);
-        self.stats.panels_ms += tessellate_started.elapsed().as_secs_f64() * 1e3;
+        self.readouts.stats.panels_ms += tessellate_started.elapsed().as_secs_f64() * 1e3;
         gfx.egui.set_textures(&gfx.renderer.gpu, &mut full.textures_delta);
         let screen = egui_wgpu::ScreenDescriptor {
             size_in_pixels: [gfx.config.width, gfx.config.height],
@@ -182,8 +191,8 @@ impl App {
         // Trace: the one encode path that headless rendering uses too. An
         // accumulation that starts over is preceded by a preview frame, shown
         // until its first sample (which may come in bands) is complete.
-        let wants_path = path_traced(&self.state, self.motion.moving());
-        let (scene, state) = (&self.editor.scene, &self.state);
+        let wants_path = path_traced(&self.state, self.frames.motion.moving());
+        let (scene, state) = (&self.doc.editor.scene, &self.state);
         let view = PathView {
             tree: &scene.tree,
             palette: &scene.palette,
@@ -191,17 +200,19 @@ impl App {
             size: trace_size,
             settings: &state.path_settings,
         };
-        let restarts = wants_path && gfx.renderer.path_restarts(&view, self.path_stale);
-        let path = wants_path && (!restarts || self.preview_before_path);
-        self.preview_before_path = wants_path && !path;
+        let revision = self.doc.editor.revision();
+        let scene_changed = self.frames.path_drawn != Some(revision);
+        let restarts = wants_path && gfx.renderer.path_restarts(&view, scene_changed);
+        let path = wants_path && (!restarts || self.frames.preview_before_path);
+        self.frames.preview_before_path = wants_path && !path;
         if path {
-            let changed = std::mem::take(&mut self.path_stale);
+            self.frames.path_drawn = Some(revision);
             gfx.renderer.sample_target = self.state.sample_target.max(1);
-            let frame = gfx.renderer.render_path(&view, changed);
+            let frame = gfx.renderer.render_path(&view, scene_changed);
             match frame {
                 Ok(frame) => {
                     if frame.added {
-                        self.stats.trace_ms = frame.ms;
+                        self.readouts.stats.trace_ms = frame.ms;
                         // A slow sample is spread over frames of about the
                         // frame-time target: a frame that must show a moved
                         // camera then waits for one band, not a whole sample.
@@ -212,7 +223,7 @@ impl App {
                             report!("path: {} samples, effects [{effects}]", frame.samples);
                         }
                     }
-                    self.stats.path = Some(frame);
+                    self.readouts.stats.path = Some(frame);
                 }
                 Err(err) => log::error!("path tracing failed: {err}"),
             }
@@ -221,19 +232,20 @@ impl App {
             let highlight = if self.state.select_mode {
                 selection.map(|r| (r.min, r.max))
             } else {
-                self.pick.map(|pick| self.state.preview_box(&self.editor.tools, &pick))
+                self.hover.pick.map(|pick| self.state.preview_box(&self.doc.editor.tools, &pick))
             };
             let settings = &self.state.settings;
-            match gfx.renderer.render(&self.editor.scene.tree, &self.state.camera, trace_size, settings, highlight) {
-                Ok(ms) => self.stats.trace_ms = ms,
+            match gfx.renderer.render(&self.doc.editor.scene.tree, &self.state.camera, trace_size, settings, highlight)
+            {
+                Ok(ms) => self.readouts.stats.trace_ms = ms,
                 Err(err) => log::error!("trace failed: {err}"),
             }
-            self.stats.path = None;
+            self.readouts.stats.path = None;
         }
 
         // Blit + egui onto the swapchain image.
         let present_started = Instant::now();
-        let frame = acquire_frame(gfx, &self.redraw_wanted)?;
+        let frame = acquire_frame(gfx, &self.frames.redraw_wanted)?;
         let acquired = Instant::now();
         let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
         gfx.blit.prepare(&gfx.renderer.gpu.device, gfx.renderer.output_view());
@@ -241,7 +253,7 @@ impl App {
             gfx.renderer.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("present") });
         gfx.blit.encode(&mut encoder, &view, None);
         let user_buffers = gfx.egui.encode(&gfx.renderer.gpu, &mut encoder, &view, &panels, &overlays, &screen);
-        let window_copy = (self.screenshot_requested && gfx.can_copy_frame)
+        let window_copy = (self.frames.screenshot_requested && gfx.can_copy_frame)
             .then(|| capture::copy_frame(gfx, &mut encoder, &frame.texture));
         let recorded = Instant::now();
         gfx.renderer.gpu.queue.submit(user_buffers.into_iter().chain([encoder.finish()]));
@@ -250,44 +262,46 @@ impl App {
         gfx.egui.free_textures();
         let ms = |from: Instant, to: Instant| to.duration_since(from).as_secs_f64() * 1e3;
         let now = Instant::now();
-        (self.stats.acquire_ms, self.stats.draw_ms) = (ms(present_started, acquired), ms(acquired, recorded));
-        (self.stats.submit_ms, self.stats.present_ms) = (ms(recorded, now), ms(present_started, now));
+        (self.readouts.stats.acquire_ms, self.readouts.stats.draw_ms) =
+            (ms(present_started, acquired), ms(acquired, recorded));
+        (self.readouts.stats.submit_ms, self.readouts.stats.present_ms) = (ms(recorded, now), ms(present_started, now));
         Some(window_copy)
     }
 
     /// Keeps drawing while something moves; otherwise waits for input (or
     /// for when egui asks to be drawn again).
     fn schedule_repaint(&mut self, repaint_delay: Option<Duration>) {
-        let accumulating = self.stats.path.is_some_and(|p| p.samples < self.state.sample_target);
+        let accumulating = self.readouts.stats.path.is_some_and(|p| p.samples < self.state.sample_target);
         let animating = accumulating
-            || self.preview_before_path
-            || self.loading.is_some()
+            || self.frames.preview_before_path
+            || self.doc.loading.is_some()
             || self.input.fly_direction().is_some()
-            || self.bench.is_some()
-            || self.player.is_some();
-        self.next_repaint = match repaint_delay {
+            || self.frames.bench.is_some()
+            || self.doc.player.is_some();
+        self.frames.next_repaint = match repaint_delay {
             _ if animating => Some(Instant::now()),
             // An open native dialog is looked at ten times a second.
-            _ if self.file_dialog.is_some() => Some(Instant::now() + Duration::from_millis(100)),
+            _ if self.doc.file_dialog.is_some() => Some(Instant::now() + Duration::from_millis(100)),
             Some(delay) if delay < Duration::from_secs(5) => Some(Instant::now() + delay),
             _ => None,
         };
         // Input draws the frames while the camera moves; once it keeps
         // still, one more frame draws the resting view at full scale.
-        if let Some(at) = self.motion.settles_at() {
-            self.next_repaint = Some(self.next_repaint.map_or(at, |next| next.min(at)));
+        if let Some(at) = self.frames.motion.settles_at() {
+            self.frames.next_repaint = Some(self.frames.next_repaint.map_or(at, |next| next.min(at)));
         }
     }
 
     /// Rebuilds and uploads the dense grid while grid mode is on and the voxels changed.
     fn sync_grid(&mut self) {
-        if self.state.settings.mode != TraceMode::Grid || !self.grid_stale {
+        let revision = self.doc.editor.revision();
+        if self.state.settings.mode != TraceMode::Grid || self.frames.grid_drawn == Some(revision) {
             return;
         }
         let Some(gfx) = &mut self.gfx else { return };
-        match DenseGrid::from_octree(&self.editor.scene.tree) {
+        match DenseGrid::from_octree(&self.doc.editor.scene.tree) {
             Ok(grid) => match gfx.renderer.set_grid(&grid) {
-                Ok(()) => self.grid_stale = false,
+                Ok(()) => self.frames.grid_drawn = Some(revision),
                 Err(err) => {
                     self.state.settings.mode = TraceMode::Svo;
                     self.ui.error(format!("{err}; back to SVO"));

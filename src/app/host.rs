@@ -50,7 +50,7 @@ impl App {
             // A journal that the line starts begins with the selection before it.
             self.open_journal(selection);
         }
-        let (tools, camera) = (self.editor.tools, self.state.camera);
+        let (tools, camera) = (self.doc.editor.tools, self.state.camera);
         let gesture = self.continues_gesture(line);
         let ran = |r: &mut Recorder| r.ran(line, &tools, &camera, gesture);
         match (outcome, line) {
@@ -61,7 +61,7 @@ impl App {
                 self.after_change(if undo { "undo" } else { "redo" }, |_| Ok(()));
             }
             // A block copied before the journal started: the journal starts again after the paste.
-            (Outcome::Changed, Line::Paste(_)) if !self.clipboard_journaled => {
+            (Outcome::Changed, Line::Paste(_)) if !self.doc.clipboard_journaled => {
                 self.record_to_recording(ran);
                 self.restart_journal_from_snapshot();
                 self.after_change("paste", |_| Ok(()));
@@ -80,7 +80,7 @@ impl App {
             }
         }
         if matches!(line, Line::Copy | Line::Cut) {
-            self.clipboard_journaled = self.journal.is_some();
+            self.doc.clipboard_journaled = self.doc.journal.is_some();
         }
     }
 
@@ -88,14 +88,14 @@ impl App {
     /// script's viewport, the default settings), by the window's renderer.
     fn render_for_script(&mut self, path: &Path) -> Result<image::RgbaImage, HostError> {
         let gfx = self.gfx.as_mut().ok_or(HostError::NoGpuYet)?;
-        let viewport = self.player.as_ref().map_or(octovox::replay::DEFAULT_VIEWPORT, |p| p.viewport);
+        let viewport = self.doc.player.as_ref().map_or(octovox::replay::DEFAULT_VIEWPORT, |p| p.viewport);
         let settings = RenderSettings::default();
-        gfx.renderer.render(&self.editor.scene.tree, &self.state.camera, viewport, &settings, None)?;
+        gfx.renderer.render(&self.doc.editor.scene.tree, &self.state.camera, viewport, &settings, None)?;
         let image = gfx.renderer.read_image()?;
         octovox::io::png::save_png(&image, path, WriteOptions::default())?;
         report!("screenshot: {}", path.display());
         // The window's next frame traces its own view again.
-        self.path_stale = true;
+        self.frames.path_drawn = None;
         self.request_redraw();
         Ok(image)
     }
@@ -103,7 +103,7 @@ impl App {
 
 impl Host for App {
     fn editor(&mut self) -> &mut Editor {
-        &mut self.editor
+        &mut self.doc.editor
     }
 
     /// Read in the background, as File ▸ Open does; the player waits for it.
@@ -120,7 +120,7 @@ impl Host for App {
 
     /// The size of the script's renders; clicks name pixels of the window.
     fn set_viewport(&mut self, width: u32, height: u32) {
-        if let Some(player) = &mut self.player {
+        if let Some(player) = &mut self.doc.player {
             player.viewport = (width, height);
         }
     }
@@ -135,17 +135,17 @@ impl Host for App {
 
     fn render(&mut self, path: &Path) -> Result<(), HostError> {
         let image = self.render_for_script(path)?;
-        if let Some(player) = &mut self.player {
+        if let Some(player) = &mut self.doc.player {
             player.last_render = Some(image);
         }
         Ok(())
     }
 
     fn last_render(&self) -> Option<&image::RgbaImage> {
-        self.player.as_ref()?.last_render.as_ref()
+        self.doc.player.as_ref()?.last_render.as_ref()
     }
 
     fn last_written(&self) -> Option<u64> {
-        self.stats.last_edit_bytes
+        self.readouts.stats.last_edit_bytes
     }
 }

@@ -75,8 +75,8 @@ impl App {
     /// (the next save, or another document).
     pub(super) fn record(&mut self, f: impl Fn(&mut Recorder) -> std::io::Result<()>) {
         self.record_to_recording(&f);
-        self.open_journal(self.editor.selection);
-        if let Some(journal) = &mut self.journal
+        self.open_journal(self.doc.editor.selection);
+        if let Some(journal) = &mut self.doc.journal
             && let Err(err) = f(journal)
         {
             let text = format!("the crash-recovery journal {} stopped: {err}", journal.path().display());
@@ -90,8 +90,8 @@ impl App {
         log::warn!("{text}");
         report!("journal failed: {text}");
         self.ui.journal_warning = Some(format!("unsaved edits are not protected: {text}"));
-        self.journal = None;
-        self.journal_start.clear();
+        self.doc.journal = None;
+        self.doc.journal_start.clear();
     }
 
     /// Records an undo (or redo) the history just made. The journal gets
@@ -99,7 +99,7 @@ impl App {
     /// snapshot of the scene as it is now.
     pub(super) fn record_undo(&mut self, undo: bool) {
         let step = |r: &mut Recorder| if undo { r.undo() } else { r.redo() };
-        let journal_has_it = self.journal.as_ref().is_some_and(|j| if undo { j.can_undo() } else { j.can_redo() });
+        let journal_has_it = self.doc.journal.as_ref().is_some_and(|j| if undo { j.can_undo() } else { j.can_redo() });
         if journal_has_it {
             return self.record(step);
         }
@@ -109,11 +109,11 @@ impl App {
 
     /// Runs `f` on the `--record` recorder only.
     pub(super) fn record_to_recording(&mut self, f: impl Fn(&mut Recorder) -> std::io::Result<()>) {
-        if let Some(recorder) = &mut self.recorder
+        if let Some(recorder) = &mut self.doc.recorder
             && let Err(err) = f(recorder)
         {
             self.ui.error(format!("recording to {} stopped: {err}", recorder.path().display()));
-            self.recorder = None;
+            self.doc.recorder = None;
         }
     }
 
@@ -132,7 +132,7 @@ impl App {
     /// `selection`: the selection in force before the change (a `move` as
     /// the first edit moves it).
     pub(super) fn open_journal(&mut self, selection: Option<octovox::edit::selection::Region>) {
-        if self.journal.is_some() || !self.state.dirty || self.journal_start.lines.is_empty() {
+        if self.doc.journal.is_some() || !self.state.dirty || self.doc.journal_start.lines.is_empty() {
             return;
         }
         let path = self.journal_file();
@@ -145,7 +145,7 @@ impl App {
             let _ = std::fs::create_dir_all(dir);
         }
         let selection = selection.map(|r| Line::Select(Some((r.min, r.max))));
-        let (lines, stamp) = (&self.journal_start.lines, &self.journal_start.stamp);
+        let (lines, stamp) = (&self.doc.journal_start.lines, &self.doc.journal_start.stamp);
         let started = Recorder::journal(&path, &header).and_then(|mut journal| {
             let write = |journal: &mut Recorder| -> std::io::Result<()> {
                 if let Some(stamp) = stamp {
@@ -162,10 +162,10 @@ impl App {
         });
         match started {
             Ok(journal) => {
-                self.journal = Some(journal);
+                self.doc.journal = Some(journal);
                 self.ui.journal_warning = None;
                 // What the clipboard holds was copied before this journal.
-                self.clipboard_journaled = false;
+                self.doc.clipboard_journaled = false;
             }
             Err(err) => {
                 self.journal_failed(format!("cannot write the crash-recovery journal {}: {err}", path.display()))
@@ -176,7 +176,7 @@ impl App {
     /// Starts the journal again from a snapshot of the scene as it is now,
     /// saved beside it (`octovox::journal::snapshot_path`).
     pub(super) fn restart_journal_from_snapshot(&mut self) {
-        if self.journal_start.lines.is_empty() {
+        if self.doc.journal_start.lines.is_empty() {
             return;
         }
         let journal = self.journal_file();
@@ -189,11 +189,11 @@ impl App {
         let hash = std::cell::RefCell::new(None);
         let keep = |sha256: &str| *hash.borrow_mut() = Some(sha256.to_owned());
         let options = octovox::io::atomic::WriteOptions { before_replace: Some(&keep), ..Default::default() };
-        match octovox::io::save_scene(&snapshot, &self.editor.scene, options) {
+        match octovox::io::save_scene(&snapshot, &self.doc.editor.scene, options) {
             Ok(()) => {
                 let absolute = std::fs::canonicalize(&snapshot).unwrap_or(snapshot);
-                self.journal_start = JournalStart::load(absolute, hash.into_inner());
-                self.open_journal(self.editor.selection);
+                self.doc.journal_start = JournalStart::load(absolute, hash.into_inner());
+                self.open_journal(self.doc.editor.selection);
             }
             Err(err) => self.journal_failed(format!("cannot snapshot the scene for the crash-recovery journal: {err}")),
         }
@@ -203,7 +203,7 @@ impl App {
     /// recorder, after the file): the scene was saved, or its edits
     /// discarded.
     pub(super) fn close_journal(&mut self) {
-        if let Some(journal) = self.journal.take() {
+        if let Some(journal) = self.doc.journal.take() {
             let _ = std::fs::remove_file(octovox::journal::snapshot_path(journal.path()));
             let _ = std::fs::remove_file(journal.path());
         }

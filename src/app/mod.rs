@@ -15,11 +15,14 @@ macro_rules! report {
 mod actions;
 mod camera_control;
 mod capture;
+mod clock;
 mod command;
+mod document;
 mod egui_layers;
 mod file_dialog;
 mod files;
 mod frame;
+mod gesture;
 mod host;
 mod input;
 mod journal;
@@ -32,11 +35,9 @@ mod selection;
 mod state;
 mod ui;
 
-use std::cell::Cell;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
-use std::sync::mpsc::Receiver;
 use std::time::Instant;
 
 use anyhow::Context as _;
@@ -48,7 +49,6 @@ use winit::window::{Window, WindowId};
 
 use octovox::camera::Camera;
 use octovox::edit::Edit;
-use octovox::editor::Editor;
 use octovox::gpu::scene_buffers::UploadStats;
 use octovox::gpu::{BlitMode, BlitPass, GpuContext, Renderer};
 use octovox::io::atomic::WriteOptions;
@@ -57,11 +57,15 @@ use octovox::scene::Scene;
 use octovox::trace::svo;
 
 use crate::cli::WindowArgs;
+use clock::FrameClock;
 pub use command::{Choice, Command, Nudge, Pending, StrokePhase};
+use document::Document;
 use egui_layers::EguiLayers;
+use gesture::{Gesture, Stroke};
 use input::Input;
+use preview::Hover;
 use state::{EditorState, Pick, Tool};
-use ui::{DialogKind, Stats, UiState};
+use ui::{DialogKind, Readouts, UiState};
 
 /// Where screenshots and the journal of an untitled scene go, relative to
 /// the working directory.
@@ -78,7 +82,7 @@ pub fn run(args: WindowArgs) -> anyhow::Result<ExitCode> {
     let instance = GpuContext::window_instance(Box::new(event_loop.owned_display_handle()));
     let mut app = App::new(args, instance);
     event_loop.run_app(&mut app).context("the event loop failed")?;
-    if let Some(frames) = &app.moving_frames {
+    if let Some(frames) = &app.frames.moving_frames {
         report!("frame-stats: {}", frames.summary());
     }
     match app.fatal.take() {
@@ -102,94 +106,25 @@ struct Gfx {
     egui: EguiLayers,
 }
 
-/// A .vox being read on a background thread.
-struct Loading {
-    path: PathBuf,
-    started: Instant,
-    progress: octovox::io::progress::Progress,
-    result: Receiver<Result<(Scene, Option<octovox::journal::FileStamp>), octovox::io::LoadError>>,
-}
-
-/// An open mouse stroke: its tool, the face (normal and layer) it started
-/// on, the last brush centre applied, and whether the line being run is
-/// the stroke's own (a step of it, not a key action that ends it).
-struct Stroke {
-    tool: Tool,
-    plane: Option<(IVec3, i32)>,
-    last_center: Option<IVec3>,
-    applying: bool,
-}
-
-/// `--bench-frames`: frames left and the measurements so far.
-struct Bench {
-    left: u32,
-    total: u32,
-    started: Option<Instant>,
-    trace_ms: f64,
-}
-
+/// The window. What it holds is in plain structs, each in its own file:
+/// the document, the gesture under way, what the cursor is over, the
+/// frame clock, the panels' state and readouts.
 struct App {
-    instance: Option<wgpu::Instance>,
     args: WindowArgs,
+    /// Until the window opens.
+    instance: Option<wgpu::Instance>,
+    /// The window and everything on the GPU, once it is open.
     gfx: Option<Gfx>,
-    /// Scene, history, brush, colour, mirror, selection: the engine's editor,
-    /// which played scripts drive too.
-    editor: Editor,
+    doc: Document,
+    /// The tool, modes, camera, render settings and the file's name.
     state: EditorState,
+    gesture: Gesture,
+    hover: Hover,
+    frames: FrameClock,
     ui: UiState,
+    readouts: Readouts,
     input: Input,
-    stats: Stats,
-    shown_stats: ui::ShownStats,
-    /// The last frame traced the preview in place of a path-traced frame
-    /// that would have started the accumulation over; the next one starts it.
-    preview_before_path: bool,
-    pick: Option<Pick>,
-    /// The render scale while the camera moves.
-    motion: motion::MotionScale,
-    /// Frame intervals while the camera moved (`--frame-stats`).
-    moving_frames: Option<motion::MovingFrames>,
-    pointer_over_ui: bool,
-    stroke: Option<Stroke>,
-    loading: Option<Loading>,
-    grid_stale: bool,
-    /// The voxels or palette changed since the path tracer last looked.
-    path_stale: bool,
-    /// A palette control is held: its changes are one undo step.
-    palette_stroke: bool,
-    /// What the last measurement of the quality presets found.
-    presets_measured: Option<Vec<presets::Measured>>,
-    screenshot_requested: bool,
-    ready: bool,
-    last_frame: Option<Instant>,
-    next_repaint: Option<Instant>,
-    /// A frame was asked for since the last one (see `request_redraw`).
-    redraw_wanted: Cell<bool>,
-    bench: Option<Bench>,
     fatal: Option<anyhow::Error>,
-    /// `--replay`: the script being played.
-    player: Option<script::Player>,
-    /// `--record`: where the session is written as a script.
-    recorder: Option<octovox::replay::Recorder>,
-    /// The crash-recovery journal of the open document (`octovox::journal`),
-    /// and what starts it (the document as saved).
-    journal: Option<octovox::replay::Recorder>,
-    journal_start: journal::JournalStart,
-    /// The clipboard was filled by a `copy` or `cut` the open journal holds
-    /// (else a paste starts the journal again from a snapshot).
-    clipboard_journaled: bool,
-    /// A native file dialog that is open.
-    file_dialog: Option<file_dialog::NativeDialog>,
-    /// File ▸ Open recent.
-    recent: recent::Recent,
-    /// A box-select drag under way (select mode).
-    select_drag: Option<selection::SelectDrag>,
-    /// What an extrude from the face under the cursor (Ctrl held) or the
-    /// Ctrl+drag under way would move.
-    extrude_preview: Option<preview::ExtrudePreview>,
-    /// What a Shift+click fill with Paint would recolour.
-    fill_preview: Option<preview::FillPreview>,
-    /// The face a Ctrl+drag extrude started on and where the drag began.
-    extrude_from: Option<(Pick, (f64, f64))>,
 }
 
 impl App {
@@ -197,41 +132,15 @@ impl App {
         let mut app = App {
             instance: Some(instance),
             gfx: None,
-            editor: Editor::default(),
+            doc: Document::default(),
             state: EditorState::default(),
+            gesture: Gesture::Idle,
+            hover: Hover::default(),
+            frames: FrameClock::new(&args),
             ui: UiState::default(),
+            readouts: Readouts::default(),
             input: Input::default(),
-            stats: Stats::default(),
-            shown_stats: ui::ShownStats::default(),
-            preview_before_path: false,
-            pick: None,
-            motion: motion::MotionScale::default(),
-            moving_frames: args.frame_stats.then(motion::MovingFrames::default),
-            pointer_over_ui: false,
-            stroke: None,
-            loading: None,
-            grid_stale: true,
-            path_stale: true,
-            palette_stroke: false,
-            presets_measured: None,
-            screenshot_requested: false,
-            ready: false,
-            last_frame: None,
-            next_repaint: None,
-            redraw_wanted: Cell::new(true),
-            bench: args.bench_frames.map(|n| Bench { left: n.max(1), total: n.max(1), started: None, trace_ms: 0.0 }),
             fatal: None,
-            player: None,
-            recorder: None,
-            journal: None,
-            journal_start: journal::JournalStart::default(),
-            clipboard_journaled: false,
-            file_dialog: None,
-            recent: recent::Recent::load(),
-            select_drag: None,
-            extrude_preview: None,
-            fill_preview: None,
-            extrude_from: None,
             args,
         };
         app.open_script_files();
@@ -285,7 +194,7 @@ impl App {
             config.usage |= wgpu::TextureUsages::COPY_SRC;
         }
         let cpu = gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu;
-        config.present_mode = present_mode(&caps.present_modes, cpu, self.bench.is_some());
+        config.present_mode = present_mode(&caps.present_modes, cpu, self.frames.bench.is_some());
         surface.configure(&gpu.device, &config);
         let blit = BlitPass::new(&gpu, config.format, BlitMode::Replace)?;
         let mut renderer = Renderer::new(gpu)?;
@@ -321,7 +230,7 @@ impl App {
     /// drawing those would keep two cores busy with an unchanged picture.
     fn request_redraw(&self) {
         if let Some(gfx) = &self.gfx {
-            self.redraw_wanted.set(true);
+            self.frames.redraw_wanted.set(true);
             gfx.window.request_redraw();
         }
     }
@@ -331,7 +240,7 @@ impl App {
     /// Ctrl+Z / Ctrl+Shift+Z: one step, if there is one.
     fn undo_redo(&mut self, undo: bool) {
         let what = if undo { "undo" } else { "redo" };
-        let (undoable, redoable) = self.editor.history.steps();
+        let (undoable, redoable) = self.doc.editor.history.steps();
         if (if undo { undoable } else { redoable }) == 0 {
             return self.ui.info(format!("nothing to {what}"));
         }
@@ -356,18 +265,16 @@ impl App {
         self.ui.change_made();
         self.record(record);
         let upload = self.upload();
-        self.stats.last_edit_bytes = Some(upload.bytes);
-        self.stats.last_edit_ranges = upload.ranges;
+        self.readouts.stats.last_edit_bytes = Some(upload.bytes);
+        self.readouts.stats.last_edit_ranges = upload.ranges;
         report!(
             "{what}: {} bytes written in {} ranges{}",
             upload.bytes,
             upload.ranges,
             if upload.grew { " (buffer grew)" } else { "" }
         );
-        self.extrude_preview = None;
-        self.fill_preview = None;
-        self.grid_stale = true;
-        self.path_stale = true;
+        self.hover.extrude_preview = None;
+        self.hover.fill_preview = None;
         self.update_title();
         self.request_redraw();
     }
@@ -376,7 +283,7 @@ impl App {
     /// which palette edits change) to the GPU buffers; the stats count the pool.
     fn upload(&mut self) -> UploadStats {
         match &mut self.gfx {
-            Some(gfx) => gfx.renderer.sync(&mut self.editor.scene.tree, &self.editor.scene.palette),
+            Some(gfx) => gfx.renderer.sync(&mut self.doc.editor.scene.tree, &self.doc.editor.scene.palette),
             // No device yet: the ranges stay dirty and go up with the first frame.
             None => UploadStats::default(),
         }
@@ -393,7 +300,7 @@ impl App {
     /// Carries out one command. Panels, keys, the mouse and played replay
     /// scripts all end up here.
     fn execute(&mut self, command: Command, event_loop: &ActiveEventLoop) {
-        let busy_loading = self.loading.is_some();
+        let busy_loading = self.doc.loading.is_some();
         match command {
             Command::PointerEdit { phase, tool, x, y } if !busy_loading => self.pointer_edit(phase, tool, x, y),
             Command::ExtrudeDrag { phase, x, y } if !busy_loading => self.extrude_drag(phase, x, y),
@@ -425,7 +332,7 @@ impl App {
             Command::ToggleSelect => self.state.toggle_select_mode(),
             Command::Copy => match self.run_line(&octovox::script::Command::Copy) {
                 Ok(_) => {
-                    let voxels = self.editor.clipboard().map_or(0, octovox::edit::selection::Block::voxels);
+                    let voxels = self.doc.editor.clipboard().map_or(0, octovox::edit::selection::Block::voxels);
                     self.ui.info(format!("copied {voxels} voxels"));
                 }
                 Err(err) => self.ui.error(format!("copy refused: {err}")),
@@ -439,7 +346,7 @@ impl App {
             Command::PickColor { x, y } => {
                 if let Some(pick) = self.pick_or_say(x, y, "no voxel there to pick a colour from") {
                     self.act(octovox::script::Command::Pick(pick.voxel), "pick");
-                    report!("picked colour {}", self.editor.tools.color);
+                    report!("picked colour {}", self.doc.editor.tools.color);
                 }
             }
             Command::SetTool(tool) => self.state.tool = tool,
@@ -474,7 +381,7 @@ impl App {
                 self.ask_path(DialogKind::Export, start.display().to_string());
             }
             Command::Export(path) => self.export(&path),
-            Command::Screenshot => self.screenshot_requested = true,
+            Command::Screenshot => self.frames.screenshot_requested = true,
             Command::Resolve(choice) => self.resolve(choice, event_loop),
             Command::RecoverJournal(journal, checks) => self.recover_journal(&journal, checks),
             Command::DiscardJournal(journal) => {
@@ -487,7 +394,7 @@ impl App {
     /// Frames the whole model, centred in the part of the window that the
     /// side panel leaves free.
     fn frame_model(&mut self) {
-        camera_control::frame_model(&mut self.state.camera, self.editor.scene.tree.solid_bounds());
+        camera_control::frame_model(&mut self.state.camera, self.doc.editor.scene.tree.solid_bounds());
         let (scale, height) =
             self.gfx.as_ref().map_or((1.0, self.args.size.1), |g| (g.window.scale_factor(), g.config.height));
         camera_control::pan(&mut self.state.camera, f64::from(ui::PANEL_WIDTH) * scale * 0.5, 0.0, height);
@@ -498,7 +405,7 @@ impl App {
     /// The render scale this frame traces at: the user's, lowered while the
     /// camera moves.
     fn render_scale(&self) -> f32 {
-        self.state.settings.render_scale.clamp(octovox::settings::MIN_RENDER_SCALE, 1.0) * self.motion.factor()
+        self.state.settings.render_scale.clamp(octovox::settings::MIN_RENDER_SCALE, 1.0) * self.frames.motion.factor()
     }
 
     /// The window's size in physical pixels (the requested one before it opens).
@@ -525,7 +432,7 @@ impl App {
         }
         let px = ((x * f64::from(w) / f64::from(window_w)) as u32).min(w - 1);
         let py = ((y * f64::from(h) / f64::from(window_h)) as u32).min(h - 1);
-        let hit = svo::pick(&self.editor.scene.tree, &self.state.camera, (w, h), px, py)?;
+        let hit = svo::pick(&self.doc.editor.scene.tree, &self.state.camera, (w, h), px, py)?;
         Ok(hit.map(|hit| Pick { voxel: hit.voxel, normal: hit.normal, value: hit.value }))
     }
 
@@ -574,10 +481,10 @@ impl App {
     fn extrude_drag(&mut self, phase: StrokePhase, x: f64, y: f64) {
         match phase {
             StrokePhase::Begin => {
-                self.extrude_from = self
+                self.gesture = self
                     .pick_or_say(x, y, "no face under the cursor to extrude")
                     .filter(|p| p.normal != IVec3::ZERO)
-                    .map(|p| (p, (x, y)));
+                    .map_or(Gesture::Idle, |face| Gesture::Extrude { face, start: (x, y) });
             }
             // While dragging, the message line says what the release will do.
             StrokePhase::Move => {
@@ -588,7 +495,7 @@ impl App {
             }
             StrokePhase::End => {
                 let layers = self.extrude_layers(x, y);
-                let Some((pick, _)) = self.extrude_from.take() else { return };
+                let Gesture::Extrude { face: pick, .. } = std::mem::take(&mut self.gesture) else { return };
                 let Some(layers) = layers.filter(|l| *l != 0) else { return };
                 self.act(octovox::script::Command::Extrude(pick.voxel, pick.normal, layers), "extrude");
             }
@@ -598,8 +505,8 @@ impl App {
 
     /// The layers a Ctrl+drag from its start to (x, y) covers.
     fn extrude_layers(&self, x: f64, y: f64) -> Option<i32> {
-        let (pick, start) = self.extrude_from?;
-        let face = (pick.voxel - self.editor.scene.tree.origin()).as_vec3()
+        let Gesture::Extrude { face: pick, start } = self.gesture else { return None };
+        let face = (pick.voxel - self.doc.editor.scene.tree.origin()).as_vec3()
             + glam::Vec3::splat(0.5)
             + pick.normal.as_vec3() * 0.5;
         self.screen_steps(face, pick.normal, start, (x, y))
@@ -610,7 +517,7 @@ impl App {
     /// `face` is drawn on screen: extrudes and selection handles.
     fn screen_steps(&self, face: glam::Vec3, normal: IVec3, start: (f64, f64), end: (f64, f64)) -> Option<i32> {
         let (w, h) = self.window_size();
-        let basis = self.state.camera.basis(w, h, self.editor.scene.tree.origin());
+        let basis = self.state.camera.basis(w, h, self.doc.editor.scene.tree.origin());
         let (a, b) = (basis.project(face)?, basis.project(face + normal.as_vec3())?);
         let step = glam::DVec2::new(f64::from(b.0 - a.0), f64::from(b.1 - a.1));
         let drag = glam::DVec2::new(end.0 - start.0, end.1 - start.1);
@@ -622,7 +529,7 @@ impl App {
     fn measure_presets(&mut self) {
         let window = self.window_size();
         let Some(gfx) = &mut self.gfx else { return };
-        match presets::measure(&mut gfx.renderer, &self.editor.scene, &self.state.camera, window) {
+        match presets::measure(&mut gfx.renderer, &self.doc.editor.scene, &self.state.camera, window) {
             Ok(measured) => {
                 let line: Vec<String> = presets::PRESETS
                     .iter()
@@ -630,11 +537,12 @@ impl App {
                     .map(|(p, m)| format!("{} {:.1} ms FLIP {:.3}", p.name, m.ms, m.flip))
                     .collect();
                 report!("presets: {}", line.join("; "));
-                self.presets_measured = Some(measured);
+                self.readouts.presets_measured = Some(measured);
             }
             Err(err) => self.ui.error(format!("cannot measure the presets: {err}")),
         }
-        self.path_stale = true;
+        // The measurement traced other frames: the accumulation starts over.
+        self.frames.path_drawn = None;
         self.request_redraw();
     }
 
@@ -643,7 +551,7 @@ impl App {
     /// step, and so do the two lines of one change.
     fn palette_edit(&mut self, edit: Edit, dragging: bool) {
         let Edit::Palette { index, color: [r, g, b, _], material } = edit else { return };
-        let palette = &self.editor.scene.palette;
+        let palette = &self.doc.editor.scene.palette;
         let mut lines = Vec::new();
         if palette.color(index)[..3] != [r, g, b] {
             lines.push(octovox::script::Command::Rgb(index, [r, g, b]));
@@ -651,9 +559,9 @@ impl App {
         if *palette.material(index) != *material {
             lines.push(octovox::script::Command::Material(index, material));
         }
-        if !self.palette_stroke {
-            self.editor.history.begin_stroke();
-            self.palette_stroke = true;
+        if !matches!(self.gesture, Gesture::Palette) {
+            self.doc.editor.history.begin_stroke();
+            self.gesture = Gesture::Palette;
         }
         for line in &lines {
             if let Err(err) = self.run_line(line) {
@@ -669,8 +577,9 @@ impl App {
     /// Closes the open undo step of a mouse drag or a held palette control,
     /// in the history and the recording alike.
     pub(super) fn close_strokes(&mut self) {
-        if self.stroke.take().is_some() | std::mem::take(&mut self.palette_stroke) {
-            self.editor.history.end_stroke();
+        if self.gesture.groups_edits() {
+            self.gesture = Gesture::Idle;
+            self.doc.editor.history.end_stroke();
         }
         self.record(|r| {
             r.end_step();
@@ -687,8 +596,8 @@ impl App {
         }
         match phase {
             StrokePhase::Begin => {
-                self.editor.history.begin_stroke();
-                self.stroke = Some(Stroke { tool, plane: None, last_center: None, applying: false });
+                self.doc.editor.history.begin_stroke();
+                self.gesture = Gesture::Stroke(Stroke { tool, plane: None, last_center: None, applying: false });
                 self.stroke_step(x, y);
             }
             StrokePhase::Move => self.stroke_step(x, y),
@@ -703,7 +612,7 @@ impl App {
     /// One brush application of the open stroke at (x, y), if it lands on a
     /// new cell of the stroke's layer.
     fn stroke_step(&mut self, x: f64, y: f64) {
-        let Some(stroke) = &self.stroke else { return };
+        let Some(stroke) = self.gesture.stroke() else { return };
         let pick = match self.pick_at(x, y) {
             Ok(Some(pick)) => pick,
             Ok(None) => return,
@@ -720,7 +629,7 @@ impl App {
         // the brush's reach of its layer: the cells they reveal or create
         // would otherwise be picked next and the stroke would dig or pile up
         // toward the camera.
-        let reach = self.editor.tools.brush.reach();
+        let reach = self.doc.editor.tools.brush.reach();
         let off_layer = |(normal, depth): (IVec3, i32)| normal != layer.0 || (layer.1 - depth).abs() > reach;
         if stroke.tool != Tool::Paint && stroke.plane.is_some_and(off_layer) {
             return;
@@ -745,7 +654,7 @@ impl App {
     }
 
     fn with_stroke(&mut self, f: impl FnOnce(&mut Stroke)) {
-        if let Some(stroke) = &mut self.stroke {
+        if let Some(stroke) = self.gesture.stroke_mut() {
             f(stroke);
         }
     }
@@ -755,8 +664,8 @@ impl App {
     fn continues_gesture(&self, line: &octovox::script::Command) -> bool {
         use octovox::script::Command as Line;
         match line {
-            Line::Place(_) | Line::Remove(_) | Line::Paint(_) => self.stroke.as_ref().is_some_and(|s| s.applying),
-            Line::Rgb(..) | Line::Material(..) => self.palette_stroke,
+            Line::Place(_) | Line::Remove(_) | Line::Paint(_) => self.gesture.stroke().is_some_and(|s| s.applying),
+            Line::Rgb(..) | Line::Material(..) => matches!(self.gesture, Gesture::Palette),
             _ => false,
         }
     }
@@ -794,7 +703,7 @@ impl ApplicationHandler for App {
         }
         let response = gfx.egui_state.on_window_event(&gfx.window, &event);
         if response.repaint && !matches!(event, WindowEvent::RedrawRequested) {
-            self.redraw_wanted.set(true);
+            self.frames.redraw_wanted.set(true);
             gfx.window.request_redraw();
         }
         match &event {
@@ -808,7 +717,7 @@ impl ApplicationHandler for App {
                 if size.width > 0 && size.height > 0 {
                     (gfx.config.width, gfx.config.height) = surface_size(*size, &gfx.renderer.gpu);
                     gfx.surface.configure(&gfx.renderer.gpu.device, &gfx.config);
-                    self.redraw_wanted.set(true);
+                    self.frames.redraw_wanted.set(true);
                     gfx.window.request_redraw();
                 }
                 return;
@@ -819,7 +728,7 @@ impl ApplicationHandler for App {
             }
             WindowEvent::RedrawRequested => {
                 let size = gfx.window.inner_size();
-                if size.width > 0 && size.height > 0 && self.redraw_wanted.take() {
+                if size.width > 0 && size.height > 0 && self.frames.redraw_wanted.take() {
                     self.frame(event_loop);
                 }
                 return;
@@ -830,7 +739,7 @@ impl ApplicationHandler for App {
         // wheel over the side panel is the panel's even where egui lets it
         // go (at the end of its scroll range), never a zoom of the view.
         let wheel_on_panel = matches!(event, WindowEvent::MouseWheel { .. })
-            && (self.pointer_over_ui
+            && (self.hover.pointer_over_ui
                 || self
                     .input
                     .cursor()
@@ -842,9 +751,9 @@ impl ApplicationHandler for App {
     }
 
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
-        match self.next_repaint {
+        match self.frames.next_repaint {
             Some(at) if at <= Instant::now() => {
-                self.next_repaint = None;
+                self.frames.next_repaint = None;
                 self.request_redraw();
                 event_loop.set_control_flow(ControlFlow::Wait);
             }

@@ -9,6 +9,7 @@ use glam::IVec3;
 use octovox::edit::selection::Region;
 
 use super::App;
+use super::gesture::Gesture;
 use super::state::Tool;
 
 /// The faces an extrude would move: those of the region around `face`
@@ -26,6 +27,21 @@ pub(super) struct FillPreview {
     pub region: Option<((IVec3, IVec3), usize)>,
 }
 
+/// What the cursor is over, and what the actions it would start there
+/// would change.
+#[derive(Default)]
+pub(super) struct Hover {
+    /// The voxel and face under the cursor.
+    pub pick: Option<super::state::Pick>,
+    /// The cursor is over a panel: the scene takes no clicks.
+    pub pointer_over_ui: bool,
+    /// What an extrude from the face under the cursor (Ctrl held) or the
+    /// Ctrl+drag under way would move.
+    pub extrude_preview: Option<ExtrudePreview>,
+    /// What a Shift+click fill with Paint would recolour.
+    pub fill_preview: Option<FillPreview>,
+}
+
 impl App {
     pub(super) fn update_previews(&mut self) {
         self.update_extrude_preview();
@@ -36,25 +52,25 @@ impl App {
     /// Ctrl+drag started on, else of the face under the cursor while Ctrl
     /// is held (line and select modes have no extrude).
     fn update_extrude_preview(&mut self) {
-        let face = match self.extrude_from {
-            Some((pick, _)) => Some(pick),
-            None if self.input.ctrl_held() && !self.state.line_mode && !self.state.select_mode => self.pick,
-            None => None,
+        let face = match self.gesture {
+            Gesture::Extrude { face, .. } => Some(face),
+            _ if self.input.ctrl_held() && !self.state.line_mode && !self.state.select_mode => self.hover.pick,
+            _ => None,
         }
         .filter(|p| p.normal != IVec3::ZERO)
         .map(|p| (p.voxel, p.normal));
         let Some(face) = face else {
-            self.extrude_preview = None;
+            self.hover.extrude_preview = None;
             return;
         };
-        if self.extrude_preview.as_ref().is_none_or(|p| p.face != face) {
+        if self.hover.extrude_preview.as_ref().is_none_or(|p| p.face != face) {
             // A region too large to extrude previews nothing; the release says why.
-            let region = octovox::edit::extrude::face_region(&self.editor.scene.tree, face.0, face.1);
+            let region = octovox::edit::extrude::face_region(&self.doc.editor.scene.tree, face.0, face.1);
             let voxels = region.map(|r| r.into_iter().map(|(p, _)| p).collect()).unwrap_or_default();
-            self.extrude_preview = Some(ExtrudePreview { face, voxels, layers: 0 });
+            self.hover.extrude_preview = Some(ExtrudePreview { face, voxels, layers: 0 });
         }
         let layers = self.input.cursor().and_then(|(x, y)| self.extrude_layers(x, y)).unwrap_or(0);
-        if let Some(preview) = &mut self.extrude_preview {
+        if let Some(preview) = &mut self.hover.extrude_preview {
             preview.layers = layers;
         }
     }
@@ -64,33 +80,34 @@ impl App {
     fn update_fill_preview(&mut self) {
         let plain_mode = !self.state.line_mode && !self.state.select_mode;
         let start = self
+            .hover
             .pick
             .filter(|_| plain_mode && self.state.tool == Tool::Paint && self.input.shift_held())
             .map(|p| p.voxel);
         let Some(start) = start else {
-            self.fill_preview = None;
+            self.hover.fill_preview = None;
             return;
         };
-        if self.fill_preview.as_ref().is_some_and(|p| p.start == start) {
+        if self.hover.fill_preview.as_ref().is_some_and(|p| p.start == start) {
             return;
         }
-        let region = octovox::edit::fill::fill_region(&self.editor.scene.tree, start).ok().map(|voxels| {
+        let region = octovox::edit::fill::fill_region(&self.doc.editor.scene.tree, start).ok().map(|voxels| {
             let lo = voxels.iter().copied().reduce(IVec3::min).unwrap_or(start);
             let hi = voxels.iter().copied().reduce(IVec3::max).unwrap_or(start);
             ((lo, hi), voxels.len())
         });
-        self.fill_preview = Some(FillPreview { start, region });
+        self.hover.fill_preview = Some(FillPreview { start, region });
     }
 
     /// The box Ctrl+V would fill: in select mode, the clipboard's block in
     /// front of the face under the cursor.
     pub(super) fn paste_preview(&self) -> Option<Region> {
-        let pick = self.pick.filter(|_| self.state.select_mode)?;
-        Some(self.editor.clipboard()?.region_at(pick.voxel + pick.normal))
+        let pick = self.hover.pick.filter(|_| self.state.select_mode)?;
+        Some(self.doc.editor.clipboard()?.region_at(pick.voxel + pick.normal))
     }
 
     /// The colour Alt+click would pick: the voxel's under the cursor.
     pub(super) fn eyedropper_preview(&self) -> Option<u8> {
-        self.pick.filter(|_| self.input.alt_held()).map(|p| p.value)
+        self.hover.pick.filter(|_| self.input.alt_held()).map(|p| p.value)
     }
 }

@@ -36,14 +36,14 @@ impl App {
     /// Plays the next script line, if a script is playing and the app is
     /// idle (not loading). Prints the summary after the last line.
     pub(super) fn play_step(&mut self) {
-        if self.loading.is_some() {
+        if self.doc.loading.is_some() {
             return;
         }
-        let Some(player) = &mut self.player else { return };
+        let Some(player) = &mut self.doc.player else { return };
         let Some(line) = player.script.lines.get(player.next).cloned() else {
             report!("replay: {} passed, {} failed", player.passed, player.failed);
             self.ui.info(format!("replay done: {} passed, {} failed", player.passed, player.failed));
-            self.player = None;
+            self.doc.player = None;
             return;
         };
         player.next += 1;
@@ -71,7 +71,7 @@ impl App {
     }
 
     fn with_player(&mut self, f: impl FnOnce(&mut Player)) {
-        if let Some(player) = &mut self.player {
+        if let Some(player) = &mut self.doc.player {
             f(player);
         }
     }
@@ -82,7 +82,7 @@ impl App {
     pub(super) fn open_script_files(&mut self) {
         if let Some(path) = self.args.replay.clone() {
             match octovox::script::load_script(&path) {
-                Ok(script) => self.player = Some(Player::new(script)),
+                Ok(script) => self.doc.player = Some(Player::new(script)),
                 Err(errors) => {
                     for error in &errors {
                         report!("{error}");
@@ -93,7 +93,7 @@ impl App {
         }
         if let Some(path) = self.args.record.clone() {
             match octovox::replay::Recorder::create(&path) {
-                Ok(recorder) => self.recorder = Some(recorder),
+                Ok(recorder) => self.doc.recorder = Some(recorder),
                 Err(err) => self.ui.error(format!("cannot record to {}: {err}", path.display())),
             }
         }

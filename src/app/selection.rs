@@ -11,6 +11,7 @@ use octovox::camera::Camera;
 use octovox::edit::selection::Region;
 use octovox::script::Command as Line;
 
+use super::gesture::Gesture;
 use super::{App, Nudge, StrokePhase};
 
 /// A selection drag under way.
@@ -27,18 +28,19 @@ impl App {
     pub(super) fn select_drag(&mut self, phase: StrokePhase, x: f64, y: f64) {
         match phase {
             StrokePhase::Begin => {
-                self.select_drag = match self.handle_at(x, y) {
+                let drag = match self.handle_at(x, y) {
                     Some(normal) => Some(SelectDrag::Face { normal, start: (x, y) }),
                     None => {
                         self.pick_or_say(x, y, "no voxel there to select from").map(|p| SelectDrag::NewBox(p.voxel))
                     }
                 };
+                self.gesture = drag.map_or(Gesture::Idle, Gesture::Select);
                 self.state.select_preview = self.dragged_box(x, y);
             }
             StrokePhase::Move => self.state.select_preview = self.dragged_box(x, y),
             StrokePhase::End => {
                 let region = self.dragged_box(x, y);
-                self.select_drag = None;
+                self.gesture = Gesture::Idle;
                 self.state.select_preview = None;
                 if let Some(r) = region {
                     self.act(Line::Select(Some((r.min, r.max))), "select");
@@ -51,19 +53,20 @@ impl App {
     /// The box to show as the selection: the one being dragged, else the
     /// selected one.
     pub(super) fn shown_selection(&self) -> Option<Region> {
-        self.state.select_preview.or(self.editor.selection)
+        self.state.select_preview.or(self.doc.editor.selection)
     }
 
     /// The box the drag so far would select.
     fn dragged_box(&self, x: f64, y: f64) -> Option<Region> {
-        match self.select_drag? {
+        let Gesture::Select(drag) = self.gesture else { return None };
+        match drag {
             SelectDrag::NewBox(from) => {
                 let to = self.pick_at(x, y).ok().flatten().map_or(from, |pick| pick.voxel);
                 Region::new(from, to).ok()
             }
             SelectDrag::Face { normal, start } => {
-                let region = self.editor.selection?;
-                let (lo, hi) = box_corners(&region, self.editor.scene.tree.origin());
+                let region = self.doc.editor.selection?;
+                let (lo, hi) = box_corners(&region, self.doc.editor.scene.tree.origin());
                 let face = (lo + hi) * 0.5 + normal.as_vec3() * (hi - lo) * 0.5;
                 let steps = self.screen_steps(face, normal, start, (x, y))?;
                 // The face moves along its normal; the box never turns inside out.
@@ -81,9 +84,9 @@ impl App {
     /// The outward normal of the selected box's face under window pixel
     /// (x, y), if the pointer is on the box.
     fn handle_at(&self, x: f64, y: f64) -> Option<IVec3> {
-        let region = self.editor.selection?;
+        let region = self.doc.editor.selection?;
         let (w, h) = self.window_size();
-        let origin = self.editor.scene.tree.origin();
+        let origin = self.doc.editor.scene.tree.origin();
         let (eye, dir) = self.state.camera.basis(w, h, origin).ray_through(x as f32, y as f32);
         let (lo, hi) = box_corners(&region, origin);
         entry_face(eye, dir, lo, hi)
@@ -101,7 +104,7 @@ impl App {
     /// An arrow key: `move` the selection one voxel along the world axis
     /// nearest to that direction as the camera sees it.
     pub(super) fn nudge(&mut self, nudge: Nudge) {
-        if self.editor.selection.is_none() {
+        if self.doc.editor.selection.is_none() {
             self.ui.info("nothing is selected: B, then drag a box");
             return;
         }

@@ -52,6 +52,15 @@ pub struct Stats {
     pub path: Option<octovox::gpu::PathFrame>,
 }
 
+/// What the panels read out: the last frame's numbers, the ones on
+/// screen, and what the last measurement of the quality presets found.
+#[derive(Default)]
+pub struct Readouts {
+    pub stats: Stats,
+    pub shown_stats: ShownStats,
+    pub presets_measured: Option<Vec<super::presets::Measured>>,
+}
+
 /// How often the Stats panel takes new numbers.
 const STATS_REFRESH: std::time::Duration = std::time::Duration::from_millis(250);
 

@@ -1,0 +1,60 @@
+//! The frame clock: when the window is ready, when the last frame was
+//! drawn and the next is due, the render scale while the camera moves,
+//! `--bench-frames` and `--frame-stats`, and what the next frame must
+//! redo because something changed since it was last drawn.
+
+use std::cell::Cell;
+use std::time::Instant;
+
+use super::motion;
+use crate::cli::WindowArgs;
+
+/// `--bench-frames`: frames left and the measurements so far.
+pub(super) struct Bench {
+    pub left: u32,
+    pub total: u32,
+    pub started: Option<Instant>,
+    pub trace_ms: f64,
+}
+
+pub(super) struct FrameClock {
+    /// The first frame has been presented (`octovox: ready` printed).
+    pub ready: bool,
+    pub last_frame: Option<Instant>,
+    pub next_repaint: Option<Instant>,
+    /// A frame was asked for since the last one (see `App::request_redraw`).
+    pub redraw_wanted: Cell<bool>,
+    pub screenshot_requested: bool,
+    pub bench: Option<Bench>,
+    /// The render scale while the camera moves.
+    pub motion: motion::MotionScale,
+    /// Frame intervals while the camera moved (`--frame-stats`).
+    pub moving_frames: Option<motion::MovingFrames>,
+    /// The last frame traced the preview in place of a path-traced frame
+    /// that would have started the accumulation over; the next one starts it.
+    pub preview_before_path: bool,
+    /// The editor's revision (`Editor::revision`) the dense grid of grid
+    /// mode was built from, and the one the path tracer's accumulation
+    /// holds: a frame redoes what is older than the scene. `None`: nothing
+    /// known to be up to date (the renderer was used for something else).
+    pub grid_drawn: Option<u64>,
+    pub path_drawn: Option<u64>,
+}
+
+impl FrameClock {
+    pub fn new(args: &WindowArgs) -> FrameClock {
+        FrameClock {
+            ready: false,
+            last_frame: None,
+            next_repaint: None,
+            redraw_wanted: Cell::new(true),
+            screenshot_requested: false,
+            bench: args.bench_frames.map(|n| Bench { left: n.max(1), total: n.max(1), started: None, trace_ms: 0.0 }),
+            motion: motion::MotionScale::default(),
+            moving_frames: args.frame_stats.then(motion::MovingFrames::default),
+            preview_before_path: false,
+            grid_drawn: None,
+            path_drawn: None,
+        }
+    }
+}

@@ -1,0 +1,53 @@
+//! The drag or held control under way, one at a time.
+
+use glam::IVec3;
+
+use super::selection::SelectDrag;
+use super::state::{Pick, Tool};
+
+/// What the mouse (or a held panel control) is doing now.
+#[derive(Default)]
+pub(super) enum Gesture {
+    #[default]
+    Idle,
+    /// A brush stroke: its steps are one undo step.
+    Stroke(Stroke),
+    /// A palette control is held: its changes are one undo step.
+    Palette,
+    /// A box-select drag (select mode).
+    Select(SelectDrag),
+    /// A Ctrl+drag extrude: the face it started on and where the drag began.
+    Extrude { face: Pick, start: (f64, f64) },
+}
+
+/// An open mouse stroke: its tool, the face (normal and layer) it started
+/// on, the last brush centre applied, and whether the line being run is
+/// the stroke's own (a step of it, not a key action that ends it).
+pub(super) struct Stroke {
+    pub tool: Tool,
+    pub plane: Option<(IVec3, i32)>,
+    pub last_center: Option<IVec3>,
+    pub applying: bool,
+}
+
+impl Gesture {
+    /// Whether the gesture groups edits into one undo step (a stroke, a
+    /// held palette control).
+    pub fn groups_edits(&self) -> bool {
+        matches!(self, Gesture::Stroke(_) | Gesture::Palette)
+    }
+
+    pub fn stroke_mut(&mut self) -> Option<&mut Stroke> {
+        match self {
+            Gesture::Stroke(stroke) => Some(stroke),
+            _ => None,
+        }
+    }
+
+    pub fn stroke(&self) -> Option<&Stroke> {
+        match self {
+            Gesture::Stroke(stroke) => Some(stroke),
+            _ => None,
+        }
+    }
+}
