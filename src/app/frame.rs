@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 
 use winit::event_loop::ActiveEventLoop;
 
-use octovox::gpu::PathView;
+use octovox::gpu::{FrameInput, PathView, Submitted};
 use octovox::settings::{Shading, TraceMode, View};
 use octovox::trace::grid::DenseGrid;
 
@@ -188,9 +188,15 @@ impl App {
             pixels_per_point: full.pixels_per_point,
         };
 
-        // Trace: the one encode path that headless rendering uses too. An
+        // One encoder and one submit a frame: the trace (the one encode path
+        // that headless rendering uses too), the blit and the panels. An
         // accumulation that starts over is preceded by a preview frame, shown
         // until its first sample (which may come in bands) is complete.
+        let present_started = Instant::now();
+        let frame = acquire_frame(gfx, &self.frames.redraw_wanted)?;
+        let acquired = Instant::now();
+        let device = gfx.renderer.gpu.device.clone();
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         let wants_path = path_traced(&self.state, self.frames.motion.moving());
         let (scene, state) = (&self.doc.editor.scene, &self.state);
         let view = PathView {
@@ -205,28 +211,10 @@ impl App {
         let restarts = wants_path && gfx.renderer.path_restarts(&view, scene_changed);
         let path = wants_path && (!restarts || self.frames.preview_before_path);
         self.frames.preview_before_path = wants_path && !path;
-        if path {
+        let input = if path {
             self.frames.path_drawn = Some(revision);
             gfx.renderer.sample_target = self.state.sample_target.max(1);
-            let frame = gfx.renderer.render_path(&view, scene_changed);
-            match frame {
-                Ok(frame) => {
-                    if frame.added {
-                        self.readouts.stats.trace_ms = frame.ms;
-                        // A slow sample is spread over frames of about the
-                        // frame-time target: a frame that must show a moved
-                        // camera then waits for one band, not a whole sample.
-                        let bands = (frame.ms / f64::from(self.state.frame_target_ms)).ceil();
-                        gfx.renderer.path_bands = (bands as u32).clamp(1, MAX_PATH_BANDS);
-                        if frame.samples == gfx.renderer.sample_target {
-                            let effects = frame.effects.names().join(" ");
-                            report!("path: {} samples, effects [{effects}]", frame.samples);
-                        }
-                    }
-                    self.readouts.stats.path = Some(frame);
-                }
-                Err(err) => log::error!("path tracing failed: {err}"),
-            }
+            FrameInput::Path { view, scene_changed }
         } else {
             // Select mode tints the selected voxels; the other modes what the brush would touch.
             let highlight = if self.state.select_mode {
@@ -234,29 +222,26 @@ impl App {
             } else {
                 self.hover.pick.map(|pick| self.state.preview_box(&self.doc.editor.tools, &pick))
             };
-            let settings = &self.state.settings;
-            match gfx.renderer.render(&self.doc.editor.scene.tree, &self.state.camera, trace_size, settings, highlight)
-            {
-                Ok(ms) => self.readouts.stats.trace_ms = ms,
-                Err(err) => log::error!("trace failed: {err}"),
-            }
-            self.readouts.stats.path = None;
+            FrameInput::preview(&scene.tree, &state.camera, trace_size, &state.settings, highlight)
+        };
+        if let Err(err) = gfx.renderer.encode(&mut encoder, &input) {
+            log::error!("trace failed: {err}");
         }
-
-        // Blit + egui onto the swapchain image.
-        let present_started = Instant::now();
-        let frame = acquire_frame(gfx, &self.frames.redraw_wanted)?;
-        let acquired = Instant::now();
         let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
-        gfx.blit.prepare(&gfx.renderer.gpu.device, gfx.renderer.output_view());
-        let mut encoder =
-            gfx.renderer.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("present") });
+        gfx.blit.prepare(&device, gfx.renderer.output_view());
+        // The blit and the panels are render passes labelled with their
+        // names; a debug group around a render pass crashes lavapipe (Mesa
+        // 22.3) in `CommandEncoder::finish`, so only the compute passes get one.
         gfx.blit.encode(&mut encoder, &view, None);
         let user_buffers = gfx.egui.encode(&gfx.renderer.gpu, &mut encoder, &view, &panels, &overlays, &screen);
         let window_copy = (self.frames.screenshot_requested && gfx.can_copy_frame)
             .then(|| capture::copy_frame(gfx, &mut encoder, &frame.texture));
         let recorded = Instant::now();
-        gfx.renderer.gpu.queue.submit(user_buffers.into_iter().chain([encoder.finish()]));
+        match gfx.renderer.submit(user_buffers, encoder) {
+            Ok(submitted) => self.frame_submitted(path, submitted),
+            Err(err) => log::error!("the frame failed: {err}"),
+        }
+        let Some(gfx) = self.gfx.as_mut() else { return Some(window_copy) };
         gfx.window.pre_present_notify();
         gfx.renderer.gpu.queue.present(frame);
         gfx.egui.free_textures();
@@ -266,6 +251,31 @@ impl App {
             (ms(present_started, acquired), ms(acquired, recorded));
         (self.readouts.stats.submit_ms, self.readouts.stats.present_ms) = (ms(recorded, now), ms(present_started, now));
         Some(window_copy)
+    }
+
+    /// What a submitted frame took, for the stats and the path tracer's
+    /// band size.
+    fn frame_submitted(&mut self, path: bool, submitted: Submitted) {
+        let Some(gfx) = self.gfx.as_mut() else { return };
+        if !path {
+            self.readouts.stats.trace_ms = submitted.ms;
+            self.readouts.stats.path = None;
+            return;
+        }
+        let Some(frame) = submitted.path else { return };
+        if frame.added {
+            self.readouts.stats.trace_ms = frame.ms;
+            // A slow sample is spread over frames of about the frame-time
+            // target: a frame that must show a moved camera then waits for
+            // one band, not a whole sample.
+            let bands = (frame.ms / f64::from(self.state.frame_target_ms)).ceil();
+            gfx.renderer.path_bands = (bands as u32).clamp(1, MAX_PATH_BANDS);
+            if frame.samples == gfx.renderer.sample_target {
+                let effects = frame.effects.names().join(" ");
+                report!("path: {} samples, effects [{effects}]", frame.samples);
+            }
+        }
+        self.readouts.stats.path = Some(frame);
     }
 
     /// Keeps drawing while something moves; otherwise waits for input (or

@@ -110,12 +110,7 @@ impl GpuContext {
     /// while it records or submits (an oversized binding, a bad dispatch) is
     /// an error of the command instead of a line in the log and a blank image.
     pub fn checked<T>(&self, work: impl FnOnce() -> Result<T, GpuError>) -> Result<T, GpuError> {
-        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let result = work();
-        match pollster::block_on(scope.pop()) {
-            Some(err) => Err(GpuError::Validation(err.to_string())),
-            None => result,
-        }
+        validated(&self.device, work)
     }
 
     /// Fails unless a `width`×`height` image fits the adapter's textures.
@@ -185,4 +180,18 @@ pub(super) fn compute_pipeline(
             cache: None,
         })
     })
+}
+
+/// [`GpuContext::checked`] on a device handle, for work that needs the
+/// context's owner mutably.
+///
+/// # Errors
+/// The work's own error, or the first validation error it caused.
+pub fn validated<T>(device: &wgpu::Device, work: impl FnOnce() -> Result<T, GpuError>) -> Result<T, GpuError> {
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let result = work();
+    match pollster::block_on(scope.pop()) {
+        Some(err) => Err(GpuError::Validation(err.to_string())),
+        None => result,
+    }
 }

@@ -3,6 +3,7 @@
 
 pub mod blit_pass;
 pub mod context;
+pub mod layout;
 pub mod path_pass;
 pub mod prelude;
 pub mod readback;
@@ -13,7 +14,8 @@ pub mod trace_pass;
 
 pub use blit_pass::{BlitMode, BlitPass};
 pub use context::{GpuContext, GpuError};
-pub use path_pass::{PathPass, PathUniforms};
-pub use renderer::{PathFrame, PathView, Renderer};
+pub use layout::{FrameUniforms, PathUniforms};
+pub use path_pass::PathPass;
+pub use renderer::{FrameInput, PathFrame, PathView, Preview, Renderer, Submitted};
 pub use scene_buffers::SceneBuffers;
-pub use trace_pass::{FrameUniforms, Kernel, TracePass};
+pub use trace_pass::{Kernel, TracePass};

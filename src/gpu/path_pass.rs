@@ -10,35 +10,23 @@
 use std::collections::HashMap;
 use std::sync::mpsc;
 
-use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
 use super::context::compute_pipeline;
+use super::layout::{
+    FrameUniforms, PathUniforms, buffer_entry, constants_buffer, constants_entry, output_entry, output_texture,
+};
 use super::prelude::with_prelude;
 use super::readback::{read_storage, read_texture_rgba8};
-use super::trace_pass::{FrameUniforms, buffer_entry, constants_buffer, constants_entry, output_entry, output_texture};
 use super::{GpuContext, GpuError, SceneBuffers};
+use crate::camera::RayBasis;
+use crate::settings::PathSettings;
 use crate::trace::path::lights::Emitter;
 use crate::trace::path::materials::{Effects, GpuMaterial};
 
 const COMMON_WGSL: &str = include_str!("../../shaders/common.wgsl");
 const SVO_WGSL: &str = include_str!("../../shaders/trace_svo.wgsl");
 const PATH_WGSL: &str = include_str!("../../shaders/path.wgsl");
-
-/// Twin of `PathUniforms` in `shaders/path.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-pub struct PathUniforms {
-    pub sky_horizon: [f32; 3],
-    pub sample_index: u32,
-    pub sky_zenith: [f32; 3],
-    pub bounces: u32,
-    pub shadow_samples: u32,
-    pub emitter_count: u32,
-    /// The band of rows this dispatch traces (`end_row` at most the height).
-    pub first_row: u32,
-    pub end_row: u32,
-}
 
 /// A kernel: compiled, or being compiled on a worker thread.
 enum Compiled {
@@ -84,6 +72,42 @@ pub struct PathPass {
     target: Target,
     bind_group: wgpu::BindGroup,
     bound_generation: u64,
+    /// The accumulation's state on the CPU side: what it is of, its samples.
+    pub accumulation: Accumulation,
+}
+
+/// What an accumulation is of: a change restarts it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathKey {
+    pub basis: RayBasis,
+    pub settings: PathSettings,
+    pub effects: Effects,
+}
+
+/// The path tracer's accumulation: its key, the samples so far, the lights
+/// sent with the scene, and the band of the sample under way (of how many,
+/// and the milliseconds of its bands so far).
+#[derive(Clone, Copy, Debug)]
+pub struct Accumulation {
+    pub key: Option<PathKey>,
+    pub samples: u32,
+    pub lights: usize,
+    pub band: (u32, u32),
+    pub band_ms: f64,
+}
+
+impl Default for Accumulation {
+    fn default() -> Accumulation {
+        Accumulation { key: None, samples: 0, lights: 0, band: (0, 1), band_ms: 0.0 }
+    }
+}
+
+impl Accumulation {
+    /// Whether an accumulation of `key` starts over: the scene or the size
+    /// changed, or the key (camera, settings, effects) differs.
+    pub fn starts_over(&self, key: &PathKey, resized: bool, scene_changed: bool) -> bool {
+        scene_changed || resized || self.key != Some(*key)
+    }
 }
 
 fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
@@ -174,6 +198,7 @@ impl PathPass {
             target,
             bind_group,
             bound_generation: buffers.generation,
+            accumulation: Accumulation::default(),
         })
     }
 

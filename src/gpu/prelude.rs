@@ -4,7 +4,7 @@
 
 use std::fmt::Write as _;
 
-use super::trace_pass::{FLOOR_ROW, ROW_TILES};
+use super::layout::{FLOOR_ROW, ROW_TILES};
 use crate::gpu_pool::{LOD_WORD, NODE_WORDS, POINTER_BIT};
 use crate::settings::{SUN_DIR, View};
 use crate::trace::path::{self, materials};

@@ -4,10 +4,12 @@
 
 use glam::IVec3;
 
+use super::context::validated;
+use super::path_pass::PathKey;
 use super::scene_buffers::UploadStats;
 use super::timer::PassTimer;
 use super::{FrameUniforms, GpuContext, GpuError, Kernel, PathPass, PathUniforms, SceneBuffers, TracePass};
-use crate::camera::{Camera, RayBasis};
+use crate::camera::Camera;
 use crate::scene::{Octree, Palette};
 use crate::settings::{PathSettings, RenderSettings, View};
 use crate::trace::grid::DenseGrid;
@@ -40,6 +42,62 @@ pub struct PathFrame {
     pub added: bool,
 }
 
+/// What one frame draws: the preview (a trace kernel: the SVO or grid
+/// tracer, or the floor) or the next band of a path-traced sample.
+pub enum FrameInput<'a> {
+    Trace(Preview<'a>),
+    Path {
+        view: PathView<'a>,
+        /// The voxels or the palette changed since the accumulation began.
+        scene_changed: bool,
+    },
+}
+
+/// A frame of a trace kernel.
+#[derive(Clone, Copy)]
+pub struct Preview<'a> {
+    pub tree: &'a Octree,
+    pub camera: &'a Camera,
+    pub size: (u32, u32),
+    pub view: View,
+    pub lod: f32,
+    /// An inclusive world-space voxel box to tint.
+    pub highlight: Option<(IVec3, IVec3)>,
+    pub kernel: Kernel,
+}
+
+impl<'a> FrameInput<'a> {
+    /// The preview of `tree` with `settings`.
+    pub fn preview(
+        tree: &'a Octree,
+        camera: &'a Camera,
+        size: (u32, u32),
+        settings: &RenderSettings,
+        highlight: Option<(IVec3, IVec3)>,
+    ) -> FrameInput<'a> {
+        let (view, lod, kernel) = (settings.view, settings.lod, Kernel::from(settings));
+        FrameInput::Trace(Preview { tree, camera, size, view, lod, highlight, kernel })
+    }
+}
+
+/// What [`Renderer::encode`] recorded, for [`Renderer::submit`] to complete.
+enum Recorded {
+    Trace,
+    Path {
+        kernel: Effects,
+        effects: Effects,
+    },
+    /// The accumulation has its samples: no pass this frame.
+    Nothing(PathFrame),
+}
+
+/// A submitted frame: the pass's milliseconds, and what a path-traced
+/// frame added.
+pub struct Submitted {
+    pub ms: f64,
+    pub path: Option<PathFrame>,
+}
+
 /// What a path-traced accumulation is of: the scene, the camera, the
 /// traced size and the settings. A change to any of them starts it over.
 #[derive(Clone, Copy)]
@@ -57,21 +115,6 @@ fn path_key(view: &PathView) -> PathKey {
     PathKey { basis, settings: *settings, effects: effects_for(tree, palette, settings) }
 }
 
-/// Whether an accumulation of `key` starts over: the scene or the size
-/// changed, or the key (camera, settings, effects) differs from the one
-/// `accumulating`.
-fn starts_over(accumulating: Option<PathKey>, key: &PathKey, resized: bool, scene_changed: bool) -> bool {
-    scene_changed || resized || accumulating != Some(*key)
-}
-
-/// What an accumulation is of: a change restarts it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct PathKey {
-    basis: RayBasis,
-    settings: PathSettings,
-    effects: Effects,
-}
-
 pub struct Renderer {
     pub gpu: GpuContext,
     pub buffers: SceneBuffers,
@@ -79,14 +122,6 @@ pub struct Renderer {
     pub path: PathPass,
     timer: PassTimer,
     shown: Shown,
-    /// The accumulation's key and sample count.
-    path_key: Option<PathKey>,
-    path_samples: u32,
-    path_lights: usize,
-    /// The band of the sample under way, of how many, and the milliseconds
-    /// of its bands so far.
-    path_band: (u32, u32),
-    path_band_ms: f64,
     /// Bands a path-traced sample is split into, one per call (taken when
     /// a sample starts; 1 by default): the window spreads a slow sample over
     /// several frames, so that a frame that must show a moved camera does
@@ -110,6 +145,8 @@ pub struct Renderer {
     /// Why the last sync could not upload the pool; frames fail with it
     /// until a sync succeeds.
     pool_error: Option<String>,
+    /// What the frame being recorded holds, until it is submitted.
+    recorded: Option<Recorded>,
 }
 
 impl Renderer {
@@ -125,17 +162,13 @@ impl Renderer {
             path,
             timer,
             shown: Shown::Trace,
-            path_key: None,
-            path_samples: 0,
-            path_lights: 0,
-            path_band: (0, 1),
-            path_band_ms: 0.0,
             path_bands: 1,
             sample_target: u32::MAX,
             wait_for_frames: true,
             hit_records: false,
             records_written: false,
             pool_error: None,
+            recorded: None,
         })
     }
 
@@ -191,7 +224,7 @@ impl Renderer {
         settings: &RenderSettings,
         highlight: Option<(IVec3, IVec3)>,
     ) -> Result<f64, GpuError> {
-        self.frame(tree, camera, size, (settings.view, settings.lod), highlight, Kernel::from(settings))
+        Ok(self.render_frame(&FrameInput::preview(tree, camera, size, settings, highlight))?.ms)
     }
 
     /// A frame of the floor kernel (everything but the traversal, see
@@ -200,40 +233,10 @@ impl Renderer {
     /// # Errors
     /// As [`Renderer::render`].
     pub fn render_floor(&mut self, tree: &Octree, camera: &Camera, size: (u32, u32)) -> Result<f64, GpuError> {
-        self.frame(tree, camera, size, (View::Shaded, 0.0), None, Kernel::Floor)
-    }
-
-    /// The one encode path of a frame: outputs sized, uniforms written, the
-    /// kernel dispatched and timed, all inside a validation scope.
-    fn frame(
-        &mut self,
-        tree: &Octree,
-        camera: &Camera,
-        size: (u32, u32),
-        (view, lod): (View, f32),
-        highlight: Option<(IVec3, IVec3)>,
-        kernel: Kernel,
-    ) -> Result<f64, GpuError> {
-        self.check_pool()?;
-        let gpu = &self.gpu;
-        gpu.checked(|| {
-            self.pass.resize(gpu, &self.buffers, size, self.hit_records)?;
-            self.pass.ensure_kernel(gpu, kernel)?;
-            let basis = camera.basis(size.0.max(1), size.1.max(1), tree.origin());
-            let local = highlight.map(|(lo, hi)| (lo - tree.origin(), hi - tree.origin()));
-            let uniforms = FrameUniforms {
-                hit_records: u32::from(self.hit_records),
-                ..FrameUniforms::new(&basis, tree, &self.buffers, view, local, Footprint::of_pixels(&basis, lod))
-            };
-            self.records_written = self.hit_records;
-            self.shown = Shown::Trace;
-            self.pass.prepare(&gpu.device, &gpu.queue, &self.buffers, &uniforms);
-            let mut encoder =
-                gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
-            self.pass.encode(&mut encoder, kernel, self.timer.pass_writes());
-            self.timer.resolve(&mut encoder);
-            submit(&mut self.timer, gpu, self.wait_for_frames, encoder)
-        })
+        let floor =
+            Preview { tree, camera, size, view: View::Shaded, lod: 0.0, highlight: None, kernel: Kernel::Floor };
+        let input = FrameInput::Trace(floor);
+        Ok(self.render_frame(&input)?.ms)
     }
 
     /// Adds one path-traced sample per pixel to the accumulation and shows
@@ -245,65 +248,178 @@ impl Renderer {
     /// # Errors
     /// As [`Renderer::render`].
     pub fn render_path(&mut self, view: &PathView, scene_changed: bool) -> Result<PathFrame, GpuError> {
+        let submitted = self.render_frame(&FrameInput::Path { view: *view, scene_changed })?;
+        submitted.path.ok_or_else(|| GpuError::Readback("a path frame reported no sample".into()))
+    }
+
+    /// One frame on its own encoder, submitted at once (headless renders;
+    /// the window records its blit and panels after [`Renderer::encode`] in
+    /// the same encoder and then calls [`Renderer::submit`]).
+    fn render_frame(&mut self, input: &FrameInput) -> Result<Submitted, GpuError> {
+        let mut encoder =
+            self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        self.encode(&mut encoder, input)?;
+        self.submit(Vec::new(), encoder)
+    }
+
+    /// Records the frame's pass into `encoder`, in a debug group of its
+    /// name: the outputs sized, the uniforms written, the kernel dispatched
+    /// and timed. [`Renderer::submit`] completes it.
+    ///
+    /// # Errors
+    /// As [`Renderer::render`].
+    pub fn encode(&mut self, encoder: &mut wgpu::CommandEncoder, input: &FrameInput) -> Result<(), GpuError> {
         self.check_pool()?;
+        self.recorded = None;
+        let device = self.gpu.device.clone();
+        let recorded = validated(&device, || match *input {
+            FrameInput::Trace(preview) => {
+                encoder.push_debug_group("trace");
+                let traced = self.encode_trace(encoder, &preview);
+                encoder.pop_debug_group();
+                traced.map(|()| Recorded::Trace)
+            }
+            FrameInput::Path { view, scene_changed } => {
+                encoder.push_debug_group("path");
+                let traced = self.encode_path(encoder, &view, scene_changed);
+                encoder.pop_debug_group();
+                traced
+            }
+        })?;
+        self.recorded = Some(recorded);
+        Ok(())
+    }
+
+    fn encode_trace(&mut self, encoder: &mut wgpu::CommandEncoder, preview: &Preview) -> Result<(), GpuError> {
+        let Preview { tree, camera, size, view, lod, highlight, kernel } = *preview;
+        let gpu = &self.gpu;
+        self.pass.resize(gpu, &self.buffers, size, self.hit_records)?;
+        self.pass.ensure_kernel(gpu, kernel)?;
+        let basis = camera.basis(size.0.max(1), size.1.max(1), tree.origin());
+        let local = highlight.map(|(lo, hi)| (lo - tree.origin(), hi - tree.origin()));
+        let uniforms = FrameUniforms {
+            hit_records: u32::from(self.hit_records),
+            ..FrameUniforms::new(&basis, tree, &self.buffers, view, local, Footprint::of_pixels(&basis, lod))
+        };
+        self.records_written = self.hit_records;
+        self.shown = Shown::Trace;
+        self.pass.prepare(&gpu.device, &gpu.queue, &self.buffers, &uniforms);
+        self.pass.encode(encoder, kernel, self.timer.pass_writes());
+        self.timer.resolve(encoder);
+        Ok(())
+    }
+
+    /// Records the next band of a path-traced sample, or nothing when the
+    /// accumulation has its samples.
+    fn encode_path(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &PathView,
+        scene_changed: bool,
+    ) -> Result<Recorded, GpuError> {
         let PathView { tree, palette, size, settings, .. } = *view;
         let gpu = &self.gpu;
-        gpu.checked(|| {
-            let resized = self.path.resize(gpu, &self.buffers, size)?;
-            let key = path_key(view);
-            let effects = key.effects;
-            // The materials and lights go up again when the scene or the effect set changed.
-            let send_scene = scene_changed || resized || self.path_key.is_none_or(|k| k.effects != effects);
-            if send_scene {
-                let lights = if effects.emit { lights::emitters(tree, palette) } else { Vec::new() };
-                self.path.upload_scene(gpu, &self.buffers, &material_table(palette), &lights);
-                self.path_lights = lights.len();
+        let resized = self.path.resize(gpu, &self.buffers, size)?;
+        let mut acc = self.path.accumulation;
+        let key = path_key(view);
+        let effects = key.effects;
+        // The materials and lights go up again when the scene or the effect set changed.
+        let send_scene = scene_changed || resized || acc.key.is_none_or(|k| k.effects != effects);
+        if send_scene {
+            let lights = if effects.emit { lights::emitters(tree, palette) } else { Vec::new() };
+            self.path.upload_scene(gpu, &self.buffers, &material_table(palette), &lights);
+            acc.lights = lights.len();
+        }
+        if acc.starts_over(&key, resized, scene_changed) {
+            acc.samples = 0;
+            acc.key = Some(key);
+            acc.band.0 = 0;
+        }
+        if acc.band.0 == 0 {
+            acc.band = (0, self.path_bands.clamp(1, size.1.max(1)));
+            acc.band_ms = 0.0;
+        }
+        self.path.accumulation = acc;
+        if acc.samples >= self.sample_target && self.shown == Shown::Path {
+            let (lights, samples) = (acc.lights, acc.samples);
+            return Ok(Recorded::Nothing(PathFrame {
+                ms: 0.0,
+                samples,
+                effects,
+                kernel: effects,
+                lights,
+                added: false,
+            }));
+        }
+        let (band, bands) = acc.band;
+        let band_rows = |band: u32| size.1.max(1) * band / bands;
+        let (first_row, end_row) = (band_rows(band), band_rows(band + 1));
+        let (sky_horizon, sky_zenith) = settings.sky.colors();
+        let path = PathUniforms {
+            sky_horizon,
+            sample_index: acc.samples,
+            sky_zenith,
+            bounces: settings.bounces,
+            shadow_samples: settings.shadow_samples,
+            emitter_count: acc.lights as u32,
+            first_row,
+            end_row,
+        };
+        let frame = FrameUniforms::new(&key.basis, tree, &self.buffers, View::Shaded, None, Footprint::EXACT);
+        self.path.prepare(gpu, &self.buffers, &frame, &path);
+        let kernel = self.path.encode(gpu, encoder, effects, end_row - first_row, self.timer.pass_writes())?;
+        self.timer.resolve(encoder);
+        // Until its first sample has every row, the accumulation is not
+        // shown: the trace output is (the window traces the preview first).
+        // What this band completes is shown by the frame that records it.
+        let completes = band + 1 == bands;
+        self.shown = if acc.samples + u32::from(completes) > 0 { Shown::Path } else { Shown::Trace };
+        Ok(Recorded::Path { kernel, effects })
+    }
+
+    /// Submits the frame [`Renderer::encode`] recorded, after `before` (the
+    /// window's panels upload their buffers in them), as one submit; waits
+    /// for path-traced frames and where `wait_for_frames` says so, and
+    /// returns the pass's milliseconds (a frame old when it did not wait)
+    /// and, for a path-traced frame, what it added.
+    ///
+    /// # Errors
+    /// Any validation error of the frame's commands.
+    pub fn submit(
+        &mut self,
+        before: Vec<wgpu::CommandBuffer>,
+        encoder: wgpu::CommandEncoder,
+    ) -> Result<Submitted, GpuError> {
+        let recorded = self.recorded.take();
+        let (gpu, timer) = (&self.gpu, &mut self.timer);
+        let wait = self.wait_for_frames || matches!(recorded, Some(Recorded::Path { .. }));
+        let ms = gpu.checked(|| {
+            let buffers: Vec<wgpu::CommandBuffer> = before.into_iter().chain([encoder.finish()]).collect();
+            match recorded {
+                None | Some(Recorded::Nothing(_)) => {
+                    gpu.queue.submit(buffers);
+                    Ok(0.0)
+                }
+                Some(_) if wait => timer.submit_and_measure(gpu, buffers),
+                Some(_) => timer.submit_without_waiting(gpu, buffers),
             }
-            if starts_over(self.path_key, &key, resized, scene_changed) {
-                self.path_samples = 0;
-                self.path_key = Some(key);
-                self.path_band.0 = 0;
-            }
-            if self.path_band.0 == 0 {
-                self.path_band = (0, self.path_bands.clamp(1, size.1.max(1)));
-                self.path_band_ms = 0.0;
-            }
-            let (band, bands) = self.path_band;
-            let band_rows = |band: u32| size.1.max(1) * band / bands;
-            let (first_row, end_row) = (band_rows(band), band_rows(band + 1));
-            if self.path_samples >= self.sample_target && self.shown == Shown::Path {
-                let lights = self.path_lights;
-                let samples = self.path_samples;
-                return Ok(PathFrame { ms: 0.0, samples, effects, kernel: effects, lights, added: false });
-            }
-            let (sky_horizon, sky_zenith) = settings.sky.colors();
-            let path = PathUniforms {
-                sky_horizon,
-                sample_index: self.path_samples,
-                sky_zenith,
-                bounces: settings.bounces,
-                shadow_samples: settings.shadow_samples,
-                emitter_count: self.path_lights as u32,
-                first_row,
-                end_row,
-            };
-            let frame = FrameUniforms::new(&key.basis, tree, &self.buffers, View::Shaded, None, Footprint::EXACT);
-            self.path.prepare(gpu, &self.buffers, &frame, &path);
-            let mut encoder =
-                gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("path frame") });
-            let rows = end_row - first_row;
-            let kernel = self.path.encode(gpu, &mut encoder, effects, rows, self.timer.pass_writes())?;
-            self.timer.resolve(&mut encoder);
-            self.path_band_ms += submit(&mut self.timer, gpu, true, encoder)?;
-            self.path_band.0 = (band + 1) % bands;
-            let added = self.path_band.0 == 0;
-            self.path_samples += u32::from(added);
-            // Until its first sample has every row, the accumulation is not
-            // shown: the trace output is (the window traces the preview first).
-            self.shown = if self.path_samples > 0 { Shown::Path } else { Shown::Trace };
-            let (ms, samples, lights) = (self.path_band_ms, self.path_samples, self.path_lights);
-            Ok(PathFrame { ms, samples, effects, kernel, lights, added })
-        })
+        })?;
+        let path = match recorded {
+            Some(Recorded::Path { kernel, effects }) => Some(self.path_band_done(ms, kernel, effects)),
+            Some(Recorded::Nothing(frame)) => Some(frame),
+            _ => None,
+        };
+        Ok(Submitted { ms, path })
+    }
+
+    /// Counts a submitted band of a path-traced sample.
+    fn path_band_done(&mut self, ms: f64, kernel: Effects, effects: Effects) -> PathFrame {
+        let acc = &mut self.path.accumulation;
+        acc.band_ms += ms;
+        acc.band.0 = (acc.band.0 + 1) % acc.band.1;
+        let added = acc.band.0 == 0;
+        acc.samples += u32::from(added);
+        PathFrame { ms: acc.band_ms, samples: acc.samples, effects, kernel, lights: acc.lights, added }
     }
 
     /// Whether [`Renderer::render_path`] with these arguments would start
@@ -312,7 +428,7 @@ impl Renderer {
     /// in bands, is complete.
     pub fn path_restarts(&self, view: &PathView, scene_changed: bool) -> bool {
         let resized = self.path.size() != (view.size.0.max(1), view.size.1.max(1));
-        starts_over(self.path_key, &path_key(view), resized, scene_changed)
+        self.path.accumulation.starts_over(&path_key(view), resized, scene_changed)
     }
 
     /// Compiles the path kernel a scene needs with `settings` now, so that the
@@ -366,10 +482,4 @@ impl Renderer {
         };
         image::RgbaImage::from_raw(w, h, bytes).ok_or_else(|| GpuError::Readback("texture size mismatch".into()))
     }
-}
-
-/// Submits a frame: waits for it and returns its milliseconds, or, without
-/// `wait`, returns at once with the latest time read back (an earlier frame's).
-fn submit(timer: &mut PassTimer, gpu: &GpuContext, wait: bool, encoder: wgpu::CommandEncoder) -> Result<f64, GpuError> {
-    if wait { timer.submit_and_measure(gpu, encoder) } else { timer.submit_without_waiting(gpu, encoder) }
 }

@@ -90,16 +90,20 @@ impl PassTimer {
         }
     }
 
-    /// Submits `encoder` and returns at once with the pass time of the
+    /// Submits `buffers` and returns at once with the pass time of the
     /// latest frame read back so far (the window's frames). Adapters without
     /// timestamps measure wall time, which needs the wait.
-    pub fn submit_without_waiting(&mut self, gpu: &GpuContext, encoder: wgpu::CommandEncoder) -> Result<f64, GpuError> {
+    pub fn submit_without_waiting(
+        &mut self,
+        gpu: &GpuContext,
+        buffers: Vec<wgpu::CommandBuffer>,
+    ) -> Result<f64, GpuError> {
         self.unwaited += 1;
         if !self.trusted || self.unwaited.is_multiple_of(CHECK_EVERY) {
-            return self.submit_and_measure(gpu, encoder);
+            return self.submit_and_measure(gpu, buffers);
         }
-        let Some((_, _, read)) = &self.queries else { return self.submit_and_measure(gpu, encoder) };
-        gpu.queue.submit([encoder.finish()]);
+        let Some((_, _, read)) = &self.queries else { return self.submit_and_measure(gpu, buffers) };
+        gpu.queue.submit(buffers);
         if self.state.compare_exchange(WRITTEN, MAPPING, Ordering::AcqRel, Ordering::Acquire).is_ok() {
             let state = Arc::clone(&self.state);
             read.slice(..).map_async(wgpu::MapMode::Read, move |result| {
@@ -124,11 +128,11 @@ impl PassTimer {
         Ok(())
     }
 
-    /// Submits `encoder`, waits, and returns the pass's milliseconds (GPU
+    /// Submits `buffers`, waits, and returns the pass's milliseconds (GPU
     /// timestamps if available, else wall time of submit + wait).
-    pub fn submit_and_measure(&mut self, gpu: &GpuContext, encoder: wgpu::CommandEncoder) -> Result<f64, GpuError> {
+    pub fn submit_and_measure(&mut self, gpu: &GpuContext, buffers: Vec<wgpu::CommandBuffer>) -> Result<f64, GpuError> {
         let start = Instant::now();
-        gpu.queue.submit([encoder.finish()]);
+        gpu.queue.submit(buffers);
         gpu.wait()?;
         let wall_ms = start.elapsed().as_secs_f64() * 1e3;
         if let Some((_, _, read)) = &self.queries
