@@ -216,7 +216,7 @@ impl Editor {
     ///
     /// # Errors
     /// A refused edit; then nothing changed.
-    pub fn apply_mirrored(&mut self, edits: Vec<Edit>) -> Result<bool, EditError> {
+    fn apply_mirrored(&mut self, edits: Vec<Edit>) -> Result<bool, EditError> {
         let edits = edits.into_iter().flat_map(|e| self.tools.mirror.edits(e)).collect();
         self.commit(edits)
     }
@@ -226,7 +226,7 @@ impl Editor {
     ///
     /// # Errors
     /// A refused edit; then nothing changed.
-    pub fn commit(&mut self, edits: Vec<Edit>) -> Result<bool, EditError> {
+    fn commit(&mut self, edits: Vec<Edit>) -> Result<bool, EditError> {
         let any = !edits.is_empty();
         self.history.apply_group(&mut self.scene, edits)?;
         self.revision += u64::from(any);

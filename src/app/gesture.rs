@@ -2,7 +2,6 @@
 
 use glam::IVec3;
 
-use super::selection::SelectDrag;
 use super::state::{Pick, Tool};
 
 /// What the mouse (or a held panel control) is doing now.
@@ -18,6 +17,16 @@ pub(super) enum Gesture {
     Select(SelectDrag),
     /// A Ctrl+drag extrude: the face it started on and where the drag began.
     Extrude { face: Pick, start: (f64, f64) },
+}
+
+/// A selection drag under way.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum SelectDrag {
+    /// A new box from this voxel.
+    NewBox(IVec3),
+    /// A face of the selected box, by its outward normal, dragged from
+    /// this window pixel.
+    Face { normal: IVec3, start: (f64, f64) },
 }
 
 /// An open mouse stroke: its tool, the face (normal and layer) it started

@@ -1,7 +1,9 @@
-//! The sandbox window: winit `ApplicationHandler`, the wgpu surface, the one
-//! path for edits (edit → history → octree → pool upload), and `execute`, the
-//! one place every command — mouse, keyboard, panel, played script — is
-//! carried out. The frame is in `frame`, opening and saving in `files`.
+//! The sandbox window: the winit `ApplicationHandler`, the wgpu surface,
+//! and `execute`, the one place every command (mouse, keyboard, panel) is
+//! carried out. What it holds is in plain structs, each in its own file
+//! (`document`, `gesture`, `preview`'s `Hover`, `clock`, `ui`); edits are
+//! script lines run through the one interpreter (`host`); the frame is in
+//! `frame`, opening and saving in `files`.
 
 /// Prints one status line on stdout (`edit: …`, `saved: …`, `octovox: ready`;
 /// tests and scripts read them). A closed stdout is not an error worth dying for.

@@ -11,18 +11,8 @@ use octovox::camera::Camera;
 use octovox::edit::selection::Region;
 use octovox::script::Command as Line;
 
-use super::gesture::Gesture;
+use super::gesture::{Gesture, SelectDrag};
 use super::{App, Nudge, StrokePhase};
-
-/// A selection drag under way.
-#[derive(Clone, Copy, Debug)]
-pub(super) enum SelectDrag {
-    /// A new box from this voxel.
-    NewBox(IVec3),
-    /// A face of the selected box, by its outward normal, dragged from
-    /// this window pixel.
-    Face { normal: IVec3, start: (f64, f64) },
-}
 
 impl App {
     pub(super) fn select_drag(&mut self, phase: StrokePhase, x: f64, y: f64) {
