@@ -35,8 +35,6 @@ pub struct Input {
     right: Option<((f64, f64), bool)>,
     keys: HashSet<KeyCode>,
     modifiers: ModifiersState,
-    /// A Ctrl+drag extrude is under way.
-    extruding: bool,
 }
 
 impl Input {
@@ -76,8 +74,9 @@ impl Input {
 
     /// Handles one event. `consumed` is egui's verdict: a consumed press
     /// starts nothing, but releases and motion are always tracked so that no
-    /// button stays stuck.
-    pub fn on_event(&mut self, event: &WindowEvent, consumed: bool, tool: Tool) -> Vec<Command> {
+    /// button stays stuck. `extruding`: a Ctrl+drag extrude is under way
+    /// (the window's gesture), so motion and the release go to it.
+    pub fn on_event(&mut self, event: &WindowEvent, consumed: bool, tool: Tool, extruding: bool) -> Vec<Command> {
         let mut out = Vec::new();
         match event {
             WindowEvent::ModifiersChanged(m) => self.modifiers = m.state(),
@@ -113,7 +112,7 @@ impl Input {
                 if self.left {
                     out.push(Command::PointerEdit { phase: StrokePhase::Move, tool, x, y });
                 }
-                if self.extruding {
+                if extruding {
                     out.push(Command::ExtrudeDrag { phase: StrokePhase::Move, x, y });
                 }
             }
@@ -130,12 +129,10 @@ impl Input {
                     // Ctrl+drag from a face: extrude.
                     (MouseButton::Left, true) if !consumed && self.modifiers.control_key() => {
                         if let Some((x, y)) = at {
-                            self.extruding = true;
                             out.push(Command::ExtrudeDrag { phase: StrokePhase::Begin, x, y });
                         }
                     }
-                    (MouseButton::Left, false) if self.extruding => {
-                        self.extruding = false;
+                    (MouseButton::Left, false) if extruding => {
                         let (x, y) = at.unwrap_or_default();
                         out.push(Command::ExtrudeDrag { phase: StrokePhase::End, x, y });
                     }

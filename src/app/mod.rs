@@ -747,7 +747,8 @@ impl ApplicationHandler for App {
                     .cursor()
                     .is_some_and(|(x, _)| x < f64::from(ui::PANEL_WIDTH) * gfx.window.scale_factor()));
         let consumed = response.consumed || self.ui.prompt_open || wheel_on_panel;
-        for command in self.input.on_event(&event, consumed, self.state.tool) {
+        let extruding = matches!(self.gesture, Gesture::Extrude { .. });
+        for command in self.input.on_event(&event, consumed, self.state.tool, extruding) {
             self.execute(command, event_loop);
         }
     }
