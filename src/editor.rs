@@ -284,7 +284,7 @@ fn picked_color(scene: &Scene, at: IVec3) -> Result<u8, EditorError> {
 /// `expect effects`: whether the effect set the scene calls for (with the
 /// default path settings, so a script means one thing in every host) is
 /// exactly `want` (in any order), and the set's names.
-pub fn effects_match(scene: &Scene, want: &[String]) -> (bool, Vec<&'static str>) {
+fn effects_match(scene: &Scene, want: &[String]) -> (bool, Vec<&'static str>) {
     let names = crate::trace::path::effects_for(&scene.tree, &scene.palette, &PathSettings::default()).names();
     let mut got = names.clone();
     let mut expected: Vec<&str> = want.iter().map(String::as_str).collect();

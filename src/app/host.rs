@@ -29,19 +29,21 @@ impl App {
     /// action during a drag ends the drag's undo step first: the history
     /// and the recording count steps alike.
     pub(super) fn run_script_line(&mut self, base: &Path, line: &Line) -> Result<StepResult, StepError> {
-        if !self.continues_gesture(line) {
+        let gesture = self.continues_gesture(line);
+        if !gesture {
             self.close_strokes();
         }
         let result = step(self, base, line)?;
         if let StepResult::Ran(Ran { line, outcome, selection }) = &result {
-            self.followed_up(line, outcome, *selection);
+            self.followed_up(line, outcome, *selection, gesture);
         }
         Ok(result)
     }
 
     /// Follows up an editor line: an edit goes to the GPU, the recording
     /// and the journal; a new scene starts its journal as Open does.
-    fn followed_up(&mut self, line: &Line, outcome: &Outcome, selection: Option<Region>) {
+    /// `gesture`: the line is a step of the stroke or palette control under way.
+    fn followed_up(&mut self, line: &Line, outcome: &Outcome, selection: Option<Region>, gesture: bool) {
         if matches!(outcome, Outcome::Replaced) {
             return self.scene_replaced(line.clone(), None);
         }
@@ -51,7 +53,6 @@ impl App {
             self.open_journal(selection);
         }
         let (tools, camera) = (self.doc.editor.tools, self.state.camera);
-        let gesture = self.continues_gesture(line);
         let ran = |r: &mut Recorder| r.ran(line, &tools, &camera, gesture);
         match (outcome, line) {
             // Undo and redo: the journal gets them as lines only if it holds the steps.

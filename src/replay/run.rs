@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{DVec3, IVec3};
 
-use super::step::{Host, HostError, StepResult, step};
+use super::step::{Host, HostError, StepError, StepResult, step};
 use crate::camera::Camera;
 use crate::editor::{Editor, Outcome};
 use crate::gpu::Renderer;
@@ -17,8 +17,6 @@ use crate::script::{Line, Script};
 use crate::settings::RenderSettings;
 use crate::trace::render::render_scene_cpu;
 use crate::trace::svo;
-
-pub use super::step::StepError;
 
 /// Where renders and pool flushes go.
 pub enum RunnerMode {

@@ -131,8 +131,6 @@ pub enum HostError {
     /// The window could not save (it says why on its message line).
     #[error("could not save {0}")]
     NotSaved(std::path::PathBuf),
-    #[error("cannot write the journal: {0}")]
-    Journal(std::io::Error),
 }
 
 /// Carries out one line for `host`; relative paths are taken from `base`
