@@ -12,6 +12,7 @@ use octovox::camera::Camera;
 use octovox::edit::selection::Region;
 use octovox::editor::{Editor, Outcome};
 use octovox::io::atomic::WriteOptions;
+use octovox::io::output::{OutputKind, check_output};
 use octovox::replay::{Host, HostError, Ran, Recorder, StepError, StepResult, step};
 use octovox::script::Command as Line;
 use octovox::settings::RenderSettings;
@@ -88,6 +89,9 @@ impl App {
     /// `render PATH` in the window: the image `octovox replay` makes (the
     /// script's viewport, the default settings), by the window's renderer.
     fn render_for_script(&mut self, path: &Path) -> Result<image::RgbaImage, HostError> {
+        // The rule every command that writes follows: a .png, never an input.
+        let inputs: Vec<&Path> = self.doc.player.iter().map(|p| p.path()).chain(self.state.path.as_deref()).collect();
+        check_output(path, OutputKind::Image, &inputs, false)?;
         let gfx = self.gfx.as_mut().ok_or(HostError::NoGpuYet)?;
         let viewport = self.doc.player.as_ref().map_or(octovox::replay::DEFAULT_VIEWPORT, |p| p.viewport);
         let settings = RenderSettings::default();

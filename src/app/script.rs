@@ -30,6 +30,11 @@ impl Player {
         let base = script.path.parent().unwrap_or(Path::new(".")).to_path_buf();
         Player { script, base, next: 0, passed: 0, failed: 0, viewport: DEFAULT_VIEWPORT, last_render: None }
     }
+
+    /// The script's file.
+    pub fn path(&self) -> &Path {
+        &self.script.path
+    }
 }
 
 impl App {

@@ -153,4 +153,16 @@ fn a_played_script_renders_and_checks_images_as_octovox_replay_does() {
     assert_eq!(summary, "replay: 1 passed, 0 failed", "{:?}", lines.seen);
     let window = image::open(dir.path().join("window.png")).unwrap().to_rgb8();
     assert_eq!(window.dimensions(), (160, 120), "the script's viewport, not the window's size");
+    drop(app);
+
+    // The rule of every command that writes: `render` makes a .png and
+    // never writes over a document (the window wrote its PNG bytes there).
+    let document = dir.path().join("keep.vox");
+    std::fs::write(&document, b"not an image").unwrap();
+    std::fs::write(&script, format!("{scene}render keep.vox\n")).unwrap();
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
+    find_window(&display, &mut app, &stderr_path);
+    let summary = lines.wait_for("replay:", Duration::from_secs(120));
+    assert_eq!(summary, "replay: 0 passed, 1 failed", "{:?}", lines.seen);
+    assert_eq!(std::fs::read(&document).unwrap(), b"not an image");
 }
