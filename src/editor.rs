@@ -9,9 +9,9 @@ use glam::IVec3;
 use crate::edit::brush::Brush;
 use crate::edit::mirror::Mirror;
 use crate::edit::selection::{self, Block, Region};
-use crate::edit::{Edit, History};
+use crate::edit::{Edit, Hideable, History};
 use crate::scene::{EditError, Op, Palette, Scene};
-use crate::script::Command;
+use crate::script::{Command, ObjectLine, ObjectRef};
 use crate::settings::PathSettings;
 
 /// Why a line could not run. A refused line changes nothing.
@@ -29,6 +29,9 @@ pub enum EditorError {
     NoSteps(&'static str),
     #[error("only {available} step(s) to {what}, not {wanted}")]
     TooFewSteps { what: &'static str, available: usize, wanted: u32 },
+    /// An `object` or `layer` line that names nothing, or more than one thing.
+    #[error("{0}")]
+    Object(String),
 }
 
 /// What brush edits use: the brush, the colour and the mirror planes.
@@ -174,6 +177,32 @@ impl Editor {
                 let (ok, got) = effects_match(&self.scene, want);
                 return Ok(checked(ok, format!("effects [{}]", want.join(" ")), format!("[{}]", got.join(" "))));
             }
+            Command::Object(ObjectLine::Pick(which)) => {
+                let index = self.object_named(which)?;
+                self.set(|e| {
+                    if let Some(objects) = &mut e.scene.objects {
+                        objects.selected = Some(index);
+                    }
+                })
+            }
+            Command::Object(ObjectLine::Hide(hidden)) => {
+                let index = self.picked_object()?;
+                self.commit(vec![Edit::Hide { target: Hideable::Object(index), hidden: *hidden }])?
+            }
+            Command::Layer(id, hidden) => {
+                if self.scene.objects.is_none() {
+                    return Err(EditorError::Object("the scene is one model: it has no layers".to_owned()));
+                }
+                self.commit(vec![Edit::Hide { target: Hideable::Layer(*id), hidden: *hidden }])?
+            }
+            Command::ExpectObjects(want) => {
+                let got = self.scene.objects.as_ref().map_or(1, |o| o.list().len());
+                return Ok(checked(got == *want, format!("{want} objects"), got));
+            }
+            Command::ExpectModels(want) => {
+                let got = self.scene.objects.as_ref().map_or(1, |o| o.models.len());
+                return Ok(checked(got == *want, format!("{want} models"), got));
+            }
             Command::Load(_)
             | Command::Camera { .. }
             | Command::Viewport(..)
@@ -184,6 +213,53 @@ impl Editor {
             | Command::ExpectImage(..) => return Ok(Outcome::Host),
         };
         Ok(if changed { Outcome::Changed } else { Outcome::State })
+    }
+
+    /// The index of the object `which` names: by index in walk order, or by
+    /// its name or the path of names down to it. A scene of one model is
+    /// object 0.
+    fn object_named(&self, which: &ObjectRef) -> Result<usize, EditorError> {
+        let Some(objects) = &self.scene.objects else {
+            return match which {
+                ObjectRef::Index(0) => Ok(0),
+                _ => Err(EditorError::Object("the scene is one model: object 0 is all there is".to_owned())),
+            };
+        };
+        let list = objects.list();
+        match which {
+            ObjectRef::Index(n) if *n < list.len() => Ok(*n),
+            ObjectRef::Index(n) => Err(EditorError::Object(format!(
+                "there is no object {n}: the scene has {} (0 to {})",
+                list.len(),
+                list.len().saturating_sub(1)
+            ))),
+            ObjectRef::Name(name) => {
+                let own = |path: &str| path.rsplit('/').next().unwrap_or("").to_owned();
+                let found: Vec<usize> =
+                    (0..list.len()).filter(|&i| list[i].path == *name || own(&list[i].path) == *name).collect();
+                match found.as_slice() {
+                    [one] => Ok(*one),
+                    [] => Err(EditorError::Object(format!("no object is named '{name}'"))),
+                    many => {
+                        let candidates: Vec<String> =
+                            many.iter().take(8).map(|&i| format!("{i} ({})", list[i].path)).collect();
+                        Err(EditorError::Object(format!(
+                            "{} objects are named '{name}': {}{}; name one by index or by its path",
+                            many.len(),
+                            candidates.join(", "),
+                            if many.len() > 8 { ", …" } else { "" }
+                        )))
+                    }
+                }
+            }
+        }
+    }
+
+    /// The object an `object hide|show` line acts on.
+    fn picked_object(&self) -> Result<usize, EditorError> {
+        self.scene.objects.as_ref().and_then(|o| o.selected).ok_or_else(|| {
+            EditorError::Object("no object is picked: pick one first (object N or object NAME)".to_owned())
+        })
     }
 
     /// A change of tool state, selection or clipboard: never an edit.

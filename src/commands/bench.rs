@@ -65,7 +65,7 @@ fn source(model: &Model) -> anyhow::Result<Source> {
 /// The procedural 10 M-voxel sculpture as a scene (default palette).
 pub(super) fn sculpture_scene() -> anyhow::Result<Scene> {
     let dense = sculpture::sculpture_dense();
-    Ok(Scene { palette: Palette::default(), tree: Octree::from_dense(sculpture::DIMS, IVec3::ZERO, &dense)? })
+    Ok(Scene::new(Palette::default(), Octree::from_dense(sculpture::DIMS, IVec3::ZERO, &dense)?))
 }
 
 fn build(source: &Source) -> anyhow::Result<Octree> {
@@ -275,7 +275,7 @@ fn bench_render(quick: bool, lod: f32) -> anyhow::Result<(String, String)> {
     let mut renderer = Renderer::headless().context("bench render needs a GPU (lavapipe works)")?;
     let mut rows = Vec::new();
     for model in &MODELS {
-        let mut scene = Scene { palette: Palette::default(), tree: build(&source(model)?)? };
+        let mut scene = Scene::new(Palette::default(), build(&source(model)?)?);
         let grid = DenseGrid::from_octree(&scene.tree)?;
         renderer.sync(&mut scene.tree, &scene.palette);
         renderer.set_grid(&grid)?;

@@ -22,7 +22,7 @@ pub fn run(args: &ImportArgs) -> anyhow::Result<ExitCode> {
     let voxelized = start.elapsed();
     let (lo, hi) = tree.solid_bounds().unwrap_or_default();
     let d = hi - lo + IVec3::ONE;
-    let scene = Scene { palette: Palette::default(), tree };
+    let scene = Scene::new(Palette::default(), tree);
     let options = WriteOptions::forced(args.force);
     octovox::io::save_scene(&args.output, &scene, options)
         .with_context(|| format!("saving {}", args.output.display()))?;

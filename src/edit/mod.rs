@@ -16,6 +16,7 @@ pub mod selection;
 
 use std::collections::VecDeque;
 
+use crate::scene::objects::Objects;
 use crate::scene::{EditError, Material, Op, Patch, Scene, Shape};
 
 /// One change to the scene.
@@ -23,20 +24,69 @@ use crate::scene::{EditError, Material, Op, Patch, Scene, Shape};
 pub enum Edit {
     /// Apply a brush shape with an operation.
     Brush { shape: Shape, op: Op },
+    /// A brush in object `object`'s model (what a brush becomes in a scene
+    /// of objects: see [`Edit::resolved`]).
+    InObject { object: usize, shape: Shape, op: Op },
     /// Put back cells saved by an earlier edit (what undo sends).
     Restore(Patch),
+    /// Put back cells of model `model` (what undo sends for `InObject`).
+    RestoreModel { model: usize, patch: Patch },
+    /// Hide or show an object or a layer.
+    Hide { target: Hideable, hidden: bool },
     /// Give a palette entry (1..=255) a colour and a material: every voxel of
     /// that index changes look at once.
     Palette { index: u8, color: [u8; 4], material: Box<Material> },
 }
 
+/// What [`Edit::Hide`] hides: an object (by index in walk order) or a layer (by id).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Hideable {
+    Object(usize),
+    Layer(u32),
+}
+
 impl Edit {
+    /// The edit as it applies to `scene`: in a scene of objects a brush goes
+    /// into the model of the object [`Objects::target_at`] names at the
+    /// brush's centre, fixed now so that a redo lands where the edit did.
+    ///
+    /// [`Objects::target_at`]: crate::scene::objects::Objects::target_at
+    pub fn resolved(self, scene: &Scene) -> Edit {
+        match (self, &scene.objects) {
+            (Edit::Brush { shape, op }, Some(objects)) => {
+                let (lo, hi) = shape.bounds();
+                match objects.target_at(lo + (hi - lo) / 2) {
+                    Some(object) => Edit::InObject { object, shape, op },
+                    None => Edit::Brush { shape, op },
+                }
+            }
+            (edit, _) => edit,
+        }
+    }
+
     /// Applies the edit; returns the edit that undoes it. A refused edit
     /// changes nothing.
     pub fn apply(&self, scene: &mut Scene) -> Result<Edit, EditError> {
         match self {
             Edit::Brush { shape, op } => Ok(Edit::Restore(scene.tree.apply_brush(shape, *op)?)),
             Edit::Restore(patch) => Ok(Edit::Restore(scene.tree.apply_patch(patch)?)),
+            Edit::InObject { object, shape, op } => {
+                let (tree, objects) = objects_of(scene)?;
+                let (model, patch) = objects.apply_brush(tree, *object, shape, *op)?;
+                Ok(Edit::RestoreModel { model, patch })
+            }
+            Edit::RestoreModel { model, patch } => {
+                let (tree, objects) = objects_of(scene)?;
+                Ok(Edit::RestoreModel { model: *model, patch: objects.apply_patch(tree, *model, patch)? })
+            }
+            Edit::Hide { target, hidden } => {
+                let (tree, objects) = objects_of(scene)?;
+                let before = match *target {
+                    Hideable::Object(index) => objects.set_hidden(tree, index, *hidden)?,
+                    Hideable::Layer(id) => objects.set_layer_hidden(tree, id, *hidden)?,
+                };
+                Ok(Edit::Hide { target: *target, hidden: before })
+            }
             Edit::Palette { index, color, material } => {
                 if *index == 0 {
                     return Err(EditError::ZeroColor);
@@ -57,11 +107,11 @@ impl Edit {
     pub fn estimated_bytes(&self) -> u64 {
         let own = 2 * std::mem::size_of::<Edit>() as u64;
         own.saturating_add(match self {
-            Edit::Brush { shape, .. } => {
+            Edit::Brush { shape, .. } | Edit::InObject { shape, .. } => {
                 shape.surface_voxels().saturating_mul(crate::scene::apply::EDIT_BYTES_PER_SURFACE_VOXEL)
             }
-            Edit::Restore(patch) => 2 * patch.heap_bytes() as u64,
-            Edit::Palette { .. } => 0,
+            Edit::Restore(patch) | Edit::RestoreModel { patch, .. } => 2 * patch.heap_bytes() as u64,
+            Edit::Palette { .. } | Edit::Hide { .. } => 0,
         })
     }
 
@@ -69,6 +119,14 @@ impl Edit {
     pub fn changes_palette(&self) -> bool {
         matches!(self, Edit::Palette { .. })
     }
+}
+
+/// The drawn tree and the objects of a scene of objects, or why an edit for
+/// one cannot apply.
+fn objects_of(scene: &mut Scene) -> Result<(&mut crate::scene::Octree, &mut Objects), EditError> {
+    let Scene { tree, objects, .. } = scene;
+    let objects = objects.as_deref_mut().ok_or_else(|| EditError::Brush("the scene has no objects".to_owned()))?;
+    Ok((tree, objects))
 }
 
 /// One undo step: a single edit or a whole mouse stroke.
@@ -106,6 +164,7 @@ impl Default for History {
 impl History {
     /// Applies an edit and records it (into the open stroke, if any).
     pub fn apply(&mut self, scene: &mut Scene, edit: Edit) -> Result<(), EditError> {
+        let edit = edit.resolved(scene);
         let inverse = edit.apply(scene)?;
         self.undone.clear();
         match &mut self.stroke {
@@ -130,6 +189,7 @@ impl History {
         }
         let mut step = Step::default();
         for edit in edits {
+            let edit = edit.resolved(scene);
             match edit.apply(scene) {
                 Ok(inverse) => {
                     step.edits.push(edit);
@@ -241,8 +301,8 @@ impl History {
 
 fn edit_bytes(edit: &Edit) -> usize {
     match edit {
-        Edit::Brush { .. } => std::mem::size_of::<Edit>(),
-        Edit::Restore(patch) => patch.heap_bytes(),
+        Edit::Brush { .. } | Edit::InObject { .. } | Edit::Hide { .. } => std::mem::size_of::<Edit>(),
+        Edit::Restore(patch) | Edit::RestoreModel { patch, .. } => patch.heap_bytes(),
         Edit::Palette { material, .. } => {
             std::mem::size_of::<Edit>() + material.params.iter().map(|(k, v)| k.len() + v.len() + 48).sum::<usize>()
         }

@@ -42,7 +42,7 @@ pub fn load_scene_with(path: &Path, frame: usize, progress: &progress::Progress)
     }
     if is_mesh_path(path) {
         let tree = mesh::voxelize_obj_with(path, mesh::DEFAULT_MESH_SIZE, mesh::UpAxis::Y, mesh::MESH_COLOR, progress)?;
-        return Ok(Scene { palette: crate::scene::Palette::default(), tree });
+        return Ok(Scene::new(crate::scene::Palette::default(), tree));
     }
     let (scene, meta) = vox::load_vox_scene_file(path, frame)?;
     for warning in &meta.warnings {
@@ -82,5 +82,8 @@ pub fn save_scene(path: &Path, scene: &Scene, options: atomic::WriteOptions) -> 
         let reason = std::io::Error::new(std::io::ErrorKind::InvalidInput, "scenes are saved as .vox or .ovx files");
         return Err(vox::VoxError::Write { path: path.to_path_buf(), source: reason }.into());
     }
-    Ok(vox::save_tree(path, &scene.palette, &scene.tree, options)?)
+    match &scene.objects {
+        Some(objects) => Ok(vox::save_objects(path, &scene.palette, objects, options)?),
+        None => Ok(vox::save_tree(path, &scene.palette, &scene.tree, options)?),
+    }
 }

@@ -388,7 +388,7 @@ fn read_payload(input: &mut Payload) -> Result<Scene, OvxError> {
     })?;
     palette.materials = decode_materials(&input.items::<u8>(materials_len, |_, _| Ok(()))?)?;
     let tree = Octree::from_parts(origin, depth, root, nodes, bricks).map_err(|e| corrupt(e.to_string()))?;
-    Ok(Scene { palette, tree })
+    Ok(Scene::new(palette, tree))
 }
 
 /// What one stored node can be told wrong by on its own, as it is read (a

@@ -64,6 +64,14 @@ impl Patch {
         self.cells.len() * std::mem::size_of::<(IVec3, u32, usize)>() + self.words.len() * 4
     }
 
+    /// Inclusive box of the cells recorded; `None` when there are none.
+    pub fn bounds(&self) -> Option<(IVec3, IVec3)> {
+        self.cells.iter().fold(None, |acc, &(min, level, _)| {
+            let max = min + IVec3::splat((1 << level) - 1);
+            Some(acc.map_or((min, max), |(lo, hi): (IVec3, IVec3)| (lo.min(min), hi.max(max))))
+        })
+    }
+
     fn subtree(&self, cell: usize) -> &[u32] {
         let start = self.cells[cell].2;
         let end = self.cells.get(cell + 1).map_or(self.words.len(), |c| c.2);

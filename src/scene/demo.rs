@@ -126,7 +126,7 @@ pub fn demo_scene() -> Scene {
     // The terrain list is bounded (128² columns) and well inside the limits.
     let mut tree = Octree::from_voxels(&terrain()).unwrap_or_default();
     decorate(&mut tree);
-    Scene { palette: demo_palette(), tree }
+    Scene::new(demo_palette(), tree)
 }
 
 /// The scenes built in, for `--demo` and replay's `demo`.

@@ -4,12 +4,15 @@ pub mod apply;
 pub mod build;
 pub mod counts;
 pub mod demo;
+pub mod graph;
 pub mod lod;
+pub mod objects;
 pub mod octree;
 pub mod palette;
 pub mod sculpture;
 pub mod shape;
 pub mod showroom;
+pub mod transform;
 
 pub use apply::{EditError, Patch};
 pub use build::BuildError;
@@ -60,12 +63,21 @@ pub fn grow_bounds(bounds: Option<(IVec3, IVec3)>, p: IVec3) -> (IVec3, IVec3) {
 #[derive(Clone, Debug, Default)]
 pub struct Scene {
     pub palette: Palette,
+    /// What is drawn: the one model, or the visible objects composed.
     pub tree: Octree,
+    /// The objects and models of a scene of several (`None`: the tree is
+    /// the one model).
+    pub objects: Option<Box<objects::Objects>>,
 }
 
 impl Scene {
+    /// A scene of one model.
+    pub fn new(palette: Palette, tree: Octree) -> Scene {
+        Scene { palette, tree, objects: None }
+    }
+
     /// Builds the octree of a loaded model.
     pub fn from_model(model: &VoxelModel) -> Result<Scene, BuildError> {
-        Ok(Scene { palette: model.palette.clone(), tree: Octree::from_voxels(&model.voxels)? })
+        Ok(Scene::new(model.palette.clone(), Octree::from_voxels(&model.voxels)?))
     }
 }

@@ -63,7 +63,7 @@ pub fn showroom_scene() -> Scene {
         // The shapes are fixed and well inside the world limits.
         let _ = tree.apply_brush(&shape, Op::Place(color));
     }
-    Scene { palette: showroom_palette(), tree }
+    Scene::new(showroom_palette(), tree)
 }
 
 /// A camera inside the interior, looking at the table from a corner.
@@ -96,5 +96,5 @@ pub fn interior_scene() -> Scene {
         // The shapes are fixed and well inside the world limits.
         let _ = tree.apply_brush(&shape, op);
     }
-    Scene { palette, tree }
+    Scene::new(palette, tree)
 }

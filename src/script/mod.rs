@@ -84,6 +84,31 @@ pub enum Command {
     /// `move DX DY DZ`: the selected voxels move by (DX, DY, DZ), and the
     /// selection with them (one undo step).
     Move(IVec3),
+    /// `object N|NAME|hide|show`: pick the object later edits go to (by
+    /// index in walk order from 0, or by name or `group/name` path), or
+    /// hide or show the picked one (an undoable edit).
+    Object(ObjectLine),
+    /// `layer N hide|show`: hide or show layer N (an undoable edit).
+    Layer(u32, bool),
+    /// `expect objects N`: the scene places N objects.
+    ExpectObjects(usize),
+    /// `expect models N`: the scene stores N models (each once).
+    ExpectModels(usize),
+}
+
+/// What an `object` line does.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum ObjectLine {
+    Pick(ObjectRef),
+    /// `object hide` (true) or `object show` (false).
+    Hide(bool),
+}
+
+/// Which object an `object` line names.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum ObjectRef {
+    Index(usize),
+    Name(String),
 }
 
 /// A parsed command with its 1-based line number.

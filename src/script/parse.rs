@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{DVec3, IVec3};
 
-use super::{Command, Line, Script};
+use super::{Command, Line, ObjectLine, ObjectRef, Script};
 use crate::camera::{FOV_RANGE_DEG, check_fov};
 use crate::edit::brush::{Brush, Tool};
 use crate::scene::demo::BuiltIn;
@@ -366,7 +366,31 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
         "save" => Command::Save(c.path()?),
         "render" => Command::Render(c.path()?),
         "expect" => parse_expect(c)?,
+        "object" => Command::Object(parse_object(c)?),
+        "layer" => {
+            let id = c.int_in("layer id", 0..=i64::from(u32::MAX - 1))? as u32;
+            let what = c.word("hide or show")?;
+            match what.text.as_str() {
+                "hide" => Command::Layer(id, true),
+                "show" => Command::Layer(id, false),
+                other => return Err((what.column, format!("expected hide or show, found '{other}'"))),
+            }
+        }
         other => return Err((name.column, format!("unknown command '{other}'"))),
+    })
+}
+
+/// `object N`, `object NAME`, `object hide`, `object show`.
+fn parse_object(c: &mut Cursor) -> Result<ObjectLine, Fail> {
+    let word = c.word("an object index or name, hide or show")?;
+    Ok(match word.text.as_str() {
+        "hide" => ObjectLine::Hide(true),
+        "show" => ObjectLine::Hide(false),
+        text if !text.is_empty() && text.bytes().all(|b| b.is_ascii_digit()) => ObjectLine::Pick(ObjectRef::Index(
+            text.parse().map_err(|_| (word.column, format!("object index '{text}' is too large")))?,
+        )),
+        "" => return Err((word.column, "an empty object name".to_owned())),
+        text => ObjectLine::Pick(ObjectRef::Name(text.to_owned())),
     })
 }
 
@@ -388,7 +412,7 @@ fn parse_brush(c: &mut Cursor) -> Result<Brush, Fail> {
 }
 
 fn parse_expect(c: &mut Cursor) -> Result<Command, Fail> {
-    let what = c.word("voxel, count, written, image or effects")?;
+    let what = c.word("voxel, count, written, image, effects, objects or models")?;
     Ok(match what.text.as_str() {
         "voxel" => {
             let p = c.position()?;
@@ -416,8 +440,13 @@ fn parse_expect(c: &mut Cursor) -> Result<Command, Fail> {
             Command::ExpectImage(path, tolerance)
         }
         "effects" => Command::ExpectEffects(parse_effect_names(c)?),
+        "objects" => Command::ExpectObjects(c.number("an object count")?),
+        "models" => Command::ExpectModels(c.number("a model count")?),
         other => {
-            return Err((what.column, format!("expected voxel, count, written, image or effects, found '{other}'")));
+            return Err((
+                what.column,
+                format!("expected voxel, count, written, image, effects, objects or models, found '{other}'"),
+            ));
         }
     })
 }
@@ -535,7 +564,8 @@ mod tests {
                     demo showroom\nexpect effects sun glass\nexpect effects none\nrgb 4 1 2 3\nselect 1 2 3 -4 5 6\nselect off\ncopy\ncut\ndelete\n\
                     paste 1 -2 3\nmove 0 0 -1\n\
                     material 4 glass _ri 1.45 _trans 0.5\nmaterial 5 diffuse\npick 1 -2 3\nfill 0 0 -1\nmirror x 4.5\nmirror z -2\nmirror off\nline 1 2 3 -4 5 6\n\
-                    extrude 1 2 3 0 -1 0 -2\n";
+                    extrude 1 2 3 0 -1 0 -2\nobject 3\nobject \"tree 4/top\"\nobject hide\nobject show\nlayer 2 hide\n\
+                    layer 0 show\nexpect objects 19\nexpect models 15\n";
         let script = parse_script(Path::new("t.ovr"), text).unwrap();
         let printed: String = script.lines.iter().map(|l| format!("{}\n", l.command)).collect();
         let again = parse_script(Path::new("t.ovr"), &printed).unwrap();
@@ -543,7 +573,7 @@ mod tests {
             script.lines.iter().map(|l| &l.command).collect::<Vec<_>>(),
             again.lines.iter().map(|l| &l.command).collect::<Vec<_>>()
         );
-        assert_eq!(script.lines.len(), 41);
+        assert_eq!(script.lines.len(), 49);
     }
 
     #[test]

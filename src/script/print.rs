@@ -5,7 +5,7 @@ use std::fmt;
 
 use glam::IVec3;
 
-use super::Command;
+use super::{Command, ObjectLine, ObjectRef};
 use crate::edit::brush::Brush;
 
 /// Writes a command back as a script line (what `--record` produces).
@@ -61,6 +61,15 @@ impl fmt::Display for Command {
             Command::Move(d) => write!(f, "move {}", v(*d)),
             Command::ExpectEffects(names) if names.is_empty() => write!(f, "expect effects none"),
             Command::ExpectEffects(names) => write!(f, "expect effects {}", names.join(" ")),
+            Command::Object(ObjectLine::Pick(ObjectRef::Index(n))) => write!(f, "object {n}"),
+            Command::Object(ObjectLine::Pick(ObjectRef::Name(name))) => {
+                write!(f, "object {}", quoted(std::path::Path::new(name)))
+            }
+            Command::Object(ObjectLine::Hide(true)) => write!(f, "object hide"),
+            Command::Object(ObjectLine::Hide(false)) => write!(f, "object show"),
+            Command::Layer(id, hidden) => write!(f, "layer {id} {}", if *hidden { "hide" } else { "show" }),
+            Command::ExpectObjects(n) => write!(f, "expect objects {n}"),
+            Command::ExpectModels(n) => write!(f, "expect models {n}"),
         }
     }
 }

@@ -175,7 +175,7 @@ fn closed_volume(positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> f64 {
 fn sculpture_file(dir: &Path) -> (std::path::PathBuf, u64) {
     let tree = common::sculpture();
     let path = dir.join("sculpture.vox");
-    let scene = octovox::scene::Scene { palette: Default::default(), tree };
+    let scene = octovox::scene::Scene::new(Default::default(), tree);
     octovox::io::save_scene(&path, &scene, Default::default()).unwrap();
     (path, scene.tree.solid_voxels())
 }
@@ -300,7 +300,7 @@ fn glb_materials_follow_matl_and_pass_the_khronos_validator() {
     assert!(json["extensionsRequired"].is_null(), "a viewer without them still shows the colours");
     // An empty scene is a valid file too: a node without a mesh.
     let empty = dir.path().join("empty.vox");
-    let nothing = octovox::scene::Scene { palette: Default::default(), tree: Default::default() };
+    let nothing = octovox::scene::Scene::new(Default::default(), Default::default());
     octovox::io::save_scene(&empty, &nothing, Default::default()).unwrap();
     let empty_glb = dir.path().join("empty.glb");
     let out = octovox(&["export", empty.to_str().unwrap(), "-o", empty_glb.to_str().unwrap()]);

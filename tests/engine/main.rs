@@ -21,3 +21,4 @@ mod trace_exact;
 mod vox_info;
 mod vox_robust;
 mod vox_roundtrip;
+mod vox_scene;

@@ -86,7 +86,7 @@ fn gpu_traces_every_listed_tile() {
 fn gpu_matches_cpu_on_a_voxelized_scan() {
     let path = common::assets().join("meshes/nefertiti.obj");
     let tree = voxelize_obj(&path, 96, UpAxis::Z, MESH_COLOR).unwrap();
-    let mut scene = Scene { palette: Palette::default(), tree };
+    let mut scene = Scene::new(Palette::default(), tree);
     let (lo, hi) = scene.tree.solid_bounds().unwrap();
     check_scene(&mut scene.tree, &cameras_for(lo, hi), (96, 72));
 }
@@ -301,7 +301,7 @@ fn frame_times_stay_plausible_after_path_traced_frames() {
 fn gpu_level_of_detail_matches_cpu() {
     let path = common::assets().join("meshes/nefertiti.obj");
     let tree = voxelize_obj(&path, 96, UpAxis::Z, MESH_COLOR).unwrap();
-    let mut scene = Scene { palette: Palette::default(), tree };
+    let mut scene = Scene::new(Palette::default(), tree);
     scene.tree.apply_brush(&Shape::Sphere { center: IVec3::new(40, 60, 40), radius: 12 }, Op::Paint(9)).unwrap();
     let (lo, hi) = scene.tree.solid_bounds().unwrap();
     let size = (96, 72);

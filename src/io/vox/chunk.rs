@@ -2,6 +2,7 @@
 //! and its byte offset.
 
 use super::VoxError;
+use crate::scene::graph::Attributes;
 
 /// Chunk id, content size, children size.
 const CHUNK_HEADER_BYTES: usize = 12;
@@ -111,27 +112,29 @@ impl<'a> Cursor<'a> {
         self.u32(what).map(f32::from_bits)
     }
 
-    pub(super) fn skip_string(&mut self, what: &str) -> Result<(), VoxError> {
+    pub(super) fn string(&mut self, what: &str) -> Result<&'a str, VoxError> {
         let len = widen(self.u32(what)?);
         let at = self.pos;
         let text = self.take(len, what)?;
-        if std::str::from_utf8(text).is_err() {
-            return Err(self.chunk.fail(format!("has a {what} at byte {at} that is not UTF-8 text")));
-        }
-        Ok(())
+        std::str::from_utf8(text)
+            .map_err(|_| self.chunk.fail(format!("has a {what} at byte {at} that is not UTF-8 text")))
     }
 
-    pub(super) fn skip_dict(&mut self, what: &str) -> Result<(), VoxError> {
+    /// A DICT: the entry count, then key and value strings. A key given
+    /// twice keeps its last value, as `dot_vox` reads it.
+    pub(super) fn dict(&mut self, what: &str) -> Result<Attributes, VoxError> {
         let entries = widen(self.u32(what)?);
         let held = self.remaining();
         if entries > held / 8 {
             return Err(self.chunk.fail(format!("claims {entries} entries in its {what} but holds {held} bytes")));
         }
+        let mut dict = Attributes::new();
         for _ in 0..entries {
-            self.skip_string(what)?;
-            self.skip_string(what)?;
+            let key = self.string(what)?;
+            let value = self.string(what)?;
+            dict.insert(key.to_owned(), value.to_owned());
         }
-        Ok(())
+        Ok(dict)
     }
 }
 

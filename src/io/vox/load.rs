@@ -6,13 +6,14 @@ use std::path::Path;
 use dot_vox::DotVoxData;
 use glam::IVec3;
 
-use super::scene;
-use super::transform::{Placement, Transform};
 use super::validate::{self, Layout};
-use super::{MAX_FILE_BYTES, VoxError};
+use super::{MAX_FILE_BYTES, MAX_VOXELS, VoxError};
 use crate::io::guard::catch_quietly;
 use crate::io::input::{InputError, read_limited};
+use crate::scene::graph::Object;
+use crate::scene::objects::{Model, Objects};
 use crate::scene::octree::WORLD_LIMIT;
+use crate::scene::transform::{Placement, Transform};
 use crate::scene::{Material, MaterialKind, Octree, Palette, Scene, Voxel, VoxelModel};
 
 /// Reads and loads the `.vox` file at `path`; see [`load_vox`].
@@ -43,7 +44,8 @@ fn read_file(path: &Path) -> Result<Vec<u8>, VoxError> {
 /// Loads a MagicaVoxel `.vox` file held in memory.
 ///
 /// Files with a scene graph (nTRN/nGRP/nSHP) are placed by walking it from
-/// node 0 (hidden nodes and layers included, as `ogt_vox` does); `frame`
+/// node 0; hidden objects and objects on hidden layers are left out, as
+/// MagicaVoxel draws them; `frame`
 /// picks the keyframe where transforms or shapes are animated (`_f`). Files
 /// without one hold either one model or animation frames (several models,
 /// PACK), of which model `frame` is loaded as is, in its own grid.
@@ -76,19 +78,32 @@ pub struct VoxMeta {
 /// model at a time: the same voxels as [`load_vox`] then
 /// `Scene::from_model`, without ever holding the list of every voxel.
 ///
+/// A file of several models or objects, or with a hidden one, becomes a
+/// scene of objects (`Scene::objects`): its models, scene graph, layers and
+/// the chunks octovox does not read are kept, and saving writes them back.
+/// A file of one visible model loads as one model, as it always has.
+///
 /// # Errors
 /// As [`load_vox`].
 pub fn load_vox_scene(bytes: &[u8], frame: usize) -> Result<(Scene, VoxMeta), VoxError> {
     let parsed = parse(bytes, frame)?;
-    let largest = parsed.placements.iter().map(|p| parsed.layout.model_voxels[p.model]).max().unwrap_or(0);
-    let total: usize = parsed.placements.iter().map(|p| parsed.layout.model_voxels[p.model]).sum();
+    let visible = || parsed.objects.iter().filter(|o| !o.hidden).map(|o| &o.placement);
+    let largest = visible().map(|p| parsed.layout.model_voxels[p.model]).max().unwrap_or(0);
+    let total: usize = visible().map(|p| parsed.layout.model_voxels[p.model]).sum();
+    let stored: usize = parsed.layout.model_voxels.iter().sum();
     crate::budget::check(
         || format!("loading {total} voxels"),
-        largest as u64 * BYTES_PER_STREAMED_VOXEL + total as u64 * POOL_BYTES_PER_VOXEL,
+        largest as u64 * BYTES_PER_STREAMED_VOXEL + (total + stored) as u64 * POOL_BYTES_PER_VOXEL,
     )?;
+    let (palette, meta) = parsed.palette_and_meta();
+    if parsed.keeps_objects() {
+        let objects = parsed.into_objects(frame)?;
+        let tree = objects.compose().map_err(|e| VoxError::BadSceneGraph(e.to_string()))?;
+        return Ok((Scene { palette, tree, objects: Some(Box::new(objects)) }, meta));
+    }
     // The bounds first, so the root is placed as a build from the whole list places it.
     let mut bounds: Option<(IVec3, IVec3)> = None;
-    for placement in &parsed.placements {
+    for placement in visible() {
         for voxel in parsed.placed(placement) {
             let p = voxel?.0;
             bounds = Some(crate::scene::grow_bounds(bounds, p));
@@ -98,19 +113,19 @@ pub fn load_vox_scene(bytes: &[u8], frame: usize) -> Result<(Scene, VoxMeta), Vo
         Some((lo, hi)) => Octree::empty_for(lo, hi).map_err(|e| VoxError::BadSceneGraph(e.to_string()))?,
         None => Octree::default(),
     };
-    for placement in &parsed.placements {
+    for placement in visible() {
         let voxels: Vec<Voxel> = parsed.placed(placement).collect::<Result<_, _>>()?;
         tree.insert_voxels(&voxels);
     }
-    let (palette, meta) = parsed.palette_and_meta();
-    Ok((Scene { palette, tree }, meta))
+    Ok((Scene::new(palette, tree), meta))
 }
 
 /// A file parsed and checked, with its model placements.
 struct Parsed {
     data: DotVoxData,
     layout: Layout,
-    placements: Vec<Placement>,
+    /// Every object, hidden ones included, in walk order.
+    objects: Vec<Object>,
     /// (model, ordinal) of voxels with palette index 0, which are skipped.
     empty: HashSet<(usize, usize)>,
 }
@@ -119,13 +134,13 @@ fn parse(bytes: &[u8], frame: usize) -> Result<Parsed, VoxError> {
     let layout = validate::check(bytes)?;
     let data = parse_guarded(bytes)?;
     cross_check(&layout, &data)?;
-    let placements = if data.scenes.is_empty() {
-        frame_placement(data.models.len(), frame)?
+    let objects = if data.scenes.is_empty() {
+        frame_objects(data.models.len(), frame)?
     } else {
-        scene::placements(&data.scenes, &layout.node_ids, &layout.model_voxels, frame)?
+        layout.graph.objects(&layout.model_voxels, frame, MAX_VOXELS)?
     };
     let empty = layout.zero_index_voxels.iter().copied().collect();
-    Ok(Parsed { data, layout, placements, empty })
+    Ok(Parsed { data, layout, objects, empty })
 }
 
 impl Parsed {
@@ -155,8 +170,34 @@ impl Parsed {
     fn palette_and_meta(&self) -> (Palette, VoxMeta) {
         let mut warnings = self.layout.warnings.clone();
         let palette = palette_of(&self.data, &self.layout, &mut warnings);
-        let meta = VoxMeta { models: self.placements.len(), stored_models: self.data.models.len(), warnings };
+        let meta = VoxMeta { models: self.objects.len(), stored_models: self.data.models.len(), warnings };
         (palette, meta)
+    }
+
+    /// Whether the file is more than one visible model: then its objects are kept.
+    fn keeps_objects(&self) -> bool {
+        self.data.models.len() > 1 || self.objects.len() > 1 || self.objects.iter().any(|o| o.hidden)
+    }
+
+    /// The models as octrees in their own grids, the graph and the kept chunks.
+    fn into_objects(self, frame: usize) -> Result<Objects, VoxError> {
+        let mut models = Vec::with_capacity(self.data.models.len());
+        for (m, model) in self.data.models.iter().enumerate() {
+            let voxels: Vec<Voxel> = model
+                .voxels
+                .iter()
+                .enumerate()
+                .filter(|(ordinal, _)| !self.empty.contains(&(m, *ordinal)))
+                .map(|(_, v)| (IVec3::new(v.x.into(), v.y.into(), v.z.into()), v.i.saturating_add(1)))
+                .collect();
+            let tree = Octree::from_voxels(&voxels).map_err(|e| VoxError::BadSceneGraph(e.to_string()))?;
+            models.push(Model { size: [model.size.x, model.size.y, model.size.z], tree });
+        }
+        let graph = (!self.data.scenes.is_empty()).then_some(self.layout.graph);
+        Objects::new(graph, models, self.layout.kept, frame, MAX_VOXELS).map_err(|e| match e {
+            crate::scene::objects::ObjectsError::Graph(e) => e.into(),
+            other => VoxError::BadSceneGraph(other.to_string()),
+        })
     }
 }
 
@@ -182,11 +223,13 @@ fn cross_check(layout: &Layout, data: &DotVoxData) -> Result<(), VoxError> {
             layout.model_voxels.len()
         )));
     }
-    if data.scenes.len() != layout.node_ids.len() {
+    if data.scenes.len() != layout.graph.nodes.len() || data.layers.len() != layout.graph.layers.len() {
         return Err(VoxError::Inconsistent(format!(
-            "dot_vox read {} scene nodes, the pre-pass {}",
+            "dot_vox read {} scene nodes and {} layers, the pre-pass {} and {}",
             data.scenes.len(),
-            layout.node_ids.len()
+            data.layers.len(),
+            layout.graph.nodes.len(),
+            layout.graph.layers.len()
         )));
     }
     if data.version != layout.version {
@@ -196,14 +239,15 @@ fn cross_check(layout: &Layout, data: &DotVoxData) -> Result<(), VoxError> {
 }
 
 /// Without a scene graph, `frame` selects one model, placed as stored.
-fn frame_placement(models: usize, frame: usize) -> Result<Vec<Placement>, VoxError> {
+fn frame_objects(models: usize, frame: usize) -> Result<Vec<Object>, VoxError> {
     if models == 0 && frame == 0 {
         return Ok(Vec::new());
     }
     if frame >= models {
         return Err(VoxError::FrameOutOfRange { requested: frame, models });
     }
-    Ok(vec![Placement { model: frame, transform: Transform::IDENTITY, centred: false }])
+    let placement = Placement { model: frame, transform: Transform::IDENTITY, centred: false };
+    Ok(vec![Object { placement, shape_node: 0, transform_node: None, path: String::new(), layer: None, hidden: false }])
 }
 
 /// Peak bytes per voxel of a load and the octree build after it: the list
@@ -218,10 +262,11 @@ const POOL_BYTES_PER_VOXEL: u64 = 8;
 
 /// Every placed voxel in world axes, sorted by position, overlaps resolved.
 fn place_voxels(parsed: &Parsed) -> Result<Vec<Voxel>, VoxError> {
-    let total: usize = parsed.placements.iter().map(|p| parsed.layout.model_voxels[p.model]).sum();
+    let visible: Vec<&Placement> = parsed.objects.iter().filter(|o| !o.hidden).map(|o| &o.placement).collect();
+    let total: usize = visible.iter().map(|p| parsed.layout.model_voxels[p.model]).sum();
     crate::budget::check(|| format!("loading {total} voxels"), total as u64 * BYTES_PER_LOADED_VOXEL)?;
     let mut voxels = Vec::with_capacity(total);
-    for placement in &parsed.placements {
+    for placement in visible {
         for voxel in parsed.placed(placement) {
             voxels.push(voxel?);
         }

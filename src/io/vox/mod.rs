@@ -14,14 +14,12 @@
 mod chunk;
 mod load;
 mod save;
-mod scene;
-mod transform;
 mod validate;
 
 use std::path::PathBuf;
 
 pub use load::{VoxMeta, load_vox, load_vox_file, load_vox_scene, load_vox_scene_file};
-pub use save::{encode_vox, save_tree, save_vox};
+pub use save::{encode_objects, encode_vox, save_objects, save_tree, save_vox};
 
 /// Most voxels one load may produce (after scene-graph instancing).
 pub const MAX_VOXELS: usize = 1 << 26;
@@ -29,12 +27,7 @@ pub const MAX_VOXELS: usize = 1 << 26;
 /// Largest `.vox` file octovox reads.
 pub const MAX_FILE_BYTES: u64 = 1 << 30;
 
-/// Most model placements (shape instances) one scene graph may produce.
-pub const MAX_INSTANCES: usize = 1 << 20;
-
-/// Most scene-graph node visits one load may make (a node shared by several
-/// parents is visited once per path to it).
-pub const MAX_NODE_VISITS: usize = 1 << 22;
+pub use crate::scene::graph::{MAX_INSTANCES, MAX_NODE_VISITS};
 
 /// Why a `.vox` file could not be read or written.
 #[derive(Debug, thiserror::Error)]
@@ -92,6 +85,17 @@ pub enum VoxError {
     /// The voxels cannot be written as a `.vox` file.
     #[error("cannot save: {0}")]
     Unsavable(String),
+}
+
+impl From<crate::scene::graph::GraphError> for VoxError {
+    fn from(e: crate::scene::graph::GraphError) -> VoxError {
+        use crate::scene::graph::GraphError;
+        match e {
+            GraphError::Cycle(node) => VoxError::SceneCycle(node),
+            GraphError::Bad(problem) => VoxError::BadSceneGraph(problem),
+            GraphError::TooManyVoxels { limit, found } => VoxError::TooManyVoxels { limit, found },
+        }
+    }
 }
 
 fn plural(n: usize) -> &'static str {

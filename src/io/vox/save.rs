@@ -9,6 +9,8 @@ use glam::IVec3;
 use super::validate::MAX_MODEL_EDGE;
 use super::{MAX_FILE_BYTES, MAX_VOXELS, VoxError};
 use crate::io::atomic::{WriteOptions, write_atomically};
+use crate::scene::graph::{self, Attributes, Node, NodeKind, SceneGraph};
+use crate::scene::objects::{Model, Objects};
 use crate::scene::{Material, Octree, Palette, Voxel};
 
 /// Level of the octree cells that become one model: 2^8 = 256 voxels, the
@@ -149,6 +151,14 @@ fn write_chunk<W: Write>(out: &mut W, id: &[u8; 4], content: &[u8], children: u3
     out.write_all(&u32::try_from(content.len()).unwrap_or(u32::MAX).to_le_bytes())?;
     out.write_all(&children.to_le_bytes())?;
     out.write_all(content)
+}
+
+/// A chunk appended to bytes in memory.
+fn push_chunk(out: &mut Vec<u8>, id: &[u8; 4], content: &[u8], children: u32) {
+    out.extend_from_slice(id);
+    out.extend_from_slice(&u32::try_from(content.len()).unwrap_or(u32::MAX).to_le_bytes());
+    out.extend_from_slice(&children.to_le_bytes());
+    out.extend_from_slice(content);
 }
 
 fn write_string(buffer: &mut Vec<u8>, text: &str) {
@@ -305,4 +315,205 @@ fn materials(palette: &Palette) -> Vec<(u32, Vec<(String, String)>)> {
         .collect();
     out.sort_by_key(|(id, _)| *id);
     out
+}
+
+/// Saves a scene of objects to `path`, atomically (as [`save_tree`]): every
+/// model once, the scene graph, the layers and the kept chunks as loaded,
+/// with the palette and materials of the document.
+///
+/// # Errors
+/// [`VoxError::Unsavable`] before anything is written when a model no
+/// longer fits a `.vox` model; [`VoxError::Write`] naming `path` otherwise.
+pub fn save_objects(path: &Path, palette: &Palette, objects: &Objects, options: WriteOptions) -> Result<(), VoxError> {
+    let bytes = encode_objects(palette, objects)?;
+    write_atomically(path, options, |file| {
+        file.write_all(&bytes)?;
+        Ok(())
+    })
+    .map_err(|source| VoxError::Write { path: path.to_owned(), source })
+}
+
+/// The bytes [`save_objects`] writes.
+///
+/// # Errors
+/// As [`save_objects`].
+pub fn encode_objects(palette: &Palette, objects: &Objects) -> Result<Vec<u8>, VoxError> {
+    let grids: Vec<Grid> =
+        objects.models.iter().enumerate().map(|(m, model)| Grid::of(m, model)).collect::<Result<_, _>>()?;
+    let mut children = Vec::new();
+    for (model, grid) in objects.models.iter().zip(&grids) {
+        grid.write(&mut children, &model.tree);
+    }
+    if let Some(graph) = &objects.graph {
+        for node in &shifted_graph(graph, &grids)?.nodes {
+            let (id, content) = node_chunk(node);
+            push_chunk(&mut children, id, &content, 0);
+        }
+        for layer in &graph.layers {
+            let mut content = layer.id.to_le_bytes().to_vec();
+            write_attributes(&mut content, &layer.attributes);
+            content.extend_from_slice(&layer.reserved.to_le_bytes());
+            push_chunk(&mut children, b"LAYR", &content, 0);
+        }
+    }
+    push_chunk(&mut children, b"RGBA", &rgba_chunk(palette), 0);
+    for (id, material) in materials(palette) {
+        let mut chunk = id.to_le_bytes().to_vec();
+        write_dict(&mut chunk, material.iter().map(|(k, v)| (k.as_str(), v.as_str())));
+        push_chunk(&mut children, b"MATL", &chunk, 0);
+    }
+    for kept in &objects.kept {
+        push_chunk(&mut children, &kept.id, &kept.content, 0);
+    }
+    let total = 8 + CHUNK_HEADER_BYTES + children.len() as u64;
+    if total > MAX_FILE_BYTES {
+        return Err(VoxError::Unsavable(format!(
+            "the file would be {total} bytes; octovox reads .vox files of at most {MAX_FILE_BYTES}"
+        )));
+    }
+    let mut out = b"VOX ".to_vec();
+    out.extend_from_slice(&200u32.to_le_bytes());
+    push_chunk(&mut out, b"MAIN", &[], u32::try_from(children.len()).unwrap_or(u32::MAX));
+    out.extend_from_slice(&children);
+    Ok(out)
+}
+
+/// Where a model's voxels go in the file: the grid `0..size` that holds
+/// them, `shift` cells from the grid they were loaded in (an edit that
+/// reaches below the grid moves its origin; one past its end grows it).
+struct Grid {
+    size: [u32; 3],
+    shift: IVec3,
+    /// The size the model was loaded with, whose half was the pivot.
+    loaded: [u32; 3],
+}
+
+impl Grid {
+    fn of(index: usize, model: &Model) -> Result<Grid, VoxError> {
+        let loaded = model.size;
+        let top = IVec3::new(loaded[0] as i32, loaded[1] as i32, loaded[2] as i32) - IVec3::ONE;
+        let (lo, hi) =
+            model.tree.solid_bounds().map_or((IVec3::ZERO, top), |(lo, hi)| (lo.min(IVec3::ZERO), hi.max(top)));
+        let edge = hi - lo + IVec3::ONE;
+        if edge.max_element() > MAX_MODEL_EDGE as i32 {
+            return Err(VoxError::Unsavable(format!(
+                "model {index} is now {} x {} x {} voxels; a .vox model holds at most {MAX_MODEL_EDGE} a side \
+                 (splitting it into several is not written yet)",
+                edge.x, edge.y, edge.z
+            )));
+        }
+        Ok(Grid { size: [edge.x as u32, edge.y as u32, edge.z as u32], shift: lo, loaded })
+    }
+
+    fn moved(&self) -> bool {
+        self.shift != IVec3::ZERO || self.size != self.loaded
+    }
+
+    /// The SIZE and XYZI chunks.
+    fn write(&self, out: &mut Vec<u8>, tree: &Octree) {
+        let size: Vec<u8> = self.size.iter().flat_map(|s| s.to_le_bytes()).collect();
+        push_chunk(out, b"SIZE", &size, 0);
+        let mut voxels: Vec<[u8; 4]> = Vec::new();
+        tree.for_each_solid_cell(|min, edge, index| {
+            for z in 0..edge {
+                for y in 0..edge {
+                    for x in 0..edge {
+                        let p = min + IVec3::new(x, y, z) - self.shift;
+                        // Inside 0..size ≤ 256 by `Grid::of`.
+                        voxels.push([p.x as u8, p.y as u8, p.z as u8, index]);
+                    }
+                }
+            }
+        });
+        let mut content = u32::try_from(voxels.len()).unwrap_or(u32::MAX).to_le_bytes().to_vec();
+        content.extend_from_slice(voxels.as_flattened());
+        push_chunk(out, b"XYZI", &content, 0);
+    }
+}
+
+/// The graph with the translations that keep every voxel of a model whose
+/// grid moved at its world position: a placement puts model cell `v` at
+/// `R · (v − floor(size / 2)) + t` (see `scene::transform`), so the cell now
+/// stored at `v − shift` under the new pivot needs
+/// `t' = t + R · (shift + pivot' − pivot)`, in every keyframe.
+fn shifted_graph(graph: &SceneGraph, grids: &[Grid]) -> Result<SceneGraph, VoxError> {
+    let mut out = graph.clone();
+    let moved_model = |node: &Node| -> Result<Option<usize>, VoxError> {
+        let NodeKind::Shape { models } = &node.kind else { return Ok(None) };
+        let moved: Vec<usize> =
+            models.iter().map(|m| m.0 as usize).filter(|&m| grids.get(m).is_some_and(Grid::moved)).collect();
+        match moved.first() {
+            None => Ok(None),
+            Some(&m) if models.iter().all(|other| other.0 as usize == m) => Ok(Some(m)),
+            Some(&m) => Err(VoxError::Unsavable(format!(
+                "model {m} grew, and shape node {} shows other models in other frames: their placement cannot follow",
+                node.id
+            ))),
+        }
+    };
+    let mut shifts = std::collections::HashMap::new();
+    for node in &graph.nodes {
+        if let Some(m) = moved_model(node)? {
+            shifts.insert(node.id, m);
+        }
+    }
+    for node in &mut out.nodes {
+        let NodeKind::Transform { child, frames, .. } = &mut node.kind else { continue };
+        let Some(&m) = shifts.get(child) else { continue };
+        let grid = &grids[m];
+        let pivot = |size: [u32; 3]| IVec3::new((size[0] / 2) as i32, (size[1] / 2) as i32, (size[2] / 2) as i32);
+        let offset = grid.shift + pivot(grid.size) - pivot(grid.loaded);
+        if frames.is_empty() {
+            frames.push(Attributes::new());
+        }
+        for frame in frames.iter_mut() {
+            let mut transform = graph::parse_transform(frame, node.id)?;
+            let moved = transform.rotation.apply([offset.x, offset.y, offset.z].map(i64::from));
+            for (t, m) in transform.translation.iter_mut().zip(moved) {
+                *t += m;
+            }
+            graph::write_transform(frame, transform);
+        }
+    }
+    Ok(out)
+}
+
+/// An nTRN, nGRP or nSHP chunk's id and content.
+fn node_chunk(node: &Node) -> (&'static [u8; 4], Vec<u8>) {
+    let mut content = node.id.to_le_bytes().to_vec();
+    write_attributes(&mut content, &node.attributes);
+    let push = |content: &mut Vec<u8>, n: usize| {
+        content.extend_from_slice(&u32::try_from(n).unwrap_or(u32::MAX).to_le_bytes())
+    };
+    match &node.kind {
+        NodeKind::Transform { child, reserved, layer, frames } => {
+            for word in [*child, *reserved, *layer] {
+                content.extend_from_slice(&word.to_le_bytes());
+            }
+            push(&mut content, frames.len());
+            for frame in frames {
+                write_attributes(&mut content, frame);
+            }
+            (b"nTRN", content)
+        }
+        NodeKind::Group { children } => {
+            push(&mut content, children.len());
+            for child in children {
+                content.extend_from_slice(&child.to_le_bytes());
+            }
+            (b"nGRP", content)
+        }
+        NodeKind::Shape { models } => {
+            push(&mut content, models.len());
+            for (model, attributes) in models {
+                content.extend_from_slice(&model.to_le_bytes());
+                write_attributes(&mut content, attributes);
+            }
+            (b"nSHP", content)
+        }
+    }
+}
+
+fn write_attributes(buffer: &mut Vec<u8>, attributes: &Attributes) {
+    write_dict(buffer, attributes.iter().map(|(k, v)| (k.as_str(), v.as_str())));
 }

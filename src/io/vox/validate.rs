@@ -15,6 +15,8 @@ use std::collections::BTreeMap;
 
 use super::VoxError;
 use super::chunk::{Chunk, Cursor, le_u32, read_chunk_header, widen};
+use crate::scene::graph::{Layer, Node, NodeKind, SceneGraph};
+use crate::scene::objects::KeptChunk;
 use crate::scene::{Material, MaterialKind};
 
 /// "VOX " plus the version number.
@@ -31,9 +33,11 @@ pub(super) struct Layout {
     pub version: u32,
     /// Number of voxels of each model (XYZI chunk), in file order.
     pub model_voxels: Vec<usize>,
-    /// Node id of each nTRN/nGRP/nSHP chunk, in file order; `dot_vox` keeps
-    /// the nodes in this order but drops their ids.
-    pub node_ids: Vec<u32>,
+    /// The nTRN/nGRP/nSHP and LAYR chunks, in file order (`dot_vox` drops
+    /// node and layer ids, and attribute order is its hash map's).
+    pub graph: SceneGraph,
+    /// Chunks octovox does not read, in file order, to be written back.
+    pub kept: Vec<KeptChunk>,
     /// (model, voxel ordinal) of each voxel stored with colour index 0, which
     /// means "empty"; `dot_vox` would report it as index 1.
     pub zero_index_voxels: Vec<(usize, usize)>,
@@ -97,17 +101,20 @@ fn check_chunk(bytes: &[u8], chunk: &Chunk, size: &mut Option<[u32; 3]>, layout:
         }
         b"MATL" => {
             cursor.u32("material id")?;
-            cursor.skip_dict("material properties")?;
+            cursor.dict("material properties")?;
         }
         b"MATT" => {
             let (index, material) = read_matt(&mut cursor)?;
             layout.matt.insert(index, material);
         }
-        b"nTRN" => layout.node_ids.push(check_transform_node(&mut cursor)?),
-        b"nGRP" => layout.node_ids.push(check_group_node(&mut cursor)?),
-        b"nSHP" => layout.node_ids.push(check_shape_node(&mut cursor)?),
-        // LAYR, IMAP, PACK, rOBJ, rCAM, NOTE and unknown chunks are not used.
-        _ => {}
+        b"nTRN" => layout.graph.nodes.push(read_transform_node(&mut cursor)?),
+        b"nGRP" => layout.graph.nodes.push(read_group_node(&mut cursor)?),
+        b"nSHP" => layout.graph.nodes.push(read_shape_node(&mut cursor)?),
+        b"LAYR" => layout.graph.layers.push(read_layer(&mut cursor)?),
+        // PACK only counts the models that follow; the saver writes none.
+        b"PACK" | b"RGBA" => {}
+        // IMAP, rOBJ, rCAM, NOTE, META and unknown chunks are kept as read.
+        id => layout.kept.push(KeptChunk { id: *id, content: bytes[chunk.content_start..chunk.content_end].to_vec() }),
     }
     Ok(())
 }
@@ -160,40 +167,52 @@ fn check_voxels(cursor: &mut Cursor<'_>, size: Option<[u32; 3]>, layout: &mut La
     Ok(())
 }
 
-fn check_transform_node(cursor: &mut Cursor<'_>) -> Result<u32, VoxError> {
+fn read_transform_node(cursor: &mut Cursor<'_>) -> Result<Node, VoxError> {
     let id = cursor.u32("node id")?;
-    cursor.skip_dict("node attributes")?;
-    cursor.u32("child node id")?;
-    cursor.u32("reserved id")?;
-    cursor.u32("layer id")?;
-    let frames = cursor.u32("frame count")?;
-    for _ in 0..frames {
-        cursor.skip_dict("frame attributes")?;
-    }
-    Ok(id)
-}
-
-fn check_group_node(cursor: &mut Cursor<'_>) -> Result<u32, VoxError> {
-    let id = cursor.u32("node id")?;
-    cursor.skip_dict("node attributes")?;
-    let children = widen(cursor.u32("child count")?);
+    let attributes = cursor.dict("node attributes")?;
+    let child = cursor.u32("child node id")?;
+    let reserved = cursor.u32("reserved id")?;
+    let layer = cursor.u32("layer id")?;
+    let count = widen(cursor.u32("frame count")?);
     let held = cursor.remaining();
-    if children > held / 4 {
-        return Err(cursor.chunk.fail(format!("claims {children} children but holds {held} bytes")));
+    if count > held / 4 {
+        return Err(cursor.chunk.fail(format!("claims {count} frames but holds {held} bytes")));
     }
-    cursor.take(children * 4, "child ids")?;
-    Ok(id)
+    let frames = (0..count).map(|_| cursor.dict("frame attributes")).collect::<Result<_, _>>()?;
+    Ok(Node { id, attributes, kind: NodeKind::Transform { child, reserved, layer, frames } })
 }
 
-fn check_shape_node(cursor: &mut Cursor<'_>) -> Result<u32, VoxError> {
+fn read_group_node(cursor: &mut Cursor<'_>) -> Result<Node, VoxError> {
     let id = cursor.u32("node id")?;
-    cursor.skip_dict("node attributes")?;
-    let models = cursor.u32("model count")?;
-    for _ in 0..models {
-        cursor.u32("model id")?;
-        cursor.skip_dict("model attributes")?;
+    let attributes = cursor.dict("node attributes")?;
+    let count = widen(cursor.u32("child count")?);
+    let held = cursor.remaining();
+    if count > held / 4 {
+        return Err(cursor.chunk.fail(format!("claims {count} children but holds {held} bytes")));
     }
-    Ok(id)
+    let children = (0..count).map(|_| cursor.u32("child id")).collect::<Result<_, _>>()?;
+    Ok(Node { id, attributes, kind: NodeKind::Group { children } })
+}
+
+fn read_shape_node(cursor: &mut Cursor<'_>) -> Result<Node, VoxError> {
+    let id = cursor.u32("node id")?;
+    let attributes = cursor.dict("node attributes")?;
+    let count = widen(cursor.u32("model count")?);
+    let held = cursor.remaining();
+    if count > held / 8 {
+        return Err(cursor.chunk.fail(format!("claims {count} models but holds {held} bytes")));
+    }
+    let models = (0..count)
+        .map(|_| Ok((cursor.u32("model id")?, cursor.dict("model attributes")?)))
+        .collect::<Result<_, VoxError>>()?;
+    Ok(Node { id, attributes, kind: NodeKind::Shape { models } })
+}
+
+fn read_layer(cursor: &mut Cursor<'_>) -> Result<Layer, VoxError> {
+    let id = cursor.u32("layer id")?;
+    let attributes = cursor.dict("layer attributes")?;
+    let reserved = cursor.u32("reserved id")?;
+    Ok(Layer { id, attributes, reserved })
 }
 
 /// Property names of a MATT chunk's property bits 0..=6, in bit order.

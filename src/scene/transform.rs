@@ -20,19 +20,23 @@
 //! (equivalently `floor(R · (v − pivot + ½) + t)`). This is exact integer
 //! arithmetic, so every voxel lands on the cell MagicaVoxel draws it in.
 
+use glam::IVec3;
+
+use super::Shape;
+
 /// A signed permutation matrix: row `i` has `sign[i]` in column `axis[i]`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) struct Rotation {
+pub struct Rotation {
     axis: [usize; 3],
     sign: [i64; 3],
 }
 
 impl Rotation {
-    pub(super) const IDENTITY: Rotation = Rotation { axis: [0, 1, 2], sign: [1, 1, 1] };
+    pub const IDENTITY: Rotation = Rotation { axis: [0, 1, 2], sign: [1, 1, 1] };
 
     /// Decodes MagicaVoxel's `_r` byte; `None` when the two stored column
     /// indices are out of range or equal.
-    pub(super) fn from_byte(byte: u8) -> Option<Rotation> {
+    pub fn from_byte(byte: u8) -> Option<Rotation> {
         let first = usize::from(byte & 3);
         let second = usize::from((byte >> 2) & 3);
         if first > 2 || second > 2 || first == second {
@@ -43,7 +47,7 @@ impl Rotation {
     }
 
     /// `self · other`: apply `other` first.
-    pub(super) fn times(self, other: Rotation) -> Rotation {
+    pub fn times(self, other: Rotation) -> Rotation {
         let mut out = Rotation::IDENTITY;
         for row in 0..3 {
             let picked = self.axis[row];
@@ -53,23 +57,23 @@ impl Rotation {
         out
     }
 
-    pub(super) fn apply(self, v: [i64; 3]) -> [i64; 3] {
+    pub fn apply(self, v: [i64; 3]) -> [i64; 3] {
         [0, 1, 2].map(|row| self.sign[row] * v[self.axis[row]])
     }
 }
 
 /// A rigid transform of the MagicaVoxel scene: `p ↦ rotation · p + translation`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) struct Transform {
+pub struct Transform {
     pub rotation: Rotation,
     pub translation: [i64; 3],
 }
 
 impl Transform {
-    pub(super) const IDENTITY: Transform = Transform { rotation: Rotation::IDENTITY, translation: [0, 0, 0] };
+    pub const IDENTITY: Transform = Transform { rotation: Rotation::IDENTITY, translation: [0, 0, 0] };
 
     /// The transform that applies `child` first, then `self`.
-    pub(super) fn compose(self, child: Transform) -> Transform {
+    pub fn compose(self, child: Transform) -> Transform {
         let moved = self.rotation.apply(child.translation);
         Transform {
             rotation: self.rotation.times(child.rotation),
@@ -80,7 +84,7 @@ impl Transform {
 
 /// One model placed in the scene.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) struct Placement {
+pub struct Placement {
     /// Index into the file's models.
     pub model: usize,
     pub transform: Transform,
@@ -92,7 +96,7 @@ pub(super) struct Placement {
 impl Placement {
     /// Scene position (MagicaVoxel axes) of the voxel at `v` in a model of
     /// `size`, by the unit-cube rule in the module documentation.
-    pub(super) fn place(&self, v: [u8; 3], size: [u32; 3]) -> [i64; 3] {
+    pub fn place(&self, v: [u8; 3], size: [u32; 3]) -> [i64; 3] {
         let local = [0, 1, 2].map(|axis| {
             let pivot = if self.centred { i64::from(size[axis] / 2) } else { 0 };
             i64::from(v[axis]) - pivot
@@ -106,9 +110,137 @@ impl Placement {
     }
 }
 
+impl Rotation {
+    /// MagicaVoxel's `_r` byte for this rotation (the inverse of [`Rotation::from_byte`]).
+    pub fn to_byte(self) -> u8 {
+        let signs = (0..3).map(|row| u8::from(self.sign[row] < 0) << (4 + row)).sum::<u8>();
+        (self.axis[0] as u8) | ((self.axis[1] as u8) << 2) | signs
+    }
+
+    /// A quarter turn counter-clockwise seen from the positive end of MagicaVoxel axis `axis` (0, 1, 2 = x, y, z).
+    pub fn quarter_turn(axis: usize) -> Rotation {
+        let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
+        // a → b and b → −a: row b reads +a, row a reads −b.
+        let mut rotation = Rotation::IDENTITY;
+        rotation.axis[b] = a;
+        rotation.axis[a] = b;
+        rotation.sign[a] = -1;
+        rotation
+    }
+}
+
+impl Placement {
+    /// The map from model cells to octovox world cells (y up) that [`Placement::place`] and the axis change
+    /// (x, y, z) → (x, z, −y) make together; `None` when an offset leaves the 32-bit range.
+    pub fn cell_map(&self, size: [u32; 3]) -> Option<CellMap> {
+        let Transform { rotation, translation } = self.transform;
+        let row = |r: usize| {
+            let a = rotation.axis[r];
+            let s = rotation.sign[r];
+            let pivot = if self.centred { i64::from(size[a] / 2) } else { 0 };
+            let offset = translation[r] - s * pivot - i64::from(s < 0);
+            (a, s, offset)
+        };
+        let [x, y, z] = [row(0), row(1), row(2)];
+        let rows = [x, z, (y.0, -y.1, -y.2)];
+        let offset = [0, 1, 2].map(|i| i32::try_from(rows[i].2).ok());
+        Some(CellMap {
+            axis: rows.map(|r| r.0),
+            sign: rows.map(|r| r.1 as i32),
+            offset: IVec3::new(offset[0]?, offset[1]?, offset[2]?),
+        })
+    }
+}
+
+/// A signed permutation of cells plus an integer offset: world cell `w[i] = sign[i] · v[axis[i]] + offset[i]`.
+/// It maps cell centres by an isometry, so a sphere of cells maps to a sphere and a box to a box, exactly.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CellMap {
+    axis: [usize; 3],
+    sign: [i32; 3],
+    offset: IVec3,
+}
+
+impl CellMap {
+    pub const IDENTITY: CellMap = CellMap { axis: [0, 1, 2], sign: [1, 1, 1], offset: IVec3::ZERO };
+
+    /// The world cell of model cell `v`.
+    pub fn apply(&self, v: IVec3) -> IVec3 {
+        IVec3::from_array([0, 1, 2].map(|i| self.sign[i].wrapping_mul(v[self.axis[i]]).wrapping_add(self.offset[i])))
+    }
+
+    /// The model cell at world cell `w`.
+    pub fn invert(&self, w: IVec3) -> IVec3 {
+        let mut v = [0; 3];
+        for i in 0..3 {
+            v[self.axis[i]] = self.sign[i].wrapping_mul(w[i].wrapping_sub(self.offset[i]));
+        }
+        IVec3::from_array(v)
+    }
+
+    /// The image of the inclusive box `lo..=hi` of model cells.
+    pub fn apply_box(&self, lo: IVec3, hi: IVec3) -> (IVec3, IVec3) {
+        let (a, b) = (self.apply(lo), self.apply(hi));
+        (a.min(b), a.max(b))
+    }
+
+    /// The model cells of the inclusive world box `lo..=hi`.
+    pub fn invert_box(&self, lo: IVec3, hi: IVec3) -> (IVec3, IVec3) {
+        let (a, b) = (self.invert(lo), self.invert(hi));
+        (a.min(b), a.max(b))
+    }
+
+    /// The model cells a world brush shape covers, as a shape of the same kind.
+    pub fn invert_shape(&self, shape: &Shape) -> Shape {
+        match *shape {
+            Shape::Voxel(p) => Shape::Voxel(self.invert(p)),
+            Shape::Sphere { center, radius } => Shape::Sphere { center: self.invert(center), radius },
+            Shape::Box { min, max } => {
+                let (min, max) = self.invert_box(min, max);
+                Shape::Box { min, max }
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rotation_bytes_round_trip_and_quarter_turns_cycle() {
+        for byte in (0..=127u8).filter(|b| Rotation::from_byte(*b).is_some()) {
+            assert_eq!(Rotation::from_byte(byte).map(Rotation::to_byte), Some(byte));
+        }
+        // About z: x → y → −x.
+        assert_eq!(Rotation::quarter_turn(2).apply([1, 0, 0]), [0, 1, 0]);
+        assert_eq!(Rotation::quarter_turn(2).apply([0, 1, 0]), [-1, 0, 0]);
+        for axis in 0..3 {
+            let turn = Rotation::quarter_turn(axis);
+            let full = turn.times(turn).times(turn).times(turn);
+            assert_eq!(full, Rotation::IDENTITY);
+        }
+    }
+
+    /// The cell map agrees with `place` and the axis change on every cell of a small model, for all 48
+    /// rotations, and inverts exactly.
+    #[test]
+    fn cell_maps_agree_with_placement_and_invert() {
+        let size = [3, 4, 5];
+        for byte in (0..=127u8).filter(|b| Rotation::from_byte(*b).is_some()) {
+            let rotation = Rotation::from_byte(byte).unwrap();
+            let placement =
+                Placement { model: 0, transform: Transform { rotation, translation: [7, -3, 11] }, centred: true };
+            let map = placement.cell_map(size).unwrap();
+            for v in [[0u8, 0, 0], [2, 3, 4], [1, 2, 0]] {
+                let [x, y, z] = placement.place(v, size);
+                let world = IVec3::new(x as i32, z as i32, -y as i32);
+                let model = IVec3::new(v[0].into(), v[1].into(), v[2].into());
+                assert_eq!(map.apply(model), world, "rotation {byte}");
+                assert_eq!(map.invert(world), model);
+            }
+        }
+    }
 
     /// `_r` = 4 is the identity (row 0 → x, row 1 → y).
     #[test]

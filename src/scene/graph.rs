@@ -1,0 +1,443 @@
+//! A MagicaVoxel scene graph as the file holds it: transform, group and
+//! shape nodes with their attributes, and layers; and the walk that turns it
+//! into the objects of a scene.
+//!
+//! The walk starts at node 0, composes nTRN transforms down the tree (child
+//! first, as `ogt_vox` flattens them), and yields one [`Object`] per nSHP it
+//! reaches. Nodes may be shared (a model placed by several transforms); a
+//! node on its own path is a cycle. The walk is iterative, so deep graphs
+//! cannot overflow the stack, and bounded by [`MAX_NODE_VISITS`],
+//! [`MAX_INSTANCES`] and a voxel limit the caller gives.
+
+use std::collections::{BTreeMap, HashMap};
+
+use super::transform::{Placement, Rotation, Transform};
+
+/// Most model placements (shape instances) one scene graph may produce.
+pub const MAX_INSTANCES: usize = 1 << 20;
+
+/// Most scene-graph node visits one walk may make (a node shared by several
+/// parents is visited once per path to it).
+pub const MAX_NODE_VISITS: usize = 1 << 22;
+
+/// Attributes as MagicaVoxel stores them (a DICT): `_name`, `_hidden`,
+/// `_t`, `_r`, `_f`, `_color`, and whatever else a file holds.
+pub type Attributes = BTreeMap<String, String>;
+
+/// The nodes and layers of a scene, in file order.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct SceneGraph {
+    pub nodes: Vec<Node>,
+    pub layers: Vec<Layer>,
+}
+
+/// One nTRN, nGRP or nSHP chunk.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Node {
+    pub id: u32,
+    pub attributes: Attributes,
+    pub kind: NodeKind,
+}
+
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum NodeKind {
+    /// One child placed by keyframes (`_t`, `_r`, `_f`), on a layer
+    /// (`u32::MAX` for none); `reserved` is written back as read.
+    Transform {
+        child: u32,
+        reserved: u32,
+        layer: u32,
+        frames: Vec<Attributes>,
+    },
+    Group {
+        children: Vec<u32>,
+    },
+    /// Which model it shows, per keyframe (`_f`).
+    Shape {
+        models: Vec<(u32, Attributes)>,
+    },
+}
+
+/// One LAYR chunk.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Layer {
+    pub id: u32,
+    pub attributes: Attributes,
+    /// Written back as read (MagicaVoxel writes −1).
+    pub reserved: u32,
+}
+
+impl Layer {
+    pub fn name(&self) -> &str {
+        self.attributes.get("_name").map_or("", String::as_str)
+    }
+
+    pub fn hidden(&self) -> bool {
+        is_set(&self.attributes, "_hidden")
+    }
+}
+
+/// Whether a flag attribute (`_hidden`) is set: MagicaVoxel writes "1".
+pub fn is_set(attributes: &Attributes, key: &str) -> bool {
+    attributes.get(key).is_some_and(|v| v.trim() == "1")
+}
+
+/// Why a scene graph cannot be walked.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum GraphError {
+    /// A node reachable from itself.
+    #[error("scene graph cycle at node {0}")]
+    Cycle(u32),
+    /// A missing node, a model id out of range, a malformed transform.
+    #[error("scene graph: {0}")]
+    Bad(String),
+    /// The placed models hold more voxels than the caller allows.
+    #[error("the scene holds more than {limit} voxels (at least {found})")]
+    TooManyVoxels { limit: usize, found: usize },
+}
+
+/// One placed model: what the walk found at an nSHP.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Object {
+    pub placement: Placement,
+    /// The nSHP node, and the nTRN right above it (whose `_t`/`_r` move it).
+    pub shape_node: u32,
+    pub transform_node: Option<u32>,
+    /// Names of the named transforms on the way down, joined by `/`.
+    pub path: String,
+    /// Layer of its transform (`None` for none).
+    pub layer: Option<u32>,
+    /// Hidden itself, below a hidden transform, or on a hidden layer.
+    pub hidden: bool,
+}
+
+impl SceneGraph {
+    /// The objects of the scene at `frame`, in walk order (node 0 first,
+    /// children in file order). `model_voxels[m]` is the voxel count of model
+    /// `m`; the placed models may hold at most `voxel_limit` voxels together.
+    pub fn objects(&self, model_voxels: &[usize], frame: usize, voxel_limit: usize) -> Result<Vec<Object>, GraphError> {
+        let walk = Walk {
+            graph: self,
+            index_of: index_nodes(&self.nodes)?,
+            hidden_layers: self.layers.iter().filter(|l| l.hidden()).map(|l| l.id).collect(),
+            model_voxels,
+            frame,
+            voxel_limit,
+            on_path: vec![false; self.nodes.len()],
+            names: Vec::new(),
+            stack: vec![Step::Enter { id: 0, parent: None, context: Context::ROOT }],
+            visits: 0,
+            voxels: 0,
+            out: Vec::new(),
+        };
+        walk.run()
+    }
+
+    /// The node with id `id`.
+    pub fn node(&self, id: u32) -> Option<&Node> {
+        self.nodes.iter().find(|n| n.id == id)
+    }
+
+    pub fn node_mut(&mut self, id: u32) -> Option<&mut Node> {
+        self.nodes.iter_mut().find(|n| n.id == id)
+    }
+
+    /// Number of group nodes.
+    pub fn group_count(&self) -> usize {
+        self.nodes.iter().filter(|n| matches!(n.kind, NodeKind::Group { .. })).count()
+    }
+}
+
+/// What a path down the graph has gathered so far.
+#[derive(Clone, Copy)]
+struct Context {
+    transform: Transform,
+    hidden: bool,
+    /// The nearest nTRN above, and its layer.
+    transform_node: Option<u32>,
+    layer: Option<u32>,
+    /// Last named transform on the path, as an index into `Walk::names`.
+    name: Option<usize>,
+}
+
+impl Context {
+    const ROOT: Context =
+        Context { transform: Transform::IDENTITY, hidden: false, transform_node: None, layer: None, name: None };
+}
+
+/// One entry of the explicit depth-first stack.
+enum Step {
+    /// Visit node `id`, reached from `parent`.
+    Enter { id: u32, parent: Option<u32>, context: Context },
+    /// All of node `index`'s descendants are done: it leaves the current path.
+    Leave { index: usize },
+}
+
+/// State of one scene-graph walk.
+struct Walk<'a> {
+    graph: &'a SceneGraph,
+    index_of: HashMap<u32, usize>,
+    hidden_layers: Vec<u32>,
+    model_voxels: &'a [usize],
+    frame: usize,
+    voxel_limit: usize,
+    /// Nodes on the path from the root to the node being visited.
+    on_path: Vec<bool>,
+    /// Names met on the way down: (the name before it on its path, name).
+    /// Paths share their beginnings, so a deep chain costs one entry a level.
+    names: Vec<(Option<usize>, &'a str)>,
+    stack: Vec<Step>,
+    visits: usize,
+    /// Voxels of all placements so far.
+    voxels: usize,
+    out: Vec<Object>,
+}
+
+impl<'a> Walk<'a> {
+    fn run(mut self) -> Result<Vec<Object>, GraphError> {
+        while let Some(step) = self.stack.pop() {
+            match step {
+                Step::Leave { index } => self.on_path[index] = false,
+                Step::Enter { id, parent, context } => self.enter(id, parent, context)?,
+            }
+        }
+        Ok(self.out)
+    }
+
+    fn enter(&mut self, id: u32, parent: Option<u32>, context: Context) -> Result<(), GraphError> {
+        let index = self.index_of.get(&id).copied().ok_or_else(|| {
+            GraphError::Bad(match parent {
+                Some(parent) => format!("node {parent} refers to missing node {id}"),
+                None => "there is no root node 0".to_owned(),
+            })
+        })?;
+        if self.on_path[index] {
+            return Err(GraphError::Cycle(id));
+        }
+        self.visits += 1;
+        if self.visits > MAX_NODE_VISITS {
+            return Err(GraphError::Bad(format!(
+                "more than {MAX_NODE_VISITS} node visits (nodes shared along too many paths)"
+            )));
+        }
+        self.on_path[index] = true;
+        self.stack.push(Step::Leave { index });
+        let node: &'a Node = &self.graph.nodes[index];
+        match &node.kind {
+            NodeKind::Transform { frames, child, layer, .. } => {
+                let context = self.transformed(node, frames, *layer, context)?;
+                self.stack.push(Step::Enter { id: *child, parent: Some(id), context });
+            }
+            NodeKind::Group { children } => {
+                // Reversed so that children are visited in file order.
+                for &child in children.iter().rev() {
+                    self.stack.push(Step::Enter { id: child, parent: Some(id), context });
+                }
+            }
+            NodeKind::Shape { models } => self.place_shape(id, models, context)?,
+        }
+        Ok(())
+    }
+
+    /// The context below transform `node`.
+    fn transformed(
+        &mut self,
+        node: &'a Node,
+        frames: &[Attributes],
+        layer: u32,
+        context: Context,
+    ) -> Result<Context, GraphError> {
+        let local = match pick_keyframe(frames.iter(), self.frame, node.id)? {
+            Some(k) => parse_transform(&frames[k], node.id)?,
+            None => Transform::IDENTITY,
+        };
+        let layer = (layer != u32::MAX).then_some(layer);
+        let name = match node.attributes.get("_name").filter(|n| !n.is_empty()) {
+            Some(name) => {
+                self.names.push((context.name, name));
+                Some(self.names.len() - 1)
+            }
+            None => context.name,
+        };
+        Ok(Context {
+            transform: context.transform.compose(local),
+            hidden: context.hidden
+                || is_set(&node.attributes, "_hidden")
+                || layer.is_some_and(|l| self.hidden_layers.contains(&l)),
+            transform_node: Some(node.id),
+            layer,
+            name,
+        })
+    }
+
+    fn place_shape(&mut self, id: u32, models: &[(u32, Attributes)], context: Context) -> Result<(), GraphError> {
+        let Some(k) = pick_keyframe(models.iter().map(|m| &m.1), self.frame, id)? else { return Ok(()) };
+        let model = usize::try_from(models[k].0).unwrap_or(usize::MAX);
+        let count = self.model_voxels.get(model).copied().ok_or_else(|| {
+            GraphError::Bad(format!(
+                "shape node {id} uses model {model} but the file has {} models",
+                self.model_voxels.len()
+            ))
+        })?;
+        self.voxels = self.voxels.saturating_add(count);
+        if self.voxels > self.voxel_limit {
+            return Err(GraphError::TooManyVoxels { limit: self.voxel_limit, found: self.voxels });
+        }
+        if self.out.len() >= MAX_INSTANCES {
+            return Err(GraphError::Bad(format!("more than {MAX_INSTANCES} model placements")));
+        }
+        self.out.push(Object {
+            placement: Placement { model, transform: context.transform, centred: true },
+            shape_node: id,
+            transform_node: context.transform_node,
+            path: self.path(context.name),
+            layer: context.layer,
+            hidden: context.hidden,
+        });
+        Ok(())
+    }
+
+    fn path(&self, mut at: Option<usize>) -> String {
+        let mut names = Vec::new();
+        while let Some(i) = at {
+            names.push(self.names[i].1);
+            at = self.names[i].0;
+        }
+        names.reverse();
+        names.join("/")
+    }
+}
+
+fn index_nodes(nodes: &[Node]) -> Result<HashMap<u32, usize>, GraphError> {
+    let mut index_of = HashMap::with_capacity(nodes.len());
+    for (index, node) in nodes.iter().enumerate() {
+        if index_of.insert(node.id, index).is_some() {
+            return Err(GraphError::Bad(format!("node id {} is used twice", node.id)));
+        }
+    }
+    Ok(index_of)
+}
+
+/// Index of the keyframe shown at `frame`: the last one whose `_f` is at
+/// most `frame` (a missing `_f` counts as 0), else the first; `None` when
+/// there are none. MagicaVoxel interpolates translations between keyframes;
+/// octovox snaps to the earlier one.
+pub fn pick_keyframe<'a>(
+    keyframes: impl Iterator<Item = &'a Attributes>,
+    frame: usize,
+    node: u32,
+) -> Result<Option<usize>, GraphError> {
+    let mut best: Option<(usize, usize)> = None;
+    let mut any = false;
+    for (k, attributes) in keyframes.enumerate() {
+        any = true;
+        let at = match attributes.get("_f") {
+            None => 0,
+            Some(text) => text
+                .trim()
+                .parse::<usize>()
+                .map_err(|_| GraphError::Bad(format!("node {node} has a malformed frame index _f={text:?}")))?,
+        };
+        if at <= frame && best.is_none_or(|(best_at, _)| at > best_at) {
+            best = Some((at, k));
+        }
+    }
+    Ok(best.map(|(_, k)| k).or(any.then_some(0)))
+}
+
+/// Parses a keyframe's `_r` rotation byte and `_t` translation.
+pub fn parse_transform(attributes: &Attributes, node: u32) -> Result<Transform, GraphError> {
+    let rotation = match attributes.get("_r") {
+        None => Rotation::IDENTITY,
+        Some(text) => text
+            .trim()
+            .parse::<u8>()
+            .ok()
+            .and_then(Rotation::from_byte)
+            .ok_or_else(|| GraphError::Bad(format!("node {node} has an invalid rotation _r={text:?}")))?,
+    };
+    let translation = match attributes.get("_t") {
+        None => [0, 0, 0],
+        Some(text) => parse_translation(text)
+            .ok_or_else(|| GraphError::Bad(format!("node {node} has a malformed translation _t={text:?}")))?,
+    };
+    Ok(Transform { rotation, translation })
+}
+
+fn parse_translation(text: &str) -> Option<[i64; 3]> {
+    let mut parts = text.split_ascii_whitespace().map(|p| p.parse::<i32>().ok().map(i64::from));
+    let t = [parts.next()??, parts.next()??, parts.next()??];
+    parts.next().is_none().then_some(t)
+}
+
+/// Writes a transform back as `_r` and `_t` into a keyframe's attributes
+/// (leaving `_r` out for the identity, as MagicaVoxel does).
+pub fn write_transform(attributes: &mut Attributes, transform: Transform) {
+    let [x, y, z] = transform.translation;
+    attributes.insert("_t".to_owned(), format!("{x} {y} {z}"));
+    if transform.rotation == Rotation::IDENTITY {
+        attributes.remove("_r");
+    } else {
+        attributes.insert("_r".to_owned(), transform.rotation.to_byte().to_string());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn translation_parsing_is_strict() {
+        assert_eq!(parse_translation("1 -2  3"), Some([1, -2, 3]));
+        assert_eq!(parse_translation("1 2"), None);
+        assert_eq!(parse_translation("1 2 3 4"), None);
+        assert_eq!(parse_translation("1 2 x"), None);
+    }
+
+    fn transform(id: u32, child: u32, layer: u32, name: &str) -> Node {
+        let mut attributes = Attributes::new();
+        if !name.is_empty() {
+            attributes.insert("_name".into(), name.into());
+        }
+        Node { id, attributes, kind: NodeKind::Transform { child, reserved: u32::MAX, layer, frames: vec![] } }
+    }
+
+    fn shape(id: u32, model: u32) -> Node {
+        Node { id, attributes: Attributes::new(), kind: NodeKind::Shape { models: vec![(model, Attributes::new())] } }
+    }
+
+    /// Paths name the named transforms on the way; a hidden layer hides what is on it.
+    #[test]
+    fn objects_carry_paths_layers_and_hidden_flags() {
+        let hidden_layer = Layer { id: 1, attributes: [("_hidden".into(), "1".into())].into(), reserved: u32::MAX };
+        let graph = SceneGraph {
+            nodes: vec![
+                transform(0, 1, u32::MAX, ""),
+                Node { id: 1, attributes: Attributes::new(), kind: NodeKind::Group { children: vec![2, 6] } },
+                transform(2, 3, 0, "house"),
+                Node { id: 3, attributes: Attributes::new(), kind: NodeKind::Group { children: vec![4] } },
+                transform(4, 5, 1, "door"),
+                shape(5, 0),
+                transform(6, 5, 0, ""),
+            ],
+            layers: vec![hidden_layer],
+        };
+        let objects = graph.objects(&[10], 0, 100).unwrap();
+        let seen: Vec<(&str, bool, Option<u32>)> =
+            objects.iter().map(|o| (o.path.as_str(), o.hidden, o.layer)).collect();
+        assert_eq!(seen, [("house/door", true, Some(1)), ("", false, Some(0))]);
+        assert_eq!(graph.objects(&[10], 0, 15).unwrap_err(), GraphError::TooManyVoxels { limit: 15, found: 20 });
+    }
+
+    /// A chain 100,000 transforms deep walks without overflowing the stack or
+    /// copying its path at every level.
+    #[test]
+    fn a_very_deep_chain_is_walked() {
+        let depth = 100_000u32;
+        let mut nodes: Vec<Node> = (0..depth).map(|i| transform(i, i + 1, u32::MAX, "n")).collect();
+        nodes.push(shape(depth, 0));
+        let objects = SceneGraph { nodes, layers: vec![] }.objects(&[1], 0, 10).unwrap();
+        assert_eq!(objects.len(), 1);
+        assert_eq!(objects[0].path.len(), 2 * depth as usize - 1);
+    }
+}

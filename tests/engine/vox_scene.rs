@@ -1,0 +1,296 @@
+//! Scenes of several objects survive load → save: the scene graph, the
+//! layers, every model once and the chunks octovox does not read, compared
+//! with `dot_vox`'s reading of both files and a raw chunk reader here (not
+//! octovox's loader). Edits land in the models, hidden objects are not drawn.
+
+use std::collections::BTreeSet;
+use std::path::PathBuf;
+
+use dot_vox::{DotVoxData, Frame, Layer, Model, SceneNode, ShapeModel, Size, Voxel};
+use glam::IVec3;
+use octovox::editor::Editor;
+use octovox::io::vox::{encode_objects, load_vox, load_vox_scene};
+use octovox::scene::Scene;
+
+fn assets() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/vox")
+}
+
+/// The `.vox` files of the shared assets, but the one that is not one.
+fn asset_files() -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    for dir in ["seed", "magicavoxel", "format"] {
+        for entry in std::fs::read_dir(assets().join(dir)).unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().is_some_and(|e| e == "vox") && !path.ends_with("not_a.vox") {
+                files.push(path);
+            }
+        }
+    }
+    files.sort();
+    files
+}
+
+/// The children of MAIN as (id, content), read byte by byte.
+fn raw_chunks(bytes: &[u8]) -> Vec<([u8; 4], Vec<u8>)> {
+    let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
+    let mut out = Vec::new();
+    let mut at = 8 + 12;
+    while at + 12 <= bytes.len() {
+        let id: [u8; 4] = bytes[at..at + 4].try_into().unwrap();
+        let (content, children) = (word(at + 4), word(at + 8));
+        out.push((id, bytes[at + 12..at + 12 + content].to_vec()));
+        at += 12 + content + children;
+    }
+    out
+}
+
+/// The chunks a saver must keep as they are.
+fn kept_chunks(bytes: &[u8]) -> Vec<([u8; 4], Vec<u8>)> {
+    let read = [*b"SIZE", *b"XYZI", *b"nTRN", *b"nGRP", *b"nSHP", *b"LAYR", *b"RGBA", *b"MATL", *b"MATT", *b"PACK"];
+    raw_chunks(bytes).into_iter().filter(|(id, _)| !read.contains(id)).collect()
+}
+
+fn voxel_set(model: &Model) -> BTreeSet<[u8; 4]> {
+    model.voxels.iter().filter(|v| v.i != 255).map(|v| [v.x, v.y, v.z, v.i]).collect()
+}
+
+/// Both files hold the same scene graph, layers, models (each once) and kept chunks.
+fn assert_same_scene(name: &str, before: &[u8], after: &[u8]) {
+    let (a, b) = (dot_vox::load_bytes(before).unwrap(), dot_vox::load_bytes(after).unwrap());
+    assert_eq!(a.scenes, b.scenes, "{name}: scene graph");
+    assert_eq!(a.layers, b.layers, "{name}: layers");
+    assert_eq!(a.models.len(), b.models.len(), "{name}: stored models");
+    for (m, (x, y)) in a.models.iter().zip(&b.models).enumerate() {
+        assert_eq!(x.size, y.size, "{name}: size of model {m}");
+        assert!(voxel_set(x) == voxel_set(y), "{name}: voxels of model {m}");
+    }
+    assert_eq!(a.palette, b.palette, "{name}: palette");
+    assert_eq!(kept_chunks(before), kept_chunks(after), "{name}: kept chunks");
+}
+
+fn load(bytes: &[u8]) -> Scene {
+    load_vox_scene(bytes, 0).unwrap().0
+}
+
+fn saved(scene: &Scene) -> Vec<u8> {
+    encode_objects(&scene.palette, scene.objects.as_ref().expect("a scene of objects")).unwrap()
+}
+
+#[test]
+fn every_scene_file_of_the_assets_round_trips_without_loss() {
+    let mut scenes = 0;
+    for path in asset_files() {
+        let bytes = std::fs::read(&path).unwrap();
+        let scene = load(&bytes);
+        let name = path.display().to_string();
+        let parsed = dot_vox::load_bytes(&bytes).unwrap();
+        if scene.objects.is_none() {
+            assert!(parsed.models.len() <= 1, "{name}: {} models flattened", parsed.models.len());
+            continue;
+        }
+        scenes += 1;
+        let again = saved(&scene);
+        assert_same_scene(&name, &bytes, &again);
+        // And what is drawn is the same.
+        let reloaded = load(&again);
+        assert_eq!(reloaded.tree.voxels(), scene.tree.voxels(), "{name}: drawn voxels");
+    }
+    assert!(scenes >= 4, "only {scenes} scene files among the assets");
+}
+
+/// A cube-ish model with a marked corner, so that rotations show.
+fn model(size: u32, color: u8) -> Model {
+    let mut voxels = Vec::new();
+    for x in 0..size as u8 {
+        for y in 0..size as u8 {
+            voxels.push(Voxel { x, y, z: 0, i: color });
+        }
+    }
+    voxels.push(Voxel { x: 0, y: 0, z: 1, i: color + 1 });
+    Model { size: Size { x: size, y: size, z: 2 }, voxels }
+}
+
+fn dict(pairs: &[(&str, String)]) -> dot_vox::Dict {
+    pairs.iter().map(|(k, v)| ((*k).to_owned(), v.clone())).collect()
+}
+
+/// A scene the test writes with `dot_vox`: `count` references of three
+/// models with every one of the 48 rotations, two keyframes on some,
+/// names, a hidden layer and a hidden object, and the chunks a viewer or
+/// a later MagicaVoxel adds, which octovox does not read.
+fn written_scene(count: usize) -> Vec<u8> {
+    let rotations: Vec<u8> = (0..128u8)
+        .filter(|b| {
+            let (first, second) = (b & 3, (b >> 2) & 3);
+            first < 3 && second < 3 && first != second
+        })
+        .collect();
+    assert_eq!(rotations.len(), 48);
+    let mut scenes = vec![
+        SceneNode::Transform {
+            attributes: dict(&[]),
+            frames: vec![Frame::new(dict(&[]))],
+            child: 1,
+            layer_id: u32::MAX,
+        },
+        SceneNode::Group { attributes: dict(&[]), children: (0..count as u32).map(|k| 2 + 2 * k).collect() },
+    ];
+    for k in 0..count {
+        let (x, y, z) = ((k % 40) as i32 * 9 - 180, (k / 40) as i32 * 9, k as i32 % 3);
+        let mut first = vec![("_t", format!("{x} {y} {z}"))];
+        first.push(("_r", rotations[k % 48].to_string()));
+        let mut frames = vec![Frame::new(dict(&first))];
+        if k % 7 == 0 {
+            frames.push(Frame::new(dict(&[("_f", "3".into()), ("_t", format!("{x} {y} {}", z + 100))])));
+        }
+        let mut attributes = vec![("_name", format!("tree {k}"))];
+        if k % 11 == 5 {
+            attributes.push(("_hidden", "1".into()));
+        }
+        scenes.push(SceneNode::Transform {
+            attributes: dict(&attributes),
+            frames,
+            child: 3 + 2 * k as u32,
+            layer_id: (k % 3) as u32,
+        });
+        scenes.push(SceneNode::Shape {
+            attributes: dict(&[]),
+            models: vec![ShapeModel { model_id: (k % 3) as u32, attributes: dict(&[]) }],
+        });
+    }
+    let layers = (0..3)
+        .map(|l| {
+            let mut pairs = vec![("_name", format!("layer {l}")), ("_color", "255 0 128".into())];
+            if l == 2 {
+                pairs.push(("_hidden", "1".into()));
+            }
+            Layer { attributes: dict(&pairs) }
+        })
+        .collect();
+    let data = DotVoxData {
+        version: 200,
+        index_map: Vec::new(),
+        models: vec![model(5, 10), model(4, 20), model(6, 30)],
+        palette: dot_vox::DEFAULT_PALETTE.to_vec(),
+        materials: Vec::new(),
+        scenes,
+        layers,
+    };
+    let mut bytes = Vec::new();
+    data.write_vox(&mut bytes).unwrap();
+    append_chunks(&mut bytes, &[(*b"rCAM", vec![1, 2, 3, 4]), (*b"NOTE", vec![0; 8]), (*b"ABCD", b"later".to_vec())]);
+    bytes
+}
+
+/// Appends chunks to MAIN and fixes its children size.
+fn append_chunks(bytes: &mut Vec<u8>, chunks: &[([u8; 4], Vec<u8>)]) {
+    for (id, content) in chunks {
+        bytes.extend_from_slice(id);
+        bytes.extend_from_slice(&(content.len() as u32).to_le_bytes());
+        bytes.extend_from_slice(&0u32.to_le_bytes());
+        bytes.extend_from_slice(content);
+    }
+    let children = (bytes.len() - 20) as u32;
+    bytes[16..20].copy_from_slice(&children.to_le_bytes());
+}
+
+#[test]
+fn a_written_scene_of_thousands_of_references_round_trips_and_hides_what_is_hidden() {
+    let bytes = written_scene(2000);
+    let scene = load(&bytes);
+    let objects = scene.objects.as_ref().unwrap();
+    assert_eq!((objects.list().len(), objects.models.len()), (2000, 3));
+    assert_same_scene("written", &bytes, &saved(&scene));
+    // Hidden: layer 2 (every third) and k % 11 == 5. Each model's voxels
+    // land on their own cells (the placements are 9 apart, at most 6 wide).
+    let per_model = [5 * 5 + 1, 4 * 4 + 1, 6 * 6 + 1];
+    let visible: u64 = (0..2000).filter(|k| k % 3 != 2 && k % 11 != 5).map(|k| per_model[k % 3] as u64).sum();
+    assert_eq!(scene.tree.solid_voxels(), visible);
+    // At frame 3 the keyframed ones have moved up by 100 (MagicaVoxel z, octovox y).
+    let at_3 = load_vox_scene(&bytes, 3).unwrap().0;
+    assert_eq!(at_3.tree.solid_voxels(), visible);
+    assert!(at_3.tree.solid_bounds().unwrap().1.y > scene.tree.solid_bounds().unwrap().1.y + 90);
+}
+
+/// Two placements of one model (a reference), the second turned a quarter
+/// about z: an edit of the first shows in both, is saved once, and undoes.
+#[test]
+fn an_edit_goes_into_the_model_of_the_object_and_every_reference_shows_it() {
+    let mut bytes = Vec::new();
+    let data = DotVoxData {
+        version: 200,
+        index_map: Vec::new(),
+        models: vec![model(4, 10)],
+        palette: dot_vox::DEFAULT_PALETTE.to_vec(),
+        materials: Vec::new(),
+        scenes: vec![
+            SceneNode::Transform { attributes: dict(&[]), frames: vec![], child: 1, layer_id: u32::MAX },
+            SceneNode::Group { attributes: dict(&[]), children: vec![2, 4] },
+            SceneNode::Transform {
+                attributes: dict(&[("_name", "a".into())]),
+                frames: vec![Frame::new(dict(&[("_t", "0 0 0".into())]))],
+                child: 3,
+                layer_id: 0,
+            },
+            SceneNode::Shape { attributes: dict(&[]), models: vec![ShapeModel { model_id: 0, attributes: dict(&[]) }] },
+            SceneNode::Transform {
+                attributes: dict(&[("_name", "b".into())]),
+                // Quarter turn about z (x → y, y → −x): rows (0 −1 0), (1 0 0).
+                frames: vec![Frame::new(dict(&[("_t", "20 0 0".into()), ("_r", "17".into())]))],
+                child: 3,
+                layer_id: 0,
+            },
+        ],
+        layers: vec![Layer { attributes: dict(&[("_name", "0".into())]) }],
+    };
+    data.write_vox(&mut bytes).unwrap();
+    let mut editor = Editor::default();
+    editor.set_scene(load(&bytes));
+    let before = editor.scene.tree.solid_voxels();
+    assert_eq!(before, 2 * 17);
+    // Model cell (0, 0, 1) is the marked corner; a (pivot 2, 2, 1) lands it
+    // at scene (−2, −2, 0) = world (−2, 0, 2). Put a voxel on top of it.
+    // (`dot_vox` counts colour indices from 0: its 11 is the file's 12.)
+    assert_eq!(editor.scene.tree.get(IVec3::new(-2, 0, 2)), 12);
+    let script =
+        octovox::script::parse_script(std::path::Path::new("t.ovr"), "object a\ncolor 7\nplace -2 1 2").unwrap();
+    for line in &script.lines {
+        editor.run(&line.command).unwrap();
+    }
+    assert_eq!(editor.scene.tree.solid_voxels(), before + 2, "both placements show the new voxel");
+    let saved_once = saved(&editor.scene);
+    let parsed = dot_vox::load_bytes(&saved_once).unwrap();
+    assert_eq!(parsed.models.len(), 1);
+    assert_eq!(parsed.models[0].voxels.len(), 18);
+    // Reading the saved file back gives what was drawn.
+    assert_eq!(load(&saved_once).tree.voxels(), editor.scene.tree.voxels());
+    editor.run(&octovox::script::Command::Undo(1)).unwrap();
+    assert_eq!(editor.scene.tree.solid_voxels(), before);
+    assert_eq!(editor.scene.objects.as_ref().unwrap().models[0].tree.solid_voxels(), 17);
+}
+
+/// A voxel placed below a model's grid moves its origin: the saved file
+/// has a larger model and a translation that keeps every voxel in place.
+#[test]
+fn a_model_that_grows_on_one_side_keeps_its_voxels_where_they_were() {
+    let bytes = written_scene(6);
+    let mut editor = Editor::default();
+    editor.set_scene(load(&bytes));
+    let lo = editor.scene.objects.as_ref().unwrap().world_box(1).unwrap().0;
+    let place = format!("place {} {} {}", lo.x - 1, lo.y - 1, lo.z - 1);
+    for line in ["object 1", "brush box 3 3 3", place.as_str()] {
+        let script = octovox::script::parse_script(std::path::Path::new("t.ovr"), line).unwrap();
+        editor.run(&script.lines[0].command).unwrap();
+    }
+    let drawn = editor.scene.tree.voxels();
+    let again = saved(&editor.scene);
+    let grown = &dot_vox::load_bytes(&again).unwrap().models[1];
+    assert!(grown.size.x > 4 || grown.size.y > 4 || grown.size.z > 2, "{:?}", grown.size);
+    let flat = load_vox(&again, 0).unwrap();
+    let mut placed = flat.voxels;
+    placed.sort_by_key(|(p, _)| (p.x, p.y, p.z));
+    let mut expected = drawn;
+    expected.sort_by_key(|(p, _)| (p.x, p.y, p.z));
+    assert_eq!(placed, expected);
+}
