@@ -81,6 +81,9 @@ pub enum Command {
         /// Machine-readable output.
         #[arg(long)]
         json: bool,
+        /// One line per object: index, name path, model, layer, hidden, world box.
+        #[arg(long)]
+        objects: bool,
         /// Animation frame to read (files with several models and no scene graph).
         #[arg(long, default_value_t = 0)]
         frame: usize,

@@ -255,6 +255,14 @@ impl Editor {
         }
     }
 
+    /// The `object N` line that picks the object drawn at `voxel`, when that
+    /// is not the picked one already (what a click runs before its edit).
+    pub fn object_line_at(&self, voxel: IVec3) -> Option<Command> {
+        let objects = self.scene.objects.as_ref()?;
+        let owner = objects.owner_at(voxel).filter(|&i| objects.selected != Some(i))?;
+        Some(Command::Object(ObjectLine::Pick(ObjectRef::Index(owner))))
+    }
+
     /// The object an `object hide|show` line acts on.
     fn picked_object(&self) -> Result<usize, EditorError> {
         self.scene.objects.as_ref().and_then(|o| o.selected).ok_or_else(|| {

@@ -137,6 +137,7 @@ impl App {
                 fill: self.hover.fill_preview.as_ref().map(|p| p.region),
                 paste,
                 eyedropper,
+                objects: self.doc.editor.scene.objects.as_deref(),
             };
             let (state, ui_state, tools) = (&mut self.state, &mut self.ui, &mut self.doc.editor.tools);
             let pick = self.hover.pick;

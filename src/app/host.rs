@@ -35,7 +35,10 @@ impl App {
             self.close_strokes();
         }
         let result = step(self, base, line)?;
-        if let StepResult::Ran(Ran { line, outcome, selection }) = &result {
+        if let StepResult::Ran(Ran { line, outcome, selection, picked }) = &result {
+            if let Some(picked) = picked {
+                self.followed_up(picked, &Outcome::State, *selection, gesture);
+            }
             self.followed_up(line, outcome, *selection, gesture);
         }
         Ok(result)

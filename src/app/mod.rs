@@ -340,6 +340,11 @@ impl App {
                 Err(err) => self.ui.error(format!("copy refused: {err}")),
             },
             Command::SelectNone => self.act(octovox::script::Command::Select(None), "select"),
+            Command::Lines(lines) => {
+                for line in lines {
+                    self.act(line, "object");
+                }
+            }
             Command::FillAt { x, y } => {
                 if let Some(pick) = self.pick_or_say(x, y, "no voxel there to fill") {
                     self.act(octovox::script::Command::Fill(pick.voxel), "fill");
@@ -640,11 +645,17 @@ impl App {
         if stroke.last_center == Some(center) {
             return;
         }
-        // The step is the script line a click there is: the same path as
-        // every line, recorded and journaled as one edit of the stroke.
+        // The stroke's first step picks the object it hits (it edits that
+        // one to the end); each step is the script line a click there is:
+        // the same path as every line, recorded and journaled as one edit
+        // of the stroke.
+        let first = stroke.last_center.is_none();
         let line = octovox::script::edit_command(stroke.tool, center);
         self.with_stroke(|s| s.applying = true);
-        let ran = self.run_line(&line);
+        let picked = self.doc.editor.object_line_at(pick.voxel).filter(|_| first);
+        let ran = picked
+            .map_or(Ok(()), |picked| self.run_line(&picked).map(|_| ()))
+            .and_then(|()| self.run_line(&line).map(|_| ()));
         self.with_stroke(|s| s.applying = false);
         match ran {
             Ok(_) => self.with_stroke(|stroke| {
@@ -666,7 +677,9 @@ impl App {
     fn continues_gesture(&self, line: &octovox::script::Command) -> bool {
         use octovox::script::Command as Line;
         match line {
-            Line::Place(_) | Line::Remove(_) | Line::Paint(_) => self.gesture.stroke().is_some_and(|s| s.applying),
+            Line::Place(_) | Line::Remove(_) | Line::Paint(_) | Line::Object(octovox::script::ObjectLine::Pick(_)) => {
+                self.gesture.stroke().is_some_and(|s| s.applying)
+            }
             Line::Rgb(..) | Line::Material(..) => matches!(self.gesture, Gesture::Palette),
             _ => false,
         }

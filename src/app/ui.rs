@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 
 use egui::{Color32, Sense, Stroke, Vec2};
 
+use octovox::scene::objects::Objects;
 use octovox::scene::{Material, MaterialKind, Octree, Palette};
 use octovox::settings::{EffectsChoice, Shading, Sky, TraceMode, View};
 
@@ -117,6 +118,8 @@ pub struct Info<'a> {
     pub paste: Option<Region>,
     /// The colour the eyedropper would pick.
     pub eyedropper: Option<u8>,
+    /// The objects and layers of a scene of several objects.
+    pub objects: Option<&'a Objects>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -205,6 +208,10 @@ pub fn show(
             palette(ui, tools, info.palette);
             material_editor(ui, tools.color, info.palette, &mut out);
             ui.separator();
+            if let Some(objects) = info.objects {
+                objects_panel(ui, objects, &mut out);
+                ui.separator();
+            }
             render(ui, state);
             quality(ui, info.presets, &mut out);
             ui.separator();
@@ -385,6 +392,55 @@ fn palette(ui: &mut egui::Ui, tools: &mut Tools, palette: &Palette) {
 
 /// The selected entry's colour, material kind and the parameters the path
 /// tracer reads; every change is an edit (undoable, saved in RGBA/MATL).
+/// Most rows the Objects panel lists (a scene may place 10⁵ objects).
+const MAX_OBJECT_ROWS: usize = 500;
+
+/// The Objects panel: every object in walk order, an eye to hide or show
+/// it, a click to pick the one edits go to; then the layers, each with an
+/// eye. What they do are the `object` and `layer` script lines.
+fn objects_panel(ui: &mut egui::Ui, objects: &Objects, out: &mut Vec<Command>) {
+    use octovox::script::{Command as Line, ObjectLine, ObjectRef};
+    let list = objects.list();
+    egui::CollapsingHeader::new(format!("Objects ({}, {} models)", list.len(), objects.models.len()))
+        .default_open(true)
+        .show(ui, |ui| {
+            egui::ScrollArea::vertical().id_salt("objects").max_height(160.0).show(ui, |ui| {
+                for (index, object) in list.iter().enumerate().take(MAX_OBJECT_ROWS) {
+                    let pick = Line::Object(ObjectLine::Pick(ObjectRef::Index(index)));
+                    ui.horizontal(|ui| {
+                        let mut shown = !object.own_hidden;
+                        if ui.checkbox(&mut shown, "").on_hover_text("show or hide").changed() {
+                            out.push(Command::Lines(vec![pick.clone(), Line::Object(ObjectLine::Hide(!shown))]));
+                        }
+                        let name = if object.path.is_empty() { "(unnamed)" } else { &object.path };
+                        let label = format!("{index} {name} · model {}", object.placement.model);
+                        let text =
+                            if object.hidden { egui::RichText::new(label).weak() } else { egui::RichText::new(label) };
+                        if ui.selectable_label(objects.selected == Some(index), text).clicked() {
+                            out.push(Command::Lines(vec![pick]));
+                        }
+                    });
+                }
+                if list.len() > MAX_OBJECT_ROWS {
+                    ui.label(format!("… and {} more (object N picks any)", list.len() - MAX_OBJECT_ROWS));
+                }
+            });
+            let layers = objects.layers();
+            if !layers.is_empty() {
+                ui.label("Layers");
+                ui.horizontal_wrapped(|ui| {
+                    for (id, name, hidden) in layers {
+                        let mut shown = !hidden;
+                        let label = if name.is_empty() { id.to_string() } else { name };
+                        if ui.checkbox(&mut shown, label).changed() {
+                            out.push(Command::Lines(vec![Line::Layer(id, !shown)]));
+                        }
+                    }
+                });
+            }
+        });
+}
+
 fn material_editor(ui: &mut egui::Ui, index: u8, palette: &Palette, out: &mut Vec<Command>) {
     let old_color = palette.color(index);
     let old = palette.material(index);
@@ -854,6 +910,12 @@ pub fn draw_extrude(ui: &egui::Ui, state: &EditorState, info: &Info, voxels: &[I
 /// Outlines the selected box (or the one being dragged); in select mode
 /// with a dot on each face, the handle that resizes it.
 pub fn draw_selection(ui: &egui::Ui, state: &EditorState, info: &Info) {
+    // The picked object's box, in the Objects panel's highlight colour.
+    if let Some(objects) = info.objects
+        && let Some(bounds) = objects.selected.and_then(|i| objects.world_box(i))
+    {
+        outline_box(ui, state, info, bounds, egui::Color32::from_rgb(255, 190, 60), false);
+    }
     if let Some(region) = info.selection {
         outline_box(
             ui,

@@ -1,4 +1,5 @@
-//! `octovox info FILE [--json] [--frame N]`: what a .vox or .ovx file holds.
+//! `octovox info FILE [--json] [--objects] [--frame N]`: what a .vox or
+//! .ovx file holds.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -12,7 +13,7 @@ use octovox::scene::{MaterialKind, Scene};
 const MAGICAVOXEL_WORLD: i64 = 2048;
 
 /// Loads `file` and prints its summary, as JSON when `json` is set.
-pub fn run(file: &Path, json: bool, frame: usize) -> anyhow::Result<ExitCode> {
+pub fn run(file: &Path, json: bool, objects: bool, frame: usize) -> anyhow::Result<ExitCode> {
     let loading = || format!("loading {}", file.display());
     let (scene, meta) = if octovox::io::is_ovx_path(file) {
         let scene = octovox::io::ovx::load_ovx(file, &Default::default()).with_context(loading)?;
@@ -29,16 +30,44 @@ pub fn run(file: &Path, json: bool, frame: usize) -> anyhow::Result<ExitCode> {
     }
     if json {
         say!("{}", serde_json::to_string_pretty(&summary.to_json(file))?)?;
+    } else if objects {
+        std::io::Write::write_all(&mut std::io::stdout().lock(), object_lines(&scene).as_bytes())?;
     } else {
         std::io::Write::write_all(&mut std::io::stdout().lock(), summary.to_text(file).as_bytes())?;
     }
     Ok(ExitCode::SUCCESS)
 }
 
+/// `info --objects`: one line per object in walk order (a scene of one
+/// model is object 0).
+fn object_lines(scene: &Scene) -> String {
+    let corner = |p: glam::IVec3| format!("{} {} {}", p.x, p.y, p.z);
+    let Some(objects) = &scene.objects else {
+        let bounds =
+            scene.tree.solid_bounds().map_or("-".to_owned(), |(lo, hi)| format!("{} .. {}", corner(lo), corner(hi)));
+        return format!("0\t-\tmodel 0\tlayer -\tshown\t{bounds}\n");
+    };
+    let mut out = String::new();
+    for (index, object) in objects.list().iter().enumerate() {
+        let bounds =
+            objects.world_box(index).map_or("-".to_owned(), |(lo, hi)| format!("{} .. {}", corner(lo), corner(hi)));
+        let name = if object.path.is_empty() { "-" } else { &object.path };
+        let layer = object.layer.map_or("-".to_owned(), |l| l.to_string());
+        let shown = if object.hidden { "hidden" } else { "shown" };
+        out += &format!("{index}\t{name}\tmodel {}\tlayer {layer}\t{shown}\t{bounds}\n", object.placement.model);
+    }
+    out
+}
+
 /// The numbers `info` reports.
 struct Summary {
     models: usize,
     stored_models: usize,
+    /// (id, name, hidden) of every layer.
+    layers: Vec<(u32, String, bool)>,
+    groups: usize,
+    /// Bytes of the node pools of every stored model (the drawn tree's for a scene of one model).
+    pool_bytes: u64,
     warnings: Vec<String>,
     voxels: u64,
     /// Inclusive corners in world axes (y up); `None` for an empty scene.
@@ -56,9 +85,13 @@ impl Summary {
         for &index in &used {
             *materials.entry(scene.palette.material(index).kind).or_insert(0) += 1;
         }
+        let objects = scene.objects.as_deref();
         Summary {
             models: meta.models,
             stored_models: meta.stored_models,
+            layers: objects.map_or_else(Vec::new, |o| o.layers()),
+            groups: objects.map_or(0, |o| o.group_count()),
+            pool_bytes: objects.map_or(scene.tree.pool().live_bytes(), |o| o.pool_bytes()),
             warnings: meta.warnings,
             voxels: scene.tree.solid_voxels(),
             bounds: scene.tree.solid_bounds().map(|(lo, hi)| (lo.to_array(), hi.to_array())),
@@ -82,7 +115,11 @@ impl Summary {
         serde_json::json!({
             "file": file.display().to_string(),
             "models": self.models,
+            "objects": self.models,
             "stored_models": self.stored_models,
+            "layers": self.layers.iter().map(|(id, name, hidden)| serde_json::json!({"id": id, "name": name, "hidden": hidden})).collect::<Vec<_>>(),
+            "groups": self.groups,
+            "pool_bytes": self.pool_bytes,
             "warnings": self.warnings,
             "voxels": self.voxels,
             "extent": self.extent(),
@@ -101,6 +138,9 @@ impl Summary {
             ("file", file.display().to_string()),
             ("models", self.models.to_string()),
             ("stored models", self.stored_models.to_string()),
+            ("layers", self.layers.len().to_string()),
+            ("groups", self.groups.to_string()),
+            ("pool bytes", self.pool_bytes.to_string()),
             ("voxels", self.voxels.to_string()),
             ("extent", format!("{ex} x {ey} x {ez}  (x, y up, z)")),
             ("min", corner(self.bounds.map(|(lo, _)| lo))),

@@ -36,7 +36,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     octovox::budget::set_budget_bytes(cli.memory_budget);
     match cli.command {
         None => crate::app::run(cli.window),
-        Some(Command::Info { file, json, frame }) => info::run(&file, json, frame),
+        Some(Command::Info { file, json, objects, frame }) => info::run(&file, json, objects, frame),
         Some(Command::Convert { input, output, frame, force }) => convert::run(&input, &output, frame, force),
         Some(Command::Import(args)) => import::run(&args),
         Some(Command::Recover { file, output, force }) => recover::run(&file, &output, force),

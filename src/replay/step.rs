@@ -95,6 +95,9 @@ pub struct Ran {
     pub line: Command,
     pub outcome: Outcome,
     pub selection: Option<Region>,
+    /// The `object N` line a click ran first, when the voxel it hit is
+    /// another object's (a recording or journal writes it before `line`).
+    pub picked: Option<Command>,
 }
 
 /// A line that could not run: the script stops there.
@@ -144,7 +147,7 @@ pub fn step(host: &mut impl Host, base: &Path, line: &Command) -> Result<StepRes
     match outcome {
         Outcome::Checked { ok, expected, got } => Ok(check(ok, expected, || got)),
         Outcome::Host => host_line(host, base, line),
-        outcome => Ok(StepResult::Ran(Ran { line: line.clone(), outcome, selection })),
+        outcome => Ok(StepResult::Ran(Ran { line: line.clone(), outcome, selection, picked: None })),
     }
 }
 
@@ -161,9 +164,17 @@ fn host_line(host: &mut impl Host, base: &Path, line: &Command) -> Result<StepRe
                 Ok(None) => return Ok(StepResult::Failed { expected, got: "no voxel under it".into() }),
                 Err(gave_up) => return Ok(StepResult::Failed { expected, got: gave_up.to_string() }),
             };
-            // The place, remove or paint of the cell it picks, as the mouse does.
+            // The object it hits is picked; then the place, remove or paint
+            // of the cell it picks, as the mouse does.
+            let picked = host.editor().object_line_at(voxel);
+            if let Some(line) = &picked {
+                host.editor().run(line)?;
+            }
             let center = crate::edit::brush::click_target(*tool, voxel, normal);
-            return step(host, base, &edit_command(*tool, center));
+            return Ok(match step(host, base, &edit_command(*tool, center))? {
+                StepResult::Ran(ran) => StepResult::Ran(Ran { picked, ..ran }),
+                other => other,
+            });
         }
         Command::Save(path) => host.save(&base.join(path))?,
         Command::Render(path) => host.render(&base.join(path))?,

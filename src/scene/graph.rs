@@ -109,6 +109,23 @@ pub struct Object {
     pub layer: Option<u32>,
     /// Hidden itself, below a hidden transform, or on a hidden layer.
     pub hidden: bool,
+    /// Its own transform's `_hidden` flag (what `object hide` sets).
+    pub own_hidden: bool,
+}
+
+impl Object {
+    /// Model `model` of a file without a scene graph (an animation frame), as stored.
+    pub fn frame(model: usize) -> Object {
+        Object {
+            placement: Placement { model, transform: Transform::IDENTITY, centred: false },
+            shape_node: 0,
+            transform_node: None,
+            path: String::new(),
+            layer: None,
+            hidden: false,
+            own_hidden: false,
+        }
+    }
 }
 
 impl SceneGraph {
@@ -153,6 +170,7 @@ impl SceneGraph {
 struct Context {
     transform: Transform,
     hidden: bool,
+    own_hidden: bool,
     /// The nearest nTRN above, and its layer.
     transform_node: Option<u32>,
     layer: Option<u32>,
@@ -161,8 +179,14 @@ struct Context {
 }
 
 impl Context {
-    const ROOT: Context =
-        Context { transform: Transform::IDENTITY, hidden: false, transform_node: None, layer: None, name: None };
+    const ROOT: Context = Context {
+        transform: Transform::IDENTITY,
+        hidden: false,
+        own_hidden: false,
+        transform_node: None,
+        layer: None,
+        name: None,
+    };
 }
 
 /// One entry of the explicit depth-first stack.
@@ -259,11 +283,11 @@ impl<'a> Walk<'a> {
             }
             None => context.name,
         };
+        let own_hidden = is_set(&node.attributes, "_hidden");
         Ok(Context {
             transform: context.transform.compose(local),
-            hidden: context.hidden
-                || is_set(&node.attributes, "_hidden")
-                || layer.is_some_and(|l| self.hidden_layers.contains(&l)),
+            own_hidden,
+            hidden: context.hidden || own_hidden || layer.is_some_and(|l| self.hidden_layers.contains(&l)),
             transform_node: Some(node.id),
             layer,
             name,
@@ -293,6 +317,7 @@ impl<'a> Walk<'a> {
             path: self.path(context.name),
             layer: context.layer,
             hidden: context.hidden,
+            own_hidden: context.own_hidden,
         });
         Ok(())
     }

@@ -116,19 +116,7 @@ impl Objects {
                 self.models.len()
             )));
         }
-        let placement = super::transform::Placement {
-            model: self.frame,
-            transform: super::transform::Transform::IDENTITY,
-            centred: false,
-        };
-        Ok(vec![Object {
-            placement,
-            shape_node: 0,
-            transform_node: None,
-            path: String::new(),
-            layer: None,
-            hidden: false,
-        }])
+        Ok(vec![Object::frame(self.frame)])
     }
 
     /// The objects in walk order.

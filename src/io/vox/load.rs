@@ -13,7 +13,7 @@ use crate::io::input::{InputError, read_limited};
 use crate::scene::graph::Object;
 use crate::scene::objects::{Model, Objects};
 use crate::scene::octree::WORLD_LIMIT;
-use crate::scene::transform::{Placement, Transform};
+use crate::scene::transform::Placement;
 use crate::scene::{Material, MaterialKind, Octree, Palette, Scene, Voxel, VoxelModel};
 
 /// Reads and loads the `.vox` file at `path`; see [`load_vox`].
@@ -246,8 +246,7 @@ fn frame_objects(models: usize, frame: usize) -> Result<Vec<Object>, VoxError> {
     if frame >= models {
         return Err(VoxError::FrameOutOfRange { requested: frame, models });
     }
-    let placement = Placement { model: frame, transform: Transform::IDENTITY, centred: false };
-    Ok(vec![Object { placement, shape_node: 0, transform_node: None, path: String::new(), layer: None, hidden: false }])
+    Ok(vec![Object::frame(frame)])
 }
 
 /// Peak bytes per voxel of a load and the octree build after it: the list
