@@ -9,9 +9,10 @@ use glam::IVec3;
 use crate::edit::brush::Brush;
 use crate::edit::mirror::Mirror;
 use crate::edit::selection::{self, Block, Region};
-use crate::edit::{Edit, Hideable, History};
+use crate::edit::{Edit, History};
+use crate::scene::objects::Objects;
 use crate::scene::{EditError, Op, Palette, Scene};
-use crate::script::{Command, ObjectLine, ObjectRef};
+use crate::script::{Command, LayerLine, ObjectLine, ObjectRef};
 use crate::settings::PathSettings;
 
 /// Why a line could not run. A refused line changes nothing.
@@ -177,23 +178,14 @@ impl Editor {
                 let (ok, got) = effects_match(&self.scene, want);
                 return Ok(checked(ok, format!("effects [{}]", want.join(" ")), format!("[{}]", got.join(" "))));
             }
-            Command::Object(ObjectLine::Pick(which)) => {
-                let index = self.object_named(which)?;
-                self.set(|e| {
-                    if let Some(objects) = &mut e.scene.objects {
-                        objects.selected = Some(index);
-                    }
-                })
-            }
-            Command::Object(ObjectLine::Hide(hidden)) => {
-                let index = self.picked_object()?;
-                self.commit(vec![Edit::Hide { target: Hideable::Object(index), hidden: *hidden }])?
-            }
-            Command::Layer(id, hidden) => {
-                if self.scene.objects.is_none() {
-                    return Err(EditorError::Object("the scene is one model: it has no layers".to_owned()));
-                }
-                self.commit(vec![Edit::Hide { target: Hideable::Layer(*id), hidden: *hidden }])?
+            Command::Object(line) => self.object_line(line)?,
+            Command::Layer(id, line) => {
+                let objects = self.objects()?;
+                let change = match line {
+                    LayerLine::Hide(hidden) => objects.layer_with(*id, "_hidden", hidden.then_some("1"))?,
+                    LayerLine::Name(name) => objects.layer_with(*id, "_name", Some(name))?,
+                };
+                self.commit(vec![Edit::Graph(Box::new(change))])?
             }
             Command::ExpectObjects(want) => {
                 let got = self.scene.objects.as_ref().map_or(1, |o| o.list().len());
@@ -263,10 +255,80 @@ impl Editor {
         Some(Command::Object(ObjectLine::Pick(ObjectRef::Index(owner))))
     }
 
-    /// The object an `object hide|show` line acts on.
+    /// The objects of a scene of several, or why an `object`/`layer` line
+    /// cannot change anything.
+    fn objects(&self) -> Result<&Objects, EditorError> {
+        self.scene.objects.as_deref().ok_or_else(|| {
+            EditorError::Object("the scene is one model: it has no objects or layers to change".to_owned())
+        })
+    }
+
+    /// The object the `object …` lines change.
     fn picked_object(&self) -> Result<usize, EditorError> {
-        self.scene.objects.as_ref().and_then(|o| o.selected).ok_or_else(|| {
+        self.objects()?.selected.ok_or_else(|| {
             EditorError::Object("no object is picked: pick one first (object N or object NAME)".to_owned())
+        })
+    }
+
+    /// An `object` line: picking is tool state; every other line is one
+    /// undo step on the picked object, which stays picked (a new or
+    /// duplicated one is picked; a deleted one leaves none).
+    fn object_line(&mut self, line: &ObjectLine) -> Result<bool, EditorError> {
+        let (edits, picks) = match line {
+            ObjectLine::Pick(which) => {
+                let index = self.object_named(which)?;
+                if let Some(objects) = &mut self.scene.objects {
+                    objects.selected = Some(index);
+                }
+                return Ok(false);
+            }
+            ObjectLine::New(name) => {
+                let (edits, id) = self.objects()?.created(name)?;
+                (edits, Picks::Transform(id))
+            }
+            line => self.picked_object_edits(line)?,
+        };
+        let changed = self.commit(edits)?;
+        if let Some(objects) = &mut self.scene.objects {
+            objects.selected = match picks {
+                Picks::Same => objects.selected,
+                Picks::None => None,
+                Picks::Transform(id) => objects.index_of_transform(id),
+            };
+        }
+        Ok(changed)
+    }
+
+    /// The edits an `object` line makes of the picked object, and what is
+    /// picked after them.
+    fn picked_object_edits(&self, line: &ObjectLine) -> Result<(Vec<Edit>, Picks), EditorError> {
+        let index = self.picked_object()?;
+        let objects = self.objects()?;
+        let graph = |change| vec![Edit::Graph(Box::new(change))];
+        Ok(match line {
+            ObjectLine::Move(by) => (graph(objects.moved(index, *by)?), Picks::Same),
+            ObjectLine::Rotate(axis) => (graph(objects.rotated(index, *axis)?), Picks::Same),
+            ObjectLine::Hide(hidden) => {
+                (graph(objects.with_attribute(index, "_hidden", hidden.then_some("1"))?), Picks::Same)
+            }
+            ObjectLine::Rename(name) => (graph(objects.with_attribute(index, "_name", Some(name))?), Picks::Same),
+            ObjectLine::Layer(layer) => (graph(objects.on_layer(index, *layer)?), Picks::Same),
+            ObjectLine::Delete => (graph(objects.deleted(index)?), Picks::None),
+            ObjectLine::Duplicate { reference: true } => {
+                let (change, id) = objects.duplicated(index, None)?;
+                (graph(change), Picks::Transform(id))
+            }
+            ObjectLine::Duplicate { reference: false } => {
+                let (copy, model) = objects.model_copy(index);
+                let (change, id) = objects.duplicated(index, Some(model))?;
+                (vec![Edit::AddModel(Box::new(copy)), Edit::Graph(Box::new(change))], Picks::Transform(id))
+            }
+            ObjectLine::Unique => {
+                let (copy, model) = objects.model_copy(index);
+                let change = objects.made_unique(index, model)?;
+                (vec![Edit::AddModel(Box::new(copy)), Edit::Graph(Box::new(change))], Picks::Same)
+            }
+            ObjectLine::Pick(_) | ObjectLine::New(_) => (Vec::new(), Picks::Same),
         })
     }
 
@@ -335,6 +397,14 @@ impl Editor {
         }
         Ok(true)
     }
+}
+
+/// Which object an `object` line leaves picked.
+enum Picks {
+    Same,
+    None,
+    /// The one its new transform node places.
+    Transform(u32),
 }
 
 /// The scene a `new` or `demo` line makes; `None` for other lines.

@@ -6,6 +6,7 @@ use winit::keyboard::KeyCode;
 
 use super::command::{Command, Nudge};
 use super::state::Tool;
+use octovox::script::ObjectLine;
 
 /// One action: what it does, the key that does it and where its menu is.
 pub struct Action {
@@ -39,9 +40,14 @@ const FILE: Option<&str> = Some("File");
 const EDIT: Option<&str> = Some("Edit");
 const TOOLS: Option<&str> = Some("Tools");
 const VIEW: Option<&str> = Some("View");
+const OBJECT: Option<&str> = Some("Object");
+
+const fn object(label: &'static str, code: KeyCode, shift: bool, line: ObjectLine) -> Action {
+    Action { label, key: code, ctrl: true, shift, menu: OBJECT, command: Command::Object(line) }
+}
 
 /// Every keyboard action, in menu order.
-pub static ACTIONS: [Action; 27] = [
+pub static ACTIONS: [Action; 33] = [
     ctrl("New", KeyCode::KeyN, FILE, Command::New),
     ctrl("Open…", KeyCode::KeyO, FILE, Command::AskOpen),
     ctrl("Save", KeyCode::KeyS, FILE, Command::Save),
@@ -62,6 +68,12 @@ pub static ACTIONS: [Action; 27] = [
     key("Paint tool", KeyCode::KeyG, TOOLS, Command::SetTool(Tool::Paint)),
     key("Line mode", KeyCode::KeyL, TOOLS, Command::ToggleLine),
     key("Box select mode", KeyCode::KeyB, TOOLS, Command::ToggleSelect),
+    object("Duplicate object", KeyCode::KeyD, false, ObjectLine::Duplicate { reference: false }),
+    object("Duplicate object as a reference", KeyCode::KeyD, true, ObjectLine::Duplicate { reference: true }),
+    object("Make object unique", KeyCode::KeyU, false, ObjectLine::Unique),
+    object("Turn object about y", KeyCode::KeyR, false, ObjectLine::Rotate(1)),
+    object("Hide object", KeyCode::KeyH, false, ObjectLine::Hide(true)),
+    object("Delete object", KeyCode::Delete, false, ObjectLine::Delete),
     key("Frame model", KeyCode::KeyF, VIEW, Command::FrameModel),
     nudge("Move selection left", KeyCode::ArrowLeft, Nudge::Left),
     nudge("Move selection right", KeyCode::ArrowRight, Nudge::Right),

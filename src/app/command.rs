@@ -89,6 +89,8 @@ pub enum Command {
     /// Box select mode on or off (B): a left drag selects a box, or drags
     /// a face of the selected one.
     ToggleSelect,
+    /// An `object` line on the picked object (the Object menu's keys).
+    Object(octovox::script::ObjectLine),
     /// Script lines a panel asks for, run in order (the Objects panel's
     /// `object N` and `object hide`, the Layers panel's `layer N hide`).
     Lines(Vec<octovox::script::Command>),

@@ -340,6 +340,7 @@ impl App {
                 Err(err) => self.ui.error(format!("copy refused: {err}")),
             },
             Command::SelectNone => self.act(octovox::script::Command::Select(None), "select"),
+            Command::Object(line) => self.act(octovox::script::Command::Object(line), "object"),
             Command::Lines(lines) => {
                 for line in lines {
                     self.act(line, "object");

@@ -275,6 +275,7 @@ fn available(command: &Command, info: &Info) -> bool {
         Command::Redo => info.can_redo,
         Command::Copy | Command::Cut | Command::DeleteSelection | Command::SelectNone => info.selection.is_some(),
         Command::PasteAtCursor => info.has_clipboard,
+        Command::Object(_) => info.objects.is_some_and(|o| o.selected.is_some()),
         _ => true,
     }
 }
@@ -399,7 +400,7 @@ const MAX_OBJECT_ROWS: usize = 500;
 /// it, a click to pick the one edits go to; then the layers, each with an
 /// eye. What they do are the `object` and `layer` script lines.
 fn objects_panel(ui: &mut egui::Ui, objects: &Objects, out: &mut Vec<Command>) {
-    use octovox::script::{Command as Line, ObjectLine, ObjectRef};
+    use octovox::script::{Command as Line, LayerLine, ObjectLine, ObjectRef};
     let list = objects.list();
     egui::CollapsingHeader::new(format!("Objects ({}, {} models)", list.len(), objects.models.len()))
         .default_open(true)
@@ -433,7 +434,7 @@ fn objects_panel(ui: &mut egui::Ui, objects: &Objects, out: &mut Vec<Command>) {
                         let mut shown = !hidden;
                         let label = if name.is_empty() { id.to_string() } else { name };
                         if ui.checkbox(&mut shown, label).changed() {
-                            out.push(Command::Lines(vec![Line::Layer(id, !shown)]));
+                            out.push(Command::Lines(vec![Line::Layer(id, LayerLine::Hide(!shown))]));
                         }
                     }
                 });

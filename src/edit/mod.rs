@@ -16,7 +16,7 @@ pub mod selection;
 
 use std::collections::VecDeque;
 
-use crate::scene::objects::Objects;
+use crate::scene::objects::{GraphChange, Model, Objects};
 use crate::scene::{EditError, Material, Op, Patch, Scene, Shape};
 
 /// One change to the scene.
@@ -31,18 +31,16 @@ pub enum Edit {
     Restore(Patch),
     /// Put back cells of model `model` (what undo sends for `InObject`).
     RestoreModel { model: usize, patch: Patch },
-    /// Hide or show an object or a layer.
-    Hide { target: Hideable, hidden: bool },
+    /// A change to the scene graph of a scene of objects: hide, show,
+    /// move, turn, name, duplicate or delete objects, name or hide layers.
+    Graph(Box<GraphChange>),
+    /// Store one more model (a copy an object is about to place).
+    AddModel(Box<Model>),
+    /// Take the last model back out (the undo of `AddModel`).
+    PopModel,
     /// Give a palette entry (1..=255) a colour and a material: every voxel of
     /// that index changes look at once.
     Palette { index: u8, color: [u8; 4], material: Box<Material> },
-}
-
-/// What [`Edit::Hide`] hides: an object (by index in walk order) or a layer (by id).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Hideable {
-    Object(usize),
-    Layer(u32),
 }
 
 impl Edit {
@@ -79,14 +77,15 @@ impl Edit {
                 let (tree, objects) = objects_of(scene)?;
                 Ok(Edit::RestoreModel { model: *model, patch: objects.apply_patch(tree, *model, patch)? })
             }
-            Edit::Hide { target, hidden } => {
+            Edit::Graph(change) => {
                 let (tree, objects) = objects_of(scene)?;
-                let before = match *target {
-                    Hideable::Object(index) => objects.set_hidden(tree, index, *hidden)?,
-                    Hideable::Layer(id) => objects.set_layer_hidden(tree, id, *hidden)?,
-                };
-                Ok(Edit::Hide { target: *target, hidden: before })
+                Ok(Edit::Graph(Box::new(objects.apply_change(tree, change)?)))
             }
+            Edit::AddModel(model) => {
+                objects_of(scene)?.1.push_model((**model).clone());
+                Ok(Edit::PopModel)
+            }
+            Edit::PopModel => Ok(Edit::AddModel(Box::new(objects_of(scene)?.1.pop_model()?))),
             Edit::Palette { index, color, material } => {
                 if *index == 0 {
                     return Err(EditError::ZeroColor);
@@ -111,7 +110,8 @@ impl Edit {
                 shape.surface_voxels().saturating_mul(crate::scene::apply::EDIT_BYTES_PER_SURFACE_VOXEL)
             }
             Edit::Restore(patch) | Edit::RestoreModel { patch, .. } => 2 * patch.heap_bytes() as u64,
-            Edit::Palette { .. } | Edit::Hide { .. } => 0,
+            Edit::AddModel(model) => 2 * model.tree.pool().live_bytes(),
+            Edit::Palette { .. } | Edit::Graph(_) | Edit::PopModel => 0,
         })
     }
 
@@ -301,7 +301,9 @@ impl History {
 
 fn edit_bytes(edit: &Edit) -> usize {
     match edit {
-        Edit::Brush { .. } | Edit::InObject { .. } | Edit::Hide { .. } => std::mem::size_of::<Edit>(),
+        Edit::Brush { .. } | Edit::InObject { .. } | Edit::PopModel => std::mem::size_of::<Edit>(),
+        Edit::Graph(change) => change.heap_bytes(),
+        Edit::AddModel(model) => usize::try_from(model.tree.pool().live_bytes()).unwrap_or(usize::MAX),
         Edit::Restore(patch) | Edit::RestoreModel { patch, .. } => patch.heap_bytes(),
         Edit::Palette { material, .. } => {
             std::mem::size_of::<Edit>() + material.params.iter().map(|(k, v)| k.len() + v.len() + 48).sum::<usize>()

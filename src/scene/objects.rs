@@ -9,12 +9,21 @@
 //! of that model is composed again over the cells it covers. Hiding,
 //! showing and moving an object compose the cells it left and reached.
 
+use std::collections::HashMap;
+
 use glam::IVec3;
 
-use super::graph::{self, GraphError, NodeKind, Object, SceneGraph};
+use super::graph::{self, GraphError, Layer, Node, NodeKind, Object, SceneGraph};
 use super::octree::{Octree, WORLD_LIMIT};
-use super::transform::CellMap;
+use super::transform::{CellMap, Rotation, Transform};
 use super::{EditError, Op, Patch, Shape};
+
+/// What a graph change says about a file without a scene graph.
+const NO_GRAPH: &str = "a file of animation frames has no scene graph to change";
+
+/// Placements of one model beyond which an edit of it composes one box
+/// around them all (see `Objects::recompose_model`).
+const MANY_PLACEMENTS: usize = 64;
 
 /// Largest box one removal covers while composing (a brush's widest).
 const COMPOSE_BOX: i32 = super::shape::MAX_BRUSH_EXTENT;
@@ -27,6 +36,16 @@ pub struct Model {
     pub size: [u32; 3],
     pub tree: Octree,
 }
+
+/// Models are equal when they hold the same voxels in the same grid,
+/// however their pools are laid out.
+impl PartialEq for Model {
+    fn eq(&self, other: &Model) -> bool {
+        self.size == other.size && self.tree.voxels() == other.tree.voxels()
+    }
+}
+
+impl Eq for Model {}
 
 /// A chunk octovox does not interpret (`rCAM`, `rOBJ`, `NOTE`, `META`,
 /// `IMAP`, unknown ones), written back as read.
@@ -240,14 +259,20 @@ impl Objects {
         Ok(inverse)
     }
 
-    /// Composes the world cells every placement of `model` maps its cells `lo..=hi` to.
+    /// Composes the world cells every placement of `model` maps its cells
+    /// `lo..=hi` to. Each region costs a pass over the objects, so a model
+    /// placed more than [`MANY_PLACEMENTS`] times has the box around all its
+    /// regions composed in one pass instead.
     fn recompose_model(&self, tree: &mut Octree, model: usize, (lo, hi): (IVec3, IVec3)) -> Result<(), EditError> {
-        for index in 0..self.objects.len() {
-            if self.objects[index].placement.model == model {
-                self.recompose(tree, self.maps[index].apply_box(lo, hi))?;
-            }
+        let regions: Vec<(IVec3, IVec3)> = (0..self.objects.len())
+            .filter(|&i| self.objects[i].placement.model == model)
+            .map(|i| self.maps[i].apply_box(lo, hi))
+            .collect();
+        if regions.len() > MANY_PLACEMENTS {
+            let all = regions.iter().copied().reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)));
+            return all.map_or(Ok(()), |all| self.recompose(tree, all));
         }
-        Ok(())
+        regions.into_iter().try_for_each(|region| self.recompose(tree, region))
     }
 
     /// How many objects place each model.
@@ -255,65 +280,297 @@ impl Objects {
         self.objects.iter().filter(|o| o.placement.model == model).count()
     }
 
-    /// Sets object `index`'s own `_hidden` flag (on its transform node) and
-    /// composes what it covers; the flag it had before.
-    pub fn set_hidden(&mut self, tree: &mut Octree, index: usize, hidden: bool) -> Result<bool, EditError> {
-        let node = self
-            .objects
-            .get(index)
-            .and_then(|o| o.transform_node)
-            .ok_or_else(|| EditError::Brush(format!("object {index} has no transform node to hide")))?;
-        let graph = self
-            .graph
-            .as_mut()
-            .ok_or_else(|| EditError::Brush("a file without a scene graph has nothing to hide".to_owned()))?;
-        let Some(node) = graph.node_mut(node) else { return Err(EditError::Brush(format!("node {node} is missing"))) };
-        let before = graph::is_set(&node.attributes, "_hidden");
-        if hidden {
-            node.attributes.insert("_hidden".to_owned(), "1".to_owned());
-        } else {
-            node.attributes.remove("_hidden");
+    /// Applies a change to the graph, walks it again and composes the cells
+    /// of every object that moved, came, went, or was hidden or shown.
+    /// Returns the change that undoes it; a change the walk refuses (a
+    /// cycle) changes nothing.
+    pub fn apply_change(&mut self, tree: &mut Octree, change: &GraphChange) -> Result<GraphChange, EditError> {
+        let graph = self.graph.as_mut().ok_or_else(|| EditError::Brush(NO_GRAPH.to_owned()))?;
+        let saved = graph.clone();
+        let inverse = change.apply(graph);
+        let before = self.drawn();
+        if let Err(err) = self.walk(usize::MAX) {
+            self.graph = Some(saved);
+            self.walk(usize::MAX).map_err(|e| EditError::Brush(e.to_string()))?;
+            return Err(EditError::Brush(err.to_string()));
         }
-        self.changed_graph(tree, |o| o.world_box(index))?;
-        Ok(before)
+        let after = self.drawn();
+        let mut counts: HashMap<(usize, CellMap), i64> = HashMap::new();
+        for key in &before {
+            *counts.entry(*key).or_default() += 1;
+        }
+        for key in &after {
+            *counts.entry(*key).or_default() -= 1;
+        }
+        for ((model, map), count) in counts {
+            if count != 0
+                && let Some((lo, hi)) = self.models[model].tree.solid_bounds()
+            {
+                self.recompose(tree, map.apply_box(lo, hi))?;
+            }
+        }
+        Ok(inverse)
     }
 
-    /// Sets layer `id`'s `_hidden` flag and composes its objects; the flag before.
-    pub fn set_layer_hidden(&mut self, tree: &mut Octree, id: u32, hidden: bool) -> Result<bool, EditError> {
-        let graph = self
-            .graph
-            .as_mut()
-            .ok_or_else(|| EditError::Brush("a file without a scene graph has no layers".to_owned()))?;
-        let layer = graph
-            .layers
-            .iter_mut()
-            .find(|l| l.id == id)
-            .ok_or_else(|| EditError::Brush(format!("there is no layer {id}")))?;
-        let before = layer.hidden();
-        if hidden {
-            layer.attributes.insert("_hidden".to_owned(), "1".to_owned());
-        } else {
-            layer.attributes.remove("_hidden");
-        }
-        let on_layer: Vec<usize> = (0..self.objects.len()).filter(|&i| self.objects[i].layer == Some(id)).collect();
-        self.changed_graph(tree, |o| union(on_layer.iter().filter_map(|&i| o.world_box(i))))?;
-        Ok(before)
+    /// (model, cell map) of every visible object.
+    fn drawn(&self) -> Vec<(usize, CellMap)> {
+        self.visible().map(|i| (self.objects[i].placement.model, self.maps[i])).collect()
     }
 
-    /// Walks the changed graph and composes the region `region` finds,
-    /// before the change and after it.
-    fn changed_graph(
-        &mut self,
-        tree: &mut Octree,
-        region: impl Fn(&Objects) -> Option<(IVec3, IVec3)>,
-    ) -> Result<(), EditError> {
-        let before = region(self);
-        self.walk(usize::MAX).map_err(|e| EditError::Brush(e.to_string()))?;
-        let after = region(self);
-        for bounds in [before, after].into_iter().flatten() {
-            self.recompose(tree, bounds)?;
+    /// Adds a model at the end (what `object unique` and a duplicate that is
+    /// not a reference store); nothing places it yet.
+    pub fn push_model(&mut self, model: Model) -> usize {
+        self.models.push(model);
+        self.models.len() - 1
+    }
+
+    /// Takes the last model back out (the undo of [`Objects::push_model`]),
+    /// unless an object still places it.
+    pub fn pop_model(&mut self) -> Result<Model, EditError> {
+        let last =
+            self.models.len().checked_sub(1).ok_or_else(|| EditError::Brush("there are no models".to_owned()))?;
+        if self.placements_of(last) > 0 {
+            return Err(EditError::Brush(format!("model {last} is still placed")));
         }
-        Ok(())
+        Ok(self.models.pop().expect("checked above"))
+    }
+
+    /// The transform node of object `index` (what moves, turns, hides and
+    /// names it).
+    pub fn transform_node(&self, index: usize) -> Result<&Node, EditError> {
+        let graph = self.graph.as_ref().ok_or_else(|| EditError::Brush(NO_GRAPH.to_owned()))?;
+        let object = self.objects.get(index).ok_or_else(|| EditError::Brush(format!("there is no object {index}")))?;
+        object
+            .transform_node
+            .and_then(|id| graph.node(id))
+            .ok_or_else(|| EditError::Brush(format!("object {index} has no transform node")))
+    }
+
+    /// The index of the keyframe of `node` shown now (the one a move or a
+    /// turn changes), adding one to a node without any.
+    fn shown_keyframe(&self, node: &mut Node) -> Result<usize, EditError> {
+        let NodeKind::Transform { frames, .. } = &mut node.kind else {
+            return Err(EditError::Brush(format!("node {} is not a transform", node.id)));
+        };
+        if frames.is_empty() {
+            frames.push(graph::Attributes::new());
+        }
+        let shown =
+            graph::pick_keyframe(frames.iter(), self.frame, node.id).map_err(|e| EditError::Brush(e.to_string()))?;
+        Ok(shown.unwrap_or(0))
+    }
+
+    /// The change that moves object `index` by `by` world voxels.
+    pub fn moved(&self, index: usize, by: IVec3) -> Result<GraphChange, EditError> {
+        self.retransformed(index, |own, parent| {
+            // World (x, y, z) is MagicaVoxel (x, −z, y); the parent's turn
+            // is undone so that the object moves along world axes.
+            let step = parent.inverse().apply([by.x, -by.z, by.y].map(i64::from));
+            Transform { rotation: own.rotation, translation: [0, 1, 2].map(|i| own.translation[i] + step[i]) }
+        })
+    }
+
+    /// The change that turns object `index` a quarter counter-clockwise
+    /// about world axis `axis` (0, 1, 2 = x, y, z), seen from its positive
+    /// end, about the object's pivot.
+    pub fn rotated(&self, index: usize, axis: usize) -> Result<GraphChange, EditError> {
+        // World x, y, z are MagicaVoxel +x, +z and −y: a turn about world z
+        // is three about MagicaVoxel y.
+        let turn = match axis {
+            0 => Rotation::quarter_turn(0),
+            1 => Rotation::quarter_turn(2),
+            _ => {
+                let back = Rotation::quarter_turn(1);
+                back.times(back).times(back)
+            }
+        };
+        self.retransformed(index, |own, parent| Transform {
+            rotation: parent.inverse().times(turn).times(parent).times(own.rotation),
+            translation: own.translation,
+        })
+    }
+
+    /// The change that gives object `index`'s shown keyframe the transform
+    /// `f(own, parent rotation)` makes.
+    fn retransformed(
+        &self,
+        index: usize,
+        f: impl Fn(Transform, Rotation) -> Transform,
+    ) -> Result<GraphChange, EditError> {
+        let mut node = self.transform_node(index)?.clone();
+        let k = self.shown_keyframe(&mut node)?;
+        let NodeKind::Transform { frames, .. } = &mut node.kind else { unreachable!("checked by shown_keyframe") };
+        let own = graph::parse_transform(&frames[k], node.id).map_err(|e| EditError::Brush(e.to_string()))?;
+        // The whole transform is parent · own, so the parent's rotation is whole · own⁻¹.
+        let parent = self.objects[index].placement.transform.rotation.times(own.rotation.inverse());
+        graph::write_transform(&mut frames[k], f(own, parent));
+        Ok(GraphChange { nodes: vec![node], ..GraphChange::default() })
+    }
+
+    /// The change that sets an attribute of object `index`'s transform
+    /// (`_name`, `_hidden`); `None` removes it.
+    pub fn with_attribute(&self, index: usize, key: &str, value: Option<&str>) -> Result<GraphChange, EditError> {
+        let mut node = self.transform_node(index)?.clone();
+        match value {
+            Some(value) => node.attributes.insert(key.to_owned(), value.to_owned()),
+            None => node.attributes.remove(key),
+        };
+        Ok(GraphChange { nodes: vec![node], ..GraphChange::default() })
+    }
+
+    /// The change that puts object `index` on layer `layer`.
+    pub fn on_layer(&self, index: usize, layer: u32) -> Result<GraphChange, EditError> {
+        if !self.graph.as_ref().is_some_and(|g| g.layers.iter().any(|l| l.id == layer)) {
+            return Err(EditError::Brush(format!("there is no layer {layer}")));
+        }
+        let mut node = self.transform_node(index)?.clone();
+        if let NodeKind::Transform { layer: own, .. } = &mut node.kind {
+            *own = layer;
+        }
+        Ok(GraphChange { nodes: vec![node], ..GraphChange::default() })
+    }
+
+    /// The change that sets layer `id`'s attribute `key` (adding the layer
+    /// when there is none of that id).
+    pub fn layer_with(&self, id: u32, key: &str, value: Option<&str>) -> Result<GraphChange, EditError> {
+        let graph = self.graph.as_ref().ok_or_else(|| EditError::Brush(NO_GRAPH.to_owned()))?;
+        let mut layer = graph.layers.iter().find(|l| l.id == id).cloned().unwrap_or(Layer {
+            id,
+            attributes: graph::Attributes::new(),
+            reserved: u32::MAX,
+        });
+        match value {
+            Some(value) => layer.attributes.insert(key.to_owned(), value.to_owned()),
+            None => layer.attributes.remove(key),
+        };
+        Ok(GraphChange { layers: vec![layer], ..GraphChange::default() })
+    }
+
+    /// The change that places object `index` again, right after it in its
+    /// group: showing the same model (a reference), or `model`. Returns it
+    /// and the new transform node's id.
+    pub fn duplicated(&self, index: usize, model: Option<usize>) -> Result<(GraphChange, u32), EditError> {
+        let graph = self.graph.as_ref().ok_or_else(|| EditError::Brush(NO_GRAPH.to_owned()))?;
+        let own = self.transform_node(index)?;
+        let mut group = self.parent_group(own.id)?.clone();
+        let shape = graph
+            .node(self.objects[index].shape_node)
+            .ok_or_else(|| EditError::Brush("its shape is missing".to_owned()))?;
+        let next = graph.nodes.iter().map(|n| n.id).max().unwrap_or(0);
+        let (transform_id, shape_id) = (next.checked_add(1), next.checked_add(2));
+        let (Some(transform_id), Some(shape_id)) = (transform_id, shape_id) else {
+            return Err(EditError::Brush("no node ids are left".to_owned()));
+        };
+        let mut transform = own.clone();
+        transform.id = transform_id;
+        if let NodeKind::Transform { child, .. } = &mut transform.kind {
+            *child = shape_id;
+        }
+        let mut shape = shape.clone();
+        shape.id = shape_id;
+        if let (Some(model), NodeKind::Shape { models }) = (model, &mut shape.kind) {
+            for (shown, _) in models.iter_mut() {
+                *shown = u32::try_from(model).unwrap_or(u32::MAX);
+            }
+        }
+        if let NodeKind::Group { children } = &mut group.kind {
+            let at = children.iter().position(|&c| c == own.id).map_or(children.len(), |p| p + 1);
+            children.insert(at, transform_id);
+        }
+        Ok((GraphChange { nodes: vec![group, transform, shape], ..GraphChange::default() }, transform_id))
+    }
+
+    /// A copy of object `index`'s model, and the index it gets when stored.
+    pub fn model_copy(&self, index: usize) -> (Model, usize) {
+        (self.models[self.objects[index].placement.model].clone(), self.models.len())
+    }
+
+    /// The change that points object `index`'s transform at a shape of its
+    /// own showing `model` (`object unique`).
+    pub fn made_unique(&self, index: usize, model: usize) -> Result<GraphChange, EditError> {
+        let (mut change, _) = self.duplicated(index, Some(model))?;
+        // Of the duplicate keep the shape; the object's own transform takes it.
+        let shape = change.nodes.pop().ok_or_else(|| EditError::Brush("no shape".to_owned()))?;
+        let mut own = self.transform_node(index)?.clone();
+        if let NodeKind::Transform { child, .. } = &mut own.kind {
+            *child = shape.id;
+        }
+        Ok(GraphChange { nodes: vec![own, shape], ..GraphChange::default() })
+    }
+
+    /// The edits that make an empty object named `name` in the top group
+    /// (an empty model of one cell, its shape and transform), and the new
+    /// transform's id.
+    pub fn created(&self, name: &str) -> Result<(Vec<crate::edit::Edit>, u32), EditError> {
+        let graph = self.graph.as_ref().ok_or_else(|| EditError::Brush(NO_GRAPH.to_owned()))?;
+        let mut group = graph
+            .nodes
+            .iter()
+            .find(|n| matches!(n.kind, NodeKind::Group { .. }))
+            .cloned()
+            .ok_or_else(|| EditError::Brush("the scene graph has no group to put an object in".to_owned()))?;
+        let next = graph.nodes.iter().map(|n| n.id).max().unwrap_or(0);
+        let ids = next.checked_add(1).zip(next.checked_add(2));
+        let (transform_id, shape_id) = ids.ok_or_else(|| EditError::Brush("no node ids are left".to_owned()))?;
+        let layer = graph.layers.first().map_or(u32::MAX, |l| l.id);
+        let attributes = [("_name".to_owned(), name.to_owned())].into();
+        let transform = Node {
+            id: transform_id,
+            attributes,
+            kind: NodeKind::Transform {
+                child: shape_id,
+                reserved: u32::MAX,
+                layer,
+                frames: vec![graph::Attributes::new()],
+            },
+        };
+        let model = u32::try_from(self.models.len()).unwrap_or(u32::MAX);
+        let shape = Node {
+            id: shape_id,
+            attributes: graph::Attributes::new(),
+            kind: NodeKind::Shape { models: vec![(model, graph::Attributes::new())] },
+        };
+        if let NodeKind::Group { children } = &mut group.kind {
+            children.push(transform_id);
+        }
+        let empty = Model { size: [1, 1, 1], tree: Octree::default() };
+        let change = GraphChange { nodes: vec![group, transform, shape], ..GraphChange::default() };
+        Ok((
+            vec![crate::edit::Edit::AddModel(Box::new(empty)), crate::edit::Edit::Graph(Box::new(change))],
+            transform_id,
+        ))
+    }
+
+    /// The change that takes object `index` out of its group (its nodes go
+    /// too; its model stays stored).
+    pub fn deleted(&self, index: usize) -> Result<GraphChange, EditError> {
+        let own = self.transform_node(index)?;
+        let mut group = self.parent_group(own.id)?.clone();
+        if let NodeKind::Group { children } = &mut group.kind {
+            children.retain(|&c| c != own.id);
+        }
+        let shape = self.objects[index].shape_node;
+        let shared = self.objects.iter().filter(|o| o.shape_node == shape).count() > 1;
+        let mut remove = vec![own.id];
+        if !shared {
+            remove.push(shape);
+        }
+        Ok(GraphChange { nodes: vec![group], remove, ..GraphChange::default() })
+    }
+
+    /// The group that holds transform `id`.
+    fn parent_group(&self, id: u32) -> Result<&Node, EditError> {
+        let graph = self.graph.as_ref().ok_or_else(|| EditError::Brush(NO_GRAPH.to_owned()))?;
+        graph
+            .nodes
+            .iter()
+            .find(|n| matches!(&n.kind, NodeKind::Group { children } if children.contains(&id)))
+            .ok_or_else(|| EditError::Brush("the object is not in a group (it is the whole scene)".to_owned()))
+    }
+
+    /// The index of the object placed by transform node `id`.
+    pub fn index_of_transform(&self, id: u32) -> Option<usize> {
+        self.objects.iter().position(|o| o.transform_node == Some(id))
     }
 
     /// Layers by id, and whether each is hidden, for listings.
@@ -340,6 +597,69 @@ impl Objects {
     }
 }
 
+/// A change to the scene graph, as data (an undoable edit): nodes and
+/// layers to put in by id (replacing the one of that id, or added at the
+/// end), and nodes and layers to take out.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct GraphChange {
+    pub nodes: Vec<Node>,
+    pub layers: Vec<Layer>,
+    pub remove: Vec<u32>,
+    pub remove_layers: Vec<u32>,
+}
+
+impl GraphChange {
+    /// Applies it to `graph`; returns the change that undoes it.
+    fn apply(&self, graph: &mut SceneGraph) -> GraphChange {
+        let mut inverse = GraphChange::default();
+        for id in &self.remove {
+            if let Some(at) = graph.nodes.iter().position(|n| n.id == *id) {
+                inverse.nodes.push(graph.nodes.remove(at));
+            }
+        }
+        for id in &self.remove_layers {
+            if let Some(at) = graph.layers.iter().position(|l| l.id == *id) {
+                inverse.layers.push(graph.layers.remove(at));
+            }
+        }
+        for node in &self.nodes {
+            match graph.nodes.iter().position(|n| n.id == node.id) {
+                Some(at) => inverse.nodes.push(std::mem::replace(&mut graph.nodes[at], node.clone())),
+                None => {
+                    graph.nodes.push(node.clone());
+                    inverse.remove.push(node.id);
+                }
+            }
+        }
+        for layer in &self.layers {
+            match graph.layers.iter().position(|l| l.id == layer.id) {
+                Some(at) => inverse.layers.push(std::mem::replace(&mut graph.layers[at], layer.clone())),
+                None => {
+                    graph.layers.push(layer.clone());
+                    inverse.remove_layers.push(layer.id);
+                }
+            }
+        }
+        inverse
+    }
+
+    /// Bytes its nodes and layers hold, roughly (undo memory).
+    pub fn heap_bytes(&self) -> usize {
+        let attributes = |a: &graph::Attributes| a.iter().map(|(k, v)| k.len() + v.len() + 48).sum::<usize>();
+        let node = |n: &Node| {
+            64 + attributes(&n.attributes)
+                + match &n.kind {
+                    NodeKind::Transform { frames, .. } => frames.iter().map(attributes).sum(),
+                    NodeKind::Group { children } => 4 * children.len(),
+                    NodeKind::Shape { models } => models.iter().map(|m| 4 + attributes(&m.1)).sum(),
+                }
+        };
+        self.nodes.iter().map(node).sum::<usize>()
+            + self.layers.iter().map(|l| 32 + attributes(&l.attributes)).sum::<usize>()
+            + 4 * (self.remove.len() + self.remove_layers.len())
+    }
+}
+
 /// Min corners of the boxes of at most [`COMPOSE_BOX`] a side that tile `lo..=hi`.
 fn boxes_of(lo: IVec3, hi: IVec3) -> Vec<IVec3> {
     let steps = |a: i32, b: i32| (a..=b).step_by(COMPOSE_BOX as usize);
@@ -352,8 +672,4 @@ fn boxes_of(lo: IVec3, hi: IVec3) -> Vec<IVec3> {
         }
     }
     out
-}
-
-fn union(boxes: impl Iterator<Item = (IVec3, IVec3)>) -> Option<(IVec3, IVec3)> {
-    boxes.reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
 }

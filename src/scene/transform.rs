@@ -60,6 +60,16 @@ impl Rotation {
     pub fn apply(self, v: [i64; 3]) -> [i64; 3] {
         [0, 1, 2].map(|row| self.sign[row] * v[self.axis[row]])
     }
+
+    /// The inverse rotation (the transpose of a signed permutation).
+    pub fn inverse(self) -> Rotation {
+        let mut out = Rotation::IDENTITY;
+        for row in 0..3 {
+            out.axis[self.axis[row]] = row;
+            out.sign[self.axis[row]] = self.sign[row];
+        }
+        out
+    }
 }
 
 /// A rigid transform of the MagicaVoxel scene: `p ↦ rotation · p + translation`.
@@ -154,7 +164,7 @@ impl Placement {
 
 /// A signed permutation of cells plus an integer offset: world cell `w[i] = sign[i] · v[axis[i]] + offset[i]`.
 /// It maps cell centres by an isometry, so a sphere of cells maps to a sphere and a box to a box, exactly.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct CellMap {
     axis: [usize; 3],
     sign: [i32; 3],
@@ -219,6 +229,7 @@ mod tests {
             let turn = Rotation::quarter_turn(axis);
             let full = turn.times(turn).times(turn).times(turn);
             assert_eq!(full, Rotation::IDENTITY);
+            assert_eq!(turn.times(turn.inverse()), Rotation::IDENTITY);
         }
     }
 

@@ -84,12 +84,12 @@ pub enum Command {
     /// `move DX DY DZ`: the selected voxels move by (DX, DY, DZ), and the
     /// selection with them (one undo step).
     Move(IVec3),
-    /// `object N|NAME|hide|show`: pick the object later edits go to (by
-    /// index in walk order from 0, or by name or `group/name` path), or
-    /// hide or show the picked one (an undoable edit).
+    /// `object N|NAME`: pick the object later edits go to (by index in
+    /// walk order from 0, or by name or `group/name` path); the other
+    /// `object` lines change the picked one (each an undoable edit).
     Object(ObjectLine),
-    /// `layer N hide|show`: hide or show layer N (an undoable edit).
-    Layer(u32, bool),
+    /// `layer N NAME`, `layer N hide|show` (an undoable edit).
+    Layer(u32, LayerLine),
     /// `expect objects N`: the scene places N objects.
     ExpectObjects(usize),
     /// `expect models N`: the scene stores N models (each once).
@@ -100,8 +100,33 @@ pub enum Command {
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum ObjectLine {
     Pick(ObjectRef),
+    /// `object new NAME`: an empty object in the top group, picked.
+    New(String),
+    /// `object move DX DY DZ` (world voxels).
+    Move(IVec3),
+    /// `object rotate x|y|z`: a quarter turn counter-clockwise seen from the
+    /// positive axis, about the object's pivot.
+    Rotate(usize),
+    /// `object duplicate [reference]`: a copy (true: the same model placed again).
+    Duplicate {
+        reference: bool,
+    },
+    /// `object unique`: the picked placement gets a model of its own.
+    Unique,
+    Delete,
     /// `object hide` (true) or `object show` (false).
     Hide(bool),
+    Rename(String),
+    /// `object layer N`.
+    Layer(u32),
+}
+
+/// What a `layer N …` line does.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum LayerLine {
+    /// `hide` (true) or `show` (false).
+    Hide(bool),
+    Name(String),
 }
 
 /// Which object an `object` line names.

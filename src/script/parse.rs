@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{DVec3, IVec3};
 
-use super::{Command, Line, ObjectLine, ObjectRef, Script};
+use super::{Command, LayerLine, Line, ObjectLine, ObjectRef, Script};
 use crate::camera::{FOV_RANGE_DEG, check_fov};
 use crate::edit::brush::{Brush, Tool};
 use crate::scene::demo::BuiltIn;
@@ -369,23 +369,45 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
         "object" => Command::Object(parse_object(c)?),
         "layer" => {
             let id = c.int_in("layer id", 0..=i64::from(u32::MAX - 1))? as u32;
-            let what = c.word("hide or show")?;
-            match what.text.as_str() {
-                "hide" => Command::Layer(id, true),
-                "show" => Command::Layer(id, false),
-                other => return Err((what.column, format!("expected hide or show, found '{other}'"))),
-            }
+            let what = c.word("hide, show or a name")?;
+            Command::Layer(
+                id,
+                match what.text.as_str() {
+                    "hide" => LayerLine::Hide(true),
+                    "show" => LayerLine::Hide(false),
+                    _ => LayerLine::Name(what.text),
+                },
+            )
         }
         other => return Err((name.column, format!("unknown command '{other}'"))),
     })
 }
 
-/// `object N`, `object NAME`, `object hide`, `object show`.
+/// `object N|NAME`, and what the picked object does: `new NAME`, `move DX
+/// DY DZ`, `rotate x|y|z`, `duplicate [reference]`, `unique`, `delete`,
+/// `hide`, `show`, `rename NAME`, `layer N`. (An object named like one of
+/// these words is picked by its index or its path.)
 fn parse_object(c: &mut Cursor) -> Result<ObjectLine, Fail> {
-    let word = c.word("an object index or name, hide or show")?;
+    let word = c.word("an object index or name, or what the picked object does")?;
     Ok(match word.text.as_str() {
         "hide" => ObjectLine::Hide(true),
         "show" => ObjectLine::Hide(false),
+        "new" => ObjectLine::New(c.word("a name")?.text),
+        "move" => ObjectLine::Move(c.position()?),
+        "rotate" => {
+            let axis = c.word("x, y or z")?;
+            ObjectLine::Rotate(match axis.text.as_str() {
+                "x" => 0,
+                "y" => 1,
+                "z" => 2,
+                other => return Err((axis.column, format!("expected x, y or z, found '{other}'"))),
+            })
+        }
+        "duplicate" => ObjectLine::Duplicate { reference: c.take("reference") },
+        "unique" => ObjectLine::Unique,
+        "delete" => ObjectLine::Delete,
+        "rename" => ObjectLine::Rename(c.word("a name")?.text),
+        "layer" => ObjectLine::Layer(c.int_in("layer id", 0..=i64::from(u32::MAX - 1))? as u32),
         text if !text.is_empty() && text.bytes().all(|b| b.is_ascii_digit()) => ObjectLine::Pick(ObjectRef::Index(
             text.parse().map_err(|_| (word.column, format!("object index '{text}' is too large")))?,
         )),
@@ -565,7 +587,9 @@ mod tests {
                     paste 1 -2 3\nmove 0 0 -1\n\
                     material 4 glass _ri 1.45 _trans 0.5\nmaterial 5 diffuse\npick 1 -2 3\nfill 0 0 -1\nmirror x 4.5\nmirror z -2\nmirror off\nline 1 2 3 -4 5 6\n\
                     extrude 1 2 3 0 -1 0 -2\nobject 3\nobject \"tree 4/top\"\nobject hide\nobject show\nlayer 2 hide\n\
-                    layer 0 show\nexpect objects 19\nexpect models 15\n";
+                    layer 0 show\nexpect objects 19\nexpect models 15\nobject new \"a b\"\nobject move 1 -2 3\nobject rotate z\n\
+                    object duplicate\nobject duplicate reference\nobject unique\nobject delete\nobject rename top\n\
+                    object layer 3\nlayer 4 \"roof tiles\"\n";
         let script = parse_script(Path::new("t.ovr"), text).unwrap();
         let printed: String = script.lines.iter().map(|l| format!("{}\n", l.command)).collect();
         let again = parse_script(Path::new("t.ovr"), &printed).unwrap();
@@ -573,7 +597,7 @@ mod tests {
             script.lines.iter().map(|l| &l.command).collect::<Vec<_>>(),
             again.lines.iter().map(|l| &l.command).collect::<Vec<_>>()
         );
-        assert_eq!(script.lines.len(), 49);
+        assert_eq!(script.lines.len(), 59);
     }
 
     #[test]

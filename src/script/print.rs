@@ -5,7 +5,7 @@ use std::fmt;
 
 use glam::IVec3;
 
-use super::{Command, ObjectLine, ObjectRef};
+use super::{Command, LayerLine, ObjectLine, ObjectRef};
 use crate::edit::brush::Brush;
 
 /// Writes a command back as a script line (what `--record` produces).
@@ -67,7 +67,20 @@ impl fmt::Display for Command {
             }
             Command::Object(ObjectLine::Hide(true)) => write!(f, "object hide"),
             Command::Object(ObjectLine::Hide(false)) => write!(f, "object show"),
-            Command::Layer(id, hidden) => write!(f, "layer {id} {}", if *hidden { "hide" } else { "show" }),
+            Command::Object(ObjectLine::New(name)) => write!(f, "object new {}", quoted(std::path::Path::new(name))),
+            Command::Object(ObjectLine::Move(d)) => write!(f, "object move {}", v(*d)),
+            Command::Object(ObjectLine::Rotate(axis)) => write!(f, "object rotate {}", ["x", "y", "z"][*axis]),
+            Command::Object(ObjectLine::Duplicate { reference: false }) => write!(f, "object duplicate"),
+            Command::Object(ObjectLine::Duplicate { reference: true }) => write!(f, "object duplicate reference"),
+            Command::Object(ObjectLine::Unique) => write!(f, "object unique"),
+            Command::Object(ObjectLine::Delete) => write!(f, "object delete"),
+            Command::Object(ObjectLine::Rename(name)) => {
+                write!(f, "object rename {}", quoted(std::path::Path::new(name)))
+            }
+            Command::Object(ObjectLine::Layer(id)) => write!(f, "object layer {id}"),
+            Command::Layer(id, LayerLine::Hide(true)) => write!(f, "layer {id} hide"),
+            Command::Layer(id, LayerLine::Hide(false)) => write!(f, "layer {id} show"),
+            Command::Layer(id, LayerLine::Name(name)) => write!(f, "layer {id} {}", quoted(std::path::Path::new(name))),
             Command::ExpectObjects(n) => write!(f, "expect objects {n}"),
             Command::ExpectModels(n) => write!(f, "expect models {n}"),
         }

@@ -294,3 +294,61 @@ fn a_model_that_grows_on_one_side_keeps_its_voxels_where_they_were() {
     expected.sort_by_key(|(p, _)| (p.x, p.y, p.z));
     assert_eq!(placed, expected);
 }
+
+/// 100,000 objects: they load, a referenced model placed 33,334 times
+/// takes an edit in every placement, and undo takes it back.
+#[test]
+fn a_hundred_thousand_objects_load_and_edit() {
+    let bytes = written_scene(100_000);
+    let started = std::time::Instant::now();
+    let mut editor = Editor::default();
+    editor.set_scene(load(&bytes));
+    let loaded = started.elapsed();
+    let before = editor.scene.tree.solid_voxels();
+    let objects = editor.scene.objects.as_ref().unwrap();
+    assert_eq!(objects.list().len(), 100_000);
+    // Object 0 shows model 0; the cell beside its marked corner is empty in every placement.
+    let visible = (0..100_000).filter(|k| k % 3 == 0 && k % 11 != 5).count() as u64;
+    let corner = objects.world_box(0).unwrap().1 + IVec3::ONE;
+    let script = octovox::script::parse_script(
+        std::path::Path::new("t.ovr"),
+        &format!("object 0\nplace {} {} {}", corner.x, corner.y, corner.z),
+    )
+    .unwrap();
+    for line in &script.lines {
+        editor.run(&line.command).unwrap();
+    }
+    assert_eq!(editor.scene.tree.solid_voxels(), before + visible);
+    editor.run(&octovox::script::Command::Undo(1)).unwrap();
+    assert_eq!(editor.scene.tree.solid_voxels(), before);
+    assert!(started.elapsed().as_secs() < 120, "loaded in {loaded:?}, all in {:?}", started.elapsed());
+}
+
+/// Hostile graphs give a clear error naming the problem.
+#[test]
+fn broken_scene_graphs_are_refused_with_a_reason() {
+    let with = |scenes: Vec<SceneNode>| {
+        let data = DotVoxData {
+            version: 200,
+            index_map: Vec::new(),
+            models: vec![model(2, 1)],
+            palette: dot_vox::DEFAULT_PALETTE.to_vec(),
+            materials: Vec::new(),
+            scenes,
+            layers: Vec::new(),
+        };
+        let mut bytes = Vec::new();
+        data.write_vox(&mut bytes).unwrap();
+        load_vox_scene(&bytes, 0).err().map(|e| e.to_string()).unwrap_or_default()
+    };
+    let transform = |child| SceneNode::Transform { attributes: dict(&[]), frames: vec![], child, layer_id: 0 };
+    let shape = |model_id| SceneNode::Shape {
+        attributes: dict(&[]),
+        models: vec![ShapeModel { model_id, attributes: dict(&[]) }],
+    };
+    let group = |children: Vec<u32>| SceneNode::Group { attributes: dict(&[]), children };
+    assert!(with(vec![transform(1), group(vec![0])]).contains("cycle"), "a cycle");
+    assert!(with(vec![transform(1), group(vec![7])]).contains("missing node 7"), "a dangling id");
+    let missing = with(vec![transform(1), group(vec![2, 3]), shape(0), shape(5)]);
+    assert!(missing.contains("uses model 5"), "a shape naming a missing model: {missing}");
+}
