@@ -17,6 +17,7 @@ use glam::IVec3;
 use super::atomic::{WriteOptions, write_atomically};
 use super::progress::Progress;
 use crate::gpu_pool::{BRICK_BYTES, Brick, NODE_BYTES, NodeSlot, is_pointer, pointer_to, slot_of};
+use crate::scene::objects::Objects;
 use crate::scene::octree::{MAX_DEPTH, MIN_DEPTH, Octree};
 use crate::scene::{Material, MaterialKind, Palette, Scene};
 
@@ -33,6 +34,11 @@ pub const MAX_FILE_BYTES: u64 = 1 << 36;
 /// Payload bytes before the node and brick arrays: origin, depth, root,
 /// node and brick counts, the palette.
 const FIXED_PAYLOAD_BYTES: u64 = 12 + 4 + 4 + 8 + 8 + 256 * 4;
+/// Header flag: the payload ends with the scene's objects (see `docs/ovx.md`).
+const FLAG_OBJECTS: u32 = 1;
+/// Flags this version defines.
+const KNOWN_FLAGS: u32 = FLAG_OBJECTS;
+
 /// zstd level: fast (about the speed of writing the file) and within a
 /// few percent of level 9 on pools.
 const ZSTD_LEVEL: i32 = 3;
@@ -70,6 +76,8 @@ pub fn save_ovx(path: &Path, scene: &Scene, options: WriteOptions) -> Result<(),
     let write_error = |source| OvxError::Write { path: path.to_path_buf(), source };
     let compact = Compact::of(&scene.tree);
     let materials = encode_materials(&scene.palette);
+    let objects =
+        objects_section(scene).map_err(|e| write_error(io::Error::new(io::ErrorKind::InvalidInput, e.to_string())))?;
     if materials.len() as u64 > MAX_MATERIALS_BYTES {
         let text =
             format!("the materials take {} bytes, past the {MAX_MATERIALS_BYTES} an .ovx holds", materials.len());
@@ -78,21 +86,23 @@ pub fn save_ovx(path: &Path, scene: &Scene, options: WriteOptions) -> Result<(),
     let payload_len = FIXED_PAYLOAD_BYTES
         + compact.nodes.len() as u64 * NODE_BYTES
         + compact.bricks.len() as u64 * BRICK_BYTES
-        + materials.len() as u64;
+        + materials.len() as u64
+        + objects.as_ref().map_or(0, |o| OBJECTS_HEADER_BYTES + o.bytes.len() as u64);
+    let flags = if objects.is_some() { FLAG_OBJECTS } else { 0 };
     write_atomically(path, options, |file| {
         let mut out = Counting::new(io::BufWriter::new(file));
         // The file length goes in once the frame is written (a seek back).
-        out.write_all(&header(0, payload_len))?;
+        out.write_all(&header(0, payload_len, flags))?;
         let mut encoder = zstd::Encoder::new(&mut out, ZSTD_LEVEL)?;
         encoder.include_checksum(true)?;
-        write_payload(&mut encoder, &scene.tree, &scene.palette, &compact, &materials)?;
+        write_payload(&mut encoder, &scene.tree, &scene.palette, &compact, objects.as_ref(), &materials)?;
         encoder.finish()?;
         let file_len = out.written + FOOTER_BYTES;
         let file = out.into_inner()?;
         use std::io::Seek;
         file.seek(io::SeekFrom::Start(0))?;
         // The checksum covers the final header: recompute it over the file.
-        file.write_all(&header(file_len, payload_len))?;
+        file.write_all(&header(file_len, payload_len, flags))?;
         file.seek(io::SeekFrom::Start(0))?;
         let crc = crc_of(&mut *file, file_len - FOOTER_BYTES)?;
         file.seek(io::SeekFrom::End(0))?;
@@ -102,11 +112,27 @@ pub fn save_ovx(path: &Path, scene: &Scene, options: WriteOptions) -> Result<(),
     .map_err(write_error)
 }
 
-fn header(file_len: u64, payload_len: u64) -> [u8; HEADER_BYTES as usize] {
+/// The objects of a scene of several, as the `.vox` bytes that hold them
+/// (models, graph, layers, kept chunks), and the frame shown.
+struct ObjectsSection {
+    bytes: Vec<u8>,
+    frame: u64,
+}
+
+/// Bytes before the `.vox` bytes of the objects section: their length and the frame.
+const OBJECTS_HEADER_BYTES: u64 = 16;
+
+fn objects_section(scene: &Scene) -> Result<Option<ObjectsSection>, super::vox::VoxError> {
+    let Some(objects) = &scene.objects else { return Ok(None) };
+    let bytes = super::vox::encode_objects(&scene.palette, objects)?;
+    Ok(Some(ObjectsSection { bytes, frame: objects.frame as u64 }))
+}
+
+fn header(file_len: u64, payload_len: u64, flags: u32) -> [u8; HEADER_BYTES as usize] {
     let mut h = [0u8; HEADER_BYTES as usize];
     h[..8].copy_from_slice(&MAGIC);
     h[8..12].copy_from_slice(&VERSION.to_le_bytes());
-    // 12..16: flags, none yet.
+    h[12..16].copy_from_slice(&flags.to_le_bytes());
     h[16..24].copy_from_slice(&file_len.to_le_bytes());
     h[24..32].copy_from_slice(&payload_len.to_le_bytes());
     h
@@ -117,6 +143,7 @@ fn write_payload(
     tree: &Octree,
     palette: &Palette,
     compact: &Compact,
+    objects: Option<&ObjectsSection>,
     materials: &[u8],
 ) -> io::Result<()> {
     for v in tree.origin().to_array() {
@@ -129,6 +156,11 @@ fn write_payload(
     out.write_all(bytemuck::cast_slice(&palette.colors))?;
     out.write_all(bytemuck::cast_slice(&compact.nodes))?;
     out.write_all(bytemuck::cast_slice(&compact.bricks))?;
+    if let Some(objects) = objects {
+        out.write_all(&(objects.bytes.len() as u64).to_le_bytes())?;
+        out.write_all(&objects.frame.to_le_bytes())?;
+        out.write_all(&objects.bytes)?;
+    }
     out.write_all(materials)
 }
 
@@ -229,15 +261,18 @@ pub fn decode_ovx(bytes: &[u8], progress: &Progress) -> Result<Scene, OvxError> 
         return Err(OvxError::BadChecksum { stored, computed });
     }
     let flags = le_u32(bytes, 12);
-    if flags != 0 {
-        return Err(corrupt(format!("header flags {flags:#x} are set, but version {VERSION} defines none")));
+    if flags & !KNOWN_FLAGS != 0 {
+        return Err(corrupt(format!(
+            "header flags {:#x} are set, but version {VERSION} defines only {KNOWN_FLAGS:#x}",
+            flags & !KNOWN_FLAGS
+        )));
     }
     crate::budget::check(|| format!("an .ovx pool of {payload_len} bytes"), payload_len)?;
     progress.start(payload_len);
     let decoder =
         zstd::Decoder::with_buffer(&body[HEADER_BYTES as usize..]).map_err(|e| corrupt(format!("zstd: {e}")))?;
     let mut payload = Payload { decoder: decoder.single_frame(), progress, produced: 0, expected: payload_len };
-    let scene = read_payload(&mut payload)?;
+    let scene = read_payload(&mut payload, flags & FLAG_OBJECTS != 0)?;
     payload.finish()?;
     Ok(scene)
 }
@@ -350,7 +385,8 @@ impl Payload<'_> {
     }
 }
 
-fn read_payload(input: &mut Payload) -> Result<Scene, OvxError> {
+fn read_payload(input: &mut Payload, with_objects: bool) -> Result<Scene, OvxError> {
+    // The objects section's bytes come off what the materials may take.
     let payload_len = input.expected;
     let mut fixed = vec![0u8; FIXED_PAYLOAD_BYTES as usize];
     input.fill(&mut fixed)?;
@@ -366,11 +402,12 @@ fn read_payload(input: &mut Payload) -> Result<Scene, OvxError> {
         .checked_mul(NODE_BYTES)
         .zip(brick_count.checked_mul(BRICK_BYTES))
         .and_then(|(n, b)| n.checked_add(b)?.checked_add(FIXED_PAYLOAD_BYTES));
-    let Some(materials_len) = arrays.and_then(|a| payload_len.checked_sub(a)).filter(|m| *m >= MIN_MATERIALS_BYTES)
-    else {
+    // With objects, their section lies between the bricks and the materials.
+    let least = MIN_MATERIALS_BYTES + if with_objects { OBJECTS_HEADER_BYTES } else { 0 };
+    let Some(mut materials_len) = arrays.and_then(|a| payload_len.checked_sub(a)).filter(|m| *m >= least) else {
         return Err(corrupt(format!("{node_count} nodes and {brick_count} bricks do not fit its {payload_len} bytes")));
     };
-    if materials_len > MAX_MATERIALS_BYTES {
+    if !with_objects && materials_len > MAX_MATERIALS_BYTES {
         return Err(corrupt(format!(
             "a payload of {payload_len} bytes is more than {node_count} nodes and {brick_count} bricks can need \
              (their arrays and at most {MAX_MATERIALS_BYTES} bytes of materials)"
@@ -386,9 +423,37 @@ fn read_payload(input: &mut Payload) -> Result<Scene, OvxError> {
             Ok(())
         }
     })?;
+    let objects = if with_objects {
+        let (objects, taken) = read_objects(input, materials_len)?;
+        materials_len -= taken;
+        Some(objects)
+    } else {
+        None
+    };
     palette.materials = decode_materials(&input.items::<u8>(materials_len, |_, _| Ok(()))?)?;
     let tree = Octree::from_parts(origin, depth, root, nodes, bricks).map_err(|e| corrupt(e.to_string()))?;
-    Ok(Scene::new(palette, tree))
+    Ok(Scene { palette, tree, objects: objects.map(Box::new) })
+}
+
+/// Reads the objects section (at most `room` bytes, the materials' least
+/// after it): its `.vox` bytes load as a scene whose objects are kept (the
+/// pool already holds what they draw). Returns them and the bytes taken.
+fn read_objects(input: &mut Payload, room: u64) -> Result<(Objects, u64), OvxError> {
+    let head = input.items::<u8>(OBJECTS_HEADER_BYTES, |_, _| Ok(()))?;
+    let (len, frame) = (le_u64(&head, 0), le_u64(&head, 8));
+    let most = (room - OBJECTS_HEADER_BYTES - MIN_MATERIALS_BYTES).min(super::vox::MAX_FILE_BYTES);
+    if len > most {
+        return Err(corrupt(format!("an objects section of {len} bytes, past the {most} it can hold")));
+    }
+    let bytes = input.items::<u8>(len, |_, _| Ok(()))?;
+    let frame = usize::try_from(frame).map_err(|_| corrupt(format!("frame {frame}")))?;
+    let scene = super::vox::load_vox_scene(&bytes, frame).map_err(|e| corrupt(format!("its objects: {e}")))?.0;
+    let objects = scene.objects.ok_or_else(|| corrupt("its objects section holds a single model"))?;
+    let left = room - OBJECTS_HEADER_BYTES - len;
+    if left > MAX_MATERIALS_BYTES {
+        return Err(corrupt(format!("{left} bytes of materials, past the {MAX_MATERIALS_BYTES} an .ovx holds")));
+    }
+    Ok((*objects, OBJECTS_HEADER_BYTES + len))
 }
 
 /// What one stored node can be told wrong by on its own, as it is read (a
@@ -568,8 +633,7 @@ mod tests {
     fn forge(frames: &[Vec<u8>], payload_len: u64, flags: u32) -> Vec<u8> {
         let body: Vec<u8> = frames.concat();
         let file_len = HEADER_BYTES + body.len() as u64 + FOOTER_BYTES;
-        let mut bytes = header(file_len, payload_len).to_vec();
-        bytes[12..16].copy_from_slice(&flags.to_le_bytes());
+        let mut bytes = header(file_len, payload_len, flags).to_vec();
         bytes.extend(body);
         let crc = crc32fast::hash(&bytes);
         bytes.extend(crc.to_le_bytes());
@@ -601,7 +665,9 @@ mod tests {
         let good = forge(&[frame(&[&payload], 0)], payload.len() as u64, 0);
         assert!(decode_ovx(&good, &Progress::default()).is_ok(), "the forger makes loadable files");
         let (message, _) = refusal(&forge(&[frame(&[&payload], 0)], payload.len() as u64, 1));
-        assert!(message.contains("header flags 0x1 are set"), "{message}");
+        assert!(message.contains("an objects section of"), "flag 1 (objects) wants an objects section: {message}");
+        let (message, _) = refusal(&forge(&[frame(&[&payload], 0)], payload.len() as u64, 2));
+        assert!(message.contains("header flags 0x2 are set"), "{message}");
     }
 
     /// Issue 24, item 15: bytes after the 256 materials, inside the payload.

@@ -352,3 +352,26 @@ fn broken_scene_graphs_are_refused_with_a_reason() {
     let missing = with(vec![transform(1), group(vec![2, 3]), shape(0), shape(5)]);
     assert!(missing.contains("uses model 5"), "a shape naming a missing model: {missing}");
 }
+
+/// An .ovx holds the whole scene: the pool as drawn, and the objects.
+#[test]
+fn an_ovx_file_keeps_the_objects() {
+    let bytes = std::fs::read(assets().join("format/test_groups.vox")).unwrap();
+    let mut editor = Editor::default();
+    editor.set_scene(load(&bytes));
+    let script = octovox::script::parse_script(
+        std::path::Path::new("t.ovr"),
+        "object 3\nobject hide\nobject 0\nobject move 0 0 9",
+    )
+    .unwrap();
+    for line in &script.lines {
+        editor.run(&line.command).unwrap();
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("groups.ovx");
+    octovox::io::save_scene(&path, &editor.scene, Default::default()).unwrap();
+    let again = octovox::io::load_scene(&path, 0).unwrap();
+    assert_eq!(again.tree.voxels(), editor.scene.tree.voxels());
+    assert_same_scene("ovx", &saved(&editor.scene), &saved(&again));
+    assert!(again.objects.as_ref().unwrap().list()[3].hidden);
+}
