@@ -52,3 +52,70 @@ fn a_click_picks_the_object_it_hits_and_edits_its_model() {
     save(&display, &mut lines, &file);
     assert_eq!(model_sizes(&file), before, "one Ctrl+Z takes it back");
 }
+
+/// Ctrl+H hides the object a click picked: its pixels change on screen, the
+/// saved file keeps it (hidden, its model whole); Ctrl+Z shows it again.
+#[test]
+fn ctrl_h_hides_the_picked_object_and_the_file_keeps_it() {
+    use octovox::trace::{Ray, svo};
+    require_window_tools();
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("groups.vox");
+    common::copy_writable(&common::assets().join("vox/format/test_groups.vox"), &file);
+    let scene = octovox::io::load_scene(&file, 0).unwrap();
+    let objects = scene.objects.as_ref().unwrap();
+    let (lo, hi) = scene.tree.solid_bounds().unwrap();
+    let camera = Camera::framing(lo, hi, 50.0);
+    let (x, y, voxel, _) = stable_pixel(&scene.tree, &camera, |v, _| objects.owner_at(v).is_some());
+    let owner = objects.owner_at(voxel).unwrap();
+    // The pixels that show the object, by the CPU tracer.
+    let basis = camera.basis(WIDTH, HEIGHT, scene.tree.origin());
+    let shows: Vec<(u32, u32)> = (FREE_Y..HEIGHT)
+        .step_by(2)
+        .flat_map(|py| (FREE_X..WIDTH).step_by(2).map(move |px| (px, py)))
+        .filter(|&(px, py)| {
+            let (o, d) = basis.ray(px, py);
+            let hit = svo::trace(&scene.tree, &Ray::new(o, d));
+            hit.is_hit() && objects.owner_at(hit.voxel + scene.tree.origin()) == Some(owner)
+        })
+        .collect();
+    assert!(shows.len() > 20, "object {owner} covers {} pixels", shows.len());
+
+    let (_xvfb, display) = start_xvfb(22);
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &document_args(&file, &camera, &[]));
+    let window = find_window(&display, &mut app, &stderr_path);
+    lines.wait_for("octovox: ready", Duration::from_secs(90));
+    xdotool(&display, &["windowfocus", "--sync", &window]);
+    // Paint picks the object without changing its shape.
+    xdotool(&display, &["key", "g"]);
+    click(&display, &window, &mut lines, x, y);
+    xdotool(&display, &["mousemove", "--window", &window, "790", "590"]);
+    std::thread::sleep(Duration::from_millis(800));
+    let before = screenshot_x(&display, &dir.path().join("before.png"));
+    xdotool(&display, &["key", "ctrl+h"]);
+    lines.wait_for("object:", Duration::from_secs(30));
+    std::thread::sleep(Duration::from_millis(800));
+    let after = screenshot_x(&display, &dir.path().join("after.png"));
+    if let Ok(keep) = std::env::var("OCTOVOX_KEEP_SHOTS") {
+        before.save(format!("{keep}/hide-before.png")).unwrap();
+        after.save(format!("{keep}/hide-after.png")).unwrap();
+    }
+    let changed = shows.iter().filter(|&&(px, py)| before.get_pixel(px, py) != after.get_pixel(px, py)).count();
+    assert!(changed * 10 >= shows.len() * 9, "{changed} of the object's {} pixels changed", shows.len());
+
+    save(&display, &mut lines, &file);
+    let data = dot_vox::load_bytes(&std::fs::read(&file).unwrap()).unwrap();
+    let original =
+        dot_vox::load_bytes(&std::fs::read(common::assets().join("vox/format/test_groups.vox")).unwrap()).unwrap();
+    assert_eq!(data.models.len(), original.models.len(), "every model is kept");
+    let node = objects.list()[owner].transform_node.unwrap() as usize;
+    let dot_vox::SceneNode::Transform { attributes, .. } = &data.scenes[node] else { panic!("node {node}") };
+    assert_eq!(attributes.get("_hidden").map(String::as_str), Some("1"), "saved hidden");
+
+    xdotool(&display, &["key", "ctrl+z"]);
+    lines.wait_for("undo:", Duration::from_secs(30));
+    save(&display, &mut lines, &file);
+    let data = dot_vox::load_bytes(&std::fs::read(&file).unwrap()).unwrap();
+    let dot_vox::SceneNode::Transform { attributes, .. } = &data.scenes[node] else { panic!("node {node}") };
+    assert_eq!(attributes.get("_hidden"), None, "one Ctrl+Z shows it again");
+}
