@@ -286,6 +286,8 @@ pub enum BenchKind {
     Quality,
     /// Nefertiti at 512 to 4096 voxels tall: import, memory, .ovx, frame, edit.
     Scale,
+    /// A forest of 2,000 references of one tree against the merged model.
+    Scene,
 }
 
 /// Parses "WxH".

@@ -96,6 +96,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<ExitCode> {
         BenchKind::Effects => super::bench_effects::bench_effects(args.quick)?,
         BenchKind::Quality => super::bench_quality::bench_quality(args.quick, &args.out)?,
         BenchKind::Scale => super::bench_scale::bench_scale(args.quick)?,
+        BenchKind::Scene => super::bench_scene::bench_scene(args.quick)?,
     };
     say!("{markdown}")?;
     let mut name = format!("{:?}", args.what).to_lowercase();

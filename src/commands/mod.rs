@@ -13,6 +13,7 @@ mod bench;
 mod bench_effects;
 mod bench_quality;
 mod bench_scale;
+mod bench_scene;
 mod convert;
 mod export;
 mod import;
