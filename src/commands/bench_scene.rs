@@ -179,7 +179,7 @@ pub fn bench_scene(quick: bool) -> anyhow::Result<(String, String)> {
         merged_pool_bytes: merged.tree.pool().live_bytes(),
         move_bytes_written,
     };
-    Ok((report(&row), serde_json::to_string_pretty(&row)?))
+    Ok((report(&row), serde_json::to_string_pretty(&[row])?))
 }
 
 fn report(r: &SceneRow) -> String {

@@ -66,6 +66,11 @@ impl Edit {
     /// changes nothing.
     pub fn apply(&self, scene: &mut Scene) -> Result<Edit, EditError> {
         match self {
+            // In a scene of objects the drawn tree follows the models: a brush
+            // must go into one (see `Edit::resolved`), or be refused.
+            Edit::Brush { .. } if scene.objects.is_some() => {
+                Err(EditError::Brush("the scene has no object to edit: `object new NAME` makes one".to_owned()))
+            }
             Edit::Brush { shape, op } => Ok(Edit::Restore(scene.tree.apply_brush(shape, *op)?)),
             Edit::Restore(patch) => Ok(Edit::Restore(scene.tree.apply_patch(patch)?)),
             Edit::InObject { object, shape, op } => {

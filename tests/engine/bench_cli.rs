@@ -13,6 +13,7 @@ fn every_bench_runs_and_writes_its_tables() {
         ("edit", &["one voxel", "sphere r = 8", "sphere r = 32"][..]),
         ("render", &["torus64", "teapot256", "nefertiti512", "sculpture10M"][..]),
         ("scale", &["64", "128"][..]),
+        ("scene", &["frame ms", "pool bytes (models, CPU)", "pool bytes (drawn, GPU)", "load ms"][..]),
     ] {
         let run = Command::new(env!("CARGO_BIN_EXE_octovox"))
             .args(["bench", kind, "--quick", "--out"])

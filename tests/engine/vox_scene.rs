@@ -375,3 +375,25 @@ fn an_ovx_file_keeps_the_objects() {
     assert_same_scene("ovx", &saved(&editor.scene), &saved(&again));
     assert!(again.objects.as_ref().unwrap().list()[3].hidden);
 }
+
+/// With every object deleted, an edit is refused (it would change what is
+/// drawn but no model, and be lost on save); `object new` makes one to edit.
+#[test]
+fn an_edit_with_no_object_left_is_refused_and_a_new_object_takes_it() {
+    let bytes = written_scene(2);
+    let mut editor = Editor::default();
+    editor.set_scene(load(&bytes));
+    let run = |editor: &mut Editor, text: &str| {
+        let script = octovox::script::parse_script(std::path::Path::new("t.ovr"), text).unwrap();
+        script.lines.iter().try_for_each(|l| editor.run(&l.command).map(|_| ()))
+    };
+    run(&mut editor, "object 0\nobject delete\nobject 0\nobject delete").unwrap();
+    assert_eq!(editor.scene.objects.as_ref().unwrap().list().len(), 0);
+    assert_eq!(editor.scene.tree.solid_voxels(), 0);
+    let refused = run(&mut editor, "place 0 0 0").unwrap_err().to_string();
+    assert!(refused.contains("no object to edit"), "{refused}");
+    assert_eq!(editor.scene.tree.solid_voxels(), 0, "a refused edit changes nothing");
+    run(&mut editor, "object new fresh\nplace 0 0 0").unwrap();
+    assert_eq!(editor.scene.tree.solid_voxels(), 1);
+    assert_eq!(load(&saved(&editor.scene)).tree.solid_voxels(), 1, "saved in the new object's model");
+}

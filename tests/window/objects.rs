@@ -119,3 +119,47 @@ fn ctrl_h_hides_the_picked_object_and_the_file_keeps_it() {
     let dot_vox::SceneNode::Transform { attributes, .. } = &data.scenes[node] else { panic!("node {node}") };
     assert_eq!(attributes.get("_hidden"), None, "one Ctrl+Z shows it again");
 }
+
+/// A click on an object, Ctrl+H on another, then a kill: `octovox recover`
+/// gives the scene the session held (the edit in the right model, the
+/// hidden object), read back with `dot_vox`.
+#[test]
+fn object_edits_survive_a_kill() {
+    require_window_tools();
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("groups.vox");
+    common::copy_writable(&common::assets().join("vox/format/test_groups.vox"), &file);
+    let scene = octovox::io::load_scene(&file, 0).unwrap();
+    let objects = scene.objects.as_ref().unwrap();
+    let (lo, hi) = scene.tree.solid_bounds().unwrap();
+    let camera = Camera::framing(lo, hi, 50.0);
+    let (x, y, voxel, _) = stable_pixel(&scene.tree, &camera, |v, _| objects.owner_at(v).is_some());
+    let owner = objects.owner_at(voxel).unwrap();
+    let model = objects.list()[owner].placement.model;
+    let before = model_sizes(&file);
+
+    let (_xvfb, display) = start_xvfb(23);
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &document_args(&file, &camera, &[]));
+    let window = find_window(&display, &mut app, &stderr_path);
+    lines.wait_for("octovox: ready", Duration::from_secs(90));
+    xdotool(&display, &["windowfocus", "--sync", &window]);
+    click(&display, &window, &mut lines, x, y);
+    xdotool(&display, &["key", "ctrl+h"]);
+    lines.wait_for("object:", Duration::from_secs(30));
+    app.0.kill().unwrap();
+    app.0.wait().unwrap();
+
+    let recovered = dir.path().join("recovered.vox");
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_octovox"))
+        .args(["recover", file.to_str().unwrap(), "-o", recovered.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let mut expected = before;
+    expected[model] += 1;
+    assert_eq!(model_sizes(&recovered), expected, "the attached voxel is in model {model}");
+    let data = dot_vox::load_bytes(&std::fs::read(&recovered).unwrap()).unwrap();
+    let node = objects.list()[owner].transform_node.unwrap() as usize;
+    let dot_vox::SceneNode::Transform { attributes, .. } = &data.scenes[node] else { panic!("node {node}") };
+    assert_eq!(attributes.get("_hidden").map(String::as_str), Some("1"), "the hide is recovered");
+}
