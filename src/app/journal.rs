@@ -145,13 +145,23 @@ impl App {
             let _ = std::fs::create_dir_all(dir);
         }
         let selection = selection.map(|r| Line::Select(Some((r.min, r.max))));
+        // The object picked before the journal began (a click's `object N` runs before its edit).
+        let picked = self
+            .doc
+            .editor
+            .scene
+            .objects
+            .as_ref()
+            .and_then(|o| o.selected)
+            .map(|i| Line::Object(octovox::script::ObjectLine::Pick(octovox::script::ObjectRef::Index(i))));
+        let selection = selection.into_iter().chain(picked);
         let (lines, stamp) = (&self.doc.journal_start.lines, &self.doc.journal_start.stamp);
         let started = Recorder::journal(&path, &header).and_then(|mut journal| {
             let write = |journal: &mut Recorder| -> std::io::Result<()> {
                 if let Some(stamp) = stamp {
                     journal.note(&stamp.note())?;
                 }
-                lines.iter().cloned().chain(selection).try_for_each(|line| journal.scene(line))
+                lines.iter().cloned().chain(selection.clone()).try_for_each(|line| journal.scene(line))
             };
             if let Err(err) = write(&mut journal) {
                 // No journal that holds only part of its start is left behind.
