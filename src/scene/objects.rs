@@ -587,14 +587,6 @@ impl Objects {
     pub fn pool_bytes(&self) -> u64 {
         self.models.iter().map(|m| m.tree.pool().live_bytes()).sum()
     }
-
-    /// Whether the shape node of object `index` shows other models in other frames.
-    pub fn animated_shape(&self, index: usize) -> bool {
-        let Some(graph) = &self.graph else { return false };
-        graph
-            .node(self.objects[index].shape_node)
-            .is_some_and(|n| matches!(&n.kind, NodeKind::Shape { models } if models.len() > 1))
-    }
 }
 
 /// A change to the scene graph, as data (an undoable edit): nodes and

@@ -16,13 +16,19 @@ fn model_sizes(file: &std::path::Path) -> Vec<usize> {
     data.models.iter().map(|m| m.voxels.len()).collect()
 }
 
-#[test]
-fn a_click_picks_the_object_it_hits_and_edits_its_model() {
+/// A writable copy of `test_groups.vox` in a new folder, and the scene it holds.
+fn groups_document() -> (tempfile::TempDir, std::path::PathBuf, octovox::scene::Scene) {
     require_window_tools();
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("groups.vox");
     common::copy_writable(&common::assets().join("vox/format/test_groups.vox"), &file);
     let scene = octovox::io::load_scene(&file, 0).unwrap();
+    (dir, file, scene)
+}
+
+#[test]
+fn a_click_picks_the_object_it_hits_and_edits_its_model() {
+    let (dir, file, scene) = groups_document();
     let objects = scene.objects.as_ref().expect("test_groups.vox is a scene of objects");
     let (lo, hi) = scene.tree.solid_bounds().unwrap();
     let camera = Camera::framing(lo, hi, 50.0);
@@ -58,11 +64,7 @@ fn a_click_picks_the_object_it_hits_and_edits_its_model() {
 #[test]
 fn ctrl_h_hides_the_picked_object_and_the_file_keeps_it() {
     use octovox::trace::{Ray, svo};
-    require_window_tools();
-    let dir = tempfile::tempdir().unwrap();
-    let file = dir.path().join("groups.vox");
-    common::copy_writable(&common::assets().join("vox/format/test_groups.vox"), &file);
-    let scene = octovox::io::load_scene(&file, 0).unwrap();
+    let (dir, file, scene) = groups_document();
     let objects = scene.objects.as_ref().unwrap();
     let (lo, hi) = scene.tree.solid_bounds().unwrap();
     let camera = Camera::framing(lo, hi, 50.0);
@@ -125,11 +127,7 @@ fn ctrl_h_hides_the_picked_object_and_the_file_keeps_it() {
 /// picked), read back with `dot_vox`.
 #[test]
 fn object_edits_survive_a_kill() {
-    require_window_tools();
-    let dir = tempfile::tempdir().unwrap();
-    let file = dir.path().join("groups.vox");
-    common::copy_writable(&common::assets().join("vox/format/test_groups.vox"), &file);
-    let scene = octovox::io::load_scene(&file, 0).unwrap();
+    let (dir, file, scene) = groups_document();
     let objects = scene.objects.as_ref().unwrap();
     let (lo, hi) = scene.tree.solid_bounds().unwrap();
     let camera = Camera::framing(lo, hi, 50.0);
