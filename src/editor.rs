@@ -166,6 +166,8 @@ impl Editor {
                 changed
             }
             Command::Move(by) => self.move_selection(*by)?,
+            Command::Rotate(axis) => self.turn_selection(*axis, false)?,
+            Command::Flip(axis) => self.turn_selection(*axis, true)?,
             Command::ExpectVoxel(p, want) => {
                 let got = self.scene.tree.get(*p);
                 return Ok(checked(got == *want, format!("voxel {p} = {want}"), got));
@@ -357,6 +359,21 @@ impl Editor {
         Ok(changed)
     }
 
+    /// `rotate` (`flip`): the selected voxels leave their box and land
+    /// turned (mirrored) in the turned box about the same centre, as one
+    /// undo step; the selection follows. Whether the voxels changed.
+    fn turn_selection(&mut self, axis: usize, flip: bool) -> Result<bool, EditorError> {
+        let region = self.selected()?;
+        let (turned, map) = region.turned(axis, flip);
+        let turned = turned.inside_world()?;
+        let block = selection::copy(&self.scene.tree, region)?.mapped(&map, turned.size());
+        let mut edits = vec![region.clear_edit()];
+        edits.extend(block.place_edits(turned.min));
+        let changed = self.commit(edits)?;
+        self.selection = Some(turned);
+        Ok(changed)
+    }
+
     /// Brush edits and their mirror images as one undo step (or part of the
     /// open stroke); whether there was any.
     ///
@@ -518,6 +535,94 @@ mod tests {
         let far = crate::scene::octree::WORLD_LIMIT - 1;
         assert!(run(&mut editor, &format!("move {far} 0 0")).unwrap_err().to_string().contains("outside the world"));
         assert_eq!(editor.selection, Some(Region { min: IVec3::new(10, 0, 0), max: IVec3::new(11, 1, 1) }));
+    }
+
+    /// Every solid voxel of the editor's scene with its colour.
+    fn voxels(editor: &Editor) -> Vec<(IVec3, u8)> {
+        let mut out = Vec::new();
+        editor.scene.tree.for_each_solid_cell_in(IVec3::splat(-64), IVec3::splat(64), |min, size, color| {
+            for z in 0..size {
+                for y in 0..size {
+                    for x in 0..size {
+                        out.push((min + IVec3::new(x, y, z), color));
+                    }
+                }
+            }
+        });
+        out.sort_by_key(|(p, _)| (p.x, p.y, p.z));
+        out
+    }
+
+    /// An uneven shape in a 5×3×2 box (sizes that differ by odd counts).
+    fn uneven(editor: &mut Editor) {
+        for (i, line) in ["place 0 0 0", "place 1 0 0", "place 4 0 0", "place 4 2 1", "place 0 1 1"].iter().enumerate()
+        {
+            run(editor, &format!("color {}", i + 1)).unwrap();
+            run(editor, line).unwrap();
+        }
+        run(editor, "select 0 0 0 4 2 1").unwrap();
+    }
+
+    #[test]
+    fn two_quarter_turns_are_two_flips_and_four_come_back() {
+        for axis in ["x", "y", "z"] {
+            let (mut turned, mut flipped) = (Editor::default(), Editor::default());
+            uneven(&mut turned);
+            uneven(&mut flipped);
+            let start = (voxels(&turned), turned.selection);
+            run(&mut turned, &format!("rotate {axis}")).unwrap();
+            assert_ne!(voxels(&turned), start.0, "about {axis}");
+            run(&mut turned, &format!("rotate {axis}")).unwrap();
+            let others: Vec<&str> = ["x", "y", "z"].into_iter().filter(|a| *a != axis).collect();
+            for other in others {
+                run(&mut flipped, &format!("flip {other}")).unwrap();
+            }
+            assert_eq!(voxels(&turned), voxels(&flipped), "a half turn about {axis}");
+            assert_eq!(turned.selection, flipped.selection);
+            run(&mut turned, &format!("rotate {axis}")).unwrap();
+            run(&mut turned, &format!("rotate {axis}")).unwrap();
+            assert_eq!((voxels(&turned), turned.selection), start, "four turns about {axis}");
+            assert_eq!(turned.history.steps().0, 5 + 4, "each turn is one undo step");
+            run(&mut turned, "undo 4").unwrap();
+            assert_eq!((voxels(&turned), turned.selection.is_some()), (start.0, true));
+        }
+    }
+
+    #[test]
+    fn a_turn_swaps_the_box_sizes_about_its_centre() {
+        let mut editor = Editor::default();
+        uneven(&mut editor);
+        // About y a 5×3×2 box becomes 2×3×5: x moves in by 2 (half of 3,
+        // away from zero), z out by 2.
+        run(&mut editor, "rotate y").unwrap();
+        assert_eq!(editor.selection, Some(Region { min: IVec3::new(2, 0, -2), max: IVec3::new(3, 2, 2) }));
+        // Counter-clockwise seen from +y: +x turns to −z, +z to +x.
+        assert_eq!(editor.scene.tree.get(IVec3::new(2, 0, 2)), 1, "(0, 0, 0) went to the far +z end");
+        assert_eq!(editor.scene.tree.get(IVec3::new(2, 0, -2)), 3, "(4, 0, 0) went to the −z end");
+        assert_eq!(editor.scene.tree.get(IVec3::new(3, 2, -2)), 4, "(4, 2, 1) went +x of it");
+        assert_eq!(editor.scene.tree.solid_voxels(), 5);
+    }
+
+    #[test]
+    fn a_turn_needs_a_selection_and_a_refused_one_changes_nothing() {
+        let mut editor = Editor::default();
+        assert!(run(&mut editor, "rotate y").unwrap_err().to_string().contains("nothing is selected"));
+        // A column 8 high at the world's +x edge turned about z lies 8 wide
+        // about its centre: 3 cells past the edge.
+        let edge = crate::scene::octree::WORLD_LIMIT - 2;
+        for line in ["brush box 1 8 1".to_owned(), format!("place {edge} 4 0"), format!("select {edge} 0 0 {edge} 7 0")]
+        {
+            run(&mut editor, &line).unwrap();
+        }
+        let column = |e: &Editor| (0..8).filter(|&y| e.scene.tree.get(IVec3::new(edge, y, 0)) != 0).count();
+        let before = (column(&editor), editor.scene.tree.solid_voxels(), editor.selection, editor.history.steps());
+        assert_eq!(before.0, 8);
+        let err = run(&mut editor, "rotate z").unwrap_err().to_string();
+        assert!(err.contains("outside the world"), "{err}");
+        assert_eq!(
+            (column(&editor), editor.scene.tree.solid_voxels(), editor.selection, editor.history.steps()),
+            before
+        );
     }
 
     #[test]

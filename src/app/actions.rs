@@ -32,6 +32,10 @@ const fn ctrl_shift(label: &'static str, key: KeyCode, menu: Option<&'static str
     Action { label, key, ctrl: true, shift: true, menu, command }
 }
 
+const fn turn(label: &'static str, code: KeyCode, axis: usize, flip: bool) -> Action {
+    Action { label, key: code, ctrl: false, shift: flip, menu: EDIT, command: Command::Turn { axis, flip } }
+}
+
 const fn nudge(label: &'static str, code: KeyCode, direction: Nudge) -> Action {
     key(label, code, None, Command::Nudge(direction))
 }
@@ -47,7 +51,7 @@ const fn object(label: &'static str, code: KeyCode, shift: bool, line: ObjectLin
 }
 
 /// Every keyboard action, in menu order.
-pub static ACTIONS: [Action; 33] = [
+pub static ACTIONS: [Action; 39] = [
     ctrl("New", KeyCode::KeyN, FILE, Command::New),
     ctrl("Open…", KeyCode::KeyO, FILE, Command::AskOpen),
     ctrl("Save", KeyCode::KeyS, FILE, Command::Save),
@@ -63,6 +67,12 @@ pub static ACTIONS: [Action; 33] = [
     ctrl("Paste on the face under the cursor", KeyCode::KeyV, EDIT, Command::PasteAtCursor),
     key("Delete selection", KeyCode::Delete, EDIT, Command::DeleteSelection),
     key("Select none", KeyCode::Escape, EDIT, Command::SelectNone),
+    turn("Turn selection about x", KeyCode::KeyX, 0, false),
+    turn("Turn selection about y", KeyCode::KeyY, 1, false),
+    turn("Turn selection about z", KeyCode::KeyZ, 2, false),
+    turn("Flip selection along x", KeyCode::KeyX, 0, true),
+    turn("Flip selection along y", KeyCode::KeyY, 1, true),
+    turn("Flip selection along z", KeyCode::KeyZ, 2, true),
     key("Attach tool", KeyCode::KeyT, TOOLS, Command::SetTool(Tool::Attach)),
     key("Erase tool", KeyCode::KeyR, TOOLS, Command::SetTool(Tool::Erase)),
     key("Paint tool", KeyCode::KeyG, TOOLS, Command::SetTool(Tool::Paint)),

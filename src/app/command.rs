@@ -105,6 +105,12 @@ pub enum Command {
     /// `move` the selection one voxel along the world axis nearest to a
     /// direction on screen (arrow keys, Page Up / Page Down).
     Nudge(Nudge),
+    /// `rotate` (a quarter turn about world axis `axis`) or `flip` (a
+    /// mirror image along it) of the selection.
+    Turn {
+        axis: usize,
+        flip: bool,
+    },
     /// Set the quality knobs to preset `PRESETS[i]`.
     ApplyPreset(usize),
     /// Measure what each preset costs and how far it is from the reference.

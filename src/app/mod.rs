@@ -311,6 +311,12 @@ impl App {
             Command::DeleteSelection if !busy_loading => self.act(octovox::script::Command::Delete, "delete"),
             Command::PasteAtCursor if !busy_loading => self.paste_at_cursor(),
             Command::Nudge(nudge) if !busy_loading => self.nudge(nudge),
+            Command::Turn { axis, flip: false } if !busy_loading => {
+                self.act(octovox::script::Command::Rotate(axis), "rotate")
+            }
+            Command::Turn { axis, flip: true } if !busy_loading => {
+                self.act(octovox::script::Command::Flip(axis), "flip")
+            }
             Command::Undo if !busy_loading => self.undo_redo(true),
             Command::Redo if !busy_loading => self.undo_redo(false),
             Command::PointerEdit { .. }
@@ -318,6 +324,7 @@ impl App {
             | Command::DeleteSelection
             | Command::PasteAtCursor
             | Command::Nudge(_)
+            | Command::Turn { .. }
             | Command::ExtrudeDrag { .. }
             | Command::EditPalette { .. }
             | Command::Undo

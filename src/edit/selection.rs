@@ -7,6 +7,7 @@ use glam::IVec3;
 
 use crate::edit::Edit;
 use crate::scene::shape::MAX_BRUSH_EXTENT;
+use crate::scene::transform::CellMap;
 use crate::scene::{EditError, Octree, Op, Shape};
 
 /// Most voxels one copy holds (16 Mi).
@@ -49,6 +50,28 @@ impl Region {
         Region { min: self.min + by, max: self.max + by }
     }
 
+    /// The box turned a quarter about `axis` (`flip`: mirrored along it)
+    /// about its centre, and the map from cells of this box (relative to
+    /// its min corner) to cells of the new one. A turned box whose two
+    /// sizes differ by an odd count cannot keep its centre exactly: it
+    /// moves half a cell away from it, and turning back returns it.
+    pub fn turned(&self, axis: usize, flip: bool) -> (Region, CellMap) {
+        let size = self.size();
+        let (map, new_size) = if flip {
+            (CellMap::flip_in(axis, size), size)
+        } else {
+            let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
+            let mut turned = size;
+            (turned[a], turned[b]) = (size[b], size[a]);
+            (CellMap::quarter_turn_in(axis, size), turned)
+        };
+        // Half the size change, rounded away from zero: a turn and the turn
+        // back shift the box by opposite amounts.
+        let d = size - new_size;
+        let min = self.min + (d + d.signum()) / 2;
+        (Region { min, max: min + new_size - IVec3::ONE }, map)
+    }
+
     /// The box as it may be placed: inside the world's limits.
     ///
     /// # Errors
@@ -67,11 +90,12 @@ impl Region {
     }
 }
 
-/// `len` voxels of one colour from `start` along +x.
+/// An inclusive box of voxels of one colour: a run along x as copied, a
+/// run along another axis once turned.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Run {
-    start: IVec3,
-    len: i32,
+    min: IVec3,
+    max: IVec3,
     color: u8,
 }
 
@@ -100,12 +124,25 @@ impl Block {
     pub fn place_edits(&self, at: IVec3) -> Vec<Edit> {
         self.runs
             .iter()
-            .map(|run| {
-                let min = at + run.start;
-                let max = min + IVec3::new(run.len - 1, 0, 0);
-                Edit::Brush { shape: Shape::Box { min, max }, op: Op::Place(run.color) }
+            .map(|run| Edit::Brush {
+                shape: Shape::Box { min: at + run.min, max: at + run.max },
+                op: Op::Place(run.color),
             })
             .collect()
+    }
+
+    /// The block with its cells taken through `map` (a turn or a mirror
+    /// image of its box, [`Region::turned`]), whose box is `size`.
+    pub fn mapped(&self, map: &CellMap, size: IVec3) -> Block {
+        let runs = self
+            .runs
+            .iter()
+            .map(|run| {
+                let (min, max) = map.apply_box(run.min, run.max);
+                Run { min, max, color: run.color }
+            })
+            .collect();
+        Block { size, runs, voxels: self.voxels }
     }
 }
 
@@ -141,19 +178,19 @@ pub fn copy(tree: &Octree, region: Region) -> Result<Block, EditError> {
         .flat_map(|(lo, hi, color)| {
             (lo.z..=hi.z).flat_map(move |z| {
                 (lo.y..=hi.y).map(move |y| Run {
-                    start: IVec3::new(lo.x, y, z) - region.min,
-                    len: hi.x - lo.x + 1,
+                    min: IVec3::new(lo.x, y, z) - region.min,
+                    max: IVec3::new(hi.x, y, z) - region.min,
                     color,
                 })
             })
         })
         .collect();
-    runs.sort_unstable_by_key(|r| (r.start.z, r.start.y, r.start.x));
+    runs.sort_unstable_by_key(|r| (r.min.z, r.min.y, r.min.x));
     // Neighbouring cells of one colour on a row become one run.
     runs.dedup_by(|next, run| {
-        let joins = next.start == run.start + IVec3::new(run.len, 0, 0) && next.color == run.color;
+        let joins = next.min == run.max + IVec3::X && next.color == run.color;
         if joins {
-            run.len += next.len;
+            run.max = next.max;
         }
         joins
     });

@@ -11,7 +11,7 @@ use crate::camera::Camera;
 use crate::edit::brush::{Brush, Tool};
 use crate::edit::mirror::Mirror;
 use crate::editor::Tools;
-use crate::script::{Command, edit_command};
+use crate::script::{Command, ObjectLine, edit_command};
 
 /// Writes script lines as the user works. Lines are flushed as they are
 /// written, so a crash loses nothing that was recorded.
@@ -147,12 +147,38 @@ impl Recorder {
             | Command::Delete
             | Command::Paste(_)
             | Command::Move(_)
+            | Command::Rotate(_)
+            | Command::Flip(_)
             | Command::Rgb(..)
-            | Command::Material(..) => None,
+            | Command::Material(..)
+            | Command::Layer(..) => None,
+            // Picking an object is tool state every later edit depends on.
+            Command::Object(ObjectLine::Pick(_)) => return self.command(command),
+            Command::Object(_) => None,
             Command::Select(_) | Command::Copy => return self.command(command),
             Command::Undo(n) => return (0..*n).try_for_each(|_| self.undo()),
             Command::Redo(n) => return (0..*n).try_for_each(|_| self.redo()),
-            _ => return Ok(()),
+            // Tool state is written before the edit that uses it; scene,
+            // camera, file and expectation lines are not part of a recording.
+            Command::Load(_)
+            | Command::New
+            | Command::Demo(_)
+            | Command::Camera { .. }
+            | Command::Viewport(..)
+            | Command::Brush(_)
+            | Command::Color(_)
+            | Command::Mirror(_)
+            | Command::Pick(_)
+            | Command::Click { .. }
+            | Command::Save(_)
+            | Command::Render(_)
+            | Command::ExpectVoxel(..)
+            | Command::ExpectCount(_)
+            | Command::ExpectWritten(_)
+            | Command::ExpectImage(..)
+            | Command::ExpectEffects(_)
+            | Command::ExpectObjects(_)
+            | Command::ExpectModels(_) => return Ok(()),
         };
         if !in_stroke {
             self.end_step();
@@ -262,6 +288,24 @@ mod tests {
     #![allow(clippy::unwrap_used)] // in tests a panic is the failure report
 
     use super::*;
+
+    /// Issue 26: `object` and `layer` lines were not recorded, so a kill
+    /// after Ctrl+H (or any object change) lost it at recovery.
+    #[test]
+    fn object_and_layer_lines_are_recorded_in_order() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("r.ovr");
+        let mut recorder = Recorder::create(&path).unwrap();
+        let text = ["object 2", "object hide", "layer 1 hide", "object move 1 0 0", "rotate y", "flip x"];
+        let script = crate::script::parse_script(&path, &text.join("\n")).unwrap();
+        for line in &script.lines {
+            recorder.ran(&line.command, &Tools::default(), &Camera::default(), false).unwrap();
+        }
+        drop(recorder);
+        let written = std::fs::read_to_string(&path).unwrap();
+        let kept: Vec<&str> = written.lines().filter(|l| text.contains(l)).collect();
+        assert_eq!(kept, text, "{written}");
+    }
 
     /// Issue 24, item 6: a journal whose first line could not be written
     /// (a full disk) was left behind empty. `/dev/full` is such a disk.

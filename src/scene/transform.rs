@@ -174,6 +174,28 @@ pub struct CellMap {
 impl CellMap {
     pub const IDENTITY: CellMap = CellMap { axis: [0, 1, 2], sign: [1, 1, 1], offset: IVec3::ZERO };
 
+    /// The quarter turn counter-clockwise seen from the positive end of
+    /// `axis` (0, 1, 2 = x, y, z) that takes the box of cells `0..size` onto
+    /// the box `0..size'` of the turned size (the other two sizes swapped).
+    pub fn quarter_turn_in(axis: usize, size: IVec3) -> CellMap {
+        let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
+        // a → b and b → −a, then back into the box.
+        let mut map = CellMap::IDENTITY;
+        map.axis[b] = a;
+        map.axis[a] = b;
+        map.sign[a] = -1;
+        map.offset[a] = size[b] - 1;
+        map
+    }
+
+    /// The mirror image along `axis` that takes the box of cells `0..size` onto itself.
+    pub fn flip_in(axis: usize, size: IVec3) -> CellMap {
+        let mut map = CellMap::IDENTITY;
+        map.sign[axis] = -1;
+        map.offset[axis] = size[axis] - 1;
+        map
+    }
+
     /// The world cell of model cell `v`.
     pub fn apply(&self, v: IVec3) -> IVec3 {
         IVec3::from_array([0, 1, 2].map(|i| self.sign[i].wrapping_mul(v[self.axis[i]]).wrapping_add(self.offset[i])))

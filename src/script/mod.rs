@@ -84,6 +84,13 @@ pub enum Command {
     /// `move DX DY DZ`: the selected voxels move by (DX, DY, DZ), and the
     /// selection with them (one undo step).
     Move(IVec3),
+    /// `rotate x|y|z`: the selected voxels turn a quarter counter-clockwise
+    /// seen from the positive axis, about the selected box's centre; the
+    /// selection becomes the turned box (one undo step).
+    Rotate(usize),
+    /// `flip x|y|z`: the selected voxels are mirrored along the axis within
+    /// their box (one undo step).
+    Flip(usize),
     /// `object N|NAME`: pick the object later edits go to (by index in
     /// walk order from 0, or by name or `group/name` path); the other
     /// `object` lines change the picked one (each an undoable edit).

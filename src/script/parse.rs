@@ -200,6 +200,17 @@ impl Cursor {
         Ok(IVec3::from(p))
     }
 
+    /// `x`, `y` or `z`, as 0, 1 or 2.
+    fn axis(&mut self) -> Result<usize, Fail> {
+        let axis = self.word("x, y or z")?;
+        match axis.text.as_str() {
+            "x" => Ok(0),
+            "y" => Ok(1),
+            "z" => Ok(2),
+            other => Err((axis.column, format!("expected x, y or z, found '{other}'"))),
+        }
+    }
+
     fn path(&mut self) -> Result<PathBuf, Fail> {
         let token = self.word("a path")?;
         if token.text.is_empty() {
@@ -329,6 +340,8 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
         "delete" => Command::Delete,
         "paste" => Command::Paste(c.position()?),
         "move" => Command::Move(c.position()?),
+        "rotate" => Command::Rotate(c.axis()?),
+        "flip" => Command::Flip(c.axis()?),
         "mirror" => {
             let axis = c.word("x, y, z or off")?;
             match axis.text.as_str() {
@@ -394,15 +407,7 @@ fn parse_object(c: &mut Cursor) -> Result<ObjectLine, Fail> {
         "show" => ObjectLine::Hide(false),
         "new" => ObjectLine::New(c.word("a name")?.text),
         "move" => ObjectLine::Move(c.position()?),
-        "rotate" => {
-            let axis = c.word("x, y or z")?;
-            ObjectLine::Rotate(match axis.text.as_str() {
-                "x" => 0,
-                "y" => 1,
-                "z" => 2,
-                other => return Err((axis.column, format!("expected x, y or z, found '{other}'"))),
-            })
-        }
+        "rotate" => ObjectLine::Rotate(c.axis()?),
         "duplicate" => ObjectLine::Duplicate { reference: c.take("reference") },
         "unique" => ObjectLine::Unique,
         "delete" => ObjectLine::Delete,
@@ -584,7 +589,7 @@ mod tests {
                     color 7\nplace -1 2 3\nremove 1 2 3\npaint 1 2 -3\nclick 3 4 erase\nundo 2\nredo 1\nsave b.vox\n\
                     render c.png\nexpect voxel 1 2 3 0\nexpect count 5\nexpect written <= 512\nexpect image c.png 0.01\n\
                     demo showroom\nexpect effects sun glass\nexpect effects none\nrgb 4 1 2 3\nselect 1 2 3 -4 5 6\nselect off\ncopy\ncut\ndelete\n\
-                    paste 1 -2 3\nmove 0 0 -1\n\
+                    paste 1 -2 3\nmove 0 0 -1\nrotate y\nflip z\n\
                     material 4 glass _ri 1.45 _trans 0.5\nmaterial 5 diffuse\npick 1 -2 3\nfill 0 0 -1\nmirror x 4.5\nmirror z -2\nmirror off\nline 1 2 3 -4 5 6\n\
                     extrude 1 2 3 0 -1 0 -2\nobject 3\nobject \"tree 4/top\"\nobject hide\nobject show\nlayer 2 hide\n\
                     layer 0 show\nexpect objects 19\nexpect models 15\nobject new \"a b\"\nobject move 1 -2 3\nobject rotate z\n\
@@ -597,7 +602,7 @@ mod tests {
             script.lines.iter().map(|l| &l.command).collect::<Vec<_>>(),
             again.lines.iter().map(|l| &l.command).collect::<Vec<_>>()
         );
-        assert_eq!(script.lines.len(), 59);
+        assert_eq!(script.lines.len(), 61);
     }
 
     #[test]

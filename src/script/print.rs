@@ -59,6 +59,8 @@ impl fmt::Display for Command {
             Command::Delete => write!(f, "delete"),
             Command::Paste(p) => write!(f, "paste {}", v(*p)),
             Command::Move(d) => write!(f, "move {}", v(*d)),
+            Command::Rotate(axis) => write!(f, "rotate {}", ["x", "y", "z"][*axis]),
+            Command::Flip(axis) => write!(f, "flip {}", ["x", "y", "z"][*axis]),
             Command::ExpectEffects(names) if names.is_empty() => write!(f, "expect effects none"),
             Command::ExpectEffects(names) => write!(f, "expect effects {}", names.join(" ")),
             Command::Object(ObjectLine::Pick(ObjectRef::Index(n))) => write!(f, "object {n}"),
