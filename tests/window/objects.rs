@@ -122,9 +122,9 @@ fn ctrl_h_hides_the_picked_object_and_the_file_keeps_it() {
     assert_eq!(attributes.get("_hidden"), None, "one Ctrl+Z shows it again");
 }
 
-/// A click on an object, then a kill: `octovox recover` puts the edit in
-/// that object's model (the journal starts with the object the click
-/// picked), read back with `dot_vox`.
+/// A click on an object and Ctrl+H, then a kill: `octovox recover` puts
+/// the edit in that object's model (the journal starts with the object the
+/// click picked) and keeps the object hidden, read back with `dot_vox`.
 #[test]
 fn object_edits_survive_a_kill() {
     let (dir, file, scene) = groups_document();
@@ -142,6 +142,9 @@ fn object_edits_survive_a_kill() {
     lines.wait_for("octovox: ready", Duration::from_secs(90));
     xdotool(&display, &["windowfocus", "--sync", &window]);
     click(&display, &window, &mut lines, x, y);
+    // Before object lines were journaled, this hide was lost at recovery.
+    xdotool(&display, &["key", "ctrl+h"]);
+    lines.wait_for("object:", Duration::from_secs(30));
     app.0.kill().unwrap();
     app.0.wait().unwrap();
 
@@ -154,4 +157,8 @@ fn object_edits_survive_a_kill() {
     let mut expected = before;
     expected[model] += 1;
     assert_eq!(model_sizes(&recovered), expected, "the attached voxel is in model {model}");
+    let data = dot_vox::load_bytes(&std::fs::read(&recovered).unwrap()).unwrap();
+    let node = objects.list()[owner].transform_node.unwrap() as usize;
+    let dot_vox::SceneNode::Transform { attributes, .. } = &data.scenes[node] else { panic!("node {node}") };
+    assert_eq!(attributes.get("_hidden").map(String::as_str), Some("1"), "the Ctrl+H before the kill is kept");
 }
