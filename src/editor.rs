@@ -12,7 +12,7 @@ use crate::edit::selection::{self, Block, Region};
 use crate::edit::{Edit, History};
 use crate::scene::objects::Objects;
 use crate::scene::{EditError, Op, Palette, Scene};
-use crate::script::{Command, LayerLine, ObjectLine, ObjectRef};
+use crate::script::{Command, LayerLine, ObjectLine, ObjectRef, PaletteLine};
 use crate::settings::PathSettings;
 
 /// Why a line could not run. A refused line changes nothing.
@@ -139,6 +139,23 @@ impl Editor {
                 Some(edit) => self.commit(vec![edit])?,
                 None => false,
             },
+            Command::Palette(PaletteLine::Set { first, colors }) => {
+                self.commit(palette_colors(&self.scene.palette, *first, colors))?
+            }
+            Command::Palette(PaletteLine::Preset(name)) => {
+                let colors = crate::io::palette_file::preset(name)
+                    .ok_or_else(|| EditorError::Object(format!("there is no palette preset '{name}'")))?;
+                self.commit(palette_colors(&self.scene.palette, 1, &colors))?
+            }
+            Command::ExpectPalette(index, want) => {
+                let [r, g, b, _] = self.scene.palette.color(*index);
+                let got = format!("{r} {g} {b}");
+                return Ok(checked(
+                    [r, g, b] == *want,
+                    format!("palette {index} = {} {} {}", want[0], want[1], want[2]),
+                    got,
+                ));
+            }
             Command::Undo(n) => self.repeat(*n, true)?,
             Command::Redo(n) => self.repeat(*n, false)?,
             Command::Select(None) => self.set(|e| e.selection = None),
@@ -198,6 +215,7 @@ impl Editor {
                 return Ok(checked(got == *want, format!("{want} models"), got));
             }
             Command::Load(_)
+            | Command::Palette(PaletteLine::Load(_) | PaletteLine::Save(_))
             | Command::Camera { .. }
             | Command::Viewport(..)
             | Command::Click { .. }
@@ -442,6 +460,17 @@ fn palette_edit(command: &Command, palette: &Palette) -> Option<Edit> {
         _ => return None,
     };
     Some(Edit::Palette { index, color, material: Box::new(material) })
+}
+
+/// The edits that give palette entries `first..` the colours `colors`
+/// (opaque), each keeping its material; entries already so make none.
+fn palette_colors(palette: &Palette, first: u8, colors: &[[u8; 3]]) -> Vec<Edit> {
+    (first..=255)
+        .zip(colors)
+        .map(|(index, &[r, g, b])| (index, [r, g, b, 255]))
+        .filter(|&(index, color)| palette.color(index) != color)
+        .map(|(index, color)| Edit::Palette { index, color, material: Box::new(palette.material(index).clone()) })
+        .collect()
 }
 
 /// `pick X Y Z`: the colour of the voxel there, or why there is none.

@@ -91,8 +91,9 @@ pub enum Command {
     ToggleSelect,
     /// An `object` line on the picked object (the Object menu's keys).
     Object(octovox::script::ObjectLine),
-    /// Script lines a panel asks for, run in order (the Objects panel's
-    /// `object N` and `object hide`, the Layers panel's `layer N hide`).
+    /// Script lines a panel or dialog asks for, run in order (the Objects
+    /// panel's `object N` and `object hide`, the Layers panel's `layer N
+    /// hide`, the palette's `palette preset`, `load` and `save`).
     Lines(Vec<octovox::script::Command>),
     /// Edit ▸ Copy, Cut, Delete, Select none: the `copy`, `cut`, `delete`
     /// and `select off` lines.
@@ -144,6 +145,10 @@ pub enum Command {
     AskOpen,
     AskSaveAs,
     AskExport,
+    /// Ask for a palette file to load, or to save the palette to.
+    AskPalette {
+        save: bool,
+    },
     Screenshot,
     Quit,
     /// Answer to the unsaved-changes prompt.

@@ -9,8 +9,8 @@ use std::time::{Duration, Instant};
 
 use winit::event_loop::ActiveEventLoop;
 
+use super::App;
 use super::ui::DialogKind;
-use super::{App, Command};
 
 /// A dialog that answers faster than this never showed itself: nobody
 /// picks or cancels a file that fast.
@@ -50,21 +50,10 @@ fn dialog(kind: DialogKind, start: &Path) -> rfd::FileDialog {
         _ => PathBuf::from("."),
     };
     let folder = std::fs::canonicalize(&folder).unwrap_or(folder);
-    let dialog = rfd::FileDialog::new().set_directory(folder);
-    match kind {
-        DialogKind::Open => dialog
-            .set_title("Open")
-            .add_filter("Voxel scenes and meshes", &["vox", "ovx", "obj"])
-            .add_filter("All files", &["*"]),
-        DialogKind::SaveAs => dialog
-            .set_title("Save as")
-            .add_filter("MagicaVoxel .vox or octovox .ovx", &["vox", "ovx"])
-            .set_file_name(start.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned())),
-        DialogKind::Export => dialog
-            .set_title("Export a mesh")
-            .add_filter("Meshes", &["obj", "ply", "glb"])
-            .set_file_name(start.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned())),
-    }
+    let name = start.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+    let dialog = rfd::FileDialog::new().set_directory(folder).set_title(kind.title());
+    let dialog = dialog.add_filter(kind.extensions().join(", "), kind.extensions());
+    if kind.opens() { dialog.add_filter("All files", &["*"]) } else { dialog.set_file_name(name) }
 }
 
 impl App {
@@ -82,7 +71,7 @@ impl App {
         let from = PathBuf::from(&start);
         let spawned = std::thread::Builder::new().name("file dialog".into()).spawn(move || {
             let (d, opened) = (dialog(kind, &from), Instant::now());
-            let chosen = if kind == DialogKind::Open { d.pick_file() } else { d.save_file() };
+            let chosen = if kind.opens() { d.pick_file() } else { d.save_file() };
             let _ = tx.send((chosen, opened.elapsed()));
         });
         match spawned {
@@ -104,14 +93,7 @@ impl App {
         };
         let Some(open) = self.doc.file_dialog.take() else { return };
         match answer {
-            Some(path) => {
-                let command = match open.kind {
-                    DialogKind::Open => Command::Open(path),
-                    DialogKind::SaveAs => Command::SaveAs(path),
-                    DialogKind::Export => Command::Export(path),
-                };
-                self.execute(command, event_loop);
-            }
+            Some(path) => self.execute(open.kind.command(path), event_loop),
             None if took < NO_DIALOG_WITHIN => {
                 report!("file dialog: none showed; asking in the window");
                 self.ui.dialog = Some((open.kind, open.start));

@@ -350,7 +350,8 @@ impl App {
             Command::Object(line) => self.act(octovox::script::Command::Object(line), "object"),
             Command::Lines(lines) => {
                 for line in lines {
-                    self.act(line, "object");
+                    let text = line.to_string();
+                    self.act(line, text.split(' ').next().unwrap_or("line"));
                 }
             }
             Command::FillAt { x, y } => {
@@ -394,6 +395,10 @@ impl App {
             Command::AskExport => {
                 let start = self.state.path.as_ref().map_or("saves/untitled.obj".into(), |p| p.with_extension("obj"));
                 self.ask_path(DialogKind::Export, start.display().to_string());
+            }
+            Command::AskPalette { save } => {
+                let kind = if save { DialogKind::SavePalette } else { DialogKind::LoadPalette };
+                self.ask_path(kind, if save { "saves/palette.png".into() } else { String::new() });
             }
             Command::Export(path) => self.export(&path),
             Command::Screenshot => self.frames.screenshot_requested = true,

@@ -127,6 +127,47 @@ pub enum DialogKind {
     Open,
     SaveAs,
     Export,
+    LoadPalette,
+    SavePalette,
+}
+
+impl DialogKind {
+    /// Whether it picks an existing file (rather than a name to write).
+    pub fn opens(self) -> bool {
+        matches!(self, DialogKind::Open | DialogKind::LoadPalette)
+    }
+
+    pub fn title(self) -> &'static str {
+        match self {
+            DialogKind::Open => "Open .vox, .ovx or .obj",
+            DialogKind::SaveAs => "Save as .vox or .ovx",
+            DialogKind::Export => "Export a mesh (.obj, .ply or .glb)",
+            DialogKind::LoadPalette => "Load a palette (.png, .hex or .gpl)",
+            DialogKind::SavePalette => "Save the palette as .png, .hex or .gpl",
+        }
+    }
+
+    /// The extensions it lists.
+    pub fn extensions(self) -> &'static [&'static str] {
+        match self {
+            DialogKind::Open => &["vox", "ovx", "obj"],
+            DialogKind::SaveAs => &["vox", "ovx"],
+            DialogKind::Export => &["obj", "ply", "glb"],
+            DialogKind::LoadPalette | DialogKind::SavePalette => &["png", "hex", "gpl"],
+        }
+    }
+
+    /// What the chosen path does.
+    pub fn command(self, path: PathBuf) -> Command {
+        use octovox::script::{Command as Line, PaletteLine};
+        match self {
+            DialogKind::Open => Command::Open(path),
+            DialogKind::SaveAs => Command::SaveAs(path),
+            DialogKind::Export => Command::Export(path),
+            DialogKind::LoadPalette => Command::Lines(vec![Line::Palette(PaletteLine::Load(path))]),
+            DialogKind::SavePalette => Command::Lines(vec![Line::Palette(PaletteLine::Save(path))]),
+        }
+    }
 }
 
 /// How long an info message (`saved …`, `copied 6 voxels`) stays.
@@ -205,7 +246,7 @@ pub fn show(
             tool_panel(ui, state, tools);
             mirror(ui, tools);
             ui.separator();
-            palette(ui, tools, info.palette);
+            palette(ui, tools, info.palette, &mut out);
             material_editor(ui, tools.color, info.palette, &mut out);
             ui.separator();
             if let Some(objects) = info.objects {
@@ -343,8 +384,24 @@ fn tool_panel(ui: &mut egui::Ui, state: &mut EditorState, tools: &mut Tools) {
     ui.small("left: apply · Ctrl+drag a face: extrude · right-drag: orbit · right-click: erase (Attach) · middle: pan · wheel: zoom · WASDQE + right: fly · F: frame");
 }
 
-fn palette(ui: &mut egui::Ui, tools: &mut Tools, palette: &Palette) {
-    ui.heading("Palette");
+fn palette(ui: &mut egui::Ui, tools: &mut Tools, palette: &Palette, out: &mut Vec<Command>) {
+    use octovox::script::{Command as Line, PaletteLine};
+    ui.horizontal(|ui| {
+        ui.heading("Palette");
+        egui::ComboBox::from_id_salt("palette presets").selected_text("Preset").show_ui(ui, |ui| {
+            for (name, _) in octovox::io::palette_file::PRESETS {
+                if ui.selectable_label(false, name).on_hover_text(format!("palette preset {name}")).clicked() {
+                    out.push(Command::Lines(vec![Line::Palette(PaletteLine::Preset(name.to_owned()))]));
+                }
+            }
+        });
+        if ui.button("Load…").on_hover_text("a MagicaVoxel .png, Lospec .hex or GIMP .gpl palette").clicked() {
+            out.push(Command::AskPalette { save: false });
+        }
+        if ui.button("Save…").on_hover_text("as .png (256×1), .hex or .gpl").clicked() {
+            out.push(Command::AskPalette { save: true });
+        }
+    });
     // One 16×16 block painted by hand: 256 widgets would be slow and loose.
     let cell = ((ui.available_width() - 4.0) / 16.0).floor().clamp(8.0, 16.0);
     let (rect, response) = ui.allocate_exact_size(Vec2::splat(cell * 16.0), Sense::click());
@@ -391,8 +448,6 @@ fn palette(ui: &mut egui::Ui, tools: &mut Tools, palette: &Palette) {
     }
 }
 
-/// The selected entry's colour, material kind and the parameters the path
-/// tracer reads; every change is an edit (undoable, saved in RGBA/MATL).
 /// Most rows the Objects panel lists (a scene may place 10⁵ objects).
 const MAX_OBJECT_ROWS: usize = 500;
 
@@ -442,6 +497,8 @@ fn objects_panel(ui: &mut egui::Ui, objects: &Objects, out: &mut Vec<Command>) {
         });
 }
 
+/// The selected entry's colour, material kind and the parameters the path
+/// tracer reads; every change is an edit (undoable, saved in RGBA/MATL).
 fn material_editor(ui: &mut egui::Ui, index: u8, palette: &Palette, out: &mut Vec<Command>) {
     let old_color = palette.color(index);
     let old = palette.material(index);
@@ -662,12 +719,8 @@ fn nearby_files(kind: DialogKind) -> Vec<PathBuf> {
         .filter_map(Result::ok)
         .map(|e| e.path())
         .filter(|p| {
-            let scene = p.extension().is_some_and(|e| e.eq_ignore_ascii_case("vox")) || octovox::io::is_ovx_path(p);
-            match kind {
-                DialogKind::Open => scene || octovox::io::is_mesh_path(p),
-                DialogKind::SaveAs => scene,
-                DialogKind::Export => octovox::io::export::MeshFormat::of(p).is_some(),
-            }
+            let extension = p.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+            kind.extensions().contains(&extension.as_str())
         })
         .collect();
     files.sort();
@@ -676,13 +729,8 @@ fn nearby_files(kind: DialogKind) -> Vec<PathBuf> {
 
 fn dialog(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
     let Some((kind, path)) = &mut ui_state.dialog else { return };
-    let title = match kind {
-        DialogKind::Open => "Open .vox, .ovx or .obj",
-        DialogKind::SaveAs => "Save as .vox or .ovx",
-        DialogKind::Export => "Export a mesh (.obj, .ply or .glb)",
-    };
     let mut close = false;
-    egui::Window::new(title).collapsible(false).resizable(false).show(ctx, |ui| {
+    egui::Window::new(kind.title()).collapsible(false).resizable(false).show(ctx, |ui| {
         ui.label("Path:");
         let field = ui.text_edit_singleline(path);
         let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
@@ -697,18 +745,13 @@ fn dialog(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
         }
         ui.horizontal(|ui| {
             let verb = match kind {
-                DialogKind::Open => "Open",
-                DialogKind::SaveAs => "Save",
+                DialogKind::Open | DialogKind::LoadPalette => "Open",
+                DialogKind::SaveAs | DialogKind::SavePalette => "Save",
                 DialogKind::Export => "Export",
             };
             let ok = ui.button(verb).clicked();
             if (ok || entered) && !path.trim().is_empty() {
-                let chosen = PathBuf::from(path.trim());
-                out.push(match kind {
-                    DialogKind::Open => Command::Open(chosen),
-                    DialogKind::SaveAs => Command::SaveAs(chosen),
-                    DialogKind::Export => Command::Export(chosen),
-                });
+                out.push(kind.command(PathBuf::from(path.trim())));
                 close = true;
             }
             if ui.button("Cancel").clicked() {

@@ -8,6 +8,7 @@ pub mod input;
 pub mod mesh;
 pub mod output;
 pub mod ovx;
+pub mod palette_file;
 pub mod png;
 pub mod progress;
 pub mod vox;

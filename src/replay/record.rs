@@ -11,7 +11,7 @@ use crate::camera::Camera;
 use crate::edit::brush::{Brush, Tool};
 use crate::edit::mirror::Mirror;
 use crate::editor::Tools;
-use crate::script::{Command, ObjectLine, edit_command};
+use crate::script::{Command, ObjectLine, PaletteLine, edit_command};
 
 /// Writes script lines as the user works. Lines are flushed as they are
 /// written, so a crash loses nothing that was recorded.
@@ -151,7 +151,8 @@ impl Recorder {
             | Command::Flip(_)
             | Command::Rgb(..)
             | Command::Material(..)
-            | Command::Layer(..) => None,
+            | Command::Layer(..)
+            | Command::Palette(PaletteLine::Set { .. } | PaletteLine::Preset(_)) => None,
             // Picking an object is tool state every later edit depends on.
             Command::Object(ObjectLine::Pick(_)) => return self.command(command),
             Command::Object(_) => None,
@@ -178,7 +179,10 @@ impl Recorder {
             | Command::ExpectImage(..)
             | Command::ExpectEffects(_)
             | Command::ExpectObjects(_)
-            | Command::ExpectModels(_) => return Ok(()),
+            | Command::ExpectModels(_)
+            | Command::ExpectPalette(..)
+            // A load runs as the `palette set` it became; a save is a file line.
+            | Command::Palette(PaletteLine::Load(_) | PaletteLine::Save(_)) => return Ok(()),
         };
         if !in_stroke {
             self.end_step();

@@ -15,7 +15,7 @@ use glam::{DVec3, IVec3};
 use crate::edit::selection::Region;
 use crate::editor::{Editor, EditorError, Outcome};
 use crate::io::png::{differing_fraction, load_png, save_png};
-use crate::script::{Command, edit_command};
+use crate::script::{Command, PaletteLine, edit_command};
 use crate::trace::svo;
 
 /// The size of renders (and of the pixels `click` names headless) before a
@@ -125,6 +125,8 @@ pub enum HostError {
     #[error(transparent)]
     Png(#[from] crate::io::png::PngError),
     #[error(transparent)]
+    Palette(#[from] crate::io::palette_file::PaletteFileError),
+    #[error(transparent)]
     Gpu(#[from] crate::gpu::GpuError),
     #[error("{reference} ({hint})")]
     Reference { reference: crate::io::png::PngError, hint: &'static str },
@@ -175,6 +177,16 @@ fn host_line(host: &mut impl Host, base: &Path, line: &Command) -> Result<StepRe
                 StepResult::Ran(ran) => StepResult::Ran(Ran { picked, ..ran }),
                 other => other,
             });
+        }
+        // The file's colours become the `palette set` line a recording or
+        // journal keeps (it needs no file at recovery).
+        Command::Palette(PaletteLine::Load(path)) => {
+            let mut colors = crate::io::palette_file::read_colors(&base.join(path)).map_err(HostError::from)?;
+            colors.truncate(255);
+            return step(host, base, &Command::Palette(PaletteLine::Set { first: 1, colors }));
+        }
+        Command::Palette(PaletteLine::Save(path)) => {
+            crate::io::palette_file::save(&host.editor().scene.palette, &base.join(path)).map_err(HostError::from)?;
         }
         Command::Save(path) => host.save(&base.join(path))?,
         Command::Render(path) => host.render(&base.join(path))?,

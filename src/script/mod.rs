@@ -97,6 +97,11 @@ pub enum Command {
     Object(ObjectLine),
     /// `layer N NAME`, `layer N hide|show` (an undoable edit).
     Layer(u32, LayerLine),
+    /// `palette load PATH`, `palette save PATH`, `palette set INDEX HEX…`,
+    /// `palette preset NAME`.
+    Palette(PaletteLine),
+    /// `expect palette INDEX R G B`: the entry's colour.
+    ExpectPalette(u8, [u8; 3]),
     /// `expect objects N`: the scene places N objects.
     ExpectObjects(usize),
     /// `expect models N`: the scene stores N models (each once).
@@ -126,6 +131,20 @@ pub enum ObjectLine {
     Rename(String),
     /// `object layer N`.
     Layer(u32),
+}
+
+/// What a `palette` line does.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum PaletteLine {
+    /// `palette load PATH`: a .png, .hex or .gpl file's colours from index 1
+    /// on (one undo step; a recording writes the `palette set` it became).
+    Load(PathBuf),
+    /// `palette save PATH`: the 255 colours as .png (256×1), .hex or .gpl.
+    Save(PathBuf),
+    /// `palette set INDEX RRGGBB…`: colours from entry INDEX on (one undo step).
+    Set { first: u8, colors: Vec<[u8; 3]> },
+    /// `palette preset NAME`: a built-in palette (one undo step).
+    Preset(String),
 }
 
 /// What a `layer N …` line does.

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{DVec3, IVec3};
 
-use super::{Command, LayerLine, Line, ObjectLine, ObjectRef, Script};
+use super::{Command, LayerLine, Line, ObjectLine, ObjectRef, PaletteLine, Script};
 use crate::camera::{FOV_RANGE_DEG, check_fov};
 use crate::edit::brush::{Brush, Tool};
 use crate::scene::demo::BuiltIn;
@@ -200,6 +200,15 @@ impl Cursor {
         Ok(IVec3::from(p))
     }
 
+    /// Red, green and blue, each 0..=255.
+    fn rgb(&mut self) -> Result<[u8; 3], Fail> {
+        let mut rgb = [0u8; 3];
+        for (slot, what) in rgb.iter_mut().zip(["red", "green", "blue"]) {
+            *slot = self.int_in(what, 0..=255)? as u8;
+        }
+        Ok(rgb)
+    }
+
     /// `x`, `y` or `z`, as 0, 1 or 2.
     fn axis(&mut self) -> Result<usize, Fail> {
         let axis = self.word("x, y or z")?;
@@ -309,12 +318,9 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
         "color" => Command::Color(c.int_in("palette index", 1..=255)? as u8),
         "rgb" => {
             let index = c.int_in("palette index", 1..=255)? as u8;
-            let mut rgb = [0u8; 3];
-            for (slot, what) in rgb.iter_mut().zip(["red", "green", "blue"]) {
-                *slot = c.int_in(what, 0..=255)? as u8;
-            }
-            Command::Rgb(index, rgb)
+            Command::Rgb(index, c.rgb()?)
         }
+        "palette" => Command::Palette(parse_palette(c)?),
         "material" => parse_material(c)?,
         "place" => Command::Place(c.position()?),
         "remove" => Command::Remove(c.position()?),
@@ -421,6 +427,41 @@ fn parse_object(c: &mut Cursor) -> Result<ObjectLine, Fail> {
     })
 }
 
+/// `palette load PATH`, `palette save PATH`, `palette set INDEX RRGGBB…`
+/// (entries INDEX.. up to 255) or `palette preset NAME`.
+fn parse_palette(c: &mut Cursor) -> Result<PaletteLine, Fail> {
+    let what = c.word("load, save, set or preset")?;
+    Ok(match what.text.as_str() {
+        "load" => PaletteLine::Load(c.path()?),
+        "save" => PaletteLine::Save(c.path()?),
+        "set" => {
+            let first = c.int_in("palette index", 1..=255)? as u8;
+            let mut colors = Vec::new();
+            while let Some(word) = c.optional() {
+                if usize::from(first) + colors.len() > 255 {
+                    return Err((word.column, format!("colours past palette index 255 (from {first})")));
+                }
+                let color = crate::io::palette_file::parse_hex(&word.text)
+                    .ok_or((word.column, format!("expected a colour RRGGBB, found '{}'", word.text)))?;
+                colors.push(color);
+            }
+            if colors.is_empty() {
+                return Err((c.end_column, "expected at least one colour RRGGBB".to_owned()));
+            }
+            PaletteLine::Set { first, colors }
+        }
+        "preset" => {
+            let name = c.word("a preset name")?;
+            if crate::io::palette_file::preset(&name.text).is_none() {
+                let names: Vec<&str> = crate::io::palette_file::PRESETS.iter().map(|(n, _)| *n).collect();
+                return Err((name.column, format!("expected a preset ({}), found '{}'", names.join(", "), name.text)));
+            }
+            PaletteLine::Preset(name.text)
+        }
+        other => return Err((what.column, format!("expected load, save, set or preset, found '{other}'"))),
+    })
+}
+
 fn parse_brush(c: &mut Cursor) -> Result<Brush, Fail> {
     let kind = c.word("voxel, sphere or box")?;
     let extent = i64::from(MAX_BRUSH_EXTENT);
@@ -439,7 +480,7 @@ fn parse_brush(c: &mut Cursor) -> Result<Brush, Fail> {
 }
 
 fn parse_expect(c: &mut Cursor) -> Result<Command, Fail> {
-    let what = c.word("voxel, count, written, image, effects, objects or models")?;
+    let what = c.word("voxel, count, written, image, effects, palette, objects or models")?;
     Ok(match what.text.as_str() {
         "voxel" => {
             let p = c.position()?;
@@ -467,12 +508,16 @@ fn parse_expect(c: &mut Cursor) -> Result<Command, Fail> {
             Command::ExpectImage(path, tolerance)
         }
         "effects" => Command::ExpectEffects(parse_effect_names(c)?),
+        "palette" => {
+            let index = c.int_in("palette index", 1..=255)? as u8;
+            Command::ExpectPalette(index, c.rgb()?)
+        }
         "objects" => Command::ExpectObjects(c.number("an object count")?),
         "models" => Command::ExpectModels(c.number("a model count")?),
         other => {
             return Err((
                 what.column,
-                format!("expected voxel, count, written, image, effects, objects or models, found '{other}'"),
+                format!("expected voxel, count, written, image, effects, palette, objects or models, found '{other}'"),
             ));
         }
     })
@@ -589,7 +634,8 @@ mod tests {
                     color 7\nplace -1 2 3\nremove 1 2 3\npaint 1 2 -3\nclick 3 4 erase\nundo 2\nredo 1\nsave b.vox\n\
                     render c.png\nexpect voxel 1 2 3 0\nexpect count 5\nexpect written <= 512\nexpect image c.png 0.01\n\
                     demo showroom\nexpect effects sun glass\nexpect effects none\nrgb 4 1 2 3\nselect 1 2 3 -4 5 6\nselect off\ncopy\ncut\ndelete\n\
-                    paste 1 -2 3\nmove 0 0 -1\nrotate y\nflip z\n\
+                    paste 1 -2 3\nmove 0 0 -1\nrotate y\nflip z\npalette load \"my p.gpl\"\npalette save p.hex\n\
+                    palette set 3 ff0000 00Ff00\npalette preset pico8\nexpect palette 7 1 2 3\n\
                     material 4 glass _ri 1.45 _trans 0.5\nmaterial 5 diffuse\npick 1 -2 3\nfill 0 0 -1\nmirror x 4.5\nmirror z -2\nmirror off\nline 1 2 3 -4 5 6\n\
                     extrude 1 2 3 0 -1 0 -2\nobject 3\nobject \"tree 4/top\"\nobject hide\nobject show\nlayer 2 hide\n\
                     layer 0 show\nexpect objects 19\nexpect models 15\nobject new \"a b\"\nobject move 1 -2 3\nobject rotate z\n\
@@ -602,7 +648,7 @@ mod tests {
             script.lines.iter().map(|l| &l.command).collect::<Vec<_>>(),
             again.lines.iter().map(|l| &l.command).collect::<Vec<_>>()
         );
-        assert_eq!(script.lines.len(), 61);
+        assert_eq!(script.lines.len(), 66);
     }
 
     #[test]

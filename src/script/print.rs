@@ -5,7 +5,7 @@ use std::fmt;
 
 use glam::IVec3;
 
-use super::{Command, LayerLine, ObjectLine, ObjectRef};
+use super::{Command, LayerLine, ObjectLine, ObjectRef, PaletteLine};
 use crate::edit::brush::Brush;
 
 /// Writes a command back as a script line (what `--record` produces).
@@ -83,6 +83,14 @@ impl fmt::Display for Command {
             Command::Layer(id, LayerLine::Hide(true)) => write!(f, "layer {id} hide"),
             Command::Layer(id, LayerLine::Hide(false)) => write!(f, "layer {id} show"),
             Command::Layer(id, LayerLine::Name(name)) => write!(f, "layer {id} {}", quoted(std::path::Path::new(name))),
+            Command::Palette(PaletteLine::Load(path)) => write!(f, "palette load {}", quoted(path)),
+            Command::Palette(PaletteLine::Save(path)) => write!(f, "palette save {}", quoted(path)),
+            Command::Palette(PaletteLine::Set { first, colors }) => {
+                write!(f, "palette set {first}")?;
+                colors.iter().try_for_each(|[r, g, b]| write!(f, " {r:02x}{g:02x}{b:02x}"))
+            }
+            Command::Palette(PaletteLine::Preset(name)) => write!(f, "palette preset {name}"),
+            Command::ExpectPalette(index, [r, g, b]) => write!(f, "expect palette {index} {r} {g} {b}"),
             Command::ExpectObjects(n) => write!(f, "expect objects {n}"),
             Command::ExpectModels(n) => write!(f, "expect models {n}"),
         }

@@ -15,6 +15,7 @@ mod hostile_input;
 mod mesh_import;
 mod octree_props;
 mod ovx;
+mod palette_files;
 mod replay_cli;
 mod trace_cpu;
 mod trace_exact;
