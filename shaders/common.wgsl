@@ -30,6 +30,11 @@ struct FrameUniforms {
     // this many voxels wide per unit of t (the `--lod` pixels' footprint);
     // 0 = exact. See `Footprint` in src/trace/mod.rs.
     lod_per_t: f32,
+    // 1: an orthographic view, whose rays start across the image plane
+    // (`eye` its centre) and all run along `forward` (`RayBasis::ortho`).
+    ortho: u32,
+    // Level of detail of orthographic rays: the footprint at every t.
+    lod_at_start: f32,
 }
 
 // Read-only storage, not uniform: see `constants_entry` in src/gpu/trace_pass.rs.
@@ -93,10 +98,25 @@ fn make_ray(o: vec3<f32>, d_in: vec3<f32>) -> Ray {
     return Ray(o, d, vec3<f32>(1.0) / d);
 }
 
+// The ray through a point of the image given in pixels (pixel (x, y) spans
+// x..x + 1, y..y + 1); twin of `RayBasis::ray_through`.
+fn image_ray(p: vec2<f32>) -> Ray {
+    let ndc_x = 2.0 * p.x / f32(u.width) - 1.0;
+    let ndc_y = 1.0 - 2.0 * p.y / f32(u.height);
+    let offset = u.right * ndc_x + u.up * ndc_y;
+    if (u.ortho != 0u) {
+        return make_ray(u.eye + offset, u.forward);
+    }
+    return make_ray(u.eye, u.forward + offset);
+}
+
 fn pixel_ray(px: vec2<u32>) -> Ray {
-    let ndc_x = 2.0 * (f32(px.x) + 0.5) / f32(u.width) - 1.0;
-    let ndc_y = 1.0 - 2.0 * (f32(px.y) + 0.5) / f32(u.height);
-    return make_ray(u.eye, u.forward + u.right * ndc_x + u.up * ndc_y);
+    return image_ray(vec2<f32>(px) + vec2<f32>(0.5));
+}
+
+// The level-of-detail footprint of camera rays (`Footprint::of_pixels`).
+fn camera_footprint() -> vec2<f32> {
+    return vec2<f32>(u.lod_at_start, u.lod_per_t);
 }
 
 fn plane_t(r: Ray, axis: u32, coord: f32) -> f32 {

@@ -490,9 +490,7 @@ fn path(@builtin(global_invocation_id) gid: vec3<u32>) {
     rng_init(pixel, pu.sample_index);
     let jx = rng_next();
     let jy = rng_next();
-    let ndc_x = 2.0 * (f32(px.x) + jx) / f32(u.width) - 1.0;
-    let ndc_y = 1.0 - 2.0 * (f32(px.y) + jy) / f32(u.height);
-    let r = make_ray(u.eye, u.forward + u.right * ndc_x + u.up * ndc_y);
+    let r = image_ray(vec2<f32>(px) + vec2<f32>(jx, jy));
     let sample = clamp_sample(radiance(r));
     let sum = select(accum[pixel].rgb, vec3<f32>(0.0), pu.sample_index == 0u) + sample;
     accum[pixel] = vec4<f32>(sum, f32(pu.sample_index + 1u));

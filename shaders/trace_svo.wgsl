@@ -232,6 +232,11 @@ fn beam_search(tile: vec2<u32>) -> f32 {
     let n3 = inward(cross(c01, c00), center);
     var best = BEAM_NONE;
     let depth = u.depth;
+    // An orthographic view's rays are parallel (no pyramid about the eye):
+    // every tile is traced from its rays' origins.
+    if (u.ortho != 0u) {
+        return select(0.0, BEAM_NONE, u.root == 0u);
+    }
     if ((u.root & POINTER_BIT) == 0u || depth <= BEAM_LEVEL) {
         // Too small to search: start every ray at the eye.
         return select(0.0, BEAM_NONE, u.root == 0u);
@@ -379,13 +384,14 @@ fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_id) lid
     let r = pixel_ray(px);
     let distance = beam_distance[pixel.z];
     let t_start = max(distance - 1.0, 0.0) / length(r.d);
-    let hit = trace_svo(r, t_start, 0u, vec2<f32>(0.0, u.lod_per_t));
+    let hit = trace_svo(r, t_start, 0u, camera_footprint());
     var in_shadow = false;
     if (SHADOWS && u.view == VIEW_SHADED && hit.value != 0u && hit.normal_code != 0u) {
         // The shadow ray keeps the footprint the camera ray had at the hit
         // voxel's depth (`hit_depth` in src/trace/render.rs).
         let depth = dot(vec3<f32>(hit.voxel) + vec3<f32>(0.5) - u.eye, u.forward);
-        in_shadow = trace_svo(shadow_ray(hit), 0.0, 0u, vec2<f32>(u.lod_per_t * depth, 0.0)).value != 0u;
+        let footprint = u.lod_at_start + u.lod_per_t * depth;
+        in_shadow = trace_svo(shadow_ray(hit), 0.0, 0u, vec2<f32>(footprint, 0.0)).value != 0u;
     }
     write_pixel(px, hit, r.d, in_shadow);
 }

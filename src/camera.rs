@@ -1,5 +1,5 @@
-//! A pinhole camera and the per-pixel ray basis that the CPU tracers and the
-//! GPU shaders share.
+//! A camera, pinhole or orthographic, and the per-pixel ray basis that the
+//! CPU tracers and the GPU shaders share.
 
 use glam::{DVec3, IVec3, Vec3};
 
@@ -27,6 +27,8 @@ pub enum CameraError {
     SamePoint,
     #[error("field of view {0} must be {lo}..={hi} degrees", lo = FOV_RANGE_DEG.start(), hi = FOV_RANGE_DEG.end())]
     Fov(f32),
+    #[error("orthographic height {0} must be {lo}..={hi} voxels", lo = ORTHO_RANGE.start(), hi = ORTHO_RANGE.end())]
+    Ortho(f32),
 }
 
 /// Checks a camera given by the user: eye and target finite, within
@@ -51,17 +53,37 @@ pub fn check_fov(fov: f32) -> Result<f32, CameraError> {
     if FOV_RANGE_DEG.contains(&fov) { Ok(fov) } else { Err(CameraError::Fov(fov)) }
 }
 
-/// Eye, target and vertical field of view, in world coordinates (y up).
+/// The world heights an orthographic view may show (voxels).
+pub const ORTHO_RANGE: std::ops::RangeInclusive<f32> = 0.5..=65536.0;
+
+/// How far behind the target the rays of an orthographic view start
+/// (voxels), whatever the eye's distance: so two views from one direction
+/// at different distances are the same picture, and what lies behind the
+/// eye is seen as MagicaVoxel's and Goxel's orthographic views show it. At
+/// 4096 the f32 ray origins keep 1/2048 of a voxel.
+pub const ORTHO_DEPTH: f64 = 4096.0;
+
+/// Checks an orthographic view height given by the user.
+pub fn check_ortho(height: f32) -> Result<f32, CameraError> {
+    if ORTHO_RANGE.contains(&height) { Ok(height) } else { Err(CameraError::Ortho(height)) }
+}
+
+/// Eye, target and projection, in world coordinates (y up).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
     pub eye: DVec3,
     pub target: DVec3,
+    /// The vertical field of view of the perspective projection.
     pub fov_y_deg: f32,
+    /// `Some(height)`: an orthographic projection showing `height` world
+    /// voxels from the bottom of the image to the top, looking from the eye
+    /// to the target; `None`: perspective.
+    pub ortho: Option<f32>,
 }
 
 impl Default for Camera {
     fn default() -> Camera {
-        Camera { eye: DVec3::new(40.0, 30.0, 50.0), target: DVec3::ZERO, fov_y_deg: 50.0 }
+        Camera { eye: DVec3::new(40.0, 30.0, 50.0), target: DVec3::ZERO, fov_y_deg: 50.0, ortho: None }
     }
 }
 
@@ -78,25 +100,52 @@ impl Camera {
         // a little closer crops its empty rim. Never inside the sphere.
         let distance = (radius / half_fov.sin() * 0.85).max(radius * 1.1);
         let dir = DVec3::new(0.55, 0.45, 0.7).normalize();
-        Camera { eye: center + dir * distance, target: center, fov_y_deg }
+        Camera { eye: center + dir * distance, target: center, fov_y_deg, ortho: None }
+    }
+
+    /// The world height the view shows at the target: the orthographic
+    /// height, or what the field of view spans at the target's distance
+    /// (what a switch between the two keeps).
+    pub fn view_height(&self) -> f64 {
+        match self.ortho {
+            Some(height) => f64::from(height),
+            None => {
+                let half_fov = f64::from(clamp_fov(self.fov_y_deg)).to_radians() * 0.5;
+                2.0 * (self.target - self.eye).length() * half_fov.tan()
+            }
+        }
+    }
+
+    /// The view's forward, right and up unit vectors. Up is world y, except
+    /// looking straight down (or up), where it is −z (+z): a top view has x
+    /// to the right and the front (+z) at the bottom, as the front view has
+    /// x to the right.
+    pub fn axes(&self) -> (DVec3, DVec3, DVec3) {
+        let forward = (self.target - self.eye).try_normalize().unwrap_or(DVec3::NEG_Z);
+        let world_up = if forward.y.abs() > 0.999 { DVec3::new(0.0, 0.0, forward.y.signum()) } else { DVec3::Y };
+        let right = forward.cross(world_up).normalize();
+        (forward, right, right.cross(forward))
     }
 
     /// Ray basis for a viewport, with the eye relative to `origin` (the tree's
     /// origin) so that far-away cameras keep f32 precision.
     pub fn basis(&self, width: u32, height: u32, origin: IVec3) -> RayBasis {
-        let forward = (self.target - self.eye).try_normalize().unwrap_or(DVec3::NEG_Z);
-        let world_up = if forward.y.abs() > 0.999 { DVec3::Z } else { DVec3::Y };
-        let right = forward.cross(world_up).normalize();
-        let up = right.cross(forward);
-        let tan_half = (f64::from(clamp_fov(self.fov_y_deg)).to_radians() * 0.5).tan();
+        let (forward, right, up) = self.axes();
         let aspect = f64::from(width.max(1)) / f64::from(height.max(1));
+        // Perspective: the image plane one unit ahead, tan(fov / 2) high.
+        // Orthographic: rays along `forward` from a plane `height` high.
+        let (eye, half) = match self.ortho {
+            Some(height) => (self.target - forward * ORTHO_DEPTH, f64::from(height) * 0.5),
+            None => (self.eye, (f64::from(clamp_fov(self.fov_y_deg)).to_radians() * 0.5).tan()),
+        };
         RayBasis {
-            eye: (self.eye - origin.as_dvec3()).as_vec3(),
+            eye: (eye - origin.as_dvec3()).as_vec3(),
             forward: forward.as_vec3(),
-            right: (right * tan_half * aspect).as_vec3(),
-            up: (up * tan_half).as_vec3(),
+            right: (right * half * aspect).as_vec3(),
+            up: (up * half).as_vec3(),
             width: width.max(1),
             height: height.max(1),
+            ortho: self.ortho.is_some(),
         }
     }
 }
@@ -105,14 +154,18 @@ impl Camera {
 /// The WGSL twin is the camera part of `FrameUniforms` in `shaders/common.wgsl`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RayBasis {
+    /// The eye; orthographic: the centre of the plane the rays start from.
     pub eye: Vec3,
     pub forward: Vec3,
-    /// Right vector scaled by tan(fov/2) · aspect.
+    /// Right vector scaled by tan(fov/2) · aspect (orthographic: by half
+    /// the view's width).
     pub right: Vec3,
-    /// Up vector scaled by tan(fov/2).
+    /// Up vector scaled by tan(fov/2) (orthographic: by half its height).
     pub up: Vec3,
     pub width: u32,
     pub height: u32,
+    /// Rays start across the image plane, all along `forward`.
+    pub ortho: bool,
 }
 
 impl RayBasis {
@@ -130,8 +183,9 @@ impl RayBasis {
         if depth <= 0.0 {
             return None;
         }
-        let ndc_x = d.dot(self.right) / self.right.length_squared() / depth;
-        let ndc_y = d.dot(self.up) / self.up.length_squared() / depth;
+        let scale = if self.ortho { 1.0 } else { depth };
+        let ndc_x = d.dot(self.right) / self.right.length_squared() / scale;
+        let ndc_y = d.dot(self.up) / self.up.length_squared() / scale;
         Some(((ndc_x + 1.0) * 0.5 * self.width as f32, (1.0 - ndc_y) * 0.5 * self.height as f32))
     }
 
@@ -140,6 +194,7 @@ impl RayBasis {
     pub fn ray_through(&self, px: f32, py: f32) -> (Vec3, Vec3) {
         let ndc_x = 2.0 * px / self.width as f32 - 1.0;
         let ndc_y = 1.0 - 2.0 * py / self.height as f32;
-        (self.eye, self.forward + self.right * ndc_x + self.up * ndc_y)
+        let offset = self.right * ndc_x + self.up * ndc_y;
+        if self.ortho { (self.eye + offset, self.forward) } else { (self.eye, self.forward + offset) }
     }
 }

@@ -189,6 +189,11 @@ pub struct RenderArgs {
     /// Vertical field of view in degrees (1..=179).
     #[arg(long, default_value_t = 50.0, value_parser = parse_fov)]
     pub fov: f32,
+    /// An orthographic view showing HEIGHT world voxels from the image's
+    /// bottom to its top, looking from the camera's eye to its target
+    /// (the eye's distance then changes nothing).
+    #[arg(long, value_parser = parse_ortho, value_name = "HEIGHT", conflicts_with = "fov")]
+    pub ortho: Option<f32>,
     #[arg(long, value_enum, default_value_t = TraceMode::Svo)]
     pub mode: TraceMode,
     #[arg(long, value_enum, default_value_t = View::Shaded)]
@@ -315,6 +320,12 @@ pub fn parse_fov(s: &str) -> Result<f32, String> {
     octovox::camera::check_fov(fov).map_err(|e| e.to_string())
 }
 
+/// Parses an orthographic view height, within [`octovox::camera::ORTHO_RANGE`].
+pub fn parse_ortho(s: &str) -> Result<f32, String> {
+    let height: f32 = s.trim().parse().map_err(|_| format!("orthographic height '{s}' is not a number"))?;
+    octovox::camera::check_ortho(height).map_err(|e| e.to_string())
+}
+
 /// Parses a render scale in `MIN_RENDER_SCALE..=1`.
 pub fn parse_render_scale(s: &str) -> Result<f32, String> {
     let range = octovox::settings::MIN_RENDER_SCALE..=1.0;
@@ -354,7 +365,7 @@ pub fn parse_camera(s: &str) -> Result<(DVec3, DVec3), String> {
 /// The camera given on the command line, or one framing the scene.
 pub fn camera_or_framing(camera: Option<(DVec3, DVec3)>, fov: f32, scene: &octovox::scene::Scene) -> Camera {
     match camera {
-        Some((eye, target)) => Camera { eye, target, fov_y_deg: fov },
+        Some((eye, target)) => Camera { eye, target, fov_y_deg: fov, ortho: None },
         None => match scene.tree.solid_bounds() {
             Some((lo, hi)) => Camera::framing(lo, hi, fov),
             None => Camera { fov_y_deg: fov, ..Camera::default() },

@@ -217,6 +217,7 @@ impl Editor {
             Command::Load(_)
             | Command::Palette(PaletteLine::Load(_) | PaletteLine::Save(_))
             | Command::Camera { .. }
+            | Command::Projection(_)
             | Command::Viewport(..)
             | Command::Click { .. }
             | Command::Save(_)

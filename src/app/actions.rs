@@ -2,6 +2,7 @@
 //! label and its menu. The key handler, the menu bar and the key table in
 //! `docs/window.md` (checked by a test) all read it.
 
+use glam::IVec3;
 use winit::keyboard::KeyCode;
 
 use super::command::{Command, Nudge};
@@ -51,7 +52,7 @@ const fn object(label: &'static str, code: KeyCode, shift: bool, line: ObjectLin
 }
 
 /// Every keyboard action, in menu order.
-pub static ACTIONS: [Action; 39] = [
+pub static ACTIONS: [Action; 47] = [
     ctrl("New", KeyCode::KeyN, FILE, Command::New),
     ctrl("Open…", KeyCode::KeyO, FILE, Command::AskOpen),
     ctrl("Save", KeyCode::KeyS, FILE, Command::Save),
@@ -85,6 +86,14 @@ pub static ACTIONS: [Action; 39] = [
     object("Hide object", KeyCode::KeyH, false, ObjectLine::Hide(true)),
     object("Delete object", KeyCode::Delete, false, ObjectLine::Delete),
     key("Frame model", KeyCode::KeyF, VIEW, Command::FrameModel),
+    key("Orthographic or perspective", KeyCode::KeyO, VIEW, Command::ToggleProjection),
+    key("Orthographic or perspective", KeyCode::Numpad5, None, Command::ToggleProjection),
+    key("Front view", KeyCode::Numpad1, VIEW, Command::ViewFrom(IVec3::Z)),
+    ctrl("Back view", KeyCode::Numpad1, VIEW, Command::ViewFrom(IVec3::NEG_Z)),
+    key("Right view", KeyCode::Numpad3, VIEW, Command::ViewFrom(IVec3::X)),
+    ctrl("Left view", KeyCode::Numpad3, VIEW, Command::ViewFrom(IVec3::NEG_X)),
+    key("Top view", KeyCode::Numpad7, VIEW, Command::ViewFrom(IVec3::Y)),
+    ctrl("Bottom view", KeyCode::Numpad7, VIEW, Command::ViewFrom(IVec3::NEG_Y)),
     nudge("Move selection left", KeyCode::ArrowLeft, Nudge::Left),
     nudge("Move selection right", KeyCode::ArrowRight, Nudge::Right),
     nudge("Move selection away", KeyCode::ArrowUp, Nudge::Away),

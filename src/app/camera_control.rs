@@ -10,16 +10,10 @@ use octovox::camera::Camera;
 const ORBIT_RAD_PER_PIXEL: f64 = 0.006;
 /// Closest the eye may come to the target (voxels).
 const MIN_DISTANCE: f64 = 0.5;
+/// Farthest a zoom takes the eye from the target (voxels).
+const MAX_DISTANCE: f64 = 1.0e6;
 /// Fly speed in units of the current eye–target distance per second.
 const FLY_DISTANCES_PER_SECOND: f64 = 0.6;
-
-/// The camera's forward, right and up unit vectors.
-fn frame(camera: &Camera) -> (DVec3, DVec3, DVec3) {
-    let forward = (camera.target - camera.eye).try_normalize().unwrap_or(DVec3::NEG_Z);
-    let world_up = if forward.y.abs() > 0.999 { DVec3::Z } else { DVec3::Y };
-    let right = forward.cross(world_up).normalize();
-    (forward, right, right.cross(forward))
-}
 
 /// Turns the eye around the target: `dx` pixels of yaw, `dy` of pitch. Pitch
 /// stops just short of straight up or down so the view never flips.
@@ -35,26 +29,54 @@ pub fn orbit(camera: &mut Camera, dx: f64, dy: f64) {
 /// Slides eye and target together so the scene follows the mouse; `height`
 /// is the view's height in pixels.
 pub fn pan(camera: &mut Camera, dx: f64, dy: f64, height: u32) {
-    let (_, right, up) = frame(camera);
-    let distance = (camera.target - camera.eye).length();
-    let half_fov = f64::from(octovox::camera::clamp_fov(camera.fov_y_deg)).to_radians() * 0.5;
-    let units_per_pixel = 2.0 * distance * half_fov.tan() / f64::from(height.max(1));
+    let (_, right, up) = camera.axes();
+    let units_per_pixel = camera.view_height() / f64::from(height.max(1));
     let shift = (-right * dx + up * dy) * units_per_pixel;
     camera.eye += shift;
     camera.target += shift;
 }
 
-/// Moves the eye toward the target by wheel `steps` (positive = closer).
-pub fn zoom(camera: &mut Camera, steps: f64) {
-    let offset = camera.eye - camera.target;
-    let distance = (offset.length() * 0.85_f64.powf(steps)).max(MIN_DISTANCE);
-    camera.eye = camera.target + offset.normalize_or(DVec3::Z) * distance;
+/// How much one wheel notch scales the view: eight notches halve it.
+const ZOOM_PER_STEP: f64 = 0.917;
+
+/// Zooms by wheel `steps` (positive = closer) toward `toward`, the point
+/// under the cursor, which stays where it is on screen (the target when
+/// the cursor is over the sky): the camera is scaled about that point, and
+/// an orthographic view's height with it.
+pub fn zoom(camera: &mut Camera, steps: f64, toward: Option<DVec3>) {
+    let distance = (camera.eye - camera.target).length().max(MIN_DISTANCE);
+    // The eye stays MIN_DISTANCE..=MAX_DISTANCE from the target.
+    let factor = ZOOM_PER_STEP.powf(steps).clamp(MIN_DISTANCE / distance, MAX_DISTANCE / distance);
+    let center = toward.unwrap_or(camera.target);
+    camera.eye = center + (camera.eye - center) * factor;
+    camera.target = center + (camera.target - center) * factor;
+    if let Some(height) = camera.ortho {
+        let (lo, hi) = (octovox::camera::ORTHO_RANGE.start(), octovox::camera::ORTHO_RANGE.end());
+        camera.ortho = Some((f64::from(height) * factor).clamp(f64::from(*lo), f64::from(*hi)) as f32);
+    }
+}
+
+/// Switches between perspective and an orthographic view that shows what
+/// the perspective one shows at the target.
+pub fn toggle_projection(camera: &mut Camera) {
+    let (lo, hi) = (octovox::camera::ORTHO_RANGE.start(), octovox::camera::ORTHO_RANGE.end());
+    camera.ortho = match camera.ortho {
+        Some(_) => None,
+        None => Some((camera.view_height() as f32).clamp(*lo, *hi)),
+    };
+}
+
+/// Looks at the target from the side `from` (a world axis: +z is the
+/// front, +x the right, +y the top), at the same distance.
+pub fn view_from(camera: &mut Camera, from: DVec3) {
+    let distance = (camera.eye - camera.target).length().max(MIN_DISTANCE);
+    camera.eye = camera.target + from.normalize_or(DVec3::Z) * distance;
 }
 
 /// First-person move: `dir` is (right, up, forward) in -1..=1, `seconds` the
 /// frame time.
 pub fn fly(camera: &mut Camera, dir: DVec3, seconds: f64) {
-    let (forward, right, _) = frame(camera);
+    let (forward, right, _) = camera.axes();
     let distance = (camera.target - camera.eye).length().max(MIN_DISTANCE * 8.0);
     let step = (right * dir.x + DVec3::Y * dir.y + forward * dir.z) * distance * FLY_DISTANCES_PER_SECOND * seconds;
     camera.eye += step;
@@ -70,6 +92,9 @@ pub fn frame_model(camera: &mut Camera, bounds: Option<(glam::IVec3, glam::IVec3
     let back = (camera.eye - camera.target).try_normalize().unwrap_or((framed.eye - framed.target) / distance);
     camera.target = framed.target;
     camera.eye = framed.target + back * distance;
+    if camera.ortho.is_some() {
+        camera.ortho = Some(framed.view_height() as f32);
+    }
 }
 
 #[cfg(test)]
@@ -78,8 +103,12 @@ mod tests {
 
     #[test]
     fn orbit_keeps_distance_and_target() {
-        let mut camera =
-            Camera { eye: DVec3::new(10.0, 5.0, 20.0), target: DVec3::new(1.0, 2.0, 3.0), fov_y_deg: 50.0 };
+        let mut camera = Camera {
+            eye: DVec3::new(10.0, 5.0, 20.0),
+            target: DVec3::new(1.0, 2.0, 3.0),
+            fov_y_deg: 50.0,
+            ortho: None,
+        };
         let before = (camera.eye - camera.target).length();
         orbit(&mut camera, 120.0, -40.0);
         assert!(((camera.eye - camera.target).length() - before).abs() < 1e-9);
@@ -90,13 +119,44 @@ mod tests {
 
     #[test]
     fn zoom_and_pan_move_as_expected() {
-        let mut camera = Camera { eye: DVec3::new(0.0, 0.0, 10.0), target: DVec3::ZERO, fov_y_deg: 50.0 };
-        zoom(&mut camera, 1.0);
-        assert!((camera.eye.z - 8.5).abs() < 1e-9);
-        zoom(&mut camera, -1000.0);
-        assert!(camera.eye.is_finite());
-        let mut camera = Camera { eye: DVec3::new(0.0, 0.0, 10.0), target: DVec3::ZERO, fov_y_deg: 50.0 };
+        let mut camera = Camera { eye: DVec3::new(0.0, 0.0, 10.0), target: DVec3::ZERO, fov_y_deg: 50.0, ortho: None };
+        zoom(&mut camera, 1.0, None);
+        assert!((camera.eye.z - 10.0 * ZOOM_PER_STEP).abs() < 1e-9);
+        zoom(&mut camera, -1000.0, None);
+        assert!(((camera.eye - camera.target).length() - MAX_DISTANCE).abs() < 1e-3, "{camera:?}");
+        zoom(&mut camera, 2000.0, None);
+        assert!(((camera.eye - camera.target).length() - MIN_DISTANCE).abs() < 1e-6, "{camera:?}");
+        let mut camera = Camera { eye: DVec3::new(0.0, 0.0, 10.0), target: DVec3::ZERO, fov_y_deg: 50.0, ortho: None };
         pan(&mut camera, 10.0, 0.0, 100);
         assert!(camera.target.x < 0.0 && (camera.eye - camera.target).z == 10.0);
+    }
+
+    /// Zooming toward the point under the cursor keeps that point on the
+    /// same pixel, in perspective and orthographic views.
+    #[test]
+    fn zoom_toward_a_point_keeps_it_under_the_cursor() {
+        let point = DVec3::new(3.0, 1.0, -2.0);
+        for ortho in [None, Some(30.0)] {
+            let mut camera = Camera { eye: DVec3::new(20.0, 15.0, 25.0), target: DVec3::ZERO, fov_y_deg: 50.0, ortho };
+            let pixel = |c: &Camera| c.basis(200, 100, glam::IVec3::ZERO).project(point.as_vec3()).unwrap();
+            let before = pixel(&camera);
+            zoom(&mut camera, 3.0, Some(point));
+            let after = pixel(&camera);
+            assert!((before.0 - after.0).abs() < 1e-3 && (before.1 - after.1).abs() < 1e-3, "{before:?} {after:?}");
+            if let Some(height) = camera.ortho {
+                assert!((f64::from(height) - 30.0 * ZOOM_PER_STEP.powi(3)).abs() < 1e-3);
+            }
+        }
+    }
+
+    #[test]
+    fn a_switch_of_projection_keeps_the_view_height() {
+        let mut camera = Camera { eye: DVec3::new(0.0, 0.0, 10.0), target: DVec3::ZERO, fov_y_deg: 90.0, ortho: None };
+        toggle_projection(&mut camera);
+        assert!((camera.ortho.unwrap() - 20.0).abs() < 1e-4, "{camera:?}");
+        toggle_projection(&mut camera);
+        assert_eq!(camera.ortho, None);
+        view_from(&mut camera, DVec3::Y);
+        assert!((camera.eye - DVec3::new(0.0, 10.0, 0.0)).length() < 1e-9);
     }
 }

@@ -125,9 +125,15 @@ pub enum Command {
         dx: f64,
         dy: f64,
     },
+    /// Wheel `steps` toward the point under window pixel `at`, if any.
     Zoom {
         steps: f64,
+        at: Option<(f64, f64)>,
     },
+    /// Orthographic ↔ perspective.
+    ToggleProjection,
+    /// Look at the target from this side (a world axis: +z front, +x right, +y top).
+    ViewFrom(glam::IVec3),
     FrameModel,
     /// Start over with an empty scene (asks first if there are unsaved changes).
     New,

@@ -122,7 +122,12 @@ impl Host for App {
 
     fn set_camera(&mut self, eye: DVec3, target: DVec3, fov_y_deg: Option<f32>) {
         let fov_y_deg = fov_y_deg.unwrap_or(self.state.camera.fov_y_deg);
-        self.state.camera = Camera { eye, target, fov_y_deg };
+        self.state.camera = Camera { eye, target, fov_y_deg, ..self.state.camera };
+        self.request_redraw();
+    }
+
+    fn set_projection(&mut self, ortho: Option<f32>) {
+        self.state.camera.ortho = ortho;
         self.request_redraw();
     }
 

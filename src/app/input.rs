@@ -175,7 +175,7 @@ impl Input {
                     MouseScrollDelta::LineDelta(_, y) => f64::from(*y),
                     MouseScrollDelta::PixelDelta(p) => p.y / PIXELS_PER_LINE,
                 };
-                out.push(Command::Zoom { steps });
+                out.push(Command::Zoom { steps, at: self.cursor });
             }
             WindowEvent::KeyboardInput { event, is_synthetic, .. } => {
                 log::debug!(

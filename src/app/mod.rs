@@ -25,6 +25,7 @@ mod file_dialog;
 mod files;
 mod frame;
 mod gesture;
+mod gizmo;
 mod host;
 mod input;
 mod journal;
@@ -152,7 +153,7 @@ impl App {
         app.state.shading = app.args.shading;
         app.state.sample_target = app.args.samples;
         if let Some((eye, target)) = app.args.camera {
-            app.state.camera = Camera { eye, target, fov_y_deg: app.state.camera.fov_y_deg };
+            app.state.camera = Camera { eye, target, ..app.state.camera };
         }
         match app.args.file.clone() {
             Some(path) => app.start_loading(path),
@@ -371,7 +372,14 @@ impl App {
                 let height = self.gfx.as_ref().map_or(1, |g| g.config.height);
                 camera_control::pan(&mut self.state.camera, dx, dy, height);
             }
-            Command::Zoom { steps } => camera_control::zoom(&mut self.state.camera, steps),
+            Command::Zoom { steps, at } => {
+                // Toward the voxel under the cursor (a pick that fails zooms to the target).
+                let toward = at.and_then(|(x, y)| self.pick_at(x, y).ok().flatten());
+                let toward = toward.map(|pick| pick.voxel.as_dvec3() + glam::DVec3::splat(0.5));
+                camera_control::zoom(&mut self.state.camera, steps, toward);
+            }
+            Command::ToggleProjection => camera_control::toggle_projection(&mut self.state.camera),
+            Command::ViewFrom(side) => camera_control::view_from(&mut self.state.camera, side.as_dvec3()),
             Command::FrameModel => self.frame_model(),
             Command::New => self.guard_unsaved(Pending::New, event_loop),
             Command::Open(path) => self.guard_unsaved(Pending::Open(path), event_loop),

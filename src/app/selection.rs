@@ -168,10 +168,10 @@ mod tests {
 
     #[test]
     fn arrows_follow_the_camera() {
-        let from_front = Camera { eye: DVec3::new(0.0, 5.0, 20.0), target: DVec3::ZERO, fov_y_deg: 50.0 };
+        let from_front = Camera { eye: DVec3::new(0.0, 5.0, 20.0), target: DVec3::ZERO, fov_y_deg: 50.0, ortho: None };
         assert_eq!(nudge_step(&from_front, Nudge::Right), IVec3::X);
         assert_eq!(nudge_step(&from_front, Nudge::Away), IVec3::NEG_Z);
-        let from_side = Camera { eye: DVec3::new(20.0, 5.0, 1.0), target: DVec3::ZERO, fov_y_deg: 50.0 };
+        let from_side = Camera { eye: DVec3::new(20.0, 5.0, 1.0), target: DVec3::ZERO, fov_y_deg: 50.0, ortho: None };
         assert_eq!(nudge_step(&from_side, Nudge::Right), IVec3::NEG_Z);
         assert_eq!(nudge_step(&from_side, Nudge::Near), IVec3::X);
         assert_eq!(nudge_step(&from_side, Nudge::Down), IVec3::NEG_Y);

@@ -259,6 +259,7 @@ pub fn show(
             stats(ui, info);
         });
     });
+    super::gizmo::show(ui.ctx(), &state.camera, &mut out);
     dialog(ui.ctx(), ui_state, &mut out);
     prompt(ui.ctx(), ui_state, &mut out);
     read_only_prompt(ui.ctx(), ui_state, &mut out);
@@ -386,9 +387,9 @@ fn tool_panel(ui: &mut egui::Ui, state: &mut EditorState, tools: &mut Tools) {
 
 fn palette(ui: &mut egui::Ui, tools: &mut Tools, palette: &Palette, out: &mut Vec<Command>) {
     use octovox::script::{Command as Line, PaletteLine};
+    ui.heading("Palette");
     ui.horizontal(|ui| {
-        ui.heading("Palette");
-        egui::ComboBox::from_id_salt("palette presets").selected_text("Preset").show_ui(ui, |ui| {
+        egui::ComboBox::from_id_salt("palette presets").selected_text("Preset").width(90.0).show_ui(ui, |ui| {
             for (name, _) in octovox::io::palette_file::PRESETS {
                 if ui.selectable_label(false, name).on_hover_text(format!("palette preset {name}")).clicked() {
                     out.push(Command::Lines(vec![Line::Palette(PaletteLine::Preset(name.to_owned()))]));

@@ -239,7 +239,7 @@ fn lod_markdown(rows: &[LodRow]) -> String {
 fn far_camera(scene: &Scene) -> Camera {
     let (lo, hi) = scene.tree.solid_bounds().unwrap_or_default();
     let centre = (lo + hi).as_dvec3() * 0.5;
-    Camera { eye: centre + DVec3::new(1.0, 0.5, 1.4) * 2400.0, target: centre, fov_y_deg: 20.0 }
+    Camera { eye: centre + DVec3::new(1.0, 0.5, 1.4) * 2400.0, target: centre, fov_y_deg: 20.0, ortho: None }
 }
 
 fn rows_for_plot(rows: &[QualityRow]) -> Vec<super::quality_plot::Point> {

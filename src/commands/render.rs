@@ -55,7 +55,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<ExitCode> {
     };
     octovox::budget::check(|| format!("a {}x{} render", args.size.0, args.size.1), pixels * per_pixel)?;
     let mut scene = open_scene(args.file.as_deref(), args.frame, args.demo)?;
-    let camera = camera_or_framing(args.camera, args.fov, &scene);
+    let camera = Camera { ortho: args.ortho, ..camera_or_framing(args.camera, args.fov, &scene) };
     let traced = octovox::settings::scaled_size(args.size, args.render_scale);
     let (image, stats) = match args.path.spp {
         Some(spp) => path_traced(&mut scene, &camera, args, traced, spp)?,

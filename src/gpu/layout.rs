@@ -52,7 +52,10 @@ pub struct FrameUniforms {
     pub max_iterations: u32,
     /// Level of detail: [`crate::trace::Footprint::per_t`] of camera rays.
     pub lod_per_t: f32,
-    pub _pad: [u32; 2],
+    /// 1: rays start across the image plane along `forward` ([`RayBasis::ortho`]).
+    pub ortho: u32,
+    /// Level of detail: [`crate::trace::Footprint::at_start`] of camera rays.
+    pub lod_at_start: f32,
 }
 
 impl FrameUniforms {
@@ -86,7 +89,8 @@ impl FrameUniforms {
             brick_base: buffers.brick_base(),
             max_iterations: crate::trace::iteration_bound(tree.depth()),
             lod_per_t: lod.per_t,
-            _pad: [0; 2],
+            ortho: u32::from(basis.ortho),
+            lod_at_start: lod.at_start,
         }
     }
 }

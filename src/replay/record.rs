@@ -165,6 +165,7 @@ impl Recorder {
             | Command::New
             | Command::Demo(_)
             | Command::Camera { .. }
+            | Command::Projection(_)
             | Command::Viewport(..)
             | Command::Brush(_)
             | Command::Color(_)
@@ -202,9 +203,15 @@ impl Recorder {
     fn edit_state(&mut self, camera: &Camera, brush: Brush, color: Option<u8>, mirror: &Mirror) -> std::io::Result<()> {
         self.set_mirror(mirror)?;
         if self.camera != Some(*camera) {
+            // The projection with the first camera (a journal appended to
+            // may have left either in force), then where it changed.
+            let projection_was = self.camera.map(|c| c.ortho);
             self.camera = Some(*camera);
             let (eye, target) = (camera.eye, camera.target);
             self.command(&Command::Camera { eye, target, fov: Some(camera.fov_y_deg) })?;
+            if projection_was != Some(camera.ortho) {
+                self.command(&Command::Projection(camera.ortho))?;
+            }
         }
         if self.brush != Some(brush) {
             self.brush = Some(brush);

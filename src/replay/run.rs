@@ -175,7 +175,11 @@ impl Host for Runner {
     }
 
     fn set_camera(&mut self, eye: DVec3, target: DVec3, fov_y_deg: Option<f32>) {
-        self.camera = Camera { eye, target, fov_y_deg: fov_y_deg.unwrap_or(self.camera.fov_y_deg) };
+        self.camera = Camera { eye, target, fov_y_deg: fov_y_deg.unwrap_or(self.camera.fov_y_deg), ..self.camera };
+    }
+
+    fn set_projection(&mut self, ortho: Option<f32>) {
+        self.camera.ortho = ortho;
     }
 
     fn set_viewport(&mut self, width: u32, height: u32) {

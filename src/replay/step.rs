@@ -34,8 +34,11 @@ pub trait Host {
     /// The file cannot be read.
     fn load(&mut self, path: &Path) -> Result<(), HostError>;
 
-    /// `camera`: `None` keeps the field of view.
+    /// `camera`: `None` keeps the field of view; the projection stays.
     fn set_camera(&mut self, eye: DVec3, target: DVec3, fov_y_deg: Option<f32>);
+
+    /// `ortho HEIGHT` (`Some`) or `perspective`.
+    fn set_projection(&mut self, ortho: Option<f32>);
 
     /// `viewport W H`: the size of renders and of the pixels `click` names.
     fn set_viewport(&mut self, width: u32, height: u32);
@@ -159,6 +162,7 @@ fn host_line(host: &mut impl Host, base: &Path, line: &Command) -> Result<StepRe
         Command::Load(path) => host.load(&base.join(path))?,
         Command::Camera { eye, target, fov } => host.set_camera(*eye, *target, *fov),
         Command::Viewport(w, h) => host.set_viewport(*w, *h),
+        Command::Projection(ortho) => host.set_projection(*ortho),
         Command::Click { x, y, tool } => {
             let expected = format!("pixel ({x}, {y}) to hit a voxel");
             let (voxel, normal) = match host.pick(*x, *y) {

@@ -69,7 +69,12 @@ pub fn showroom_scene() -> Scene {
 /// A camera inside the interior, looking at the table from a corner.
 pub fn interior_camera() -> crate::camera::Camera {
     use glam::DVec3;
-    crate::camera::Camera { eye: DVec3::new(36.0, 18.0, 36.0), target: DVec3::new(10.0, 4.0, 10.0), fov_y_deg: 60.0 }
+    crate::camera::Camera {
+        eye: DVec3::new(36.0, 18.0, 36.0),
+        target: DVec3::new(10.0, 4.0, 10.0),
+        fov_y_deg: 60.0,
+        ortho: None,
+    }
 }
 
 /// A closed room lit only by three lamps: a wooden floor, white walls, a

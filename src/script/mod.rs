@@ -30,6 +30,10 @@ pub enum Command {
         fov: Option<f32>,
     },
     Viewport(u32, u32),
+    /// `ortho HEIGHT`: an orthographic view showing HEIGHT world voxels
+    /// from the image's bottom to its top (the `camera` line's eye gives the
+    /// direction only); `perspective` (None) goes back to the field of view.
+    Projection(Option<f32>),
     Brush(Brush),
     Color(u8),
     Place(IVec3),

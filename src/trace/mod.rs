@@ -41,10 +41,11 @@ impl Footprint {
 
     /// The footprint of `pixels` image pixels for the camera rays of
     /// `basis`: their t is the depth along the view axis, where one pixel is
-    /// `2·|up| / height` voxels wide per unit of depth.
+    /// `2·|up| / height` voxels wide per unit of depth (orthographic: that
+    /// wide at every depth).
     pub fn of_pixels(basis: &crate::camera::RayBasis, pixels: f32) -> Footprint {
-        let per_t = pixels.max(0.0) * 2.0 * basis.up.length() / basis.height.max(1) as f32;
-        Footprint { at_start: 0.0, per_t }
+        let width = pixels.max(0.0) * 2.0 * basis.up.length() / basis.height.max(1) as f32;
+        if basis.ortho { Footprint { at_start: width, per_t: 0.0 } } else { Footprint { at_start: 0.0, per_t: width } }
     }
 
     /// The footprint a shadow ray from a hit at camera-ray `t` keeps.

@@ -49,7 +49,8 @@ pub fn cameras_for(min: IVec3, max: IVec3) -> Vec<Camera> {
     let hi = max.as_dvec3() + DVec3::ONE;
     let c = (lo + hi) * 0.5;
     let r = (hi - lo).length() * 0.5 + 1.0;
-    let around = |dir: DVec3, dist: f64| Camera { eye: c + dir.normalize() * dist, target: c, fov_y_deg: 55.0 };
+    let around =
+        |dir: DVec3, dist: f64| Camera { eye: c + dir.normalize() * dist, target: c, fov_y_deg: 55.0, ortho: None };
     vec![
         Camera::framing(min, max, 50.0),
         around(DVec3::new(-1.0, 0.6, 0.3), r * 1.8),
@@ -57,13 +58,23 @@ pub fn cameras_for(min: IVec3, max: IVec3) -> Vec<Camera> {
         around(DVec3::new(0.0, 0.0, 1.0), r * 2.2),
         around(DVec3::new(0.0, 1.0, 0.0), r * 2.0),
         around(DVec3::new(1.0, 0.0, 0.0), r * 1.4),
-        Camera { eye: c + DVec3::new(0.31, 0.27, 0.23), target: c + DVec3::new(5.0, -1.0, 3.0), fov_y_deg: 90.0 },
+        Camera {
+            eye: c + DVec3::new(0.31, 0.27, 0.23),
+            target: c + DVec3::new(5.0, -1.0, 3.0),
+            fov_y_deg: 90.0,
+            ortho: None,
+        },
         Camera {
             eye: DVec3::new(lo.x - 3.0, lo.y + 0.5, c.z + 0.25),
             target: DVec3::new(hi.x, lo.y + 0.6, c.z),
             fov_y_deg: 40.0,
+            ortho: None,
         },
-        Camera { eye: DVec3::new(hi.x + 2.5, hi.y + 1.5, lo.z - 2.0), target: c, fov_y_deg: 70.0 },
+        Camera { eye: DVec3::new(hi.x + 2.5, hi.y + 1.5, lo.z - 2.0), target: c, fov_y_deg: 70.0, ortho: None },
+        // Orthographic: from outside, and with the eye inside the model
+        // (its rays start behind it all the same).
+        Camera { ortho: Some((r * 1.5) as f32), ..around(DVec3::new(0.6, 0.5, 0.7), r * 2.0) },
+        Camera { ortho: Some((r * 0.7) as f32), ..around(DVec3::new(-0.3, 0.8, -0.5), 0.5) },
     ]
 }
 

@@ -322,6 +322,7 @@ fn the_comb_ray_reaches_the_wall_in_the_pick() {
         eye: glam::DVec3::new(-2.0, 0.5, 0.5),
         target: glam::DVec3::new(100.0, 0.5, 0.5),
         fov_y_deg: 1.0,
+        ortho: None,
     };
     let hit = octovox::trace::svo::pick(&tree, &camera, (1, 1), 0, 0).unwrap().expect("the wall");
     assert_eq!(hit.voxel.x, 4010);

@@ -105,6 +105,7 @@ fn far_camera_and_deep_sparse_tree() {
         eye: far.as_dvec3() + DVec3::new(0.5, 100_000.0, 0.5),
         target: far.as_dvec3() + DVec3::splat(0.5),
         fov_y_deg: 0.01,
+        ortho: None,
     };
     let basis = camera.basis(9, 9, tree.origin());
     let hits = trace_image(Tracer::Svo(&tree), &basis, Footprint::EXACT);
@@ -144,4 +145,35 @@ fn flat_wall_has_no_holes_from_random_directions() {
         assert!(a.is_hit() && b.is_hit(), "hole at {origin} {dir}: {a:?} {b:?}");
         assert_eq!(a.normal, IVec3::new(0, 0, -1));
     }
+}
+
+/// `render --ortho`: two renders from one direction at distances ten times
+/// apart are the same picture, on the GPU and on the CPU, and the two
+/// agree; the perspective render from the nearer eye is another picture.
+#[test]
+fn orthographic_renders_do_not_depend_on_the_eye_distance() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = common::assets().join("vox/seed/torus64.vox");
+    let render = |name: &str, camera: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let mut args = vec!["render", model.to_str().unwrap(), "--size", "160x120", "--camera", camera];
+        args.extend(extra);
+        args.extend(["-o", out.to_str().unwrap()]);
+        let run = std::process::Command::new(env!("CARGO_BIN_EXE_octovox")).args(&args).output().unwrap();
+        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        octovox::io::png::load_png(&out).unwrap()
+    };
+    let (far, near) = ("60,45,80:0,0,0", "6,4.5,8:0,0,0");
+    let gpu = [render("g1.png", far, &["--ortho", "70"]), render("g2.png", near, &["--ortho", "70"])];
+    let cpu = [render("c1.png", far, &["--ortho", "70", "--cpu"]), render("c2.png", near, &["--ortho", "70", "--cpu"])];
+    assert_eq!(gpu[0], gpu[1], "GPU: the same picture from both distances");
+    assert_eq!(cpu[0], cpu[1], "CPU: the same picture from both distances");
+    let differing = octovox::io::png::differing_fraction(&gpu[0], &cpu[0]);
+    assert!(differing < 0.002, "GPU and CPU differ on {differing} of the pixels");
+    // Not a blank picture: the torus covers a good part of it.
+    let sky = *gpu[0].get_pixel(0, 0);
+    let covered = gpu[0].pixels().filter(|p| **p != sky).count();
+    assert!(covered > 160 * 120 / 5, "{covered} pixels show the torus");
+    let perspective = render("p.png", near, &[]);
+    assert!(octovox::io::png::differing_fraction(&perspective, &gpu[1]) > 0.1);
 }

@@ -310,6 +310,7 @@ fn gpu_hard_cases_against_the_reference() {
         eye: DVec3::from_array(eye),
         target: DVec3::from_array(target),
         fov_y_deg: fov,
+        ortho: None,
     };
     let classes = [
         ("axis-parallel", camera([3.0, 9.0, -60.0], [3.0, 9.0, 0.0], 20.0), 1),

@@ -53,7 +53,7 @@ fn mean(pixels: &[Vec3]) -> Vec3 {
 }
 
 fn look(eye: DVec3, target: DVec3) -> Camera {
-    Camera { eye, target, fov_y_deg: 40.0 }
+    Camera { eye, target, fov_y_deg: 40.0, ortho: None }
 }
 
 /// Pixels whose hit (by the CPU tracer) is a voxel.

@@ -71,7 +71,7 @@ fn gpu_matches_cpu_on_sculpture() {
 #[test]
 fn gpu_traces_every_listed_tile() {
     let mut tree = sculpture();
-    let camera = Camera { eye: DVec3::new(-10.0, 25.0, -30.0), target: DVec3::ZERO, fov_y_deg: 60.0 };
+    let camera = Camera { eye: DVec3::new(-10.0, 25.0, -30.0), target: DVec3::ZERO, fov_y_deg: 60.0, ortho: None };
     let size = (333, 211);
     let cpu = trace_image(Tracer::Svo(&tree), &camera.basis(size.0, size.1, tree.origin()), Footprint::EXACT);
     let tiles_with_hits: std::collections::HashSet<(usize, usize)> = (0..cpu.len())
@@ -98,14 +98,19 @@ fn gpu_hard_cases() {
     // boundary plane.
     let mut tree = sculpture();
     let cameras = [
-        Camera { eye: DVec3::new(4.0, 7.0, -40.0), target: DVec3::new(4.0, 7.0, 0.0), fov_y_deg: 30.0 },
-        Camera { eye: DVec3::new(-30.0, 30.0, 0.0), target: DVec3::new(0.0, 0.0, 0.0), fov_y_deg: 60.0 },
-        Camera { eye: DVec3::new(-30.0, 30.0, -30.0), target: DVec3::new(0.0, 0.0, 0.0), fov_y_deg: 60.0 },
-        Camera { eye: DVec3::new(-25.0, 0.0, 3.0), target: DVec3::new(25.0, 0.0, 3.0), fov_y_deg: 20.0 },
-        Camera { eye: DVec3::new(0.5, 5.5, 0.5), target: DVec3::new(3.0, 5.0, 9.0), fov_y_deg: 70.0 },
-        Camera { eye: DVec3::new(0.0, 25.0, 0.0), target: DVec3::new(1.0, 0.0, 2.0), fov_y_deg: 70.0 },
-        Camera { eye: DVec3::new(-20.0, 10.0, 30.0), target: DVec3::new(-20.0, 10.0, 0.0), fov_y_deg: 50.0 },
-        Camera { eye: DVec3::new(7.0, 40.0, 7.0), target: DVec3::new(7.0, 0.0, 7.0), fov_y_deg: 50.0 },
+        Camera { eye: DVec3::new(4.0, 7.0, -40.0), target: DVec3::new(4.0, 7.0, 0.0), fov_y_deg: 30.0, ortho: None },
+        Camera { eye: DVec3::new(-30.0, 30.0, 0.0), target: DVec3::new(0.0, 0.0, 0.0), fov_y_deg: 60.0, ortho: None },
+        Camera { eye: DVec3::new(-30.0, 30.0, -30.0), target: DVec3::new(0.0, 0.0, 0.0), fov_y_deg: 60.0, ortho: None },
+        Camera { eye: DVec3::new(-25.0, 0.0, 3.0), target: DVec3::new(25.0, 0.0, 3.0), fov_y_deg: 20.0, ortho: None },
+        Camera { eye: DVec3::new(0.5, 5.5, 0.5), target: DVec3::new(3.0, 5.0, 9.0), fov_y_deg: 70.0, ortho: None },
+        Camera { eye: DVec3::new(0.0, 25.0, 0.0), target: DVec3::new(1.0, 0.0, 2.0), fov_y_deg: 70.0, ortho: None },
+        Camera {
+            eye: DVec3::new(-20.0, 10.0, 30.0),
+            target: DVec3::new(-20.0, 10.0, 0.0),
+            fov_y_deg: 50.0,
+            ortho: None,
+        },
+        Camera { eye: DVec3::new(7.0, 40.0, 7.0), target: DVec3::new(7.0, 0.0, 7.0), fov_y_deg: 50.0, ortho: None },
     ];
     check_scene(&mut tree, &cameras, (64, 64));
 }
@@ -121,6 +126,7 @@ fn gpu_far_camera_deep_tree_empty_and_full() {
         eye: far.as_dvec3() + DVec3::new(0.5, 100_000.0, 0.5),
         target: far.as_dvec3() + DVec3::splat(0.5),
         fov_y_deg: 0.01,
+        ortho: None,
     };
     let mut renderer = renderer_for(&mut tree);
     let hits = gpu_hits(&mut renderer, &tree, &camera, (9, 9), TraceMode::Svo);
@@ -153,7 +159,7 @@ fn gpu_flat_wall_has_no_holes() {
     for _ in 0..100 {
         let target = DVec3::new(16.0 + rand() * 32.0, 16.0 + rand() * 32.0, 0.0);
         let dir = DVec3::new(rand() - 0.5, rand() - 0.5, -0.3 - rand()).normalize();
-        let camera = Camera { eye: target + dir * (10.0 + rand() * 50.0), target, fov_y_deg: 10.0 };
+        let camera = Camera { eye: target + dir * (10.0 + rand() * 50.0), target, fov_y_deg: 10.0, ortho: None };
         let hits = gpu_hits(&mut renderer, &tree, &camera, (8, 8), TraceMode::Svo);
         // The narrow view sees only wall: any miss is a hole.
         assert!(hits.iter().all(|h| h.is_hit() && h.normal == IVec3::new(0, 0, -1)), "hole from {camera:?}");
@@ -168,8 +174,12 @@ fn gpu_pool_growth_keeps_the_picture() {
     let mut tree = Octree::default();
     tree.apply_brush(&Shape::Sphere { center: IVec3::splat(8), radius: 6 }, Op::Place(3)).unwrap();
     let mut renderer = renderer_for(&mut tree);
-    let camera =
-        Camera { eye: DVec3::new(-150.0, 120.0, -160.0), target: DVec3::new(40.0, 10.0, 40.0), fov_y_deg: 60.0 };
+    let camera = Camera {
+        eye: DVec3::new(-150.0, 120.0, -160.0),
+        target: DVec3::new(40.0, 10.0, 40.0),
+        fov_y_deg: 60.0,
+        ortho: None,
+    };
     let size = (64, 48);
     let mut growths = 0;
     for i in 0..6 {

@@ -275,8 +275,12 @@ fn alt_click_picks_a_colour_and_shift_click_paint_fills_with_it() {
         scene.tree.apply_brush(&shape, op).unwrap();
     }
     octovox::io::save_scene(&file, &scene, Default::default()).unwrap();
-    let camera =
-        Camera { eye: glam::DVec3::new(8.0, 14.0, 30.0), target: glam::DVec3::new(8.0, 4.0, 4.0), fov_y_deg: 50.0 };
+    let camera = Camera {
+        eye: glam::DVec3::new(8.0, 14.0, 30.0),
+        target: glam::DVec3::new(8.0, 4.0, 4.0),
+        fov_y_deg: 50.0,
+        ortho: None,
+    };
     let (x, y, voxel, normal) = stable_pixel(&scene.tree, &camera, |v, n| scene.tree.get(v) == 77 && n == IVec3::Z);
     let args = document_args(&file, &camera, &["--shading", "preview"]);
     let (_xvfb, display) = start_xvfb(4);
@@ -401,8 +405,12 @@ fn floor_scene(dir: &std::path::Path) -> (PathBuf, octovox::scene::Scene, Camera
     let mut scene = octovox::scene::Scene::default();
     scene.tree.apply_brush(&Shape::Box { min: IVec3::ZERO, max: IVec3::new(15, 0, 15) }, Op::Place(20)).unwrap();
     octovox::io::save_scene(&file, &scene, Default::default()).unwrap();
-    let camera =
-        Camera { eye: glam::DVec3::new(8.0, 20.0, 24.0), target: glam::DVec3::new(8.0, 0.0, 8.0), fov_y_deg: 50.0 };
+    let camera = Camera {
+        eye: glam::DVec3::new(8.0, 20.0, 24.0),
+        target: glam::DVec3::new(8.0, 0.0, 8.0),
+        fov_y_deg: 50.0,
+        ortho: None,
+    };
     (file, scene, camera)
 }
 
