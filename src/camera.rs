@@ -103,6 +103,17 @@ impl Camera {
         Camera { eye: center + dir * distance, target: center, fov_y_deg, ortho: None }
     }
 
+    /// This camera moved to show the whole box `min..=max` (voxel corners),
+    /// as [`Camera::framing`] does, but keeping its viewing direction (and
+    /// projection: an orthographic one gets the height that shows the box).
+    pub fn reframed(&self, min: IVec3, max: IVec3) -> Camera {
+        let framed = Camera::framing(min, max, self.fov_y_deg);
+        let distance = (framed.eye - framed.target).length();
+        let back = (self.eye - self.target).try_normalize().unwrap_or((framed.eye - framed.target) / distance);
+        let ortho = self.ortho.map(|_| framed.view_height() as f32);
+        Camera { eye: framed.target + back * distance, target: framed.target, fov_y_deg: self.fov_y_deg, ortho }
+    }
+
     /// The world height the view shows at the target: the orthographic
     /// height, or what the field of view spans at the target's distance
     /// (what a switch between the two keeps).

@@ -74,6 +74,9 @@ pub struct Editor {
     /// The selected box, if any.
     pub selection: Option<Region>,
     clipboard: Option<Block>,
+    /// Clicks that hit no voxel land on the ground, the plane y = 0
+    /// (`ground on|off`; on for a scene that starts empty).
+    pub ground: bool,
     /// Counts the changes of the voxels and the palette, new scenes
     /// included: a frame drawn from revision r is up to date while it is r.
     revision: u64,
@@ -89,6 +92,7 @@ impl Editor {
         self.scene = scene;
         self.history.clear();
         self.selection = None;
+        self.ground = self.scene.tree.solid_voxels() == 0 && self.scene.objects.is_none();
         self.revision += 1;
     }
 
@@ -112,6 +116,7 @@ impl Editor {
                 return Ok(Outcome::Replaced);
             }
             Command::Brush(brush) => self.set(|e| e.tools.brush = *brush),
+            Command::Ground(on) => self.set(|e| e.ground = *on),
             Command::Color(c) => self.set(|e| e.tools.color = *c),
             Command::Mirror(plane) => self.set(|e| e.tools.mirror.apply_line(*plane)),
             Command::Pick(p) => {

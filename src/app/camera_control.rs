@@ -86,14 +86,8 @@ pub fn fly(camera: &mut Camera, dir: DVec3, seconds: f64) {
 /// A camera that shows the whole box `lo..=hi` (voxel corners), keeping the
 /// current viewing direction when there is one.
 pub fn frame_model(camera: &mut Camera, bounds: Option<(glam::IVec3, glam::IVec3)>) {
-    let Some((lo, hi)) = bounds else { return };
-    let framed = Camera::framing(lo, hi, camera.fov_y_deg);
-    let distance = (framed.eye - framed.target).length();
-    let back = (camera.eye - camera.target).try_normalize().unwrap_or((framed.eye - framed.target) / distance);
-    camera.target = framed.target;
-    camera.eye = framed.target + back * distance;
-    if camera.ortho.is_some() {
-        camera.ortho = Some(framed.view_height() as f32);
+    if let Some((lo, hi)) = bounds {
+        *camera = camera.reframed(lo, hi);
     }
 }
 

@@ -104,27 +104,13 @@ impl App {
             Pending::New => {
                 self.replace_scene(Scene::default(), octovox::script::Command::New, None);
                 self.state.camera = Camera { fov_y_deg: self.state.camera.fov_y_deg, ..Camera::default() };
-                // A lone voxel to attach to: an empty scene gives the mouse nothing to hit.
-                let color = self.doc.editor.tools.color.max(1);
-                if let Err(err) = self
-                    .doc
-                    .editor
-                    .scene
-                    .tree
-                    .apply_brush(&octovox::scene::Shape::Voxel(IVec3::ZERO), octovox::scene::Op::Place(color))
-                {
-                    self.ui.error(format!("cannot seed the new scene: {err}"));
-                }
-                self.record(|r| r.seed(color, IVec3::ZERO));
-                // The journal starts from the seeded scene too.
-                self.doc.journal_start.lines.extend([
-                    octovox::script::Command::Brush(octovox::edit::brush::Brush::Voxel),
-                    octovox::script::Command::Color(color),
-                    octovox::script::Command::Place(IVec3::ZERO),
-                ]);
-                self.upload();
+                // An empty scene on the ground: a first click attaches at y = 0.
                 self.state.dirty = false;
-                camera_control::frame_model(&mut self.state.camera, Some((IVec3::splat(-4), IVec3::splat(4))));
+                // The volume with a margin of half its side: the side panel covers some of the view.
+                let (side, half) = (self.state.volume, self.state.volume / 2);
+                let view = (IVec3::new(-side, -half, -side), IVec3::new(side, side + half, side) - IVec3::ONE);
+                camera_control::frame_model(&mut self.state.camera, Some(view));
+                report!("new: an empty scene on the ground");
             }
             Pending::Open(path) => self.start_loading(path),
             Pending::Quit => {

@@ -64,7 +64,10 @@ impl App {
         self.hover.pick = match self.input.cursor() {
             // A hover over a ray that gave up highlights nothing; a click says why.
             Some((x, y)) if !self.hover.pointer_over_ui && self.doc.loading.is_none() => {
-                self.pick_at(x, y).ok().flatten()
+                // What builds on the ground shows where it lands there too.
+                let on_ground =
+                    self.state.tool == super::state::Tool::Attach || self.state.line_mode || self.state.select_mode;
+                if on_ground { self.pick_or_ground(x, y) } else { self.pick_at(x, y) }.ok().flatten()
             }
             _ => None,
         };
@@ -138,11 +141,13 @@ impl App {
                 paste,
                 eyedropper,
                 objects: self.doc.editor.scene.objects.as_deref(),
+                ground: self.doc.editor.ground,
             };
             let (state, ui_state, tools) = (&mut self.state, &mut self.ui, &mut self.doc.editor.tools);
             let pick = self.hover.pick;
             ctx.run_ui(raw_input, |ui| {
                 commands = ui::show(ui, state, tools, ui_state, &info);
+                ui::draw_ground(ui, state, &info);
                 ui::draw_selection(ui, state, &info);
                 if let Some((voxels, normal, layers)) = info.extrude {
                     ui::draw_extrude(ui, state, &info, voxels, normal, layers);

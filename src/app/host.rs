@@ -138,8 +138,9 @@ impl Host for App {
         }
     }
 
-    fn pick(&mut self, x: u32, y: u32) -> Result<Option<(IVec3, IVec3)>, svo::GaveUp> {
-        Ok(self.pick_at(f64::from(x) + 0.5, f64::from(y) + 0.5)?.map(|pick| (pick.voxel, pick.normal)))
+    fn pick(&mut self, x: u32, y: u32) -> Result<Option<(IVec3, IVec3, u8)>, svo::GaveUp> {
+        let pick = self.pick_or_ground(f64::from(x) + 0.5, f64::from(y) + 0.5)?;
+        Ok(pick.map(|pick| (pick.voxel, pick.normal, pick.value)))
     }
 
     fn save(&mut self, path: &Path) -> Result<(), HostError> {

@@ -374,7 +374,7 @@ impl App {
             }
             Command::Zoom { steps, at } => {
                 // Toward the voxel under the cursor (a pick that fails zooms to the target).
-                let toward = at.and_then(|(x, y)| self.pick_at(x, y).ok().flatten());
+                let toward = at.and_then(|(x, y)| self.pick_or_ground(x, y).ok().flatten());
                 let toward = toward.map(|pick| pick.voxel.as_dvec3() + glam::DVec3::splat(0.5));
                 camera_control::zoom(&mut self.state.camera, steps, toward);
             }
@@ -453,6 +453,17 @@ impl App {
     /// pixels by the render scale; the panels sit over the image).
     /// A ray that gave up is an error, never "nothing under the cursor".
     fn pick_at(&self, x: f64, y: f64) -> Result<Option<Pick>, svo::GaveUp> {
+        self.pick_pixel(x, y, false)
+    }
+
+    /// [`App::pick_at`], or where there is no voxel and the ground is on,
+    /// the ground cell under y = 0 (value 0): what Attach, lines, selections
+    /// and pastes start from in an empty scene.
+    fn pick_or_ground(&self, x: f64, y: f64) -> Result<Option<Pick>, svo::GaveUp> {
+        self.pick_pixel(x, y, self.doc.editor.ground)
+    }
+
+    fn pick_pixel(&self, x: f64, y: f64, ground: bool) -> Result<Option<Pick>, svo::GaveUp> {
         let (window_w, window_h) = self.window_size();
         let (w, h) = self.trace_size();
         if x < 0.0 || y < 0.0 || x >= f64::from(window_w) || y >= f64::from(window_h) {
@@ -460,14 +471,23 @@ impl App {
         }
         let px = ((x * f64::from(w) / f64::from(window_w)) as u32).min(w - 1);
         let py = ((y * f64::from(h) / f64::from(window_h)) as u32).min(h - 1);
-        let hit = svo::pick(&self.doc.editor.scene.tree, &self.state.camera, (w, h), px, py)?;
+        let hit = svo::pick_with_ground(&self.doc.editor.scene.tree, &self.state.camera, (w, h), (px, py), ground)?;
         Ok(hit.map(|hit| Pick { voxel: hit.voxel, normal: hit.normal, value: hit.value }))
     }
 
     /// The voxel under window pixel (x, y) for a click; when there is none,
     /// `nothing` (or why the ray gave up) goes to the message line.
     fn pick_or_say(&mut self, x: f64, y: f64, nothing: &str) -> Option<Pick> {
-        match self.pick_at(x, y) {
+        self.say_if_none(self.pick_at(x, y), nothing)
+    }
+
+    /// [`App::pick_or_say`] with the ground ([`App::pick_or_ground`]).
+    fn pick_or_ground_or_say(&mut self, x: f64, y: f64, nothing: &str) -> Option<Pick> {
+        self.say_if_none(self.pick_or_ground(x, y), nothing)
+    }
+
+    fn say_if_none(&mut self, picked: Result<Option<Pick>, svo::GaveUp>, nothing: &str) -> Option<Pick> {
+        match picked {
             Ok(Some(pick)) => Some(pick),
             Ok(None) => {
                 self.ui.info(nothing);
@@ -483,7 +503,7 @@ impl App {
     /// Line mode: the press picks the start (in front of the face), the
     /// release the end; the brush is placed along the line as one step.
     fn line_edit(&mut self, phase: StrokePhase, x: f64, y: f64) {
-        let target = match self.pick_at(x, y) {
+        let target = match self.pick_or_ground(x, y) {
             Ok(Some(pick)) => Some(pick.voxel + pick.normal),
             Ok(None) => None,
             Err(gave_up) => {
@@ -641,7 +661,9 @@ impl App {
     /// new cell of the stroke's layer.
     fn stroke_step(&mut self, x: f64, y: f64) {
         let Some(stroke) = self.gesture.stroke() else { return };
-        let pick = match self.pick_at(x, y) {
+        // Attach builds on the ground too; Erase and Paint need a voxel.
+        let picked = if stroke.tool == Tool::Attach { self.pick_or_ground(x, y) } else { self.pick_at(x, y) };
+        let pick = match picked {
             Ok(Some(pick)) => pick,
             Ok(None) => return,
             Err(gave_up) => {

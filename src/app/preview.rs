@@ -57,7 +57,7 @@ impl App {
             _ if self.input.ctrl_held() && !self.state.line_mode && !self.state.select_mode => self.hover.pick,
             _ => None,
         }
-        .filter(|p| p.normal != IVec3::ZERO)
+        .filter(|p| p.normal != IVec3::ZERO && p.value != 0)
         .map(|p| (p.voxel, p.normal));
         let Some(face) = face else {
             self.hover.extrude_preview = None;
@@ -108,6 +108,6 @@ impl App {
 
     /// The colour Alt+click would pick: the voxel's under the cursor.
     pub(super) fn eyedropper_preview(&self) -> Option<u8> {
-        self.hover.pick.filter(|_| self.input.alt_held()).map(|p| p.value)
+        self.hover.pick.filter(|p| self.input.alt_held() && p.value != 0).map(|p| p.value)
     }
 }

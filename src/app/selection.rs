@@ -21,7 +21,8 @@ impl App {
                 let drag = match self.handle_at(x, y) {
                     Some(normal) => Some(SelectDrag::Face { normal, start: (x, y) }),
                     None => {
-                        self.pick_or_say(x, y, "no voxel there to select from").map(|p| SelectDrag::NewBox(p.voxel))
+                        let pick = self.pick_or_ground_or_say(x, y, "no voxel or ground there to select from");
+                        pick.map(|p| SelectDrag::NewBox(p.cell()))
                     }
                 };
                 self.gesture = drag.map_or(Gesture::Idle, Gesture::Select);
@@ -51,7 +52,7 @@ impl App {
         let Gesture::Select(drag) = self.gesture else { return None };
         match drag {
             SelectDrag::NewBox(from) => {
-                let to = self.pick_at(x, y).ok().flatten().map_or(from, |pick| pick.voxel);
+                let to = self.pick_or_ground(x, y).ok().flatten().map_or(from, |pick| pick.cell());
                 Region::new(from, to).ok()
             }
             SelectDrag::Face { normal, start } => {
@@ -86,7 +87,7 @@ impl App {
     /// face under the cursor.
     pub(super) fn paste_at_cursor(&mut self) {
         let Some((x, y)) = self.input.cursor() else { return };
-        if let Some(pick) = self.pick_or_say(x, y, "no face under the cursor to paste on") {
+        if let Some(pick) = self.pick_or_ground_or_say(x, y, "no face or ground under the cursor to paste on") {
             self.act(Line::Paste(pick.voxel + pick.normal), "paste");
         }
     }

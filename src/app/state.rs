@@ -20,7 +20,16 @@ use octovox::settings::{PathSettings, RenderSettings, Shading};
 pub struct Pick {
     pub voxel: IVec3,
     pub normal: IVec3,
+    /// The voxel's colour; 0 for the ground (the cell under y = 0).
     pub value: u8,
+}
+
+impl Pick {
+    /// The cell a selection starts or ends on: the voxel, or on the ground
+    /// the cell on it.
+    pub fn cell(&self) -> IVec3 {
+        if self.value == 0 { self.voxel + self.normal } else { self.voxel }
+    }
 }
 
 /// The brush shapes the panel offers; switching shapes keeps each one's
@@ -70,12 +79,23 @@ pub struct EditorState {
     pub select_mode: bool,
     /// The box a selection drag would select, while it is dragged.
     pub select_preview: Option<Region>,
+    /// Side of the working volume outlined on the ground (voxels): x and z
+    /// in -side/2..side/2, y in 0..side.
+    pub volume: i32,
 }
+
+/// The working volume's side in a new scene (MagicaVoxel opens on 40³,
+/// Goxel on a grid plane).
+pub const DEFAULT_VOLUME: i32 = 32;
+
+/// Sides the working volume may have.
+pub const VOLUME_RANGE: std::ops::RangeInclusive<i32> = 2..=1024;
 
 impl Default for EditorState {
     fn default() -> EditorState {
         EditorState {
             tool: Tool::Attach,
+            volume: DEFAULT_VOLUME,
             sphere_radius: 3,
             box_size: 3,
             camera: Camera::default(),

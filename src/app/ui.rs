@@ -120,6 +120,8 @@ pub struct Info<'a> {
     pub eyedropper: Option<u8>,
     /// The objects and layers of a scene of several objects.
     pub objects: Option<&'a Objects>,
+    /// Clicks that hit no voxel land on the ground (`ground on|off`).
+    pub ground: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -245,6 +247,7 @@ pub fn show(
         egui::ScrollArea::vertical().show(ui, |ui| {
             tool_panel(ui, state, tools);
             mirror(ui, tools);
+            ground(ui, state, info.ground, &mut out);
             ui.separator();
             palette(ui, tools, info.palette, &mut out);
             material_editor(ui, tools.color, info.palette, &mut out);
@@ -320,6 +323,21 @@ fn available(command: &Command, info: &Info) -> bool {
         Command::Object(_) => info.objects.is_some_and(|o| o.selected.is_some()),
         _ => true,
     }
+}
+
+/// The ground (`ground on|off`) and the side of the working volume drawn on it.
+fn ground(ui: &mut egui::Ui, state: &mut EditorState, on: bool, out: &mut Vec<Command>) {
+    ui.horizontal(|ui| {
+        let mut shown = on;
+        let tip = "clicks on empty space build on the ground at y = 0 (ground on|off)";
+        if ui.checkbox(&mut shown, "Ground").on_hover_text(tip).changed() {
+            out.push(Command::Lines(vec![octovox::script::Command::Ground(shown)]));
+        }
+        ui.label("volume");
+        let range = super::state::VOLUME_RANGE;
+        ui.add_enabled(on, egui::DragValue::new(&mut state.volume).range(range).suffix("³"))
+            .on_hover_text("the working volume outlined on the ground");
+    });
 }
 
 /// Mirror planes: a checkbox and the plane's coordinate per axis.
@@ -950,6 +968,35 @@ pub fn draw_extrude(ui: &egui::Ui, state: &EditorState, info: &Info, voxels: &[I
             painter.add(egui::Shape::convex_polygon(points, color.gamma_multiply(0.35), Stroke::new(1.0, color)));
         }
     }
+}
+
+/// The ground's grid at y = 0 over the working volume, and the volume's
+/// outline: where a first click in an empty scene builds. Drawn over the
+/// image, faintly (an overlay, not traced: voxels do not hide it).
+pub fn draw_ground(ui: &egui::Ui, state: &EditorState, info: &Info) {
+    if !info.ground {
+        return;
+    }
+    let screen = ui.ctx().content_rect();
+    let basis = state.camera.basis(screen.width().max(1.0) as u32, screen.height().max(1.0) as u32, info.tree.origin());
+    let origin = info.tree.origin().as_vec3();
+    let project = |p: Vec3| basis.project(p - origin).map(|(x, y)| egui::pos2(x, y));
+    let half = state.volume / 2;
+    // At most 64 lines a side: a large volume gets a coarser grid.
+    let step = (state.volume / 64).max(1) as usize;
+    let painter = scene_painter(ui.ctx());
+    let stroke = Stroke::new(1.0, Color32::from_white_alpha(70));
+    for i in (-half..=state.volume - half).step_by(step) {
+        let (i, lo, hi) = (i as f32, -half as f32, (state.volume - half) as f32);
+        for (a, b) in [(Vec3::new(i, 0.0, lo), Vec3::new(i, 0.0, hi)), (Vec3::new(lo, 0.0, i), Vec3::new(hi, 0.0, i))] {
+            if let (Some(p), Some(q)) = (project(a), project(b)) {
+                painter.line_segment([p, q], stroke);
+            }
+        }
+    }
+    let (lo, hi) =
+        (IVec3::new(-half, 0, -half), IVec3::new(state.volume - half - 1, state.volume - 1, state.volume - half - 1));
+    outline_box(ui, state, info, (lo, hi), Color32::from_white_alpha(40), false);
 }
 
 /// Outlines the selected box (or the one being dragged); in select mode

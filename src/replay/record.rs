@@ -5,13 +5,11 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use glam::IVec3;
-
 use crate::camera::Camera;
-use crate::edit::brush::{Brush, Tool};
+use crate::edit::brush::Brush;
 use crate::edit::mirror::Mirror;
 use crate::editor::Tools;
-use crate::script::{Command, ObjectLine, PaletteLine, edit_command};
+use crate::script::{Command, ObjectLine, PaletteLine};
 
 /// Writes script lines as the user works. Lines are flushed as they are
 /// written, so a crash loses nothing that was recorded.
@@ -119,18 +117,6 @@ impl Recorder {
         self.command(&command)
     }
 
-    /// A voxel the window places by itself (the seed of a new scene), not an
-    /// undo step there: recorded so the replay starts from the same voxels.
-    pub fn seed(&mut self, color: u8, at: IVec3) -> std::io::Result<()> {
-        // The seed is not mirrored.
-        self.set_mirror(&Mirror::default())?;
-        self.brush = Some(Brush::Voxel);
-        self.color = Some(color);
-        self.command(&Command::Brush(Brush::Voxel))?;
-        self.command(&Command::Color(color))?;
-        self.command(&edit_command(Tool::Attach, at))
-    }
-
     /// A line the editor ran (`octovox::editor::Editor::run`) with `tools`
     /// in force: edit lines after the state they depend on where it
     /// changed, each one undo step or, `in_stroke`, one edit of the open
@@ -168,6 +154,8 @@ impl Recorder {
             | Command::Projection(_)
             | Command::Viewport(..)
             | Command::Brush(_)
+            // Clicks are recorded as the edits they became: the ground is not needed.
+            | Command::Ground(_)
             | Command::Color(_)
             | Command::Mirror(_)
             | Command::Pick(_)

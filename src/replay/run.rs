@@ -186,8 +186,10 @@ impl Host for Runner {
         self.viewport = (width, height);
     }
 
-    fn pick(&mut self, x: u32, y: u32) -> Result<Option<(IVec3, IVec3)>, svo::GaveUp> {
-        Ok(svo::pick(&self.editor.scene.tree, &self.camera, self.viewport, x, y)?.map(|hit| (hit.voxel, hit.normal)))
+    fn pick(&mut self, x: u32, y: u32) -> Result<Option<(IVec3, IVec3, u8)>, svo::GaveUp> {
+        let (tree, ground) = (&self.editor.scene.tree, self.editor.ground);
+        let hit = svo::pick_with_ground(tree, &self.camera, self.viewport, (x, y), ground)?;
+        Ok(hit.map(|hit| (hit.voxel, hit.normal, hit.value)))
     }
 
     fn save(&mut self, path: &Path) -> Result<(), HostError> {

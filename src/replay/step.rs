@@ -43,11 +43,12 @@ pub trait Host {
     /// `viewport W H`: the size of renders and of the pixels `click` names.
     fn set_viewport(&mut self, width: u32, height: u32);
 
-    /// The world voxel and face normal under a pixel (what the mouse picks).
+    /// The world voxel, face normal and value under a pixel (what the mouse
+    /// picks); value 0: the ground (`Editor::ground`), no voxel.
     ///
     /// # Errors
     /// The traversal gave up.
-    fn pick(&mut self, x: u32, y: u32) -> Result<Option<(IVec3, IVec3)>, svo::GaveUp>;
+    fn pick(&mut self, x: u32, y: u32) -> Result<Option<(IVec3, IVec3, u8)>, svo::GaveUp>;
 
     /// `save PATH`.
     ///
@@ -166,7 +167,10 @@ fn host_line(host: &mut impl Host, base: &Path, line: &Command) -> Result<StepRe
         Command::Click { x, y, tool } => {
             let expected = format!("pixel ({x}, {y}) to hit a voxel");
             let (voxel, normal) = match host.pick(*x, *y) {
-                Ok(Some(hit)) => hit,
+                Ok(Some((voxel, normal, value))) if value != 0 || *tool == crate::edit::brush::Tool::Attach => {
+                    (voxel, normal)
+                }
+                Ok(Some(_)) => return Ok(StepResult::Failed { expected, got: "the ground (attach only)".into() }),
                 Ok(None) => return Ok(StepResult::Failed { expected, got: "no voxel under it".into() }),
                 Err(gave_up) => return Ok(StepResult::Failed { expected, got: gave_up.to_string() }),
             };

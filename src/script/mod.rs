@@ -35,6 +35,10 @@ pub enum Command {
     /// direction only); `perspective` (None) goes back to the field of view.
     Projection(Option<f32>),
     Brush(Brush),
+    /// `ground on|off`: whether a `click` (and the mouse) that hits no voxel
+    /// lands on the ground, the plane y = 0 (on after `new`, or any scene
+    /// that starts empty).
+    Ground(bool),
     Color(u8),
     Place(IVec3),
     Remove(IVec3),

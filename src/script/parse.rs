@@ -324,6 +324,14 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
         "perspective" => Command::Projection(None),
         "viewport" => Command::Viewport(c.int_in("width", 1..=8192)? as u32, c.int_in("height", 1..=8192)? as u32),
         "brush" => Command::Brush(parse_brush(c)?),
+        "ground" => {
+            let t = c.word("on or off")?;
+            Command::Ground(match t.text.as_str() {
+                "on" => true,
+                "off" => false,
+                other => return Err((t.column, format!("expected on or off, found '{other}'"))),
+            })
+        }
         "color" => Command::Color(c.int_in("palette index", 1..=255)? as u8),
         "rgb" => {
             let index = c.int_in("palette index", 1..=255)? as u8;
@@ -647,7 +655,7 @@ mod tests {
                     palette set 3 ff0000 00Ff00\npalette preset pico8\nexpect palette 7 1 2 3\n\
                     material 4 glass _ri 1.45 _trans 0.5\nmaterial 5 diffuse\npick 1 -2 3\nfill 0 0 -1\nmirror x 4.5\nmirror z -2\nmirror off\nline 1 2 3 -4 5 6\n\
                     extrude 1 2 3 0 -1 0 -2\nobject 3\nobject \"tree 4/top\"\nobject hide\nobject show\nlayer 2 hide\n\
-                    ortho 42.5\nperspective\nlayer 0 show\nexpect objects 19\nexpect models 15\nobject new \"a b\"\nobject move 1 -2 3\nobject rotate z\n\
+                    ortho 42.5\nperspective\nground off\nground on\nlayer 0 show\nexpect objects 19\nexpect models 15\nobject new \"a b\"\nobject move 1 -2 3\nobject rotate z\n\
                     object duplicate\nobject duplicate reference\nobject unique\nobject delete\nobject rename top\n\
                     object layer 3\nlayer 4 \"roof tiles\"\n";
         let script = parse_script(Path::new("t.ovr"), text).unwrap();
@@ -657,7 +665,7 @@ mod tests {
             script.lines.iter().map(|l| &l.command).collect::<Vec<_>>(),
             again.lines.iter().map(|l| &l.command).collect::<Vec<_>>()
         );
-        assert_eq!(script.lines.len(), 68);
+        assert_eq!(script.lines.len(), 70);
     }
 
     #[test]

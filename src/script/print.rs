@@ -27,6 +27,7 @@ impl fmt::Display for Command {
             Command::Viewport(w, h) => write!(f, "viewport {w} {h}"),
             Command::Projection(Some(height)) => write!(f, "ortho {height}"),
             Command::Projection(None) => write!(f, "perspective"),
+            Command::Ground(on) => write!(f, "ground {}", if *on { "on" } else { "off" }),
             Command::Brush(Brush::Voxel) => write!(f, "brush voxel"),
             Command::Brush(Brush::Sphere(r)) => write!(f, "brush sphere {r}"),
             Command::Brush(Brush::Box(s)) => write!(f, "brush box {}", v(*s)),

@@ -34,6 +34,40 @@ pub fn pick(tree: &Octree, camera: &Camera, size: (u32, u32), x: u32, y: u32) ->
     Ok(hit.is_hit().then(|| Hit { voxel: hit.voxel + tree.origin(), ..hit }))
 }
 
+/// [`pick`], and where it finds no voxel and `ground` is on, the ground:
+/// the cell under the plane y = 0 where the pixel's ray, coming down from
+/// above it, crosses it (value 0, normal +y: Attach places on (x, 0, z)).
+/// The ground of an empty scene is what a first click builds on.
+pub fn pick_with_ground(
+    tree: &Octree,
+    camera: &Camera,
+    size: (u32, u32),
+    (x, y): (u32, u32),
+    ground: bool,
+) -> Result<Option<Hit>, GaveUp> {
+    match pick(tree, camera, size, x, y)? {
+        Some(hit) => Ok(Some(hit)),
+        None if ground => Ok(ground_pick(camera, size, x, y)),
+        None => Ok(None),
+    }
+}
+
+/// The ground cell under pixel (x, y), if its ray comes down through y = 0.
+fn ground_pick(camera: &Camera, size: (u32, u32), x: u32, y: u32) -> Option<Hit> {
+    let (origin, dir) = camera.basis(size.0, size.1, glam::IVec3::ZERO).ray(x, y);
+    let (origin, dir) = (origin.as_dvec3(), dir.as_dvec3());
+    if origin.y <= 0.0 || dir.y >= 0.0 {
+        return None;
+    }
+    let at = origin + dir * (-origin.y / dir.y);
+    let limit = f64::from(crate::scene::octree::WORLD_LIMIT - 1);
+    if !(at.x.abs() < limit && at.z.abs() < limit) {
+        return None;
+    }
+    let voxel = glam::IVec3::new(at.x.floor() as i32, -1, at.z.floor() as i32);
+    Some(Hit { value: 0, voxel, normal: glam::IVec3::Y, ..Hit::default() })
+}
+
 /// A pick whose ray ran out of iterations: what lies under the pixel is
 /// unknown, which is not the same as nothing.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]

@@ -9,6 +9,7 @@ mod common;
 mod dialogs;
 mod e2e;
 mod extrude;
+mod ground;
 mod objects;
 mod record;
 mod recovery;

@@ -1,0 +1,89 @@
+//! An empty scene in the real window: File ▸ New shows the ground grid; a
+//! click on the ground and Save As give a file of one voxel (`dot_vox`
+//! reads it) at y = 0 on the cell under the cursor.
+#![allow(clippy::unwrap_used)] // in tests a panic is the failure report
+
+use crate::common;
+
+use std::time::Duration;
+
+use common::window::*;
+use glam::IVec3;
+use octovox::camera::Camera;
+use octovox::scene::Octree;
+use octovox::trace::svo;
+
+/// The working volume of a new scene (`DEFAULT_VOLUME` in src/app/state.rs).
+const VOLUME: i32 = 32;
+
+/// The camera New leaves: the default one, framing the working volume with
+/// a margin of half its side (as src/app/files.rs does).
+fn new_scene_camera() -> Camera {
+    let (side, half) = (VOLUME, VOLUME / 2);
+    Camera::default().reframed(IVec3::new(-side, -half, -side), IVec3::new(side - 1, side + half - 1, side - 1))
+}
+
+/// A pixel clear of the panels whose 5×5 neighbourhood lands on one ground
+/// cell, and that cell.
+fn stable_ground_pixel(camera: &Camera) -> (u32, u32, IVec3) {
+    let empty = Octree::default();
+    let cell = |x: u32, y: u32| {
+        svo::pick_with_ground(&empty, camera, (WIDTH, HEIGHT), (x, y), true).unwrap().map(|hit| hit.voxel)
+    };
+    for y in (HEIGHT / 2..HEIGHT - 40).step_by(7) {
+        for x in (FREE_X + 60..WIDTH - 60).step_by(7) {
+            let Some(at) = cell(x, y) else { continue };
+            if (-2..=2).all(|d: i32| {
+                (-2..=2).all(|e: i32| cell(x.wrapping_add_signed(d), y.wrapping_add_signed(e)) == Some(at))
+            }) {
+                return (x, y, at);
+            }
+        }
+    }
+    panic!("no pixel of the new scene's view lands steadily on one ground cell");
+}
+
+#[test]
+fn new_then_a_click_on_the_ground_places_a_voxel_at_y_0() {
+    require_window_tools();
+    let dir = tempfile::tempdir().unwrap();
+    let camera = new_scene_camera();
+    let (x, y, ground) = stable_ground_pixel(&camera);
+    assert_eq!((ground.y, ground.x.abs() < VOLUME, ground.z.abs() < VOLUME), (-1, true, true), "{ground}");
+
+    let (_xvfb, display) = start_xvfb(24);
+    let args = ["--size".to_owned(), format!("{WIDTH}x{HEIGHT}")];
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
+    let window = find_window(&display, &mut app, &stderr_path);
+    lines.wait_for("octovox: ready", Duration::from_secs(90));
+    xdotool(&display, &["windowfocus", "--sync", &window]);
+    let before = screenshot_x(&display, &dir.path().join("demo.png"));
+    xdotool(&display, &["key", "ctrl+n"]);
+    lines.wait_for("new: an empty scene on the ground", Duration::from_secs(30));
+    xdotool(&display, &["mousemove", "--window", &window, "790", "590"]);
+    std::thread::sleep(Duration::from_millis(800));
+    let empty = screenshot_x(&display, &dir.path().join("empty.png"));
+    if let Ok(keep) = std::env::var("OCTOVOX_KEEP_SHOTS") {
+        empty.save(format!("{keep}/new-scene.png")).unwrap();
+    }
+    // The grid's lines: lighter than the sky around them, along the ground.
+    let (mean, variance) = grey_stats(&empty, FREE_X, HEIGHT / 2, WIDTH - 20, HEIGHT - 20);
+    assert!(variance > 4.0, "the ground grid shows (grey mean {mean:.1}, variance {variance:.1})");
+    assert_ne!(before, empty, "New changed the picture");
+
+    click(&display, &window, &mut lines, x, y);
+    let file = dir.path().join("first.vox");
+    xdotool(&display, &["key", "ctrl+shift+s"]);
+    std::thread::sleep(Duration::from_millis(500));
+    xdotool(&display, &["key", "ctrl+a"]);
+    xdotool(&display, &["type", file.to_str().unwrap()]);
+    xdotool(&display, &["key", "Return"]);
+    lines.wait_for("saved:", Duration::from_secs(30));
+
+    // dot_vox's reading: one model of one voxel; where it is, octovox's.
+    let data = dot_vox::load_bytes(&std::fs::read(&file).unwrap()).unwrap();
+    assert_eq!(data.models.len(), 1);
+    assert_eq!(data.models[0].voxels.len(), 1, "one voxel");
+    let placed = octovox::io::load_scene(&file, 0).unwrap();
+    assert_eq!(placed.tree.voxels().into_iter().map(|(p, _)| p).collect::<Vec<_>>(), vec![ground + IVec3::Y]);
+}
