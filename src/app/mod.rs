@@ -511,15 +511,21 @@ impl App {
                 None
             }
         };
+        let why =
+            if self.doc.editor.ground { "no voxel or ground there" } else { "no voxel there, and the ground is off" };
         match phase {
-            StrokePhase::Begin => self.state.line_start = target,
-            StrokePhase::Move => {}
-            StrokePhase::End | StrokePhase::Click => {
-                let start = self.state.line_start.take().or(target);
-                if let (Some(a), Some(b)) = (start, target) {
-                    self.act(octovox::script::Command::Line(a, b), "line");
+            StrokePhase::Begin => {
+                self.state.line_start = target;
+                if target.is_none() {
+                    self.ui.info(format!("a line starts on a voxel face or the ground: {why}"));
                 }
             }
+            StrokePhase::Move => {}
+            StrokePhase::End | StrokePhase::Click => match (self.state.line_start.take().or(target), target) {
+                (Some(a), Some(b)) => self.act(octovox::script::Command::Line(a, b), "line"),
+                (Some(_), None) => self.ui.info(format!("no line drawn: it ends on the sky ({why})")),
+                (None, _) => {}
+            },
         }
     }
 

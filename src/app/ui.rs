@@ -256,10 +256,12 @@ pub fn show(
                 objects_panel(ui, objects, &mut out);
                 ui.separator();
             }
-            render(ui, state);
-            quality(ui, info.presets, &mut out);
-            ui.separator();
-            stats(ui, info);
+            // Sections below the palette collapse; none above it changes height.
+            egui::CollapsingHeader::new("Render").default_open(true).show(ui, |ui| {
+                render(ui, state);
+                quality(ui, info.presets, &mut out);
+            });
+            egui::CollapsingHeader::new("Stats").default_open(true).show(ui, |ui| stats(ui, info));
         });
     });
     super::gizmo::show(ui.ctx(), &state.camera, &mut out);
@@ -382,20 +384,27 @@ fn tool_panel(ui: &mut egui::Ui, state: &mut EditorState, tools: &mut Tools) {
             }
         }
     });
-    // The sliders show the brush in force (a script may have set it) and
-    // remember their sizes for the next switch.
+    // One row whatever the brush, so nothing below it moves: the slider
+    // shows the brush in force (a script may have set it) and remembers its
+    // size for the next switch; a voxel has none.
     match &mut tools.brush {
-        Brush::Voxel => {}
+        Brush::Voxel => {
+            ui.add_enabled(false, egui::Slider::new(&mut 1, 1..=1).text("size"));
+        }
         Brush::Sphere(radius) => {
             ui.add(egui::Slider::new(radius, 0..=32).text("radius"));
             state.sphere_radius = *radius;
         }
         Brush::Box(size) => {
             let mut side = size.max_element();
-            if ui.add(egui::Slider::new(&mut side, 1..=64).text("size")).changed() || size.min_element() == side {
-                *size = IVec3::splat(side);
+            let uneven = size.min_element() != side;
+            let tip = if uneven {
+                format!("{} × {} × {} (a script's box)", size.x, size.y, size.z)
             } else {
-                ui.small(format!("{} × {} × {} (a script's box)", size.x, size.y, size.z));
+                side.to_string()
+            };
+            if ui.add(egui::Slider::new(&mut side, 1..=64).text("size")).on_hover_text(tip).changed() || !uneven {
+                *size = IVec3::splat(side);
             }
             state.box_size = side;
         }
@@ -455,16 +464,13 @@ fn palette(ui: &mut egui::Ui, tools: &mut Tools, palette: &Palette, out: &mut Ve
     }
     let material = palette.material(tools.color);
     let [r, g, b, _] = palette.color(tools.color);
+    // One line whatever the entry holds (its parameters are the sliders
+    // below, their MATL keys in the sliders' tooltips).
     ui.label(format!(
         "colour {} · #{r:02x}{g:02x}{b:02x} · {}",
         tools.color,
         material.kind.vox_name().trim_start_matches('_')
     ));
-    let params: Vec<String> =
-        material.params.iter().filter(|(k, _)| k.as_str() != "_type").map(|(k, v)| format!("{k}={v}")).collect();
-    if !params.is_empty() {
-        ui.small(params.join(" "));
-    }
 }
 
 /// Most rows the Objects panel lists (a scene may place 10⁵ objects).
@@ -519,14 +525,17 @@ fn objects_panel(ui: &mut egui::Ui, objects: &Objects, out: &mut Vec<Command>) {
 /// The selected entry's colour, material kind and the parameters the path
 /// tracer reads; every change is an edit (undoable, saved in RGBA/MATL).
 fn material_editor(ui: &mut egui::Ui, index: u8, palette: &Palette, out: &mut Vec<Command>) {
-    let old_color = palette.color(index);
+    let [r, g, b, _] = palette.color(index);
+    let mut rgb = [r, g, b];
     let old = palette.material(index);
-    let mut color = Color32::from_rgba_unmultiplied(old_color[0], old_color[1], old_color[2], old_color[3]);
     let mut material = old.clone();
     let mut changed = false;
     ui.horizontal(|ui| {
-        changed |= ui.color_edit_button_srgba(&mut color).changed();
+        // A palette colour is opaque: RGB and hex, no alpha or blending.
+        changed |= ui.color_edit_button_srgb(&mut rgb).on_hover_text("rgb INDEX R G B").changed();
+        changed |= hex_field(ui, index, &mut rgb);
         egui::ComboBox::from_id_salt("material kind")
+            .width(70.0)
             .selected_text(material.kind.vox_name().trim_start_matches('_'))
             .show_ui(ui, |ui| {
                 for kind in MaterialKind::ALL {
@@ -538,6 +547,8 @@ fn material_editor(ui: &mut egui::Ui, index: u8, palette: &Palette, out: &mut Ve
                 }
             });
     });
+    // Three rows whatever the kind, so the panel below does not move: the
+    // rows a kind does not use are disabled.
     let sliders: &[(&str, &str, std::ops::RangeInclusive<f32>)] = match material.kind {
         MaterialKind::Metal => &[("_rough", "roughness", 0.0..=1.0), ("_metal", "metalness", 0.0..=1.0)],
         MaterialKind::Glass => &[
@@ -548,9 +559,14 @@ fn material_editor(ui: &mut egui::Ui, index: u8, palette: &Palette, out: &mut Ve
         MaterialKind::Emit => &[("_emit", "emission", 0.0..=1.0), ("_flux", "power", 0.0..=4.0)],
         MaterialKind::Diffuse | MaterialKind::Media => &[],
     };
-    for (key, label, range) in sliders {
+    for row in 0..MATERIAL_ROWS {
+        let Some((key, label, range)) = sliders.get(row) else {
+            ui.add_enabled(false, egui::Slider::new(&mut 0.0, 0.0..=1.0).show_value(false).text("—"));
+            continue;
+        };
         let mut value = material_value(&material, key);
-        if ui.add(egui::Slider::new(&mut value, range.clone()).text(*label)).changed() {
+        let slider = egui::Slider::new(&mut value, range.clone()).text(*label);
+        if ui.add(slider).on_hover_text(format!("MATL key {key}")).changed() {
             material.params.insert((*key).to_string(), format!("{value:.3}"));
             if *key == "_ri" {
                 // MagicaVoxel writes the index minus one as `_ior` beside `_ri`.
@@ -560,11 +576,36 @@ fn material_editor(ui: &mut egui::Ui, index: u8, palette: &Palette, out: &mut Ve
         }
     }
     if changed {
-        let edit =
-            octovox::edit::Edit::Palette { index, color: color.to_srgba_unmultiplied(), material: Box::new(material) };
+        let color = [rgb[0], rgb[1], rgb[2], 255];
+        let edit = octovox::edit::Edit::Palette { index, color, material: Box::new(material) };
         let dragging = ui.ctx().input(|i| i.pointer.any_down());
         out.push(Command::EditPalette { edit, dragging });
     }
+}
+
+/// Slider rows the material editor always shows (glass uses all three).
+const MATERIAL_ROWS: usize = 3;
+
+/// A `#rrggbb` field for the entry's colour: what is typed counts once it
+/// parses (on Enter or when the field loses focus). Whether it changed `rgb`.
+fn hex_field(ui: &mut egui::Ui, index: u8, rgb: &mut [u8; 3]) -> bool {
+    let id = egui::Id::unique(("palette hex", index));
+    let shown = format!("#{:02x}{:02x}{:02x}", rgb[0], rgb[1], rgb[2]);
+    let mut text = ui.data_mut(|d| d.get_temp::<String>(id)).unwrap_or_else(|| shown.clone());
+    let field = ui.add(egui::TextEdit::singleline(&mut text).desired_width(72.0)).on_hover_text("hex RRGGBB");
+    if field.has_focus() {
+        ui.data_mut(|d| d.insert_temp(id, text.clone()));
+    } else {
+        ui.data_mut(|d| d.remove::<String>(id));
+    }
+    if field.lost_focus()
+        && let Some(parsed) = octovox::io::palette_file::parse_hex(text.trim())
+    {
+        let changed = parsed != *rgb;
+        *rgb = parsed;
+        return changed;
+    }
+    false
 }
 
 /// The value the renderer uses for a MATL key (clamped, defaulted).
@@ -580,7 +621,6 @@ fn material_value(material: &Material, key: &str) -> f32 {
 }
 
 fn render(ui: &mut egui::Ui, state: &mut EditorState) {
-    ui.heading("Render");
     let settings = &mut state.settings;
     egui::ComboBox::from_id_salt("view").selected_text(format!("{:?}", settings.view)).show_ui(ui, |ui| {
         for view in View::ALL {
@@ -588,20 +628,21 @@ fn render(ui: &mut egui::Ui, state: &mut EditorState) {
         }
     });
     ui.horizontal(|ui| {
-        ui.label("--mode");
-        ui.radio_value(&mut settings.mode, TraceMode::Svo, "svo");
+        ui.label("Tracer").on_hover_text("--mode");
+        ui.radio_value(&mut settings.mode, TraceMode::Svo, "octree");
         ui.radio_value(&mut settings.mode, TraceMode::Grid, "grid (DDA)");
     });
-    ui.checkbox(&mut settings.shadows, "Sun shadows");
-    // The knobs carry their command-line names, as in `bench quality`;
-    // shorter sliders leave the panel room for them.
+    ui.checkbox(&mut settings.shadows, "Sun shadows").on_hover_text("--no-shadows turns them off");
+    // Plain labels; the command-line flag (the name `bench quality` uses)
+    // in each tooltip. Shorter sliders leave the panel room for them.
     ui.spacing_mut().slider_width = 64.0;
-    ui.add(egui::Slider::new(&mut settings.render_scale, 0.25..=1.0).text("--render-scale"));
-    ui.add(egui::Slider::new(&mut settings.lod, 0.0..=16.0).step_by(0.5).text("--lod (px)")).on_hover_text(
-        "level of detail: the preview stops at octree cells narrower than this many pixels \
+    ui.add(egui::Slider::new(&mut settings.render_scale, 0.25..=1.0).text("Render scale"))
+        .on_hover_text("--render-scale: the fraction of the window's pixels traced per axis");
+    ui.add(egui::Slider::new(&mut settings.lod, 0.0..=16.0).step_by(0.5).text("Level of detail (px)")).on_hover_text(
+        "--lod: the preview stops at octree cells narrower than this many pixels \
          and draws them as one solid cell (0 = exact; the path tracer is always exact)",
     );
-    ui.add(egui::Slider::new(&mut state.frame_target_ms, 10.0..=100.0).text("ms target"))
+    ui.add(egui::Slider::new(&mut state.frame_target_ms, 10.0..=100.0).text("Frame target (ms)"))
         .on_hover_text("frame time to hold while the camera moves: the render scale drops as far as needed");
     path_tracing(ui, state);
 }
@@ -641,13 +682,17 @@ fn path_tracing(ui: &mut egui::Ui, state: &mut EditorState) {
             ui.selectable_value(&mut state.shading, shading, shading.label());
         }
     });
-    if state.shading == Shading::Preview {
-        return;
-    }
+    // Disabled, not removed, in preview shading: the rows below stay put.
+    ui.add_enabled_ui(state.shading != Shading::Preview, |ui| path_knobs(ui, state));
+}
+
+fn path_knobs(ui: &mut egui::Ui, state: &mut EditorState) {
     let path = &mut state.path_settings;
-    ui.add(egui::Slider::new(&mut path.bounces, 0..=16).text("--bounces"));
-    ui.add(egui::Slider::new(&mut path.shadow_samples, 1..=16).text("--shadow-samples"));
-    ui.add(egui::Slider::new(&mut state.sample_target, 1..=4096).logarithmic(true).text("--spp"));
+    ui.add(egui::Slider::new(&mut path.bounces, 0..=16).text("Bounces")).on_hover_text("--bounces");
+    ui.add(egui::Slider::new(&mut path.shadow_samples, 1..=16).text("Shadow samples"))
+        .on_hover_text("--shadow-samples: shadow rays toward the sun and the emitters per hit");
+    ui.add(egui::Slider::new(&mut state.sample_target, 1..=4096).logarithmic(true).text("Samples per pixel"))
+        .on_hover_text("--spp: the path tracer stops at this many samples while the camera rests");
     ui.horizontal(|ui| {
         ui.checkbox(&mut path.sun, "Sun");
         egui::ComboBox::from_id_salt("sky").selected_text(format!("sky: {:?}", path.sky)).show_ui(ui, |ui| {
@@ -657,13 +702,13 @@ fn path_tracing(ui: &mut egui::Ui, state: &mut EditorState) {
         });
     });
     ui.horizontal(|ui| {
-        ui.radio_value(&mut path.effects, EffectsChoice::Auto, "effects: auto");
-        ui.radio_value(&mut path.effects, EffectsChoice::All, "all");
+        ui.radio_value(&mut path.effects, EffectsChoice::Auto, "effects: the scene's")
+            .on_hover_text("--effects auto: the kernel compiled for the effects the scene holds");
+        ui.radio_value(&mut path.effects, EffectsChoice::All, "all").on_hover_text("--effects all");
     });
 }
 
 fn stats(ui: &mut egui::Ui, info: &Info) {
-    ui.heading("Stats");
     let s = info.stats;
     let tree = info.tree;
     let pool = tree.pool();

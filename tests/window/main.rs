@@ -11,6 +11,7 @@ mod e2e;
 mod extrude;
 mod ground;
 mod objects;
+mod panel;
 mod record;
 mod recovery;
 mod select;
