@@ -52,7 +52,7 @@ const fn object(label: &'static str, code: KeyCode, shift: bool, line: ObjectLin
 }
 
 /// Every keyboard action, in menu order.
-pub static ACTIONS: [Action; 47] = [
+pub static ACTIONS: [Action; 48] = [
     ctrl("New", KeyCode::KeyN, FILE, Command::New),
     ctrl("Open…", KeyCode::KeyO, FILE, Command::AskOpen),
     ctrl("Save", KeyCode::KeyS, FILE, Command::Save),
@@ -86,6 +86,14 @@ pub static ACTIONS: [Action; 47] = [
     object("Hide object", KeyCode::KeyH, false, ObjectLine::Hide(true)),
     object("Delete object", KeyCode::Delete, false, ObjectLine::Delete),
     key("Frame model", KeyCode::KeyF, VIEW, Command::FrameModel),
+    Action {
+        label: "Frame selection",
+        key: KeyCode::KeyF,
+        ctrl: false,
+        shift: true,
+        menu: VIEW,
+        command: Command::FrameSelection,
+    },
     key("Orthographic or perspective", KeyCode::KeyO, VIEW, Command::ToggleProjection),
     key("Orthographic or perspective", KeyCode::Numpad5, None, Command::ToggleProjection),
     key("Front view", KeyCode::Numpad1, VIEW, Command::ViewFrom(IVec3::Z)),

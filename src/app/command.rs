@@ -135,6 +135,8 @@ pub enum Command {
     /// Look at the target from this side (a world axis: +z front, +x right, +y top).
     ViewFrom(glam::IVec3),
     FrameModel,
+    /// Frame the selected box (the model when nothing is selected).
+    FrameSelection,
     /// Start over with an empty scene (asks first if there are unsaved changes).
     New,
     /// Load a .vox on a background thread (asks first if there are unsaved changes).

@@ -303,7 +303,7 @@ impl App {
                 // A camera from the command line wins for the file it came with.
                 let keep_camera = self.args.camera.is_some() && self.args.file.as_ref() == Some(&loading.path);
                 if !keep_camera {
-                    self.frame_model();
+                    self.frame_box(self.doc.editor.scene.tree.solid_bounds());
                 }
                 self.ui.info(format!("opened {}", loading.path.display()));
                 if let Some(document) = self.state.path.clone()

@@ -161,7 +161,7 @@ impl App {
                 let built_in = app.args.demo.unwrap_or_default();
                 app.replace_scene(built_in.scene(), octovox::script::Command::Demo(built_in), None);
                 if app.args.camera.is_none() {
-                    app.frame_model();
+                    app.frame_box(app.doc.editor.scene.tree.solid_bounds());
                 }
                 // An untitled scene of a session that died: offer it back.
                 if let Some(journal) = octovox::journal::orphaned_untitled(std::path::Path::new(SAVES_DIR)).first() {
@@ -380,7 +380,11 @@ impl App {
             }
             Command::ToggleProjection => camera_control::toggle_projection(&mut self.state.camera),
             Command::ViewFrom(side) => camera_control::view_from(&mut self.state.camera, side.as_dvec3()),
-            Command::FrameModel => self.frame_model(),
+            Command::FrameModel => self.frame_box(self.doc.editor.scene.tree.solid_bounds()),
+            Command::FrameSelection => {
+                let selected = self.doc.editor.selection.map(|r| (r.min, r.max));
+                self.frame_box(selected.or_else(|| self.doc.editor.scene.tree.solid_bounds()));
+            }
             Command::New => self.guard_unsaved(Pending::New, event_loop),
             Command::Open(path) => self.guard_unsaved(Pending::Open(path), event_loop),
             Command::Quit => self.guard_unsaved(Pending::Quit, event_loop),
@@ -419,10 +423,10 @@ impl App {
         self.request_redraw();
     }
 
-    /// Frames the whole model, centred in the part of the window that the
-    /// side panel leaves free.
-    fn frame_model(&mut self) {
-        camera_control::frame_model(&mut self.state.camera, self.doc.editor.scene.tree.solid_bounds());
+    /// Frames the box (the whole model, or the selection), centred in the
+    /// part of the window that the side panel leaves free.
+    fn frame_box(&mut self, bounds: Option<(IVec3, IVec3)>) {
+        camera_control::frame_model(&mut self.state.camera, bounds);
         let (scale, height) =
             self.gfx.as_ref().map_or((1.0, self.args.size.1), |g| (g.window.scale_factor(), g.config.height));
         camera_control::pan(&mut self.state.camera, f64::from(ui::PANEL_WIDTH) * scale * 0.5, 0.0, height);

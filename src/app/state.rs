@@ -131,6 +131,13 @@ impl EditorState {
     }
 
     /// Inclusive world box of the cells the brush would touch at `pick`.
+    /// The brush's shape where a click at `pick` would apply it (not while
+    /// a line is dragged: then [`EditorState::preview_box`] spans it).
+    pub fn preview_shape(&self, tools: &Tools, pick: &Pick) -> Option<octovox::scene::Shape> {
+        let (center, _) = self.edit_at(tools, self.tool, pick);
+        self.line_start.is_none().then(|| tools.brush.shape_at(center))
+    }
+
     pub fn preview_box(&self, tools: &Tools, pick: &Pick) -> (IVec3, IVec3) {
         if let Some(start) = self.line_start {
             // While a line is dragged: the box from its start to here.

@@ -941,21 +941,51 @@ pub fn take_scene_overlays(ctx: &egui::Context) -> Vec<egui::epaint::ClippedShap
 /// camera), so the preview also shows Attach's target cells, which are empty
 /// and so cannot be tinted by the shader.
 pub fn draw_brush_outline(ui: &egui::Ui, state: &EditorState, tools: &Tools, pick: &Pick, info: &Info) {
+    use octovox::scene::Shape;
     let (lo, hi) = state.preview_box(tools, pick);
     let color = match state.tool {
         Tool::Attach => egui::Color32::from_rgb(120, 255, 140),
         Tool::Erase => egui::Color32::from_rgb(255, 100, 90),
         Tool::Paint => egui::Color32::from_rgb(255, 220, 90),
     };
+    // A sphere is outlined as a sphere, a box (or a line's span) as a box.
+    let shape = state.preview_shape(tools, pick).unwrap_or(Shape::Box { min: lo, max: hi });
     // With mirror planes on, where the images of the edit land too.
-    let brush = octovox::edit::Edit::Brush {
-        shape: octovox::scene::Shape::Box { min: lo, max: hi },
-        op: octovox::scene::Op::Remove,
-    };
+    let brush = octovox::edit::Edit::Brush { shape, op: octovox::scene::Op::Remove };
     for image in tools.mirror.edits(brush) {
-        if let octovox::edit::Edit::Brush { shape, .. } = image {
-            outline_box(ui, state, info, shape.bounds(), color, false);
+        match image {
+            octovox::edit::Edit::Brush { shape: Shape::Sphere { center, radius }, .. } => {
+                outline_sphere(ui, state, info, center, radius, color);
+            }
+            octovox::edit::Edit::Brush { shape, .. } => outline_box(ui, state, info, shape.bounds(), color, false),
+            _ => {}
         }
+    }
+}
+
+/// The silhouette of the sphere of cells within `radius` of `center`'s
+/// centre: a circle about it, facing the camera, and its equator.
+fn outline_sphere(ui: &egui::Ui, state: &EditorState, info: &Info, center: IVec3, radius: i32, color: Color32) {
+    let screen = ui.ctx().content_rect();
+    let basis = state.camera.basis(screen.width().max(1.0) as u32, screen.height().max(1.0) as u32, info.tree.origin());
+    let middle = (center - info.tree.origin()).as_vec3() + Vec3::splat(0.5);
+    let (_, right, up) = state.camera.axes();
+    let r = radius as f32 + 0.5;
+    let ring = |a: Vec3, b: Vec3| -> Option<Vec<egui::Pos2>> {
+        (0..=48)
+            .map(|i| {
+                let angle = i as f32 / 48.0 * std::f32::consts::TAU;
+                let p = middle + (a * angle.cos() + b * angle.sin()) * r;
+                basis.project(p).map(|(x, y)| egui::pos2(x, y))
+            })
+            .collect()
+    };
+    let painter = scene_painter(ui.ctx());
+    if let Some(points) = ring(right.as_vec3(), up.as_vec3()) {
+        painter.add(egui::Shape::line(points, Stroke::new(1.5, color)));
+    }
+    if let Some(points) = ring(Vec3::X, Vec3::Z) {
+        painter.add(egui::Shape::line(points, Stroke::new(1.0, color.gamma_multiply(0.6))));
     }
 }
 
