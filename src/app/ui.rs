@@ -868,7 +868,9 @@ fn recover_prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Com
         }
         ui.horizontal(|ui| {
             let apply = if doubt.is_some() { "Apply anyway" } else { "Recover" };
-            if ui.button(apply).clicked() {
+            // Enter recovers (where no doubt was raised): the default answer.
+            let enter = doubt.is_none() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+            if ui.button(format!("{apply}{}", if doubt.is_none() { " (Enter)" } else { "" })).clicked() || enter {
                 ui_state.recover = None;
                 let checks = octovox::journal::Checks { allow_changed_source: doubt.is_some() };
                 out.push(Command::RecoverJournal(journal.clone(), checks));

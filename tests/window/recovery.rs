@@ -395,3 +395,36 @@ fn a_journal_that_cannot_be_written_is_shown_and_leaves_nothing() {
     assert!(orange > 20, "the menu bar shows the warning ({orange} orange pixels)");
     app.0.kill().unwrap();
 }
+
+/// Issue 27, bug 1: after Recover the view showed the scene from before the
+/// crash (the GPU copy was not updated). The torus is painted red, the
+/// window killed and opened again on the file; Enter recovers, and the
+/// screenshot shows red.
+#[test]
+fn the_recovered_scene_is_what_the_window_shows() {
+    let (dir, file) = small_document();
+    let script = "rgb 5 255 0 0\ncolor 5\nbrush sphere 20\npaint 0 0 0\n";
+    let (_xvfb, display) = start_xvfb(26);
+    let (mut app, mut lines) = play_in_window(&display, dir.path(), script, &[]);
+    assert_eq!(lines.wait_for("replay:", Duration::from_secs(90)), "replay: 0 passed, 0 failed");
+    app.0.kill().unwrap();
+    app.0.wait().unwrap();
+
+    let args = [s(&file).to_string(), "--size".into(), "640x480".into()];
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
+    let window = find_window(&display, &mut app, &stderr_path);
+    lines.wait_for("asking: recover", Duration::from_secs(90));
+    let red = |shot: &image::RgbImage| shot.pixels().filter(|p| p.0[0] > 120 && p.0[1] < 60 && p.0[2] < 60).count();
+    let before = screenshot_x(&display, &dir.path().join("before.png"));
+    xdotool(&display, &["windowfocus", "--sync", &window]);
+    xdotool(&display, &["key", "Return"]);
+    lines.wait_for("recovered:", Duration::from_secs(60));
+    xdotool(&display, &["mousemove", "--window", &window, "630", "470"]);
+    std::thread::sleep(Duration::from_millis(1000));
+    let after = screenshot_x(&display, &dir.path().join("after.png"));
+    if let Ok(keep) = std::env::var("OCTOVOX_KEEP_SHOTS") {
+        after.save(format!("{keep}/recovered.png")).unwrap();
+    }
+    assert!(red(&before) < 50, "before Recover the torus is not red ({} red pixels)", red(&before));
+    assert!(red(&after) > 2000, "after Recover the view shows the red torus ({} red pixels)", red(&after));
+}
