@@ -232,13 +232,9 @@ fn beam_search(tile: vec2<u32>) -> f32 {
     let n3 = inward(cross(c01, c00), center);
     var best = BEAM_NONE;
     let depth = u.depth;
-    // An orthographic view's rays are parallel (no pyramid about the eye):
-    // every tile is traced from its rays' origins.
-    if (u.ortho != 0u) {
-        return select(0.0, BEAM_NONE, u.root == 0u);
-    }
-    if ((u.root & POINTER_BIT) == 0u || depth <= BEAM_LEVEL) {
-        // Too small to search: start every ray at the eye.
+    // Too small to search, or an orthographic view (parallel rays: no
+    // pyramid about the eye): every ray starts at its origin.
+    if (u.ortho != 0u || (u.root & POINTER_BIT) == 0u || depth <= BEAM_LEVEL) {
         return select(0.0, BEAM_NONE, u.root == 0u);
     }
     var node = u.root;

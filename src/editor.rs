@@ -11,6 +11,7 @@ use crate::edit::mirror::Mirror;
 use crate::edit::selection::{self, Block, Region};
 use crate::edit::{Edit, History};
 use crate::scene::objects::Objects;
+use crate::scene::transform::CellMap;
 use crate::scene::{EditError, Op, Palette, Scene};
 use crate::script::{Command, LayerLine, ObjectLine, ObjectRef, PaletteLine};
 use crate::settings::PathSettings;
@@ -30,6 +31,8 @@ pub enum EditorError {
     NoSteps(&'static str),
     #[error("only {available} step(s) to {what}, not {wanted}")]
     TooFewSteps { what: &'static str, available: usize, wanted: u32 },
+    #[error("there is no palette preset '{0}'")]
+    NoPreset(String),
     /// An `object` or `layer` line that names nothing, or more than one thing.
     #[error("{0}")]
     Object(String),
@@ -148,8 +151,8 @@ impl Editor {
                 self.commit(palette_colors(&self.scene.palette, *first, colors))?
             }
             Command::Palette(PaletteLine::Preset(name)) => {
-                let colors = crate::io::palette_file::preset(name)
-                    .ok_or_else(|| EditorError::Object(format!("there is no palette preset '{name}'")))?;
+                let colors =
+                    crate::io::palette_file::preset(name).ok_or_else(|| EditorError::NoPreset(name.clone()))?;
                 self.commit(palette_colors(&self.scene.palette, 1, &colors))?
             }
             Command::ExpectPalette(index, want) => {
@@ -374,13 +377,7 @@ impl Editor {
     /// new place is outside the world. Whether the voxels changed.
     fn move_selection(&mut self, by: IVec3) -> Result<bool, EditorError> {
         let region = self.selected()?;
-        let moved = region.shifted(by).inside_world()?;
-        let block = selection::copy(&self.scene.tree, region)?;
-        let mut edits = vec![region.clear_edit()];
-        edits.extend(block.place_edits(moved.min));
-        let changed = self.commit(edits)?;
-        self.selection = Some(moved);
-        Ok(changed)
+        self.relocate_selection(region, region.shifted(by), &CellMap::IDENTITY)
     }
 
     /// `rotate` (`flip`): the selected voxels leave their box and land
@@ -389,12 +386,20 @@ impl Editor {
     fn turn_selection(&mut self, axis: usize, flip: bool) -> Result<bool, EditorError> {
         let region = self.selected()?;
         let (turned, map) = region.turned(axis, flip);
-        let turned = turned.inside_world()?;
-        let block = selection::copy(&self.scene.tree, region)?.mapped(&map, turned.size());
+        self.relocate_selection(region, turned, &map)
+    }
+
+    /// The voxels of `region` leave it and land in `target`, each cell taken
+    /// through `map` (cells relative to each box's min corner), as one undo
+    /// step; `target` becomes the selection. Refused as a whole when
+    /// `target` is outside the world. Whether the voxels changed.
+    fn relocate_selection(&mut self, region: Region, target: Region, map: &CellMap) -> Result<bool, EditorError> {
+        let target = target.inside_world()?;
+        let block = selection::copy(&self.scene.tree, region)?.mapped(map, target.size());
         let mut edits = vec![region.clear_edit()];
-        edits.extend(block.place_edits(turned.min));
+        edits.extend(block.place_edits(target.min));
         let changed = self.commit(edits)?;
-        self.selection = Some(turned);
+        self.selection = Some(target);
         Ok(changed)
     }
 
@@ -572,18 +577,9 @@ mod tests {
         assert_eq!(editor.selection, Some(Region { min: IVec3::new(10, 0, 0), max: IVec3::new(11, 1, 1) }));
     }
 
-    /// Every solid voxel of the editor's scene with its colour.
+    /// Every solid voxel of the editor's scene with its colour, in one order.
     fn voxels(editor: &Editor) -> Vec<(IVec3, u8)> {
-        let mut out = Vec::new();
-        editor.scene.tree.for_each_solid_cell_in(IVec3::splat(-64), IVec3::splat(64), |min, size, color| {
-            for z in 0..size {
-                for y in 0..size {
-                    for x in 0..size {
-                        out.push((min + IVec3::new(x, y, z), color));
-                    }
-                }
-            }
-        });
+        let mut out = editor.scene.tree.voxels();
         out.sort_by_key(|(p, _)| (p.x, p.y, p.z));
         out
     }

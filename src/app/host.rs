@@ -89,12 +89,17 @@ impl App {
         }
     }
 
+    /// The rule every command that writes follows: the kind's extension,
+    /// never an input (the played script, the open document).
+    fn check_write(&self, path: &Path, kind: OutputKind) -> Result<(), HostError> {
+        let inputs: Vec<&Path> = self.doc.player.iter().map(|p| p.path()).chain(self.state.path.as_deref()).collect();
+        Ok(check_output(path, kind, &inputs, false)?)
+    }
+
     /// `render PATH` in the window: the image `octovox replay` makes (the
     /// script's viewport, the default settings), by the window's renderer.
     fn render_for_script(&mut self, path: &Path) -> Result<image::RgbaImage, HostError> {
-        // The rule every command that writes follows: a .png, never an input.
-        let inputs: Vec<&Path> = self.doc.player.iter().map(|p| p.path()).chain(self.state.path.as_deref()).collect();
-        check_output(path, OutputKind::Image, &inputs, false)?;
+        self.check_write(path, OutputKind::Image)?;
         let gfx = self.gfx.as_mut().ok_or(HostError::NoGpuYet)?;
         let viewport = self.doc.player.as_ref().map_or(octovox::replay::DEFAULT_VIEWPORT, |p| p.viewport);
         let settings = RenderSettings::default();
@@ -152,6 +157,13 @@ impl Host for App {
         if let Some(player) = &mut self.doc.player {
             player.last_render = Some(image);
         }
+        Ok(())
+    }
+
+    fn save_palette(&mut self, path: &Path) -> Result<(), HostError> {
+        self.check_write(path, OutputKind::Palette)?;
+        octovox::io::palette_file::save(&self.doc.editor.scene.palette, path)?;
+        report!("palette saved: {}", path.display());
         Ok(())
     }
 

@@ -17,6 +17,8 @@ pub enum OutputKind {
     Mesh,
     /// The materials of an exported .obj: `.mtl`.
     Materials,
+    /// A palette: `.png`, `.hex` or `.gpl`.
+    Palette,
 }
 
 impl OutputKind {
@@ -28,6 +30,7 @@ impl OutputKind {
             OutputKind::Script => &[],
             OutputKind::Mesh => &["obj", "ply", "glb"],
             OutputKind::Materials => &["mtl"],
+            OutputKind::Palette => &["png", "hex", "gpl"],
         }
     }
 }

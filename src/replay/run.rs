@@ -208,6 +208,13 @@ impl Host for Runner {
         Ok(())
     }
 
+    fn save_palette(&mut self, path: &Path) -> Result<(), HostError> {
+        self.check_output(path, OutputKind::Palette)?;
+        crate::io::palette_file::save(&self.editor.scene.palette, path)?;
+        self.written.push(path.to_path_buf());
+        Ok(())
+    }
+
     fn last_render(&self) -> Option<&image::RgbaImage> {
         self.last_render.as_ref()
     }

@@ -63,6 +63,13 @@ pub trait Host {
     /// The render failed or the file cannot be written.
     fn render(&mut self, path: &Path) -> Result<(), HostError>;
 
+    /// `palette save PATH`: the palette, under the rule every command that
+    /// writes follows (`crate::io::output`).
+    ///
+    /// # Errors
+    /// The file may not or cannot be written.
+    fn save_palette(&mut self, path: &Path) -> Result<(), HostError>;
+
     /// The image of the last `render`.
     fn last_render(&self) -> Option<&image::RgbaImage>;
 
@@ -194,7 +201,9 @@ fn host_line(host: &mut impl Host, base: &Path, line: &Command) -> Result<StepRe
             return step(host, base, &Command::Palette(PaletteLine::Set { first: 1, colors }));
         }
         Command::Palette(PaletteLine::Save(path)) => {
-            crate::io::palette_file::save(&host.editor().scene.palette, &base.join(path)).map_err(HostError::from)?;
+            // An unknown format is named as a palette's, before the rule of outputs.
+            crate::io::palette_file::PaletteFormat::of(path).map_err(HostError::from)?;
+            host.save_palette(&base.join(path))?;
         }
         Command::Save(path) => host.save(&base.join(path))?,
         Command::Render(path) => host.render(&base.join(path))?,
