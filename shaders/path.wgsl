@@ -58,7 +58,12 @@ struct Emitter {
 var<private> pu: PathUniforms;
 @group(0) @binding(9) var<storage, read> materials: array<Material>;
 @group(0) @binding(10) var<storage, read> emitters: array<Emitter>;
+// Two vec4 per pixel: the sum of the samples and their count, then the sum
+// of their squares (the denoiser's variance and the noise estimate).
 @group(0) @binding(11) var<storage, read_write> accum: array<vec4<f32>>;
+// The denoiser's guide per pixel (twin of `Guide` in src/trace/denoise.rs):
+// the point where the centre ray enters a face, as bits, then the code.
+@group(0) @binding(12) var<storage, read_write> guides: array<vec4<u32>>;
 
 // ---- random numbers (twin of src/trace/path/rng.rs) ----
 
@@ -478,6 +483,24 @@ fn clamp_sample(v: vec3<f32>) -> vec3<f32> {
     return select(vec3<f32>(0.0), clamp(v, vec3<f32>(0.0), vec3<f32>(MAX_SAMPLE_RADIANCE)), finite);
 }
 
+// The guide of a pixel: the first hit of its centre ray, if the denoiser
+// may filter it (twin of `PathScene::guide`).
+fn write_guide(px: vec2<u32>, pixel: u32) {
+    let r = pixel_ray(px);
+    let hit = cross_medium(r, 0u);
+    var guide = vec4<u32>(0u);
+    if (hit.found && hit.normal_code != 0u) {
+        let kind = materials[hit.value].kind;
+        let left = (EMIT && kind == MATERIAL_EMIT) || (GLASS && kind == MATERIAL_GLASS)
+            || (METAL && kind == MATERIAL_METAL);
+        if (!left) {
+            let code = (palette[hit.value] & 0xffffffu) | (hit.normal_code << GUIDE_NORMAL_SHIFT) | GUIDE_FILTERED;
+            guide = vec4<u32>(bitcast<vec3<u32>>(surface_point(r, hit)), code);
+        }
+    }
+    guides[pixel] = guide;
+}
+
 @compute @workgroup_size(8, 8)
 fn path(@builtin(global_invocation_id) gid: vec3<u32>) {
     load_constants();
@@ -492,7 +515,13 @@ fn path(@builtin(global_invocation_id) gid: vec3<u32>) {
     let jy = rng_next();
     let r = image_ray(vec2<f32>(px) + vec2<f32>(jx, jy));
     let sample = clamp_sample(radiance(r));
-    let sum = select(accum[pixel].rgb, vec3<f32>(0.0), pu.sample_index == 0u) + sample;
-    accum[pixel] = vec4<f32>(sum, f32(pu.sample_index + 1u));
+    let first = pu.sample_index == 0u;
+    let sum = select(accum[2u * pixel].rgb, vec3<f32>(0.0), first) + sample;
+    let squares = select(accum[2u * pixel + 1u].rgb, vec3<f32>(0.0), first) + sample * sample;
+    accum[2u * pixel] = vec4<f32>(sum, f32(pu.sample_index + 1u));
+    accum[2u * pixel + 1u] = vec4<f32>(squares, 0.0);
     textureStore(out_color, vec2<i32>(px), vec4<f32>(sum / f32(pu.sample_index + 1u), 1.0));
+    if (first) {
+        write_guide(px, pixel);
+    }
 }

@@ -218,7 +218,8 @@ pub struct RenderArgs {
     pub lod: f32,
     #[command(flatten)]
     pub path: PathArgs,
-    /// Print one JSON object on stdout: effects, spp, ms_per_sample, adapter.
+    /// Print one JSON object on stdout: effects, spp, ms_per_sample,
+    /// denoise_ms, noise_estimate, adapter, lights.
     #[arg(long)]
     pub stats: bool,
 }
@@ -226,9 +227,18 @@ pub struct RenderArgs {
 /// The path tracer's knobs on the command line.
 #[derive(Args, Debug, Clone, Copy)]
 pub struct PathArgs {
-    /// Path trace with N samples per pixel (without it: the preview shading).
+    /// Path trace with N samples per pixel (without it: the preview shading;
+    /// with --target-error: at most N).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
     pub spp: Option<u32>,
+    /// Path trace until the estimated noise (the RMS standard error of the
+    /// displayed pixels, 0..1 or a percentage such as 1%) is below E; at
+    /// most --spp samples (default 4096).
+    #[arg(long, value_parser = parse_target_error, value_name = "E")]
+    pub target_error: Option<f32>,
+    /// Denoise the path-traced image (the edge-avoiding à-trous filter).
+    #[arg(long)]
+    pub denoise: bool,
     /// Scattering events per path (passing through glass does not count).
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=i64::from(octovox::settings::MAX_BOUNCES)))]
     pub bounces: u32,
@@ -246,7 +256,20 @@ pub struct PathArgs {
     pub no_sun: bool,
 }
 
+/// Samples `--target-error` takes at most when `--spp` does not say.
+pub const TARGET_ERROR_CAP: u32 = 4096;
+
 impl PathArgs {
+    /// Whether the path tracer renders (`--spp` or `--target-error`).
+    pub fn traced(&self) -> bool {
+        self.spp.is_some() || self.target_error.is_some()
+    }
+
+    /// The samples to take, or at most to take with `--target-error`.
+    pub fn samples(&self) -> u32 {
+        self.spp.unwrap_or(TARGET_ERROR_CAP)
+    }
+
     pub fn settings(&self) -> octovox::settings::PathSettings {
         octovox::settings::PathSettings {
             bounces: self.bounces,
@@ -332,6 +355,19 @@ pub fn parse_render_scale(s: &str) -> Result<f32, String> {
     match s.trim().parse::<f32>() {
         Ok(v) if range.contains(&v) => Ok(v),
         _ => Err(format!("render scale '{s}' is not a number in {}..=1", range.start())),
+    }
+}
+
+/// Parses a noise target: a fraction in (0, 1), or a percentage ("1%").
+pub fn parse_target_error(s: &str) -> Result<f32, String> {
+    let t = s.trim();
+    let value = match t.strip_suffix('%') {
+        Some(percent) => percent.trim().parse::<f32>().map(|p| p / 100.0),
+        None => t.parse::<f32>(),
+    };
+    match value {
+        Ok(v) if v > 0.0 && v < 1.0 => Ok(v),
+        _ => Err(format!("target error '{s}' is not a fraction in (0, 1) or a percentage such as 1%")),
     }
 }
 

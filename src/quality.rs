@@ -7,7 +7,7 @@
 use image::RgbaImage;
 
 use crate::camera::Camera;
-use crate::gpu::{PathView, Renderer};
+use crate::gpu::{PathFrame, PathView, Renderer};
 use crate::io::png::upscale;
 use crate::scene::Scene;
 use crate::settings::{PathSettings, RenderSettings, TraceMode, View, scaled_size};
@@ -49,6 +49,8 @@ pub enum Setting {
         bounces: u32,
         shadow_samples: u32,
         render_scale: f32,
+        /// Denoised after the last sample (its time counted in the frame's).
+        denoise: bool,
     },
     /// The preview; `lod` is the level-of-detail footprint in pixels (0 exact).
     Preview {
@@ -71,15 +73,16 @@ pub fn render_setting(
     setting: Setting,
 ) -> Result<(f64, RgbaImage), crate::gpu::GpuError> {
     match setting {
-        Setting::Path { spp, bounces, shadow_samples, render_scale } => {
+        Setting::Path { spp, bounces, shadow_samples, render_scale, denoise } => {
             let settings = PathSettings { bounces, shadow_samples, ..PathSettings::default() };
             let traced = scaled_size(size, render_scale);
             renderer.compile_path_kernel(&scene.tree, &scene.palette, &settings)?;
             let start = std::time::Instant::now();
             let view =
                 PathView { tree: &scene.tree, palette: &scene.palette, camera, size: traced, settings: &settings };
-            for sample in 0..spp {
-                renderer.render_path(&view, sample == 0)?;
+            accumulate(renderer, &view, spp, None, |_| ())?;
+            if denoise {
+                renderer.denoise_now()?;
             }
             let ms = start.elapsed().as_secs_f64() * 1e3;
             Ok((ms, upscale(renderer.read_image()?, size)))
@@ -100,6 +103,46 @@ pub fn render_setting(
             Ok((ms, upscale(renderer.read_image()?, size)))
         }
     }
+}
+
+/// What [`accumulate`] did.
+pub struct Accumulated {
+    /// The last sample's frame.
+    pub last: PathFrame,
+    /// The milliseconds of all the samples.
+    pub ms: f64,
+    /// The noise estimate at the last sample (with `estimate_noise` on).
+    pub noise: Option<f32>,
+}
+
+/// Path traces `view` from a fresh accumulation: `cap` samples, or fewer
+/// once the noise estimate is below `target` (which needs the renderer's
+/// `estimate_noise`). `each` sees every sample's frame.
+///
+/// # Errors
+/// A failed frame.
+pub fn accumulate(
+    renderer: &mut Renderer,
+    view: &PathView,
+    cap: u32,
+    target: Option<f32>,
+    mut each: impl FnMut(&PathFrame),
+) -> Result<Accumulated, crate::gpu::GpuError> {
+    let (mut ms, mut last, mut noise) = (0.0, None, None);
+    for sample in 0..cap {
+        let frame = renderer.render_path(view, sample == 0)?;
+        ms += frame.ms;
+        each(&frame);
+        last = Some(frame);
+        if renderer.estimate_noise {
+            noise = renderer.noise_estimate()?;
+        }
+        if target.zip(noise).is_some_and(|(target, noise)| noise < target) {
+            break;
+        }
+    }
+    let last = last.ok_or_else(|| crate::gpu::GpuError::Readback("no samples were asked for".into()))?;
+    Ok(Accumulated { last, ms, noise })
 }
 
 /// For each (time, error) point, whether no other point is at least as good

@@ -220,6 +220,7 @@ impl App {
         let input = if path {
             self.frames.path_drawn = Some(revision);
             gfx.renderer.sample_target = self.state.sample_target.max(1);
+            (gfx.renderer.denoise, gfx.renderer.estimate_noise) = (self.state.denoise, true);
             FrameInput::Path { view, scene_changed }
         } else {
             // Select mode tints the selected voxels; the other modes what the brush would touch.
@@ -265,7 +266,7 @@ impl App {
         let Some(gfx) = self.gfx.as_mut() else { return };
         if !path {
             self.readouts.stats.trace_ms = submitted.ms;
-            self.readouts.stats.path = None;
+            (self.readouts.stats.path, self.readouts.stats.noise) = (None, None);
             return;
         }
         let Some(frame) = submitted.path else { return };
@@ -276,6 +277,18 @@ impl App {
             // one band, not a whole sample.
             let bands = (frame.ms / f64::from(self.state.frame_target_ms)).ceil();
             gfx.renderer.path_bands = (bands as u32).clamp(1, MAX_PATH_BANDS);
+            self.readouts.stats.noise = match gfx.renderer.noise_estimate() {
+                Ok(noise) => noise,
+                Err(err) => {
+                    log::warn!("no noise estimate: {err}");
+                    None
+                }
+            };
+            if let Some(noise) = self.readouts.stats.noise
+                && frame.samples.is_power_of_two()
+            {
+                report!("noise: {noise:.5} at {} samples", frame.samples);
+            }
             if frame.samples == gfx.renderer.sample_target {
                 let effects = frame.effects.names().join(" ");
                 report!("path: {} samples, effects [{effects}]", frame.samples);

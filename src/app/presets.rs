@@ -24,6 +24,8 @@ pub struct Preset {
     pub shadow_samples: u32,
     /// Samples accumulated at rest.
     pub samples: u32,
+    /// Whether the path-traced view is denoised.
+    pub denoise: bool,
 }
 
 pub const PRESETS: [Preset; 5] = [
@@ -35,6 +37,7 @@ pub const PRESETS: [Preset; 5] = [
         bounces: 0,
         shadow_samples: 1,
         samples: 1,
+        denoise: false,
     },
     Preset {
         name: "preview",
@@ -44,6 +47,7 @@ pub const PRESETS: [Preset; 5] = [
         bounces: 0,
         shadow_samples: 1,
         samples: 1,
+        denoise: false,
     },
     Preset {
         name: "path: quick",
@@ -53,6 +57,7 @@ pub const PRESETS: [Preset; 5] = [
         bounces: 1,
         shadow_samples: 1,
         samples: 16,
+        denoise: true,
     },
     Preset {
         name: "path: good",
@@ -62,6 +67,7 @@ pub const PRESETS: [Preset; 5] = [
         bounces: 3,
         shadow_samples: 1,
         samples: 64,
+        denoise: true,
     },
     Preset {
         name: "reference",
@@ -71,6 +77,7 @@ pub const PRESETS: [Preset; 5] = [
         bounces: 8,
         shadow_samples: 4,
         samples: 256,
+        denoise: false,
     },
 ];
 
@@ -85,6 +92,7 @@ impl Preset {
         state.path_settings =
             PathSettings { bounces: self.bounces, shadow_samples: self.shadow_samples, ..state.path_settings };
         state.sample_target = self.samples;
+        state.denoise = self.denoise;
     }
 
     /// How the measurement draws a frame of this preset.
@@ -98,6 +106,7 @@ impl Preset {
                 bounces: self.bounces,
                 shadow_samples: self.shadow_samples,
                 render_scale: self.render_scale,
+                denoise: self.denoise,
             },
         }
     }

@@ -71,6 +71,9 @@ pub struct EditorState {
     pub path_settings: PathSettings,
     /// Samples the path tracer accumulates at rest before it stops.
     pub sample_target: u32,
+    /// Whether the path-traced view is shown denoised (the raw samples
+    /// when off).
+    pub denoise: bool,
     /// Line mode (L): a press-drag-release places the brush along a line.
     pub line_mode: bool,
     /// Where the line being dragged starts (the cell in front of the face).
@@ -106,6 +109,7 @@ impl Default for EditorState {
             shading: Shading::default(),
             path_settings: PathSettings::default(),
             sample_target: octovox::settings::DEFAULT_SAMPLE_TARGET,
+            denoise: true,
             line_mode: false,
             line_start: None,
             select_mode: false,

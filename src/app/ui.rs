@@ -51,6 +51,9 @@ pub struct Stats {
     pub last_edit_ranges: usize,
     /// The path tracer's last frame, when it drew it.
     pub path: Option<octovox::gpu::PathFrame>,
+    /// The path-traced image's estimated noise at the last sample
+    /// (`Renderer::noise_estimate`).
+    pub noise: Option<f32>,
 }
 
 /// What the panels read out: the last frame's numbers, the ones on
@@ -258,7 +261,7 @@ pub fn show(
             }
             // Sections below the palette collapse; none above it changes height.
             egui::CollapsingHeader::new("Render").default_open(true).show(ui, |ui| {
-                render(ui, state);
+                render(ui, state, info.stats);
                 quality(ui, info.presets, &mut out);
             });
             egui::CollapsingHeader::new("Stats").default_open(true).show(ui, |ui| stats(ui, info));
@@ -620,7 +623,7 @@ fn material_value(material: &Material, key: &str) -> f32 {
     }
 }
 
-fn render(ui: &mut egui::Ui, state: &mut EditorState) {
+fn render(ui: &mut egui::Ui, state: &mut EditorState, stats: &Stats) {
     let settings = &mut state.settings;
     egui::ComboBox::from_id_salt("view").selected_text(format!("{:?}", settings.view)).show_ui(ui, |ui| {
         for view in View::ALL {
@@ -644,7 +647,7 @@ fn render(ui: &mut egui::Ui, state: &mut EditorState) {
     );
     ui.add(egui::Slider::new(&mut state.frame_target_ms, 10.0..=100.0).text("Frame target (ms)"))
         .on_hover_text("frame time to hold while the camera moves: the render scale drops as far as needed");
-    path_tracing(ui, state);
+    path_tracing(ui, state, stats);
 }
 
 /// Presets from draft to reference, with what each costs here and the error
@@ -676,14 +679,43 @@ fn quality(ui: &mut egui::Ui, measured: Option<&[super::presets::Measured]>, out
     });
 }
 
-fn path_tracing(ui: &mut egui::Ui, state: &mut EditorState) {
+fn path_tracing(ui: &mut egui::Ui, state: &mut EditorState, stats: &Stats) {
     egui::ComboBox::from_id_salt("shading").selected_text(state.shading.label()).show_ui(ui, |ui| {
         for shading in Shading::ALL {
             ui.selectable_value(&mut state.shading, shading, shading.label());
         }
     });
     // Disabled, not removed, in preview shading: the rows below stay put.
-    ui.add_enabled_ui(state.shading != Shading::Preview, |ui| path_knobs(ui, state));
+    ui.add_enabled_ui(state.shading != Shading::Preview, |ui| {
+        path_knobs(ui, state);
+        ui.checkbox(&mut state.denoise, "Denoise").on_hover_text(
+            "--denoise: the accumulation filtered by its first hits (colour, face, depth) \
+             and its variance; off: the raw samples",
+        );
+        ui.label(noise_text(stats, state.sample_target)).on_hover_text(
+            "the raw samples' estimated noise: the RMS standard error of the displayed pixels \
+             (render --target-error stops on it)",
+        );
+    });
+}
+
+/// The noise line of the Render panel: "≈ 1.8 % noise, ~4 s to 1 %".
+pub fn noise_text(stats: &Stats, sample_target: u32) -> String {
+    const GOAL: f32 = 0.01;
+    let (Some(path), Some(noise)) = (stats.path, stats.noise) else {
+        return "noise: measured from the second sample".into();
+    };
+    let percent = format!("≈ {:.1} % noise", 100.0 * noise);
+    if noise <= GOAL {
+        return format!("{percent}, below 1 %");
+    }
+    // The standard error falls as 1/√samples.
+    let needed = (path.samples as f32 * (noise / GOAL).powi(2)).ceil() as u32;
+    if needed > sample_target {
+        return format!("{percent}; 1 % needs ~{needed} samples (target {sample_target})");
+    }
+    let seconds = f64::from(needed - path.samples) * stats.trace_ms / 1e3;
+    format!("{percent}, ~{seconds:.0} s to 1 %")
 }
 
 fn path_knobs(ui: &mut egui::Ui, state: &mut EditorState) {

@@ -12,7 +12,8 @@ use serde::Serialize;
 
 use octovox::camera::Camera;
 use octovox::gpu::Renderer;
-use octovox::quality::{Setting, flip, pareto_front, psnr, render_setting};
+use octovox::gpu::PathView;
+use octovox::quality::{Setting, accumulate, flip, pareto_front, psnr, render_setting};
 use octovox::scene::Scene;
 use octovox::scene::demo::BuiltIn;
 use octovox::settings::{RenderSettings, TraceMode};
@@ -29,6 +30,13 @@ struct QualityRow {
     flip: f32,
     /// dB; `None` when identical to the reference.
     psnr: Option<f64>,
+    /// The row's samples were denoised.
+    denoised: bool,
+    /// Path-traced raw rows: the noise estimate at the last sample and the
+    /// measured RMS error against the reference (0..1 of full scale).
+    noise_estimate: Option<f32>,
+    rms_error: f64,
+    /// On the Pareto front of its scene's raw rows or of its denoised rows.
     pareto: bool,
 }
 
@@ -41,13 +49,28 @@ struct Sizes {
 /// The level-of-detail footprints measured, in pixels.
 const LOD_PIXELS: [f32; 3] = [1.0, 2.0, 4.0];
 
-/// The base setting and the knobs turned from it, by CLI flag.
+/// The samples per pixel measured raw and denoised: the base's among them.
+fn spp_values(sizes: &Sizes) -> Vec<u32> {
+    let base = sizes.base_spp;
+    let mut values = vec![1, 4, 8, base, base * 2, base * 4];
+    values.sort_unstable();
+    values.dedup();
+    values
+}
+
+/// The base setting and the knobs turned from it, by CLI flag; then every
+/// spp of [`spp_values`] denoised.
 fn knobs(sizes: &Sizes) -> Vec<(&'static str, String, Setting)> {
-    let base =
-        |spp, bounces, shadow_samples, render_scale| Setting::Path { spp, bounces, shadow_samples, render_scale };
+    let base = |spp, bounces, shadow_samples, render_scale| Setting::Path {
+        spp,
+        bounces,
+        shadow_samples,
+        render_scale,
+        denoise: false,
+    };
     let spp = sizes.base_spp;
     let mut out = vec![("base", format!("--spp {spp} --bounces 3"), base(spp, 3, 1, 1.0))];
-    for s in [1, 4, spp * 4] {
+    for s in spp_values(sizes).into_iter().filter(|&s| s != spp) {
         out.push(("--spp", s.to_string(), base(s, 3, 1, 1.0)));
     }
     for b in [0, 1, 6] {
@@ -62,6 +85,10 @@ fn knobs(sizes: &Sizes) -> Vec<(&'static str, String, Setting)> {
     out.push(("--mode", "grid (preview)".into(), preview(TraceMode::Grid, 0.0)));
     for lod in LOD_PIXELS {
         out.push(("--lod", format!("{lod} (preview)"), preview(TraceMode::Svo, lod)));
+    }
+    for s in spp_values(sizes) {
+        let denoised = Setting::Path { spp: s, bounces: 3, shadow_samples: 1, render_scale: 1.0, denoise: true };
+        out.push(("--denoise", format!("--spp {s}"), denoised));
     }
     out
 }
@@ -92,38 +119,217 @@ pub fn bench_quality(quick: bool, out: &Path) -> anyhow::Result<(String, String)
         Sizes { size: (320, 180), reference_spp: 256, base_spp: 16 }
     };
     let mut renderer = Renderer::headless()?;
-    let mut rows = Vec::new();
+    // As `render` does: every sample measures the noise.
+    renderer.estimate_noise = true;
+    let (mut rows, mut unbiased, mut targets) = (Vec::new(), Vec::new(), Vec::new());
     for (name, mut scene, camera) in scenes(quick)? {
         renderer.sync(&mut scene.tree, &scene.palette);
-        let reference = Setting::Path { spp: sizes.reference_spp, bounces: 8, shadow_samples: 4, render_scale: 1.0 };
+        let reference = Setting::Path {
+            spp: sizes.reference_spp,
+            bounces: 8,
+            shadow_samples: 4,
+            render_scale: 1.0,
+            denoise: false,
+        };
         let (_, reference_image) = render_setting(&mut renderer, &scene, &camera, sizes.size, reference)?;
+        let reference_noise = renderer.noise_estimate()?;
+        renderer.denoise_now()?;
+        let denoised_reference = renderer.read_image()?;
+        unbiased.push(UnbiasedRow {
+            scene: name,
+            flip: flip(&reference_image, &denoised_reference),
+            reference_noise,
+        });
         let mut scene_rows = Vec::new();
         for (knob, value, setting) in knobs(&sizes) {
             let (ms, image) = render_setting(&mut renderer, &scene, &camera, sizes.size, setting)?;
-            let row = QualityRow {
+            let path = matches!(setting, Setting::Path { .. });
+            let denoised = matches!(setting, Setting::Path { denoise: true, .. });
+            let raw_path = path && !denoised;
+            scene_rows.push(QualityRow {
                 scene: name,
                 knob,
                 value,
                 ms_per_frame: ms,
                 flip: flip(&reference_image, &image),
                 psnr: psnr(&reference_image, &image),
+                denoised,
+                noise_estimate: if raw_path { renderer.noise_estimate()? } else { None },
+                rms_error: rms_error(&reference_image, &image),
                 pareto: false,
-            };
-            scene_rows.push(row);
+            });
         }
-        let points: Vec<(f64, f64)> = scene_rows.iter().map(|r| (r.ms_per_frame, f64::from(r.flip))).collect();
-        for (row, on_front) in scene_rows.iter_mut().zip(pareto_front(&points)) {
-            row.pareto = on_front;
+        for denoised in [false, true] {
+            let group: Vec<usize> = (0..scene_rows.len()).filter(|&i| scene_rows[i].denoised == denoised).collect();
+            let points: Vec<(f64, f64)> =
+                group.iter().map(|&i| (scene_rows[i].ms_per_frame, f64::from(scene_rows[i].flip))).collect();
+            for (&i, on_front) in group.iter().zip(pareto_front(&points)) {
+                scene_rows[i].pareto = on_front;
+            }
         }
         rows.extend(scene_rows);
+        targets.extend(target_rows(&mut renderer, &scene, &camera, name, &sizes, &reference_image)?);
     }
     std::fs::create_dir_all(out)?;
     super::quality_plot::plot(&rows_for_plot(&rows), &out.join("quality.png"))?;
     let lod_rows = level_of_detail(&mut renderer, quick)?;
     let mut md = markdown(&rows, &sizes, renderer.gpu.adapter_name.as_str());
+    md += &denoise_markdown(&rows, &unbiased);
+    md += &target_markdown(&targets);
     md += &lod_markdown(&lod_rows);
-    let json = serde_json::json!({ "knobs": rows, "level_of_detail": lod_rows });
+    let json = serde_json::json!({
+        "knobs": rows,
+        "denoised_reference": unbiased,
+        "target_error": targets,
+        "level_of_detail": lod_rows,
+    });
     Ok((md, serde_json::to_string_pretty(&json)?))
+}
+
+/// The denoised reference against the raw one: what the filter's bias costs.
+#[derive(Serialize)]
+struct UnbiasedRow {
+    scene: &'static str,
+    flip: f32,
+    reference_noise: Option<f32>,
+}
+
+/// One `--target-error` render.
+#[derive(Serialize)]
+struct TargetRow {
+    scene: &'static str,
+    target: f32,
+    samples: u32,
+    noise_estimate: Option<f32>,
+    rms_error: f64,
+    flip: f32,
+}
+
+/// The targets `--target-error` is measured at.
+fn targets(quick: bool) -> [f32; 2] {
+    if quick { [0.05, 0.03] } else { [0.02, 0.01] }
+}
+
+/// Renders the base setting until the noise estimate meets each target
+/// (`render --target-error`), at most 16 times the reference's samples.
+fn target_rows(
+    renderer: &mut Renderer,
+    scene: &Scene,
+    camera: &Camera,
+    name: &'static str,
+    sizes: &Sizes,
+    reference: &image::RgbaImage,
+) -> anyhow::Result<Vec<TargetRow>> {
+    let settings = octovox::settings::PathSettings { bounces: 3, ..Default::default() };
+    let view = PathView { tree: &scene.tree, palette: &scene.palette, camera, size: sizes.size, settings: &settings };
+    let mut rows = Vec::new();
+    for target in targets(sizes.reference_spp < 64) {
+        let done = accumulate(renderer, &view, sizes.reference_spp * 16, Some(target), |_| ())?;
+        let image = renderer.read_image()?;
+        rows.push(TargetRow {
+            scene: name,
+            target,
+            samples: done.last.samples,
+            noise_estimate: done.noise,
+            rms_error: rms_error(reference, &image),
+            flip: flip(reference, &image),
+        });
+    }
+    Ok(rows)
+}
+
+/// The RMS difference of the RGB bytes, as a fraction of full scale.
+fn rms_error(reference: &image::RgbaImage, test: &image::RgbaImage) -> f64 {
+    psnr(reference, test).map_or(0.0, |db| 10f64.powf(-db / 20.0))
+}
+
+/// The raw FLIP of `scene` at `ms`, interpolated along its raw spp rows
+/// (log time); `None` outside them.
+fn raw_flip_at(rows: &[QualityRow], scene: &str, ms: f64) -> Option<f64> {
+    let mut curve: Vec<(f64, f64)> = rows
+        .iter()
+        .filter(|r| r.scene == scene && !r.denoised && (r.knob == "--spp" || r.knob == "base"))
+        .map(|r| (r.ms_per_frame.ln(), f64::from(r.flip)))
+        .collect();
+    curve.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let t = ms.ln();
+    curve.windows(2).find(|w| w[0].0 <= t && t <= w[1].0).map(|w| {
+        let f = if w[1].0 > w[0].0 { (t - w[0].0) / (w[1].0 - w[0].0) } else { 0.0 };
+        w[0].1 + f * (w[1].1 - w[0].1)
+    })
+}
+
+fn flip_of(rows: &[QualityRow], scene: &str, denoised: bool, spp: u32) -> Option<(f64, f32)> {
+    rows.iter()
+        .find(|r| {
+            r.scene == scene && r.denoised == denoised && {
+                let value = r.value.trim_start_matches("--spp ");
+                value.split(' ').next() == Some(spp.to_string().as_str())
+            }
+        })
+        .map(|r| (r.ms_per_frame, r.flip))
+}
+
+fn denoise_markdown(rows: &[QualityRow], unbiased: &[UnbiasedRow]) -> String {
+    let mut md = String::from(
+        "\n## Denoised against raw\n\nEach denoised row against the raw path tracer at the same wall time (the raw FLIP interpolated between its spp rows on a log time axis; blank where the denoised frame is faster than raw 1 spp or slower than the last raw row). Target: ratio ≤ 0.6 at 4–16 spp.\n\n| scene | spp | denoised ms | denoised FLIP | raw FLIP at that time | ratio |\n|---|---|---|---|---|---|\n",
+    );
+    let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene).collect();
+    scenes.dedup();
+    for scene in &scenes {
+        for r in rows.iter().filter(|r| r.scene == *scene && r.denoised) {
+            let raw = raw_flip_at(rows, scene, r.ms_per_frame);
+            md += &format!(
+                "| {scene} | {} | {:.1} | {:.4} | {} | {} |\n",
+                r.value.trim_start_matches("--spp "),
+                r.ms_per_frame,
+                r.flip,
+                raw.map_or(String::new(), |f| format!("{f:.4}")),
+                raw.map_or(String::new(), |f| format!("{:.2}", f64::from(r.flip) / f)),
+            );
+        }
+    }
+    md += "\nDenoised 8 spp against raw 32 spp:\n\n| scene | denoised 8 spp: ms, FLIP | raw 32 spp: ms, FLIP |\n|---|---|---|\n";
+    for scene in &scenes {
+        let cell = |v: Option<(f64, f32)>| v.map_or("–".into(), |(ms, f)| format!("{ms:.1} ms, {f:.4}"));
+        md += &format!("| {scene} | {} | {} |\n", cell(flip_of(rows, scene, true, 8)), cell(flip_of(rows, scene, false, 32)));
+    }
+    md += "\nNo bias: the reference's own samples denoised, against the raw reference (target FLIP ≤ 0.01).\n\n| scene | FLIP | the reference's noise estimate |\n|---|---|---|\n";
+    for u in unbiased {
+        md += &format!("| {} | {:.4} | {} |\n", u.scene, u.flip, u.reference_noise.map_or("–".into(), |n| format!("{n:.4}")));
+    }
+    md += "\nThe noise estimate against the measured error, raw path-traced rows: the estimate is the RMS standard error of the displayed pixels from each pixel's own samples; the measured error is the RMS difference from the reference, which has noise of its own (its estimate above) and 8-bit rounding.\n\n| scene | knob | value | estimate | measured RMS | measured / estimate |\n|---|---|---|---|---|---|\n";
+    for r in rows.iter().filter(|r| r.noise_estimate.is_some()) {
+        let estimate = f64::from(r.noise_estimate.unwrap_or(0.0));
+        md += &format!(
+            "| {} | {} | {} | {estimate:.4} | {:.4} | {:.2} |\n",
+            r.scene,
+            r.knob,
+            r.value,
+            r.rms_error,
+            r.rms_error / estimate.max(1e-9)
+        );
+    }
+    md
+}
+
+fn target_markdown(rows: &[TargetRow]) -> String {
+    let mut md = String::from(
+        "\n## Renders that stop at an error\n\n`render --target-error E` on the base setting: samples until the estimate is below E, and the error measured against the reference then.\n\n| scene | target | samples | estimate at stop | measured RMS | measured / target | FLIP |\n|---|---|---|---|---|---|---|\n",
+    );
+    for r in rows {
+        md += &format!(
+            "| {} | {} | {} | {} | {:.4} | {:.2} | {:.4} |\n",
+            r.scene,
+            r.target,
+            r.samples,
+            r.noise_estimate.map_or("–".into(), |n| format!("{n:.4}")),
+            r.rms_error,
+            r.rms_error / f64::from(r.target),
+            r.flip
+        );
+    }
+    md
 }
 
 #[derive(Serialize)]
@@ -245,7 +451,7 @@ fn far_camera(scene: &Scene) -> Camera {
 fn rows_for_plot(rows: &[QualityRow]) -> Vec<super::quality_plot::Point> {
     rows.iter()
         .map(|r| super::quality_plot::Point {
-            series: r.scene,
+            series: if r.denoised { format!("{}, denoised", r.scene) } else { r.scene.to_string() },
             label: if r.knob == "base" { "base".to_string() } else { format!("{} {}", r.knob, r.value) },
             ms: r.ms_per_frame,
             error: f64::from(r.flip),

@@ -7,7 +7,7 @@ use plotters::prelude::*;
 
 /// One measured setting.
 pub struct Point {
-    pub series: &'static str,
+    pub series: String,
     pub label: String,
     pub ms: f64,
     pub error: f64,
@@ -15,8 +15,14 @@ pub struct Point {
 }
 
 const SIZE: (u32, u32) = (1100, 700);
-const COLORS: [RGBColor; 4] =
-    [RGBColor(31, 119, 180), RGBColor(214, 39, 40), RGBColor(44, 160, 44), RGBColor(148, 103, 189)];
+const COLORS: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+    RGBColor(255, 127, 14),
+    RGBColor(23, 190, 207),
+];
 
 /// Draws the plot and writes it as a PNG.
 pub fn plot(points: &[Point], path: &Path) -> anyhow::Result<()> {
@@ -44,16 +50,18 @@ fn draw(points: &[Point], buffer: &mut [u8]) -> Result<(), Box<dyn std::error::E
         .y_label_area_size(64)
         .build_cartesian_2d((lo * 0.7..hi * 1.4).log_scale(), 0.0..top)?;
     chart.configure_mesh().x_desc("ms per frame (log)").y_desc("mean FLIP").label_style(("sans-serif", 16)).draw()?;
-    let mut series: Vec<&str> = points.iter().map(|p| p.series).collect();
+    let mut series: Vec<&str> = points.iter().map(|p| p.series.as_str()).collect();
+    series.sort_unstable();
     series.dedup();
     for (i, name) in series.iter().enumerate() {
         let color = COLORS[i % COLORS.len()];
         let mine: Vec<&Point> = points.iter().filter(|p| p.series == *name).collect();
+        let name = name.to_string();
         let mut front: Vec<(f64, f64)> = mine.iter().filter(|p| p.pareto).map(|p| (p.ms.max(0.01), p.error)).collect();
         front.sort_by(|a, b| a.0.total_cmp(&b.0));
         chart
             .draw_series(LineSeries::new(front, color.stroke_width(2)))?
-            .label(*name)
+            .label(name)
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
         chart.draw_series(mine.iter().map(|p| {
             let style = if p.pareto { color.filled() } else { color.stroke_width(1) };

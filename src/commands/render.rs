@@ -11,9 +11,11 @@ use octovox::gpu::{PathView, Renderer};
 use octovox::io::atomic::WriteOptions;
 use octovox::io::output::{OutputKind, check_output};
 use octovox::io::png::save_png;
+use octovox::quality::{Accumulated, accumulate};
 use octovox::scene::Scene;
 use octovox::scene::demo::BuiltIn;
 use octovox::settings::{RenderSettings, TraceMode, View};
+use octovox::trace::denoise::{Frame, denoise, noise_estimate};
 use octovox::trace::grid::DenseGrid;
 use octovox::trace::path::{render_cpu, to_image};
 use octovox::trace::render::render_scene_cpu;
@@ -24,8 +26,9 @@ const CPU_BYTES_PER_PIXEL: u64 = 48;
 /// Bytes per pixel of a GPU render on the host: the read-back rows (padded)
 /// and the image.
 const GPU_BYTES_PER_PIXEL: u64 = 12;
-/// A CPU path-traced render keeps the mean radiance (12 bytes) and the image.
-const CPU_PATH_BYTES_PER_PIXEL: u64 = 24;
+/// A CPU path-traced render keeps the mean radiance (12 bytes), the sums
+/// (28), the denoiser's guide (16) and two light buffers (32), and the image.
+const CPU_PATH_BYTES_PER_PIXEL: u64 = 92;
 /// A GPU path-traced render adds the accumulation buffer's readback.
 const GPU_PATH_BYTES_PER_PIXEL: u64 = 28;
 
@@ -40,14 +43,21 @@ pub fn open_scene(file: Option<&std::path::Path>, frame: usize, demo: Option<Bui
 pub fn run(args: &RenderArgs) -> anyhow::Result<ExitCode> {
     let inputs: Vec<&std::path::Path> = args.file.iter().map(|p| p.as_path()).collect();
     check_output(&args.output, OutputKind::Image, &inputs, args.force)?;
-    if args.path.spp.is_some() && (args.mode != TraceMode::Svo || args.view != View::Shaded) {
+    let traced_path = args.path.traced();
+    if traced_path && (args.mode != TraceMode::Svo || args.view != View::Shaded) {
         anyhow::bail!("the path tracer (--spp) walks the SVO and shades: it takes neither --mode grid nor --view");
     }
-    if args.lod > 0.0 && (args.path.spp.is_some() || args.mode != TraceMode::Svo) {
+    if args.lod > 0.0 && (traced_path || args.mode != TraceMode::Svo) {
         anyhow::bail!("--lod applies to the SVO preview: the path tracer (--spp) and --mode grid trace exactly");
     }
+    if args.path.denoise && !traced_path {
+        anyhow::bail!("--denoise filters the path tracer's samples: give --spp N or --target-error E");
+    }
+    if args.cpu && args.path.target_error.is_some() {
+        anyhow::bail!("--target-error samples on the GPU; the CPU reference renders a fixed --spp");
+    }
     let pixels = u64::from(args.size.0) * u64::from(args.size.1);
-    let per_pixel = match (args.cpu, args.path.spp.is_some()) {
+    let per_pixel = match (args.cpu, traced_path) {
         (true, true) => CPU_PATH_BYTES_PER_PIXEL,
         (true, false) => CPU_BYTES_PER_PIXEL,
         (false, true) => GPU_PATH_BYTES_PER_PIXEL,
@@ -57,9 +67,10 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<ExitCode> {
     let mut scene = open_scene(args.file.as_deref(), args.frame, args.demo)?;
     let camera = Camera { ortho: args.ortho, ..camera_or_framing(args.camera, args.fov, &scene) };
     let traced = octovox::settings::scaled_size(args.size, args.render_scale);
-    let (image, stats) = match args.path.spp {
-        Some(spp) => path_traced(&mut scene, &camera, args, traced, spp)?,
-        None => preview(&mut scene, &camera, args, traced)?,
+    let (image, stats) = if traced_path {
+        path_traced(&mut scene, &camera, args, traced)?
+    } else {
+        preview(&mut scene, &camera, args, traced)?
     };
     let image = octovox::io::png::upscale(image, args.size);
     save_png(&image, &args.output, WriteOptions::forced(args.force))?;
@@ -72,11 +83,16 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<ExitCode> {
 }
 
 /// What `--stats` prints.
-#[derive(serde::Serialize)]
+#[derive(serde::Serialize, Default)]
 struct Stats {
     effects: Vec<&'static str>,
+    /// The samples taken (with `--target-error`, until the estimate met it).
     spp: u32,
     ms_per_sample: f64,
+    /// The filter's milliseconds with `--denoise`.
+    denoise_ms: Option<f64>,
+    /// The raw image's estimated noise (`crate::trace::denoise::noise_estimate`).
+    noise_estimate: Option<f32>,
     adapter: String,
     /// Emissive cells sampled as lights.
     lights: usize,
@@ -100,7 +116,7 @@ fn preview(
         TraceMode::Grid => Some(DenseGrid::from_octree(&scene.tree)?),
         TraceMode::Svo => None,
     };
-    let stats = |ms, adapter| Stats { effects: Vec::new(), spp: 0, ms_per_sample: ms, adapter, lights: 0 };
+    let stats = |ms, adapter| Stats { ms_per_sample: ms, adapter, ..Stats::default() };
     if args.cpu {
         let start = Instant::now();
         let image = render_scene_cpu(scene, grid.as_ref(), camera, size, &settings);
@@ -117,45 +133,70 @@ fn preview(
     Ok((renderer.read_image()?, stats(ms, renderer.gpu.adapter_name.clone())))
 }
 
-/// `spp` samples of the path tracer, on the GPU or the CPU reference.
+/// The path tracer, on the GPU or the CPU reference: `--spp` samples, or
+/// until the noise estimate is below `--target-error`; denoised with
+/// `--denoise`.
 fn path_traced(
     scene: &mut Scene,
     camera: &Camera,
     args: &RenderArgs,
     size: (u32, u32),
-    spp: u32,
 ) -> anyhow::Result<(image::RgbaImage, Stats)> {
     let settings = args.path.settings();
     if args.cpu {
-        let start = Instant::now();
-        let frame = render_cpu(&scene.tree, &scene.palette, camera, size, &settings, spp);
-        let ms = start.elapsed().as_secs_f64() * 1e3 / f64::from(spp);
-        let image = to_image(&frame.pixels, size.0, size.1);
-        let (effects, lights) = (frame.effects.names(), frame.lights);
-        return Ok((image, Stats { effects, spp, ms_per_sample: ms, adapter: "cpu".into(), lights }));
+        return Ok(path_traced_cpu(scene, camera, args, size));
     }
     let mut renderer = Renderer::headless().context("no GPU for rendering (try --cpu)")?;
     log::info!("path tracing on {}", renderer.gpu.adapter_name);
     renderer.sync(&mut scene.tree, &scene.palette);
-    let mut total_ms = 0.0;
-    let mut last = None;
+    renderer.estimate_noise = true;
+    let (cap, target) = (args.path.samples(), args.path.target_error);
     let view = PathView { tree: &scene.tree, palette: &scene.palette, camera, size, settings: &settings };
-    let bar = super::progress_bar::bar("path tracing", u64::from(spp));
-    for sample in 0..spp {
-        let frame = renderer.render_path(&view, sample == 0)?;
-        total_ms += frame.ms;
-        last = Some(frame);
-        bar.inc(1);
-    }
+    let bar = super::progress_bar::bar("path tracing", u64::from(cap));
+    let Accumulated { last: frame, ms: total_ms, noise } = accumulate(&mut renderer, &view, cap, target, |_| bar.inc(1))?;
     bar.finish_and_clear();
-    let frame = last.context("no samples")?;
+    let denoise_ms = if args.path.denoise { Some(renderer.denoise_now()?) } else { None };
     let stats = Stats {
         effects: frame.effects.names(),
-        spp,
-        ms_per_sample: total_ms / f64::from(spp),
+        spp: frame.samples,
+        ms_per_sample: total_ms / f64::from(frame.samples.max(1)),
+        denoise_ms,
+        noise_estimate: noise,
         adapter: renderer.gpu.adapter_name.clone(),
         lights: frame.lights,
     };
-    log::info!("{spp} samples, {:.2} ms each", stats.ms_per_sample);
+    if let Some(target) = target
+        && noise.is_none_or(|n| n >= target)
+    {
+        log::warn!("stopped at the {cap}-sample cap above the target error {target} (estimate {noise:?})");
+    }
+    log::info!("{} samples, {:.2} ms each", stats.spp, stats.ms_per_sample);
     Ok((renderer.read_image()?, stats))
+}
+
+/// `--spp` samples of the CPU reference, denoised by the filter's CPU twin
+/// with `--denoise`.
+fn path_traced_cpu(scene: &Scene, camera: &Camera, args: &RenderArgs, size: (u32, u32)) -> (image::RgbaImage, Stats) {
+    let spp = args.path.samples();
+    let start = Instant::now();
+    let frame = render_cpu(&scene.tree, &scene.palette, camera, size, &args.path.settings(), spp);
+    let ms = start.elapsed().as_secs_f64() * 1e3 / f64::from(spp);
+    let (pixels, denoise_ms) = if args.path.denoise {
+        let start = Instant::now();
+        let basis = camera.basis(size.0, size.1, scene.tree.origin());
+        let pixels = denoise(&Frame::of(&basis), &frame.sums, &frame.guides);
+        (pixels, Some(start.elapsed().as_secs_f64() * 1e3))
+    } else {
+        (frame.pixels, None)
+    };
+    let stats = Stats {
+        effects: frame.effects.names(),
+        spp,
+        ms_per_sample: ms,
+        denoise_ms,
+        noise_estimate: noise_estimate(&frame.sums),
+        adapter: "cpu".into(),
+        lights: frame.lights,
+    };
+    (to_image(&pixels, size.0, size.1), stats)
 }

@@ -110,6 +110,37 @@ pub struct PathUniforms {
     pub end_row: u32,
 }
 
+/// Twin of `DenoiseUniforms` in `shaders/denoise.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct DenoiseUniforms {
+    pub eye: [f32; 3],
+    pub width: u32,
+    pub forward: [f32; 3],
+    pub height: u32,
+    /// One pixel's width in voxels: `at_start + per_t · depth`.
+    pub at_start: f32,
+    pub per_t: f32,
+    /// Pixels between the taps of an `atrous` dispatch.
+    pub step: u32,
+    pub _pad: u32,
+}
+
+impl DenoiseUniforms {
+    pub fn new(frame: &crate::trace::denoise::Frame, step: u32) -> DenoiseUniforms {
+        DenoiseUniforms {
+            eye: frame.eye.into(),
+            width: frame.width,
+            forward: frame.forward.into(),
+            height: frame.height,
+            at_start: frame.footprint.at_start,
+            per_t: frame.footprint.per_t,
+            step,
+            _pad: 0,
+        }
+    }
+}
+
 /// A compute-visible binding of a frame's constants (`size` bytes): a
 /// read-only storage buffer, not a uniform buffer. Lavapipe (Mesa 22)
 /// compiles a kernel again, on the queue, whenever its uniform buffer is

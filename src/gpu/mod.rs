@@ -3,6 +3,7 @@
 
 pub mod blit_pass;
 pub mod context;
+pub mod denoise_pass;
 pub mod layout;
 pub mod path_pass;
 pub mod prelude;
@@ -14,6 +15,7 @@ pub mod trace_pass;
 
 pub use blit_pass::{BlitMode, BlitPass};
 pub use context::{GpuContext, GpuError};
+pub use denoise_pass::DenoisePass;
 pub use layout::{FrameUniforms, PathUniforms};
 pub use path_pass::PathPass;
 pub use renderer::{FrameInput, PathFrame, PathView, Preview, Renderer, Submitted};

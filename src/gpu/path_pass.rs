@@ -1,5 +1,7 @@
 //! The progressive path tracing pass: one sample per pixel per dispatch,
-//! accumulated in a float buffer, the mean written to a display texture.
+//! accumulated in a float buffer (with the sums of squares, and the
+//! denoiser's guides from the first sample), the mean written to a display
+//! texture.
 //!
 //! The kernel is compiled per effect set (override constants of
 //! `shaders/path.wgsl`) on worker threads and kept, so a diffuse-only scene
@@ -21,6 +23,7 @@ use super::readback::{read_storage, read_texture_rgba8};
 use super::{GpuContext, GpuError, SceneBuffers};
 use crate::camera::RayBasis;
 use crate::settings::PathSettings;
+use crate::trace::denoise::{Guide, Sums};
 use crate::trace::path::lights::Emitter;
 use crate::trace::path::materials::{Effects, GpuMaterial};
 
@@ -49,13 +52,20 @@ fn compile(
 }
 
 const EMITTER_BYTES: u64 = std::mem::size_of::<Emitter>() as u64;
+/// Bytes per pixel of the accumulation: sums and count, sums of squares.
+pub const ACCUM_BYTES: u64 = 32;
+/// Bytes per pixel of the denoiser's guides.
+pub const GUIDE_BYTES: u64 = std::mem::size_of::<Guide>() as u64;
 
 /// Size-dependent outputs.
 struct Target {
     texture: wgpu::Texture,
     view: wgpu::TextureView,
-    /// RGB sums and the sample count, one vec4 per pixel.
+    /// Two vec4 per pixel: the RGB sums and the sample count, then the
+    /// sums of squares.
     accum: wgpu::Buffer,
+    /// The denoiser's [`Guide`] per pixel, written by the first sample.
+    guides: wgpu::Buffer,
     width: u32,
     height: u32,
 }
@@ -141,6 +151,7 @@ fn make_bind_group(
             entry(9, parts.materials),
             entry(10, parts.emitters),
             entry(11, &target.accum),
+            entry(12, &target.guides),
         ],
     })
 }
@@ -168,6 +179,7 @@ impl PathPass {
                 buffer_entry(9, true),
                 buffer_entry(10, true),
                 buffer_entry(11, false),
+                buffer_entry(12, false),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -204,9 +216,10 @@ impl PathPass {
 
     fn make_target(device: &wgpu::Device, width: u32, height: u32) -> Target {
         let (texture, view) = output_texture(device, "path output", width, height);
-        let accum =
-            storage(device, "accumulation", u64::from(width) * u64::from(height) * 16, wgpu::BufferUsages::COPY_SRC);
-        Target { texture, view, accum, width, height }
+        let pixels = u64::from(width) * u64::from(height);
+        let accum = storage(device, "accumulation", pixels * ACCUM_BYTES, wgpu::BufferUsages::COPY_SRC);
+        let guides = storage(device, "denoise guides", pixels * GUIDE_BYTES, wgpu::BufferUsages::COPY_SRC);
+        Target { texture, view, accum, guides, width, height }
     }
 
     fn rebind(&mut self, device: &wgpu::Device, buffers: &SceneBuffers) {
@@ -295,7 +308,7 @@ impl PathPass {
             return Ok(false);
         }
         gpu.check_image_size(width, height)?;
-        gpu.check_binding("the accumulation buffer", u64::from(width) * u64::from(height) * 16)?;
+        gpu.check_binding("the accumulation buffer", u64::from(width) * u64::from(height) * ACCUM_BYTES)?;
         self.target = Self::make_target(&gpu.device, width, height);
         self.rebind(&gpu.device, buffers);
         Ok(true)
@@ -368,9 +381,27 @@ impl PathPass {
 
     /// The mean radiance of every pixel so far, row-major.
     pub fn read_radiance(&self, gpu: &GpuContext) -> Result<Vec<Vec3>, GpuError> {
-        let sums: Vec<[f32; 4]> = read_storage(gpu, &self.target.accum, "accumulation readback")?;
+        Ok(self.read_sums(gpu)?.iter().map(Sums::mean).collect())
+    }
+
+    /// The accumulation's sums of every pixel, row-major.
+    pub fn read_sums(&self, gpu: &GpuContext) -> Result<Vec<Sums>, GpuError> {
+        let words: Vec<[f32; 4]> = read_storage(gpu, &self.target.accum, "accumulation readback")?;
         let pixels = (self.target.width * self.target.height) as usize;
-        Ok(sums.iter().take(pixels).map(|s| Vec3::new(s[0], s[1], s[2]) / s[3].max(1.0)).collect())
+        let rgb = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
+        let sums = words.chunks_exact(2).take(pixels);
+        Ok(sums.map(|p| Sums { sum: rgb(p[0]), squares: rgb(p[1]), count: p[0][3] as u32 }).collect())
+    }
+
+    /// The denoiser's guides of every pixel, row-major.
+    pub fn read_guides(&self, gpu: &GpuContext) -> Result<Vec<Guide>, GpuError> {
+        let guides: Vec<Guide> = read_storage(gpu, &self.target.guides, "guide readback")?;
+        Ok(guides.into_iter().take((self.target.width * self.target.height) as usize).collect())
+    }
+
+    /// The buffers the denoiser reads: the accumulation and the guides.
+    pub fn sample_buffers(&self) -> (&wgpu::Buffer, &wgpu::Buffer) {
+        (&self.target.accum, &self.target.guides)
     }
 
     /// The display texture as tightly packed RGBA8 rows.

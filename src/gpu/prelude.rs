@@ -7,6 +7,7 @@ use std::fmt::Write as _;
 use super::layout::{FLOOR_ROW, ROW_TILES};
 use crate::gpu_pool::{LOD_WORD, NODE_WORDS, POINTER_BIT};
 use crate::settings::{SUN_DIR, View};
+use crate::trace::denoise;
 use crate::trace::path::{self, materials};
 use crate::trace::render::GAVE_UP_COLOR;
 use crate::trace::{GAVE_UP_RECORD, MIN_DIRECTION, NO_AXIS};
@@ -39,6 +40,16 @@ pub fn shared_constants() -> String {
     line("MATERIAL_METAL", "u32", format!("{}u", materials::MATERIAL_METAL));
     line("MATERIAL_GLASS", "u32", format!("{}u", materials::MATERIAL_GLASS));
     line("MATERIAL_EMIT", "u32", format!("{}u", materials::MATERIAL_EMIT));
+    line("GUIDE_FILTERED", "u32", format!("{:#x}u", denoise::GUIDE_FILTERED));
+    line("GUIDE_NORMAL_SHIFT", "u32", format!("{}u", denoise::GUIDE_NORMAL_SHIFT));
+    line("DENOISE_ITERATIONS", "u32", format!("{}u", denoise::ITERATIONS));
+    line("SIGMA_LIGHT", "f32", format!("{:?}", denoise::SIGMA_LIGHT));
+    line("SIGMA_PLANE", "f32", format!("{:?}", denoise::SIGMA_PLANE));
+    line("SPATIAL_VARIANCE_BELOW", "u32", format!("{}u", denoise::SPATIAL_VARIANCE_BELOW));
+    line("MIN_ALBEDO", "f32", format!("{:?}", denoise::MIN_ALBEDO));
+    line("LUMINANCE", "vec3<f32>", vec3(denoise::LUMINANCE.to_array()));
+    let kernel = denoise::KERNEL.map(|k| format!("{k:?}")).join(", ");
+    line("KERNEL", "array<f32, 3>", format!("array<f32, 3>({kernel})"));
     for view in View::ALL {
         line(view.wgsl_name(), "u32", format!("{}u", view.code()));
     }

@@ -8,10 +8,13 @@ use super::context::validated;
 use super::path_pass::PathKey;
 use super::scene_buffers::UploadStats;
 use super::timer::PassTimer;
-use super::{FrameUniforms, GpuContext, GpuError, Kernel, PathPass, PathUniforms, SceneBuffers, TracePass};
+use super::{
+    DenoisePass, FrameUniforms, GpuContext, GpuError, Kernel, PathPass, PathUniforms, SceneBuffers, TracePass,
+};
 use crate::camera::Camera;
 use crate::scene::{Octree, Palette};
 use crate::settings::{PathSettings, RenderSettings, View};
+use crate::trace::denoise::Frame;
 use crate::trace::grid::DenseGrid;
 use crate::trace::path::materials::{Effects, material_table};
 use crate::trace::path::{effects_for, lights};
@@ -22,6 +25,8 @@ use crate::trace::{Footprint, Hit};
 enum Shown {
     Trace,
     Path,
+    /// The path tracer's accumulation, denoised.
+    Denoised,
 }
 
 /// What a path-traced frame did.
@@ -86,6 +91,8 @@ enum Recorded {
     Path {
         kernel: Effects,
         effects: Effects,
+        /// Whether the denoiser's `prepare` ran after this band.
+        prepared: bool,
     },
     /// The accumulation has its samples: no pass this frame.
     Nothing(PathFrame),
@@ -120,6 +127,7 @@ pub struct Renderer {
     pub buffers: SceneBuffers,
     pub pass: TracePass,
     pub path: PathPass,
+    pub denoiser: DenoisePass,
     timer: PassTimer,
     shown: Shown,
     /// Bands a path-traced sample is split into, one per call (taken when
@@ -137,6 +145,16 @@ pub struct Renderer {
     /// The accumulation stops growing at this many samples (the window's
     /// resting view); headless renders leave it unbounded.
     pub sample_target: u32,
+    /// Whether path-traced frames show the accumulation denoised (the
+    /// window); headless renders call [`Renderer::denoise_now`] once instead.
+    pub denoise: bool,
+    /// Whether each path-traced sample measures the image's noise for
+    /// [`Renderer::noise_estimate`] (denoised frames always do).
+    pub estimate_noise: bool,
+    /// The sample count the last noise measurement saw.
+    noise_of: Option<u32>,
+    /// Whether the denoised output is of the current accumulation.
+    denoised_fresh: bool,
     /// Whether frames write the per-pixel hit records that
     /// [`Renderer::read_hits`] returns; off by default, as they cost time.
     pub hit_records: bool,
@@ -154,14 +172,21 @@ impl Renderer {
         let buffers = SceneBuffers::new(&gpu.device);
         let pass = TracePass::new(&gpu, &buffers)?;
         let path = PathPass::new(&gpu, &buffers)?;
+        let mut denoiser = DenoisePass::new(&gpu)?;
+        denoiser.bind(&gpu, &path);
         let timer = PassTimer::new(&gpu);
         Ok(Renderer {
             gpu,
             buffers,
             pass,
             path,
+            denoiser,
             timer,
             shown: Shown::Trace,
+            denoise: false,
+            estimate_noise: false,
+            noise_of: None,
+            denoised_fresh: false,
             path_bands: 1,
             sample_target: u32::MAX,
             wait_for_frames: true,
@@ -320,6 +345,9 @@ impl Renderer {
         let PathView { tree, palette, size, settings, .. } = *view;
         let gpu = &self.gpu;
         let resized = self.path.resize(gpu, &self.buffers, size)?;
+        if resized {
+            self.denoiser.bind(gpu, &self.path);
+        }
         let mut acc = self.path.accumulation;
         let key = path_key(view);
         let effects = key.effects;
@@ -334,13 +362,20 @@ impl Renderer {
             acc.samples = 0;
             acc.key = Some(key);
             acc.band.0 = 0;
+            self.denoised_fresh = false;
+            self.noise_of = None;
         }
         if acc.band.0 == 0 {
             acc.band = (0, self.path_bands.clamp(1, size.1.max(1)));
             acc.band_ms = 0.0;
         }
         self.path.accumulation = acc;
-        if acc.samples >= self.sample_target && self.shown == Shown::Path {
+        if acc.samples >= self.sample_target && self.shown != Shown::Trace {
+            if self.denoise && !self.denoised_fresh {
+                self.denoiser.encode(gpu, encoder, &Frame::of(&key.basis), true);
+                (self.denoised_fresh, self.noise_of) = (true, Some(acc.samples));
+            }
+            self.shown = self.accumulation_shown();
             let (lights, samples) = (acc.lights, acc.samples);
             return Ok(Recorded::Nothing(PathFrame {
                 ms: 0.0,
@@ -373,8 +408,59 @@ impl Renderer {
         // shown: the trace output is (the window traces the preview first).
         // What this band completes is shown by the frame that records it.
         let completes = band + 1 == bands;
-        self.shown = if acc.samples + u32::from(completes) > 0 { Shown::Path } else { Shown::Trace };
-        Ok(Recorded::Path { kernel, effects })
+        let prepared = completes && (self.denoise || self.estimate_noise);
+        if prepared {
+            self.denoiser.encode(&self.gpu, encoder, &Frame::of(&key.basis), self.denoise);
+            self.denoised_fresh |= self.denoise;
+        }
+        self.shown = if acc.samples + u32::from(completes) > 0 { self.accumulation_shown() } else { Shown::Trace };
+        Ok(Recorded::Path { kernel, effects, prepared })
+    }
+
+    /// How the accumulation is shown: denoised when asked and done.
+    fn accumulation_shown(&self) -> Shown {
+        if self.denoise && self.denoised_fresh { Shown::Denoised } else { Shown::Path }
+    }
+
+    /// Denoises the accumulation as it stands and shows it; returns the
+    /// wall-clock milliseconds of the filter (submit to finish).
+    ///
+    /// # Errors
+    /// Nothing accumulated yet, or a validation error of the pass.
+    pub fn denoise_now(&mut self) -> Result<f64, GpuError> {
+        let acc = self.path.accumulation;
+        let key = acc.key.filter(|_| acc.samples > 0);
+        let key = key.ok_or_else(|| GpuError::Readback("no path-traced samples to denoise".into()))?;
+        let device = self.gpu.device.clone();
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("denoise") });
+        validated(&device, || {
+            self.denoiser.encode(&self.gpu, &mut encoder, &Frame::of(&key.basis), true);
+            Ok(())
+        })?;
+        let start = std::time::Instant::now();
+        self.gpu.checked(|| {
+            self.gpu.queue.submit([encoder.finish()]);
+            self.gpu.wait()
+        })?;
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        (self.denoised_fresh, self.noise_of, self.shown) = (true, Some(acc.samples), Shown::Denoised);
+        Ok(ms)
+    }
+
+    /// The remaining noise of the accumulation, estimated from its samples
+    /// (`crate::trace::denoise::noise_estimate`): `None` below two samples
+    /// or when the last sample was not measured ([`Renderer::estimate_noise`]).
+    ///
+    /// # Errors
+    /// A failed readback.
+    pub fn noise_estimate(&self) -> Result<Option<f32>, GpuError> {
+        let samples = self.path.accumulation.samples;
+        if samples < 2 || self.noise_of != Some(samples) {
+            return Ok(None);
+        }
+        let (w, h) = self.path.size();
+        let sum = self.denoiser.read_variance_sum(&self.gpu)?;
+        Ok(Some((sum / (3.0 * f64::from(w) * f64::from(h))).sqrt() as f32))
     }
 
     /// Submits the frame [`Renderer::encode`] recorded, after `before` (the
@@ -405,7 +491,13 @@ impl Renderer {
             }
         })?;
         let path = match recorded {
-            Some(Recorded::Path { kernel, effects }) => Some(self.path_band_done(ms, kernel, effects)),
+            Some(Recorded::Path { kernel, effects, prepared }) => {
+                let frame = self.path_band_done(ms, kernel, effects);
+                if prepared {
+                    self.noise_of = Some(frame.samples);
+                }
+                Some(frame)
+            }
             Some(Recorded::Nothing(frame)) => Some(frame),
             _ => None,
         };
@@ -462,6 +554,7 @@ impl Renderer {
         match self.shown {
             Shown::Trace => self.pass.output_view(),
             Shown::Path => self.path.output_view(),
+            Shown::Denoised => self.denoiser.output_view().unwrap_or(self.path.output_view()),
         }
     }
 
@@ -479,6 +572,7 @@ impl Renderer {
         let ((w, h), bytes) = match self.shown {
             Shown::Trace => (self.pass.size(), self.pass.read_color(&self.gpu)?),
             Shown::Path => (self.path.size(), self.path.read_color(&self.gpu)?),
+            Shown::Denoised => self.denoiser.read_color(&self.gpu)?,
         };
         image::RgbaImage::from_raw(w, h, bytes).ok_or_else(|| GpuError::Readback("texture size mismatch".into()))
     }

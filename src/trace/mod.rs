@@ -2,6 +2,7 @@
 //! `shaders/trace_svo.wgsl`) and Amanatides–Woo DDA over a dense grid (ground
 //! truth, and the report's baseline). Both work in tree-local coordinates.
 
+pub mod denoise;
 pub mod grid;
 pub mod path;
 pub mod render;

@@ -25,7 +25,8 @@ use self::materials::{Effects, GpuMaterial, MATERIAL_EMIT, MATERIAL_GLASS, MATER
 use self::rng::Rng;
 use super::render::GAVE_UP_COLOR;
 use super::svo::{Crossing, trace_through};
-use super::{Hit, Ray, argmin};
+use super::denoise::{Guide, Sums};
+use super::{Hit, Ray, argmin, normal_code};
 use crate::camera::{Camera, RayBasis};
 use crate::scene::{Octree, Palette};
 use crate::settings::{EffectsChoice, PathSettings, SUN_DIR};
@@ -90,6 +91,27 @@ impl PathScene<'_> {
         let (jx, jy) = (rng.uniform(), rng.uniform());
         let (origin, dir) = basis.ray_through(x as f32 + jx, y as f32 + jy);
         clamp_sample(self.radiance(Ray::new(origin, dir), &mut rng))
+    }
+
+    /// The denoiser's guide of pixel (x, y): the first hit of its centre
+    /// ray. Twin of `write_guide` in `shaders/path.wgsl`.
+    pub fn guide(&self, basis: &RayBasis, x: u32, y: u32) -> Guide {
+        let (origin, dir) = basis.ray(x, y);
+        let ray = Ray::new(origin, dir);
+        let c = self.cross(&ray, 0);
+        if !c.found || c.hit.gave_up || c.hit.normal == IVec3::ZERO {
+            return Guide::LEFT;
+        }
+        let kind = self.materials[usize::from(c.hit.value)].kind;
+        let effects = self.effects;
+        let left = (effects.emit && kind == MATERIAL_EMIT)
+            || (effects.glass && kind == MATERIAL_GLASS)
+            || (effects.metal && kind == MATERIAL_METAL);
+        if left {
+            return Guide::LEFT;
+        }
+        let rgb = (self.albedo[usize::from(c.hit.value)] * 255.0).round().as_uvec3();
+        Guide::filtered(surface_point(&ray, &c), normal_code(c.hit.normal), [rgb.x as u8, rgb.y as u8, rgb.z as u8])
     }
 
     fn radiance(&self, mut ray: Ray, rng: &mut Rng) -> Vec3 {
@@ -448,6 +470,10 @@ fn metal_lobe(d: Vec3, n: Vec3, albedo: Vec3, material: &GpuMaterial, rng: &mut 
 pub struct CpuRender {
     /// The mean radiance of every pixel, row-major.
     pub pixels: Vec<Vec3>,
+    /// The sums the means come from, for the denoiser and the noise estimate.
+    pub sums: Vec<Sums>,
+    /// The denoiser's guide of every pixel.
+    pub guides: Vec<Guide>,
     pub effects: Effects,
     /// Emissive cells sampled as lights.
     pub lights: usize,
@@ -465,17 +491,23 @@ pub fn render_cpu(
 ) -> CpuRender {
     let scene = PathScene::new(tree, palette, settings);
     let basis = camera.basis(size.0, size.1, tree.origin());
-    let pixels = (0..basis.height)
+    let (sums, guides): (Vec<Sums>, Vec<Guide>) = (0..basis.height)
         .into_par_iter()
         .flat_map_iter(|y| {
             let scene = &scene;
             (0..basis.width).map(move |x| {
-                let sum: Vec3 = (0..spp).map(|s| scene.sample(&basis, x, y, s)).sum();
-                sum / spp.max(1) as f32
+                let mut sums = Sums { count: spp, ..Sums::default() };
+                for s in 0..spp {
+                    let v = scene.sample(&basis, x, y, s);
+                    sums.sum += v;
+                    sums.squares += v * v;
+                }
+                (sums, scene.guide(&basis, x, y))
             })
         })
-        .collect();
-    CpuRender { pixels, effects: scene.effects, lights: scene.lights.len() }
+        .unzip();
+    let pixels = sums.iter().map(Sums::mean).collect();
+    CpuRender { pixels, sums, guides, effects: scene.effects, lights: scene.lights.len() }
 }
 
 /// Radiance to display bytes: clamped to 0..=1, as the preview's colours.
