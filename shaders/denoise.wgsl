@@ -25,7 +25,8 @@ struct DenoiseUniforms {
 
 @group(0) @binding(0) var<storage, read> constants: DenoiseUniforms;
 var<private> du: DenoiseUniforms;
-// Two vec4 per pixel (shaders/path.wgsl): sum and count, sum of squares.
+// Three vec4 per pixel (shaders/path.wgsl): sum and count, sum of
+// squares, sum of the first hits' albedo.
 @group(0) @binding(1) var<storage, read> accum: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read> guides: array<vec4<u32>>;
 // Demodulated light and the variance of its luminance, per pixel.
@@ -48,16 +49,16 @@ fn is_filtered(code: u32) -> bool {
 }
 
 fn normal_of(code: u32) -> u32 {
-    return (code >> GUIDE_NORMAL_SHIFT) & 7u;
-}
-
-fn albedo_of(code: u32) -> vec3<f32> {
-    let rgb = vec3<f32>(f32(code & 0xffu), f32((code >> 8u) & 0xffu), f32((code >> 16u) & 0xffu)) / 255.0;
-    return max(rgb, vec3<f32>(MIN_ALBEDO));
+    return code & 7u;
 }
 
 fn same_surface(p: u32, q: u32) -> bool {
     return is_filtered(q) && normal_of(q) == normal_of(p);
+}
+
+// Twin of `mixed_normal_weight`.
+fn mixed_normal_weight(pixel_width: f32) -> f32 {
+    return clamp((pixel_width - 1.0) / (MIXED_NORMALS_FROM - 1.0), 0.0, 1.0);
 }
 
 // Twin of `normal_from_code`.
@@ -68,11 +69,16 @@ fn normal_vector(code: u32) -> vec3<f32> {
 }
 
 fn count_of(i: u32) -> f32 {
-    return accum[2u * i].w;
+    return accum[3u * i].w;
 }
 
 fn mean_of(i: u32) -> vec3<f32> {
-    return accum[2u * i].rgb / max(count_of(i), 1.0);
+    return accum[3u * i].rgb / max(count_of(i), 1.0);
+}
+
+// Twin of `Sums::albedo`.
+fn albedo_of(i: u32) -> vec3<f32> {
+    return max(accum[3u * i + 2u].rgb / max(count_of(i), 1.0), vec3<f32>(MIN_ALBEDO));
 }
 
 // Twin of `Sums::variance_of_mean`.
@@ -81,8 +87,8 @@ fn variance_of_mean(i: u32) -> vec3<f32> {
     if (n < 2.0) {
         return vec3<f32>(0.0);
     }
-    let mean = accum[2u * i].rgb / n;
-    return max((accum[2u * i + 1u].rgb / n - mean * mean) / (n - 1.0), vec3<f32>(0.0));
+    let mean = accum[3u * i].rgb / n;
+    return max((accum[3u * i + 1u].rgb / n - mean * mean) / (n - 1.0), vec3<f32>(0.0));
 }
 
 // Twin of `displayed_variance`.
@@ -101,7 +107,7 @@ fn inside(x: i32, y: i32) -> bool {
 }
 
 fn demodulated(i: u32) -> vec3<f32> {
-    return mean_of(i) / albedo_of(code_of(i));
+    return mean_of(i) / albedo_of(i);
 }
 
 // Twin of one pixel of `prepare`.
@@ -129,7 +135,7 @@ fn prepared(px: vec2<i32>) -> vec4<f32> {
         }
         variance = max(m2 / n - (m1 / n) * (m1 / n), 0.0);
     } else {
-        let w = LUMINANCE / albedo_of(p);
+        let w = LUMINANCE / albedo_of(i);
         let v = variance_of_mean(i) * w * w;
         variance = v.x + v.y + v.z;
     }
@@ -206,6 +212,7 @@ fn atrous(@builtin(global_invocation_id) gid: vec3<u32>) {
     let pixel_width = du.at_start + du.per_t * max(dot(point - du.eye, du.forward), 0.0);
     let step = i32(du.step);
     let plane_scale = SIGMA_PLANE * pixel_width * f32(step);
+    let mixed = mixed_normal_weight(pixel_width);
     var kernel = KERNEL;
     var rgb = vec3<f32>(0.0);
     var variance = 0.0;
@@ -217,15 +224,17 @@ fn atrous(@builtin(global_invocation_id) gid: vec3<u32>) {
                 continue;
             }
             let j = pixel_index(q.x, q.y);
-            if (!same_surface(p, code_of(j))) {
+            let q_code = code_of(j);
+            if (!is_filtered(q_code)) {
                 continue;
             }
+            let w_normal = select(mixed, 1.0, normal_of(q_code) == normal_of(p));
             let off_plane = abs(dot(normal, point_of(j) - point));
             let distance = sqrt(f32(dx * dx + dy * dy));
             let w_plane = exp(-off_plane / (plane_scale * distance + 1e-6));
             let sigma = SIGMA_LIGHT * sqrt(variance_p + light_in[j].w) + 1e-6;
             let w_light = exp(-abs(dot(light_in[j].rgb, LUMINANCE) - luminance) / sigma);
-            let w = kernel[abs(dx)] * kernel[abs(dy)] * w_plane * w_light;
+            let w = kernel[abs(dx)] * kernel[abs(dy)] * (w_normal * w_plane * w_light);
             rgb += w * light_in[j].rgb;
             variance += w * w * light_in[j].w;
             weight += w;
@@ -242,6 +251,6 @@ fn finish(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let i = pixel_index(i32(gid.x), i32(gid.y));
     let p = code_of(i);
-    let rgb = select(mean_of(i), light_in[i].rgb * albedo_of(p), is_filtered(p));
+    let rgb = select(mean_of(i), light_in[i].rgb * albedo_of(i), is_filtered(p));
     textureStore(out_color, vec2<i32>(gid.xy), vec4<f32>(rgb, 1.0));
 }

@@ -58,12 +58,27 @@ struct Emitter {
 var<private> pu: PathUniforms;
 @group(0) @binding(9) var<storage, read> materials: array<Material>;
 @group(0) @binding(10) var<storage, read> emitters: array<Emitter>;
-// Two vec4 per pixel: the sum of the samples and their count, then the sum
-// of their squares (the denoiser's variance and the noise estimate).
+// Three vec4 per pixel: the sum of the samples and their count, the sum of
+// their squares (the denoiser's variance and the noise estimate), and the
+// sum of their first hits' `demodulation_albedo`.
 @group(0) @binding(11) var<storage, read_write> accum: array<vec4<f32>>;
 // The denoiser's guide per pixel (twin of `Guide` in src/trace/denoise.rs):
 // the point where the centre ray enters a face, as bits, then the code.
 @group(0) @binding(12) var<storage, read_write> guides: array<vec4<u32>>;
+
+// The first hit's `demodulation_albedo` of the path being traced.
+var<private> first_albedo: vec3<f32>;
+
+// Whether the denoiser leaves a pixel whose first hit is of `kind` to its
+// samples (twin of `PathScene::left_to_samples`).
+fn left_to_samples(kind: u32) -> bool {
+    return (EMIT && kind == MATERIAL_EMIT) || (GLASS && kind == MATERIAL_GLASS) || (METAL && kind == MATERIAL_METAL);
+}
+
+// Twin of `PathScene::demodulation_albedo`.
+fn demodulation_albedo(value: u32) -> vec3<f32> {
+    return select(albedo_of(value), vec3<f32>(1.0), left_to_samples(materials[value].kind));
+}
 
 // ---- random numbers (twin of src/trace/path/rng.rs) ----
 
@@ -396,6 +411,7 @@ fn radiance(ray_in: Ray) -> vec3<f32> {
     var lights_counted = false;
     var bounces = 0u;
     var transmissions = 0u;
+    var first = true;
     loop {
         let hit = cross_medium(ray, medium);
         if (hit.iterations >= u.max_iterations && !hit.found) {
@@ -412,6 +428,10 @@ fn radiance(ray_in: Ray) -> vec3<f32> {
         let d = normalize(ray.d);
         let value = hit.value;
         let m = materials[value];
+        if (first) {
+            first_albedo = demodulation_albedo(value);
+            first = false;
+        }
         var dir: vec3<f32>;
         // Leaving glass (into empty space or other glass), or entering it.
         let leaving = GLASS && medium != 0u && (value == 0u || is_glass(value));
@@ -489,14 +509,8 @@ fn write_guide(px: vec2<u32>, pixel: u32) {
     let r = pixel_ray(px);
     let hit = cross_medium(r, 0u);
     var guide = vec4<u32>(0u);
-    if (hit.found && hit.normal_code != 0u) {
-        let kind = materials[hit.value].kind;
-        let left = (EMIT && kind == MATERIAL_EMIT) || (GLASS && kind == MATERIAL_GLASS)
-            || (METAL && kind == MATERIAL_METAL);
-        if (!left) {
-            let code = (palette[hit.value] & 0xffffffu) | (hit.normal_code << GUIDE_NORMAL_SHIFT) | GUIDE_FILTERED;
-            guide = vec4<u32>(bitcast<vec3<u32>>(surface_point(r, hit)), code);
-        }
+    if (hit.found && hit.normal_code != 0u && !left_to_samples(materials[hit.value].kind)) {
+        guide = vec4<u32>(bitcast<vec3<u32>>(surface_point(r, hit)), hit.normal_code | GUIDE_FILTERED);
     }
     guides[pixel] = guide;
 }
@@ -514,12 +528,16 @@ fn path(@builtin(global_invocation_id) gid: vec3<u32>) {
     let jx = rng_next();
     let jy = rng_next();
     let r = image_ray(vec2<f32>(px) + vec2<f32>(jx, jy));
+    first_albedo = vec3<f32>(1.0);
     let sample = clamp_sample(radiance(r));
     let first = pu.sample_index == 0u;
-    let sum = select(accum[2u * pixel].rgb, vec3<f32>(0.0), first) + sample;
-    let squares = select(accum[2u * pixel + 1u].rgb, vec3<f32>(0.0), first) + sample * sample;
-    accum[2u * pixel] = vec4<f32>(sum, f32(pu.sample_index + 1u));
-    accum[2u * pixel + 1u] = vec4<f32>(squares, 0.0);
+    let at = 3u * pixel;
+    let sum = select(accum[at].rgb, vec3<f32>(0.0), first) + sample;
+    let squares = select(accum[at + 1u].rgb, vec3<f32>(0.0), first) + sample * sample;
+    let albedo = select(accum[at + 2u].rgb, vec3<f32>(0.0), first) + first_albedo;
+    accum[at] = vec4<f32>(sum, f32(pu.sample_index + 1u));
+    accum[at + 1u] = vec4<f32>(squares, 0.0);
+    accum[at + 2u] = vec4<f32>(albedo, 0.0);
     textureStore(out_color, vec2<i32>(px), vec4<f32>(sum / f32(pu.sample_index + 1u), 1.0));
     if (first) {
         write_guide(px, pixel);

@@ -54,6 +54,10 @@ pub struct WindowArgs {
     /// (the UI can change it); `--samples` is the older name.
     #[arg(long = "spp", visible_alias = "samples", value_name = "N", default_value_t = octovox::settings::DEFAULT_SAMPLE_TARGET, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub samples: u32,
+    /// Show the path tracer's raw samples, not the denoised image (the
+    /// Render panel's Denoise box).
+    #[arg(long)]
+    pub no_denoise: bool,
     /// Preview shading only, the path tracer once the camera rests, or the
     /// path tracer always (the UI can change it).
     #[arg(long, value_enum, default_value_t = octovox::settings::Shading::Rest)]

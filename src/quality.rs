@@ -53,11 +53,7 @@ pub enum Setting {
         denoise: bool,
     },
     /// The preview; `lod` is the level-of-detail footprint in pixels (0 exact).
-    Preview {
-        mode: TraceMode,
-        render_scale: f32,
-        lod: f32,
-    },
+    Preview { mode: TraceMode, render_scale: f32, lod: f32 },
 }
 
 /// Draws one frame with `setting`; returns its wall-clock milliseconds

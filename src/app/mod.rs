@@ -152,6 +152,7 @@ impl App {
         app.state.settings.lod = app.args.lod;
         app.state.shading = app.args.shading;
         app.state.sample_target = app.args.samples;
+        app.state.denoise = !app.args.no_denoise;
         if let Some((eye, target)) = app.args.camera {
             app.state.camera = Camera { eye, target, ..app.state.camera };
         }

@@ -11,8 +11,8 @@ use glam::DVec3;
 use serde::Serialize;
 
 use octovox::camera::Camera;
-use octovox::gpu::Renderer;
 use octovox::gpu::PathView;
+use octovox::gpu::Renderer;
 use octovox::quality::{Setting, accumulate, flip, pareto_front, psnr, render_setting};
 use octovox::scene::Scene;
 use octovox::scene::demo::BuiltIn;
@@ -135,11 +135,7 @@ pub fn bench_quality(quick: bool, out: &Path) -> anyhow::Result<(String, String)
         let reference_noise = renderer.noise_estimate()?;
         renderer.denoise_now()?;
         let denoised_reference = renderer.read_image()?;
-        unbiased.push(UnbiasedRow {
-            scene: name,
-            flip: flip(&reference_image, &denoised_reference),
-            reference_noise,
-        });
+        unbiased.push(UnbiasedRow { scene: name, flip: flip(&reference_image, &denoised_reference), reference_noise });
         let mut scene_rows = Vec::new();
         for (knob, value, setting) in knobs(&sizes) {
             let (ms, image) = render_setting(&mut renderer, &scene, &camera, sizes.size, setting)?;
@@ -292,11 +288,20 @@ fn denoise_markdown(rows: &[QualityRow], unbiased: &[UnbiasedRow]) -> String {
     md += "\nDenoised 8 spp against raw 32 spp:\n\n| scene | denoised 8 spp: ms, FLIP | raw 32 spp: ms, FLIP |\n|---|---|---|\n";
     for scene in &scenes {
         let cell = |v: Option<(f64, f32)>| v.map_or("–".into(), |(ms, f)| format!("{ms:.1} ms, {f:.4}"));
-        md += &format!("| {scene} | {} | {} |\n", cell(flip_of(rows, scene, true, 8)), cell(flip_of(rows, scene, false, 32)));
+        md += &format!(
+            "| {scene} | {} | {} |\n",
+            cell(flip_of(rows, scene, true, 8)),
+            cell(flip_of(rows, scene, false, 32))
+        );
     }
     md += "\nNo bias: the reference's own samples denoised, against the raw reference (target FLIP ≤ 0.01).\n\n| scene | FLIP | the reference's noise estimate |\n|---|---|---|\n";
     for u in unbiased {
-        md += &format!("| {} | {:.4} | {} |\n", u.scene, u.flip, u.reference_noise.map_or("–".into(), |n| format!("{n:.4}")));
+        md += &format!(
+            "| {} | {:.4} | {} |\n",
+            u.scene,
+            u.flip,
+            u.reference_noise.map_or("–".into(), |n| format!("{n:.4}"))
+        );
     }
     md += "\nThe noise estimate against the measured error, raw path-traced rows: the estimate is the RMS standard error of the displayed pixels from each pixel's own samples; the measured error is the RMS difference from the reference, which has noise of its own (its estimate above) and 8-bit rounding.\n\n| scene | knob | value | estimate | measured RMS | measured / estimate |\n|---|---|---|---|---|---|\n";
     for r in rows.iter().filter(|r| r.noise_estimate.is_some()) {

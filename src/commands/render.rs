@@ -27,8 +27,8 @@ const CPU_BYTES_PER_PIXEL: u64 = 48;
 /// and the image.
 const GPU_BYTES_PER_PIXEL: u64 = 12;
 /// A CPU path-traced render keeps the mean radiance (12 bytes), the sums
-/// (28), the denoiser's guide (16) and two light buffers (32), and the image.
-const CPU_PATH_BYTES_PER_PIXEL: u64 = 92;
+/// (40), the denoiser's guide (16) and two light buffers (32), and the image.
+const CPU_PATH_BYTES_PER_PIXEL: u64 = 104;
 /// A GPU path-traced render adds the accumulation buffer's readback.
 const GPU_PATH_BYTES_PER_PIXEL: u64 = 28;
 
@@ -153,7 +153,8 @@ fn path_traced(
     let (cap, target) = (args.path.samples(), args.path.target_error);
     let view = PathView { tree: &scene.tree, palette: &scene.palette, camera, size, settings: &settings };
     let bar = super::progress_bar::bar("path tracing", u64::from(cap));
-    let Accumulated { last: frame, ms: total_ms, noise } = accumulate(&mut renderer, &view, cap, target, |_| bar.inc(1))?;
+    let Accumulated { last: frame, ms: total_ms, noise } =
+        accumulate(&mut renderer, &view, cap, target, |_| bar.inc(1))?;
     bar.finish_and_clear();
     let denoise_ms = if args.path.denoise { Some(renderer.denoise_now()?) } else { None };
     let stats = Stats {

@@ -142,7 +142,8 @@ impl DenoisePass {
         for (stage, step) in target.stages.iter().zip(steps) {
             gpu.queue.write_buffer(&stage.constants, 0, bytemuck::bytes_of(&DenoiseUniforms::new(frame, step)));
         }
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("denoise"), ..Default::default() });
+        let mut pass =
+            encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("denoise"), ..Default::default() });
         let (gx, gy) = groups(target.width, target.height);
         let count = if filter { target.stages.len() } else { 1 };
         for (i, stage) in target.stages.iter().enumerate().take(count) {

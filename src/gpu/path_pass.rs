@@ -52,8 +52,9 @@ fn compile(
 }
 
 const EMITTER_BYTES: u64 = std::mem::size_of::<Emitter>() as u64;
-/// Bytes per pixel of the accumulation: sums and count, sums of squares.
-pub const ACCUM_BYTES: u64 = 32;
+/// Bytes per pixel of the accumulation: sums and count, sums of squares,
+/// sums of the first hits' albedo.
+pub const ACCUM_BYTES: u64 = 48;
 /// Bytes per pixel of the denoiser's guides.
 pub const GUIDE_BYTES: u64 = std::mem::size_of::<Guide>() as u64;
 
@@ -61,8 +62,8 @@ pub const GUIDE_BYTES: u64 = std::mem::size_of::<Guide>() as u64;
 struct Target {
     texture: wgpu::Texture,
     view: wgpu::TextureView,
-    /// Two vec4 per pixel: the RGB sums and the sample count, then the
-    /// sums of squares.
+    /// Three vec4 per pixel: the RGB sums and the sample count, the sums of
+    /// squares, the sums of the first hits' albedo.
     accum: wgpu::Buffer,
     /// The denoiser's [`Guide`] per pixel, written by the first sample.
     guides: wgpu::Buffer,
@@ -389,8 +390,10 @@ impl PathPass {
         let words: Vec<[f32; 4]> = read_storage(gpu, &self.target.accum, "accumulation readback")?;
         let pixels = (self.target.width * self.target.height) as usize;
         let rgb = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
-        let sums = words.chunks_exact(2).take(pixels);
-        Ok(sums.map(|p| Sums { sum: rgb(p[0]), squares: rgb(p[1]), count: p[0][3] as u32 }).collect())
+        let sums = words.chunks_exact(3).take(pixels);
+        Ok(sums
+            .map(|p| Sums { sum: rgb(p[0]), squares: rgb(p[1]), albedo: rgb(p[2]), count: p[0][3] as u32 })
+            .collect())
     }
 
     /// The denoiser's guides of every pixel, row-major.

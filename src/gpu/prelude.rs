@@ -41,10 +41,10 @@ pub fn shared_constants() -> String {
     line("MATERIAL_GLASS", "u32", format!("{}u", materials::MATERIAL_GLASS));
     line("MATERIAL_EMIT", "u32", format!("{}u", materials::MATERIAL_EMIT));
     line("GUIDE_FILTERED", "u32", format!("{:#x}u", denoise::GUIDE_FILTERED));
-    line("GUIDE_NORMAL_SHIFT", "u32", format!("{}u", denoise::GUIDE_NORMAL_SHIFT));
     line("DENOISE_ITERATIONS", "u32", format!("{}u", denoise::ITERATIONS));
     line("SIGMA_LIGHT", "f32", format!("{:?}", denoise::SIGMA_LIGHT));
     line("SIGMA_PLANE", "f32", format!("{:?}", denoise::SIGMA_PLANE));
+    line("MIXED_NORMALS_FROM", "f32", format!("{:?}", denoise::MIXED_NORMALS_FROM));
     line("SPATIAL_VARIANCE_BELOW", "u32", format!("{}u", denoise::SPATIAL_VARIANCE_BELOW));
     line("MIN_ALBEDO", "f32", format!("{:?}", denoise::MIN_ALBEDO));
     line("LUMINANCE", "vec3<f32>", vec3(denoise::LUMINANCE.to_array()));

@@ -6,16 +6,18 @@
 //! This is the CPU twin of `shaders/denoise.wgsl`, the reference for its
 //! tests: change both together.
 //!
-//! Per pixel the path tracer keeps the sums of its samples and of their
-//! squares, and a [`Guide`] from the ray through the pixel's centre: the
-//! point where it enters a voxel face, the face's normal, and the voxel's
-//! colour. The filter divides the mean by that colour (so a voxel-sharp
-//! colour edge is not blurred, only the light on it), averages it with
-//! neighbours on the same face plane whose light is within a few standard
-//! deviations, five times with taps 1, 2, 4, 8 and 16 pixels apart, and
+//! Per pixel the path tracer keeps the sums of its samples, of their
+//! squares and of the colour (albedo) of each sample's first hit, and a
+//! [`Guide`] from the ray through the pixel's centre: the point where it
+//! enters a voxel face and the face's normal. The filter divides the mean
+//! by the mean albedo (so a voxel-sharp colour edge is not blurred, only
+//! the light on it, and a pixel across such an edge keeps its mix), averages it with
+//! neighbours near the same face plane whose light is within a few
+//! standard deviations (facing the same way, unless voxels are smaller than
+//! a pixel), five times with taps 1, 2, 4, 8 and 16 pixels apart, and
 //! multiplies the colour back. Pixels whose first hit is the sky, a lamp,
 //! glass or metal are left to their samples: their light does not lie on
-//! the face the guide describes (measured in `docs/bench/denoise.md`).
+//! the face the guide describes.
 
 use glam::Vec3;
 
@@ -27,6 +29,11 @@ pub const SIGMA_LIGHT: f32 = 4.0;
 /// How far off a pixel's face plane a neighbour's point may lie, in pixel
 /// footprints per pixel of distance, and still weigh `1/e`.
 pub const SIGMA_PLANE: f32 = 1.0;
+/// Where a pixel spans this many voxels and more, neighbours facing
+/// another way weigh fully; at one voxel and less, nothing: a face is
+/// either wider than a pixel and has its own light, or a pixel's samples
+/// already mix the faces of the voxels it spans.
+pub const MIXED_NORMALS_FROM: f32 = 2.0;
 /// Below this many samples a pixel's variance is taken from its neighbours:
 /// its own sum of squares says too little.
 pub const SPATIAL_VARIANCE_BELOW: u32 = 4;
@@ -37,9 +44,7 @@ pub const KERNEL: [f32; 3] = [3.0 / 8.0, 1.0 / 4.0, 1.0 / 16.0];
 pub const MIN_ALBEDO: f32 = 1.0 / 255.0;
 
 /// Bit of [`Guide::code`] set where the filter may change the pixel.
-pub const GUIDE_FILTERED: u32 = 1 << 27;
-/// The shift of the normal code (`crate::trace::normal_code`) in [`Guide::code`].
-pub const GUIDE_NORMAL_SHIFT: u32 = 24;
+pub const GUIDE_FILTERED: u32 = 1 << 3;
 
 /// The first hit of a pixel's centre ray. Twin of the guide `vec4<f32>` the
 /// path kernel writes: `point` in tree-local voxels, then `code` as bits.
@@ -47,8 +52,8 @@ pub const GUIDE_NORMAL_SHIFT: u32 = 24;
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct Guide {
     pub point: [f32; 3],
-    /// The voxel's colour in bits 0..24 (RGB8), the normal code in bits
-    /// 24..27, [`GUIDE_FILTERED`].
+    /// The face's normal code (`crate::trace::normal_code`) in bits 0..3,
+    /// and [`GUIDE_FILTERED`].
     pub code: u32,
 }
 
@@ -57,9 +62,8 @@ impl Guide {
     pub const LEFT: Guide = Guide { point: [0.0; 3], code: 0 };
 
     /// A filtered pixel whose centre ray enters a face at `point`.
-    pub fn filtered(point: Vec3, normal_code: u32, rgb: [u8; 3]) -> Guide {
-        let colour = u32::from(rgb[0]) | u32::from(rgb[1]) << 8 | u32::from(rgb[2]) << 16;
-        Guide { point: point.to_array(), code: colour | normal_code << GUIDE_NORMAL_SHIFT | GUIDE_FILTERED }
+    pub fn filtered(point: Vec3, normal_code: u32) -> Guide {
+        Guide { point: point.to_array(), code: normal_code | GUIDE_FILTERED }
     }
 
     pub fn is_filtered(&self) -> bool {
@@ -67,28 +71,29 @@ impl Guide {
     }
 
     pub fn normal_code(&self) -> u32 {
-        (self.code >> GUIDE_NORMAL_SHIFT) & 7
-    }
-
-    /// The colour the light is divided by, each channel at least [`MIN_ALBEDO`].
-    pub fn albedo(&self) -> Vec3 {
-        let channel = |shift: u32| f32::from((self.code >> shift) as u8) / 255.0;
-        Vec3::new(channel(0), channel(8), channel(16)).max(Vec3::splat(MIN_ALBEDO))
+        self.code & 7
     }
 }
 
-/// One pixel of the accumulation: the sums of the samples and of their
-/// squares, per channel, and the sample count.
+/// One pixel of the accumulation: the sums of the samples, of their
+/// squares and of their first hits' albedo, per channel, and the count.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Sums {
     pub sum: Vec3,
     pub squares: Vec3,
+    pub albedo: Vec3,
     pub count: u32,
 }
 
 impl Sums {
     pub fn mean(&self) -> Vec3 {
         self.sum / self.count.max(1) as f32
+    }
+
+    /// The colour the light is divided by: the mean albedo, each channel at
+    /// least [`MIN_ALBEDO`].
+    pub fn albedo(&self) -> Vec3 {
+        (self.albedo / self.count.max(1) as f32).max(Vec3::splat(MIN_ALBEDO))
     }
 
     /// The variance of the mean, per channel; zero below two samples.
@@ -151,7 +156,7 @@ pub fn denoise(frame: &Frame, sums: &[Sums], guides: &[Guide]) -> Vec<Vec3> {
         light = atrous(frame, guides, &light, 1 << iteration);
     }
     (0..light.len())
-        .map(|i| if guides[i].is_filtered() { light[i].rgb * guides[i].albedo() } else { sums[i].mean() })
+        .map(|i| if guides[i].is_filtered() { light[i].rgb * sums[i].albedo() } else { sums[i].mean() })
         .collect()
 }
 
@@ -172,11 +177,17 @@ fn same_surface(p: &Guide, q: &Guide) -> bool {
     q.is_filtered() && q.normal_code() == p.normal_code()
 }
 
+/// The weight of a filtered neighbour facing another way, where a pixel is
+/// `pixel_width` voxels wide (see [`MIXED_NORMALS_FROM`]).
+fn mixed_normal_weight(pixel_width: f32) -> f32 {
+    ((pixel_width - 1.0) / (MIXED_NORMALS_FROM - 1.0)).clamp(0.0, 1.0)
+}
+
 /// Demodulated light and its variance per pixel; below
 /// [`SPATIAL_VARIANCE_BELOW`] samples the variance of the 5×5 neighbours'
 /// light on the same surface.
 fn prepare(frame: &Frame, sums: &[Sums], guides: &[Guide]) -> Vec<Light> {
-    let demodulated = |i: usize| sums[i].mean() / guides[i].albedo();
+    let demodulated = |i: usize| sums[i].mean() / sums[i].albedo();
     let mut out = Vec::with_capacity(sums.len());
     for y in 0..frame.height {
         for x in 0..frame.width {
@@ -194,7 +205,7 @@ fn prepare(frame: &Frame, sums: &[Sums], guides: &[Guide]) -> Vec<Light> {
                 }
                 (m2 / n - (m1 / n) * (m1 / n)).max(0.0)
             } else {
-                let albedo = g.albedo();
+                let albedo = s.albedo();
                 (s.variance_of_mean() * (LUMINANCE / albedo) * (LUMINANCE / albedo)).element_sum()
             };
             out.push(Light { rgb: demodulated(i), variance });
@@ -230,9 +241,12 @@ fn atrous(frame: &Frame, guides: &[Guide], light: &[Light], step: u32) -> Vec<Li
             let luminance = light[i].rgb.dot(LUMINANCE);
             let point = Vec3::from(p.point);
             let normal = crate::trace::normal_from_code(p.normal_code()).as_vec3();
-            let plane_scale = SIGMA_PLANE * frame.pixel_width(point) * step as f32;
+            let pixel_width = frame.pixel_width(point);
+            let plane_scale = SIGMA_PLANE * pixel_width * step as f32;
+            let mixed = mixed_normal_weight(pixel_width);
             let (mut rgb, mut variance, mut weight) = (Vec3::ZERO, 0.0f32, 0.0f32);
-            for (q, dx, dy) in taps(frame, x, y, 2, step as i32).filter(|&(q, _, _)| same_surface(p, &guides[q])) {
+            for (q, dx, dy) in taps(frame, x, y, 2, step as i32).filter(|&(q, _, _)| guides[q].is_filtered()) {
+                let w_normal = if guides[q].normal_code() == p.normal_code() { 1.0 } else { mixed };
                 let off_plane = normal.dot(Vec3::from(guides[q].point) - point).abs();
                 let distance = ((dx * dx + dy * dy) as f32).sqrt();
                 let w_plane = (-off_plane / (plane_scale * distance + 1e-6)).exp();
@@ -241,7 +255,9 @@ fn atrous(frame: &Frame, guides: &[Guide], light: &[Light], step: u32) -> Vec<Li
                 // in, so its light is spread, not lost.
                 let sigma = SIGMA_LIGHT * (variance_p + light[q].variance).sqrt() + 1e-6;
                 let w_light = (-(light[q].rgb.dot(LUMINANCE) - luminance).abs() / sigma).exp();
-                let w = KERNEL[dx.unsigned_abs() as usize] * KERNEL[dy.unsigned_abs() as usize] * w_plane * w_light;
+                let w = KERNEL[dx.unsigned_abs() as usize]
+                    * KERNEL[dy.unsigned_abs() as usize]
+                    * (w_normal * w_plane * w_light);
                 rgb += w * light[q].rgb;
                 variance += w * w * light[q].variance;
                 weight += w;
@@ -284,19 +300,20 @@ mod tests {
         Frame { width: W, height: H, eye: Vec3::new(0.0, 10.0, 0.0), forward: Vec3::NEG_Y, footprint }
     }
 
-    /// A floor seen from above: every pixel on the plane y = 0, facing +y,
-    /// coloured by `colour(x, y)`.
-    fn floor(colour: impl Fn(u32, u32) -> [u8; 3]) -> Vec<Guide> {
+    /// A floor seen from above: every pixel on the plane y = 0, facing +y;
+    /// the guides and each pixel's albedo, `colour(x, y)`.
+    fn floor(colour: impl Fn(u32, u32) -> [u8; 3]) -> (Vec<Guide>, Vec<Vec3>) {
         (0..W * H)
             .map(|i| {
                 let (x, y) = (i % W, i / W);
-                Guide::filtered(Vec3::new(x as f32 * 0.1, 0.0, y as f32 * 0.1), 3, colour(x, y))
+                let albedo = Vec3::from(colour(x, y).map(|c| f32::from(c) / 255.0));
+                (Guide::filtered(Vec3::new(x as f32 * 0.1, 0.0, y as f32 * 0.1), 3), albedo)
             })
-            .collect()
+            .unzip()
     }
 
     /// `n` noisy samples of light `light(x, y)` times each pixel's albedo.
-    fn noisy(guides: &[Guide], n: u32, light: impl Fn(u32, u32) -> f32) -> Vec<Sums> {
+    fn noisy(albedo: &[Vec3], n: u32, light: impl Fn(u32, u32) -> f32) -> Vec<Sums> {
         let mut rng = 12345u32;
         let mut uniform = move || {
             rng = rng.wrapping_mul(1664525).wrapping_add(1013904223);
@@ -304,8 +321,8 @@ mod tests {
         };
         (0..W * H)
             .map(|i| {
-                let truth = guides[i as usize].albedo() * light(i % W, i / W);
-                let mut s = Sums { count: n, ..Sums::default() };
+                let truth = albedo[i as usize] * light(i % W, i / W);
+                let mut s = Sums { count: n, albedo: albedo[i as usize] * n as f32, ..Sums::default() };
                 for _ in 0..n {
                     let v = truth * 2.0 * uniform();
                     s.sum += v;
@@ -322,9 +339,9 @@ mod tests {
 
     #[test]
     fn it_removes_most_of_the_noise_of_a_flat_floor() {
-        let guides = floor(|_, _| [200, 150, 100]);
-        let sums = noisy(&guides, 4, |_, _| 0.5);
-        let truth = |i: usize| guides[i].albedo() * 0.5;
+        let (guides, albedo) = floor(|_, _| [200, 150, 100]);
+        let sums = noisy(&albedo, 4, |_, _| 0.5);
+        let truth = |i: usize| albedo[i] * 0.5;
         let raw: Vec<Vec3> = sums.iter().map(Sums::mean).collect();
         let denoised = denoise(&frame(), &sums, &guides);
         let (before, after) = (rms(&raw, truth), rms(&denoised, truth));
@@ -333,18 +350,18 @@ mod tests {
 
     #[test]
     fn a_one_pixel_checker_of_colours_keeps_its_contrast() {
-        let guides = floor(|x, y| if (x + y) % 2 == 0 { [240, 240, 240] } else { [30, 30, 30] });
-        let sums = noisy(&guides, 2, |_, _| 0.8);
+        let (guides, albedo) = floor(|x, y| if (x + y) % 2 == 0 { [240, 240, 240] } else { [30, 30, 30] });
+        let sums = noisy(&albedo, 2, |_, _| 0.8);
         let denoised = denoise(&frame(), &sums, &guides);
         let contrast = |pixels: &dyn Fn(usize) -> Vec3| {
             let (mut light, mut dark) = (0.0, 0.0);
             for i in 0..(W * H) as usize {
                 let l = pixels(i).dot(LUMINANCE);
-                if (i as u32 % W + i as u32 / W) % 2 == 0 { light += l } else { dark += l }
+                if (i as u32 % W + i as u32 / W).is_multiple_of(2) { light += l } else { dark += l }
             }
             (light - dark) / (light + dark)
         };
-        let reference = contrast(&|i| guides[i].albedo() * 0.8);
+        let reference = contrast(&|i| albedo[i] * 0.8);
         let kept = contrast(&|i| denoised[i]);
         assert!((kept - reference).abs() < 0.01 * reference, "contrast {kept} against {reference}");
     }
@@ -353,14 +370,14 @@ mod tests {
     fn a_step_between_planes_and_pixels_left_to_their_samples_stay_sharp() {
         // The left half is a floor one voxel lower than the right half, lit
         // half as much; a column of lamp pixels down the middle.
-        let mut guides = floor(|_, _| [128, 128, 128]);
+        let (mut guides, albedo) = floor(|_, _| [128, 128, 128]);
         for (i, g) in guides.iter_mut().enumerate() {
             if i as u32 % W < W / 2 {
                 g.point[1] = -1.0;
             }
         }
         let lamp = |i: usize| i as u32 % W == W / 2;
-        let sums = noisy(&guides, 8, |x, _| if x < W / 2 { 0.25 } else { 0.5 });
+        let sums = noisy(&albedo, 8, |x, _| if x < W / 2 { 0.25 } else { 0.5 });
         let mut guides_with_lamps = guides.clone();
         for (i, g) in guides_with_lamps.iter_mut().enumerate() {
             if lamp(i) {
@@ -373,21 +390,42 @@ mod tests {
                 assert_eq!(*pixel, sums[i].mean(), "a lamp pixel changed");
                 continue;
             }
-            let truth = guides[i].albedo().x * if (i as u32 % W) < W / 2 { 0.25 } else { 0.5 };
+            let truth = albedo[i].x * if (i as u32 % W) < W / 2 { 0.25 } else { 0.5 };
             assert!((pixel.x - truth).abs() < 0.25 * truth, "pixel {i}: {} against {truth}", pixel.x);
         }
     }
 
     #[test]
     fn the_noise_estimate_follows_the_standard_error() {
-        let guides = floor(|_, _| [255, 255, 255]);
+        let (_, albedo) = floor(|_, _| [255, 255, 255]);
         let light = |_, _| 0.3;
-        let (few, many) = (noise_estimate(&noisy(&guides, 4, light)), noise_estimate(&noisy(&guides, 64, light)));
+        let (few, many) = (noise_estimate(&noisy(&albedo, 4, light)), noise_estimate(&noisy(&albedo, 64, light)));
         // Samples uniform on 0..0.6: standard deviation 0.6/√12.
         let expected = |n: f32| 0.6 / 12f32.sqrt() / n.sqrt();
         let (few, many) = (few.unwrap(), many.unwrap());
         assert!((few / expected(4.0) - 1.0).abs() < 0.2, "{few} against {}", expected(4.0));
         assert!((many / expected(64.0) - 1.0).abs() < 0.1, "{many} against {}", expected(64.0));
-        assert_eq!(noise_estimate(&noisy(&guides, 1, light)), None);
+        assert_eq!(noise_estimate(&noisy(&albedo, 1, light)), None);
+    }
+
+    #[test]
+    fn a_pixel_across_a_colour_edge_keeps_its_mix() {
+        // Light and dark columns, 4 pixels wide; the pixels of every 4th
+        // column straddle the edge: half their samples hit each colour,
+        // their centre ray the dark one.
+        let (light, dark) = (Vec3::splat(0.9), Vec3::splat(0.1));
+        let (guides, mut albedo) = floor(|x, _| if (x / 4) % 2 == 0 { [230; 3] } else { [26; 3] });
+        let edge = |i: usize| i as u32 % W % 8 == 4;
+        for (i, a) in albedo.iter_mut().enumerate() {
+            if edge(i) {
+                *a = (light + dark) * 0.5;
+            }
+        }
+        let sums = noisy(&albedo, 4, |_, _| 0.5);
+        let denoised = denoise(&frame(), &sums, &guides);
+        for (i, pixel) in denoised.iter().enumerate().filter(|(i, _)| edge(*i)) {
+            let truth = albedo[i].x * 0.5;
+            assert!((pixel.x - truth).abs() < 0.15 * truth, "edge pixel {i}: {} against {truth}", pixel.x);
+        }
     }
 }

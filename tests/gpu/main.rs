@@ -6,5 +6,6 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod denoise;
 mod path_trace;
 mod trace_gpu;

@@ -14,12 +14,12 @@ use octovox::scene::{Material, MaterialKind, Octree, Op, Palette, Shape};
 use octovox::settings::{PathSettings, Sky};
 use octovox::trace::path::{CpuRender, render_cpu};
 
-const WHITE: u8 = 1;
+pub(crate) const WHITE: u8 = 1;
 const RED: u8 = 2;
 const GREEN: u8 = 3;
 const SPECIAL: u8 = 4;
 
-fn palette() -> Palette {
+pub(crate) fn palette() -> Palette {
     let mut palette = Palette::default();
     palette.colors[usize::from(WHITE)] = [255, 255, 255, 255];
     palette.colors[usize::from(RED)] = [230, 40, 30, 255];
@@ -36,7 +36,7 @@ fn material(kind: MaterialKind, params: &[(&str, &str)]) -> Material {
     m
 }
 
-fn build(edits: &[(Shape, Op)]) -> Octree {
+pub(crate) fn build(edits: &[(Shape, Op)]) -> Octree {
     let mut tree = Octree::default();
     for (shape, op) in edits {
         tree.apply_brush(shape, *op).unwrap();
@@ -52,7 +52,7 @@ fn mean(pixels: &[Vec3]) -> Vec3 {
     pixels.iter().sum::<Vec3>() / pixels.len() as f32
 }
 
-fn look(eye: DVec3, target: DVec3) -> Camera {
+pub(crate) fn look(eye: DVec3, target: DVec3) -> Camera {
     Camera { eye, target, fov_y_deg: 40.0, ortho: None }
 }
 
@@ -231,7 +231,7 @@ fn gpu_white_furnace_converges_to_the_sky() {
 }
 
 /// A scene with every material: diffuse floor, metal, glass, a lamp.
-fn material_scene() -> (Octree, Palette) {
+pub(crate) fn material_scene() -> (Octree, Palette) {
     let mut palette = palette();
     palette.materials[5] = material(MaterialKind::Metal, &[("_rough", "0.3"), ("_metal", "0.8")]);
     palette.materials[6] = material(MaterialKind::Glass, &[("_ri", "1.5"), ("_trans", "0.9"), ("_rough", "0.05")]);

@@ -259,6 +259,35 @@ fn the_window_path_traces_the_showroom_at_rest() {
     assert!(variance > 100.0 && mean > 20.0, "a flat or black path-traced view: mean {mean}, variance {variance}");
 }
 
+/// At rest the window reports the raw samples' noise estimate at 2, 4, 8
+/// and 16 samples: it falls about as 1/√samples while the camera rests, and
+/// the view it shows (denoised, the default) is not flat.
+#[test]
+fn the_noise_estimate_falls_while_the_camera_rests() {
+    for tool in ["Xvfb", "xdotool", "import"] {
+        require_tool(tool);
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let (_xvfb, display) = start_xvfb(27);
+    let args = ["--demo", "showroom", "--size", "480x320", "--samples", "16"].map(String::from);
+    let (_app, mut lines, _stderr) = spawn_app(&display, dir.path(), &args);
+    lines.wait_for("octovox: ready", Duration::from_secs(90));
+    let mut estimates = Vec::new();
+    for samples in [2, 4, 8, 16] {
+        let line = lines.wait_for("noise: ", Duration::from_secs(120));
+        let words: Vec<&str> = line.split_whitespace().collect();
+        assert_eq!(words.get(3), Some(&samples.to_string().as_str()), "{line}");
+        estimates.push(words[1].parse::<f64>().unwrap());
+    }
+    lines.wait_for("path: 16 samples", Duration::from_secs(60));
+    assert!(estimates.windows(2).all(|w| w[1] < w[0]), "the estimate did not fall: {estimates:?}");
+    let ratio = estimates[0] / estimates[3];
+    assert!((2.0..4.5).contains(&ratio), "2 to 16 samples divided the estimate by {ratio}, not about √8");
+    let shot = screenshot_x(&display, &dir.path().join("denoised.png"));
+    let (mean, variance) = grey_stats(&shot, 300, 60, 470, 300);
+    assert!(variance > 100.0 && mean > 20.0, "a flat or black denoised view: mean {mean}, variance {variance}");
+}
+
 /// Alt+click is the eyedropper: the colour of the voxel under the cursor
 /// (found here by the CPU tracer) becomes the current colour, and the next
 /// attach uses it, as the saved file shows.

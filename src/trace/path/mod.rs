@@ -23,9 +23,9 @@ use rayon::prelude::*;
 use self::lights::Emitter;
 use self::materials::{Effects, GpuMaterial, MATERIAL_EMIT, MATERIAL_GLASS, MATERIAL_METAL};
 use self::rng::Rng;
+use super::denoise::{Guide, Sums};
 use super::render::GAVE_UP_COLOR;
 use super::svo::{Crossing, trace_through};
-use super::denoise::{Guide, Sums};
 use super::{Hit, Ray, argmin, normal_code};
 use crate::camera::{Camera, RayBasis};
 use crate::scene::{Octree, Palette};
@@ -87,10 +87,35 @@ impl PathScene<'_> {
 
     /// One sample of pixel (x, y): the radiance, finite and clamped.
     pub fn sample(&self, basis: &RayBasis, x: u32, y: u32, sample: u32) -> Vec3 {
+        self.sample_with_albedo(basis, x, y, sample).0
+    }
+
+    /// One sample of pixel (x, y) and the colour the denoiser divides its
+    /// light by: the first hit's albedo ([`PathScene::demodulation_albedo`]).
+    pub fn sample_with_albedo(&self, basis: &RayBasis, x: u32, y: u32, sample: u32) -> (Vec3, Vec3) {
         let mut rng = Rng::new(y * basis.width + x, sample);
         let (jx, jy) = (rng.uniform(), rng.uniform());
         let (origin, dir) = basis.ray_through(x as f32 + jx, y as f32 + jy);
-        clamp_sample(self.radiance(Ray::new(origin, dir), &mut rng))
+        let mut albedo = Vec3::ONE;
+        let radiance = clamp_sample(self.radiance(Ray::new(origin, dir), &mut rng, &mut albedo));
+        (radiance, albedo)
+    }
+
+    /// Whether the denoiser leaves a pixel whose first hit is of `kind` to
+    /// its samples: a lamp, glass or metal (of the effects simulated).
+    fn left_to_samples(&self, kind: u32) -> bool {
+        let effects = self.effects;
+        (effects.emit && kind == MATERIAL_EMIT)
+            || (effects.glass && kind == MATERIAL_GLASS)
+            || (effects.metal && kind == MATERIAL_METAL)
+    }
+
+    /// The colour a first hit on `value` contributes to the pixel's mean
+    /// albedo: its own, or white where the pixel is left to its samples.
+    /// Twin of `demodulation_albedo` in `shaders/path.wgsl`.
+    fn demodulation_albedo(&self, value: u8) -> Vec3 {
+        let kind = self.materials[usize::from(value)].kind;
+        if self.left_to_samples(kind) { Vec3::ONE } else { self.albedo[usize::from(value)] }
     }
 
     /// The denoiser's guide of pixel (x, y): the first hit of its centre
@@ -102,24 +127,21 @@ impl PathScene<'_> {
         if !c.found || c.hit.gave_up || c.hit.normal == IVec3::ZERO {
             return Guide::LEFT;
         }
-        let kind = self.materials[usize::from(c.hit.value)].kind;
-        let effects = self.effects;
-        let left = (effects.emit && kind == MATERIAL_EMIT)
-            || (effects.glass && kind == MATERIAL_GLASS)
-            || (effects.metal && kind == MATERIAL_METAL);
-        if left {
+        if self.left_to_samples(self.materials[usize::from(c.hit.value)].kind) {
             return Guide::LEFT;
         }
-        let rgb = (self.albedo[usize::from(c.hit.value)] * 255.0).round().as_uvec3();
-        Guide::filtered(surface_point(&ray, &c), normal_code(c.hit.normal), [rgb.x as u8, rgb.y as u8, rgb.z as u8])
+        Guide::filtered(surface_point(&ray, &c), normal_code(c.hit.normal))
     }
 
-    fn radiance(&self, mut ray: Ray, rng: &mut Rng) -> Vec3 {
+    /// The radiance along a camera ray; `first_albedo` gets the first hit's
+    /// [`PathScene::demodulation_albedo`] (left as it is on a miss).
+    fn radiance(&self, mut ray: Ray, rng: &mut Rng, first_albedo: &mut Vec3) -> Vec3 {
         let mut radiance = Vec3::ZERO;
         let mut beta = Vec3::ONE;
         let mut medium = 0u8;
         let mut lights_counted = false;
         let (mut bounces, mut transmissions) = (0, 0);
+        let mut first = true;
         loop {
             let c = self.cross(&ray, medium);
             if c.hit.gave_up {
@@ -137,6 +159,10 @@ impl PathScene<'_> {
             let d = ray.dir.normalize();
             let value = c.hit.value;
             let material = self.materials[usize::from(value)];
+            if first {
+                *first_albedo = self.demodulation_albedo(value);
+                first = false;
+            }
             let glass = |index: u8| self.materials[usize::from(index)].kind == MATERIAL_GLASS;
             let dir;
             // Leaving glass (into empty space or other glass), or entering it.
@@ -498,9 +524,10 @@ pub fn render_cpu(
             (0..basis.width).map(move |x| {
                 let mut sums = Sums { count: spp, ..Sums::default() };
                 for s in 0..spp {
-                    let v = scene.sample(&basis, x, y, s);
+                    let (v, albedo) = scene.sample_with_albedo(&basis, x, y, s);
                     sums.sum += v;
                     sums.squares += v * v;
+                    sums.albedo += albedo;
                 }
                 (sums, scene.guide(&basis, x, y))
             })

@@ -1,0 +1,248 @@
+//! The denoiser on the GPU against its CPU twin (`octovox::trace::denoise`),
+//! the guides and the noise estimate against the CPU's, what the filter
+//! must not change (a one-voxel checker, the pixels left to their samples),
+//! and renders that stop at an error.
+
+use glam::{DVec3, IVec3};
+use octovox::camera::Camera;
+use octovox::gpu::{PathView, Renderer};
+use octovox::quality::{accumulate, flip, psnr};
+use octovox::scene::{Octree, Op, Palette, Shape};
+use octovox::settings::PathSettings;
+use octovox::trace::denoise::{Frame, LUMINANCE, denoise, noise_estimate};
+use octovox::trace::path::{render_cpu, to_image};
+
+use crate::path_trace::{build, look, material_scene, palette};
+
+fn renderer_for(tree: &mut Octree, palette: &Palette) -> Renderer {
+    let mut renderer = Renderer::headless().expect("a GPU adapter (lavapipe on CI)");
+    renderer.sync(tree, palette);
+    renderer.estimate_noise = true;
+    renderer
+}
+
+/// `spp` samples of `view` on the GPU, from a fresh accumulation.
+fn sample(renderer: &mut Renderer, view: &PathView, spp: u32) {
+    accumulate(renderer, view, spp, None, |_| ()).unwrap();
+}
+
+/// Channels that differ by more than `tolerance`, over all channels.
+fn share_differing(a: &image::RgbaImage, b: &image::RgbaImage, tolerance: u8) -> f64 {
+    let differing = a
+        .pixels()
+        .zip(b.pixels())
+        .flat_map(|(p, q)| (0..3).map(move |c| p[c].abs_diff(q[c])))
+        .filter(|d| *d > tolerance)
+        .count();
+    differing as f64 / (3 * a.width() * a.height()) as f64
+}
+
+fn grey_variance(image: &image::RgbaImage) -> f64 {
+    let values: Vec<f64> = image.pixels().map(|p| f64::from(p[0]) + f64::from(p[1]) + f64::from(p[2])).collect();
+    let mean = values.iter().sum::<f64>() / values.len() as f64;
+    values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / values.len() as f64
+}
+
+#[test]
+fn the_gpu_filter_matches_its_cpu_twin() {
+    // Every effect in view, so some pixels are left to their samples; 3
+    // samples take the variance from the neighbours, 6 from the pixel's own.
+    let (mut tree, palette) = material_scene();
+    let camera = look(DVec3::new(18.0, 14.0, 26.0), DVec3::new(0.0, 3.0, 0.0));
+    let settings = PathSettings { bounces: 3, ..PathSettings::default() };
+    let size = (48, 32);
+    let mut renderer = renderer_for(&mut tree, &palette);
+    let view = PathView { tree: &tree, palette: &palette, camera: &camera, size, settings: &settings };
+    for spp in [3, 6] {
+        sample(&mut renderer, &view, spp);
+        let raw = renderer.read_image().unwrap();
+        renderer.denoise_now().unwrap();
+        let gpu = renderer.read_image().unwrap();
+        let sums = renderer.path.read_sums(&renderer.gpu).unwrap();
+        let guides = renderer.path.read_guides(&renderer.gpu).unwrap();
+        let frame = Frame::of(&camera.basis(size.0, size.1, tree.origin()));
+        let cpu = to_image(&denoise(&frame, &sums, &guides), size.0, size.1);
+        // exp and sqrt differ in their last bits; one byte of rounding.
+        let off = share_differing(&gpu, &cpu, 1);
+        println!("{spp} spp: {:.3} % of channels differ by more than 1", 100.0 * off);
+        assert!(off < 0.002, "{spp} spp: {:.3} % of channels differ by more than 1", 100.0 * off);
+        assert!(grey_variance(&gpu) > 100.0, "a flat or blank denoised image");
+        assert!(share_differing(&raw, &gpu, 2) > 0.2, "the filter changed almost nothing");
+        let left: Vec<usize> = (0..guides.len()).filter(|&i| !guides[i].is_filtered()).collect();
+        assert!(left.len() > 50, "only {} pixels are left to their samples", left.len());
+        for i in left {
+            let (x, y) = (i as u32 % size.0, i as u32 / size.0);
+            assert_eq!(gpu.get_pixel(x, y), raw.get_pixel(x, y), "pixel ({x}, {y}) is left to its samples");
+        }
+    }
+}
+
+#[test]
+fn the_gpu_guides_and_noise_estimate_match_the_cpu() {
+    let (mut tree, palette) = material_scene();
+    let camera = look(DVec3::new(-20.0, 10.0, 22.0), DVec3::new(0.0, 2.0, 0.0));
+    let settings = PathSettings { bounces: 2, ..PathSettings::default() };
+    let size = (40, 30);
+    let cpu = render_cpu(&tree, &palette, &camera, size, &settings, 1);
+    let mut renderer = renderer_for(&mut tree, &palette);
+    let view = PathView { tree: &tree, palette: &palette, camera: &camera, size, settings: &settings };
+    sample(&mut renderer, &view, 1);
+    let gpu = renderer.path.read_guides(&renderer.gpu).unwrap();
+    let same = gpu.iter().zip(&cpu.guides).filter(|(g, c)| g.code == c.code).count();
+    assert!(same * 100 >= gpu.len() * 99, "{same} of {} guides agree", gpu.len());
+    let filtered = gpu.iter().filter(|g| g.is_filtered()).count();
+    assert!(filtered * 4 > gpu.len(), "only {filtered} pixels are filtered");
+    for (g, c) in gpu.iter().zip(&cpu.guides).filter(|(g, c)| g.code == c.code) {
+        let d = glam::Vec3::from(g.point) - glam::Vec3::from(c.point);
+        assert!(d.abs().max_element() < 1e-3, "guide points {:?} and {:?}", g.point, c.point);
+    }
+    assert_eq!(renderer.noise_estimate().unwrap(), None, "one sample has no variance");
+    let mut estimates = Vec::new();
+    for spp in [4, 16] {
+        sample(&mut renderer, &view, spp);
+        let gpu = renderer.noise_estimate().unwrap().unwrap();
+        let cpu = noise_estimate(&renderer.path.read_sums(&renderer.gpu).unwrap()).unwrap();
+        assert!((gpu / cpu - 1.0).abs() < 1e-3, "{spp} spp: GPU estimate {gpu}, CPU {cpu}");
+        estimates.push(gpu);
+    }
+    // The standard error halves from 4 to 16 samples (give or take the
+    // estimate's own noise).
+    let ratio = estimates[0] / estimates[1];
+    assert!((1.6..2.5).contains(&ratio), "estimates {estimates:?}");
+}
+
+/// A floor of one-voxel checker squares in two colours under the sun, seen
+/// from straight above; the light and dark squares' cells.
+fn checker() -> (Octree, Palette, Camera) {
+    let mut palette = palette();
+    palette.colors[8] = [110, 110, 110, 255];
+    palette.colors[9] = [30, 30, 30, 255];
+    let mut edits = Vec::new();
+    for x in 0..24 {
+        for z in 0..24 {
+            edits.push((Shape::Voxel(IVec3::new(x, 0, z)), Op::Place(if (x + z) % 2 == 0 { 8 } else { 9 })));
+        }
+    }
+    // A wall beside it, so the floor has soft light from the sky and bounces.
+    edits.push((
+        Shape::Box { min: IVec3::new(-2, 0, 0), max: IVec3::new(-1, 10, 23) },
+        Op::Place(crate::path_trace::WHITE),
+    ));
+    let camera = Camera {
+        eye: DVec3::new(12.0, 40.0, 12.001),
+        target: DVec3::new(12.0, 0.0, 12.0),
+        fov_y_deg: 50.0,
+        ortho: Some(24.0),
+    };
+    (build(&edits), palette, camera)
+}
+
+/// (light − dark) / (light + dark) of the mean luminance of the squares.
+fn contrast(image: &image::RgbaImage, tree: &Octree, camera: &Camera) -> f64 {
+    let basis = camera.basis(image.width(), image.height(), tree.origin());
+    let hits = octovox::trace::render::trace_image(
+        octovox::trace::render::Tracer::Svo(tree),
+        &basis,
+        octovox::trace::Footprint::EXACT,
+    );
+    let (mut sums, mut counts) = ([0.0f64; 2], [0usize; 2]);
+    for (hit, pixel) in hits.iter().zip(image.pixels()) {
+        let class = match hit.value {
+            8 => 0,
+            9 => 1,
+            _ => continue,
+        };
+        let rgb = glam::Vec3::new(f32::from(pixel[0]), f32::from(pixel[1]), f32::from(pixel[2]));
+        sums[class] += f64::from(rgb.dot(LUMINANCE));
+        counts[class] += 1;
+    }
+    let (light, dark) = (sums[0] / counts[0] as f64, sums[1] / counts[1] as f64);
+    (light - dark) / (light + dark)
+}
+
+#[test]
+fn a_one_voxel_checker_keeps_its_contrast_and_the_filter_adds_no_bias() {
+    let (mut tree, palette, camera) = checker();
+    let settings = PathSettings { bounces: 2, ..PathSettings::default() };
+    let size = (96, 96);
+    let mut renderer = renderer_for(&mut tree, &palette);
+    let view = PathView { tree: &tree, palette: &palette, camera: &camera, size, settings: &settings };
+    // The converged image, and the one the filter is asked not to bias: 8
+    // times fewer samples, raw and denoised.
+    sample(&mut renderer, &view, 1024);
+    let converged = renderer.read_image().unwrap();
+    sample(&mut renderer, &view, 128);
+    let reference = renderer.read_image().unwrap();
+    renderer.denoise_now().unwrap();
+    let denoised_reference = renderer.read_image().unwrap();
+    sample(&mut renderer, &view, 2);
+    let raw = renderer.read_image().unwrap();
+    renderer.denoise_now().unwrap();
+    let denoised = renderer.read_image().unwrap();
+    let (want, got) = (contrast(&converged, &tree, &camera), contrast(&denoised, &tree, &camera));
+    println!("checker contrast: converged {want:.4}, denoised at 2 spp {got:.4}");
+    assert!(want > 0.5, "the converged image shows no checker: {want}");
+    assert!((got - want).abs() < 0.02 * want, "contrast {got} against the converged image's {want}");
+    // What the filter takes from 128 samples is their noise, not light: the
+    // denoised image is closer to the converged one than the raw is, and
+    // no further by FLIP (which, in the dark squares, sees the 8-bit
+    // rounding of an image 0.4 % off: 0.014).
+    let rms = |image: &image::RgbaImage| psnr(&converged, image).map_or(0.0, |db| 10f64.powf(-db / 20.0));
+    let (raw_rms, denoised_rms) = (rms(&reference), rms(&denoised_reference));
+    let (raw_off, denoised_off) = (flip(&converged, &reference), flip(&converged, &denoised_reference));
+    println!(
+        "128 spp against 1024: raw RMS {raw_rms:.4} FLIP {raw_off:.4}, denoised RMS {denoised_rms:.4} FLIP {denoised_off:.4}; denoised against raw FLIP {:.4}",
+        flip(&reference, &denoised_reference)
+    );
+    assert!(denoised_rms < raw_rms, "128 spp: RMS error {raw_rms} raw, {denoised_rms} denoised");
+    assert!(denoised_off <= raw_off + 0.001, "128 spp: FLIP {raw_off} raw, {denoised_off} denoised");
+    let (raw_error, denoised_error) = (flip(&converged, &raw), flip(&converged, &denoised));
+    println!(
+        "2 spp: raw FLIP {raw_error:.4} RMS {:.4}, denoised FLIP {denoised_error:.4} RMS {:.4}",
+        rms(&raw),
+        rms(&denoised)
+    );
+    assert!(denoised_error < 0.6 * raw_error, "denoising 2 spp: FLIP {raw_error} -> {denoised_error}");
+}
+
+#[test]
+fn a_render_to_a_target_error_stops_near_it() {
+    // Two scenes; a tighter target takes more samples, and the error then
+    // measured against a 256-sample reference is within a factor of 2 of
+    // the target (the reference's own noise included).
+    let scenes = [
+        ("materials", material_scene(), look(DVec3::new(18.0, 14.0, 26.0), DVec3::new(0.0, 3.0, 0.0))),
+        (
+            "checker",
+            {
+                let (t, p, _) = checker();
+                (t, p)
+            },
+            look(DVec3::new(30.0, 20.0, 36.0), DVec3::new(12.0, 0.0, 12.0)),
+        ),
+    ];
+    let settings = PathSettings { bounces: 2, ..PathSettings::default() };
+    let size = (48, 32);
+    for (name, (mut tree, palette), camera) in scenes {
+        let mut renderer = renderer_for(&mut tree, &palette);
+        let view = PathView { tree: &tree, palette: &palette, camera: &camera, size, settings: &settings };
+        sample(&mut renderer, &view, 256);
+        let reference = renderer.read_image().unwrap();
+        let mut taken = Vec::new();
+        for target in [0.04, 0.02] {
+            let done = accumulate(&mut renderer, &view, 4096, Some(target), |_| ()).unwrap();
+            let noise = done.noise.unwrap();
+            assert!(noise < target, "{name}: stopped at {noise} above {target}");
+            let image = renderer.read_image().unwrap();
+            let measured = psnr(&reference, &image).map_or(0.0, |db| 10f64.powf(-db / 20.0));
+            let factor = measured / f64::from(target);
+            println!(
+                "{name}: target {target}: {} samples, estimate {noise:.4}, measured {measured:.4}",
+                done.last.samples
+            );
+            assert!((0.25..2.0).contains(&factor), "{name}: measured {measured} at target {target}");
+            taken.push(done.last.samples);
+        }
+        assert!(taken[1] > taken[0], "{name}: a tighter target took {taken:?} samples");
+    }
+}
