@@ -171,9 +171,13 @@ fn prepare(
     }
 }
 
+// Twin of `kernel`.
+fn kernel(d: i32) -> f32 {
+    return select(KERNEL_SIDE, KERNEL_CENTRE, d == 0);
+}
+
 // Twin of `blurred_variance`.
 fn blurred_variance(px: vec2<i32>, p: u32) -> f32 {
-    var w = array<f32, 2>(0.5, 0.25);
     var sum = 0.0;
     var weight = 0.0;
     for (var dy = -1; dy <= 1; dy += 1) {
@@ -182,7 +186,7 @@ fn blurred_variance(px: vec2<i32>, p: u32) -> f32 {
             if (inside(q.x, q.y)) {
                 let j = pixel_index(q.x, q.y);
                 if (same_surface(p, code_of(j))) {
-                    let k = w[abs(dx)] * w[abs(dy)];
+                    let k = kernel(dx) * kernel(dy);
                     sum += k * light_in[j].w;
                     weight += k;
                 }
@@ -205,7 +209,10 @@ fn atrous(@builtin(global_invocation_id) gid: vec3<u32>) {
         light_out[i] = light_in[i];
         return;
     }
-    let variance_p = blurred_variance(px, p);
+    var variance_p = light_in[i].w;
+    if (du.step == 1u) {
+        variance_p = blurred_variance(px, p);
+    }
     let luminance = dot(light_in[i].rgb, LUMINANCE);
     let point = point_of(i);
     let normal = normal_vector(normal_of(p));
@@ -213,12 +220,11 @@ fn atrous(@builtin(global_invocation_id) gid: vec3<u32>) {
     let step = i32(du.step);
     let plane_scale = SIGMA_PLANE * pixel_width * f32(step);
     let mixed = mixed_normal_weight(pixel_width);
-    var kernel = KERNEL;
     var rgb = vec3<f32>(0.0);
     var variance = 0.0;
     var weight = 0.0;
-    for (var dy = -2; dy <= 2; dy += 1) {
-        for (var dx = -2; dx <= 2; dx += 1) {
+    for (var dy = -1; dy <= 1; dy += 1) {
+        for (var dx = -1; dx <= 1; dx += 1) {
             let q = px + vec2<i32>(dx, dy) * step;
             if (!inside(q.x, q.y)) {
                 continue;
@@ -234,7 +240,7 @@ fn atrous(@builtin(global_invocation_id) gid: vec3<u32>) {
             let w_plane = exp(-off_plane / (plane_scale * distance + 1e-6));
             let sigma = SIGMA_LIGHT * sqrt(variance_p + light_in[j].w) + 1e-6;
             let w_light = exp(-abs(dot(light_in[j].rgb, LUMINANCE) - luminance) / sigma);
-            let w = kernel[abs(dx)] * kernel[abs(dy)] * (w_normal * w_plane * w_light);
+            let w = kernel(dx) * kernel(dy) * (w_normal * w_plane * w_light);
             rgb += w * light_in[j].rgb;
             variance += w * w * light_in[j].w;
             weight += w;

@@ -32,10 +32,15 @@ struct QualityRow {
     psnr: Option<f64>,
     /// The row's samples were denoised.
     denoised: bool,
-    /// Path-traced raw rows: the noise estimate at the last sample and the
-    /// measured RMS error against the reference (0..1 of full scale).
+    /// Rows that differ from the base in their samples alone (raw or
+    /// denoised): FLIP and RMS error (0..1 of full scale) against the base
+    /// setting converged (the reference's samples, the base's bounces), so
+    /// what is left is noise and what the filter did, not the bias of fewer
+    /// bounces.
+    noise_flip: Option<f32>,
+    noise_rms: Option<f64>,
+    /// Raw ones of those: the noise estimate at the last sample.
     noise_estimate: Option<f32>,
-    rms_error: f64,
     /// On the Pareto front of its scene's raw rows or of its denoised rows.
     pareto: bool,
 }
@@ -135,13 +140,20 @@ pub fn bench_quality(quick: bool, out: &Path) -> anyhow::Result<(String, String)
         let reference_noise = renderer.noise_estimate()?;
         renderer.denoise_now()?;
         let denoised_reference = renderer.read_image()?;
+        let converged_base = Setting::Path {
+            spp: sizes.reference_spp,
+            bounces: 3,
+            shadow_samples: 1,
+            render_scale: 1.0,
+            denoise: false,
+        };
+        let (_, converged) = render_setting(&mut renderer, &scene, &camera, sizes.size, converged_base)?;
         unbiased.push(UnbiasedRow { scene: name, flip: flip(&reference_image, &denoised_reference), reference_noise });
         let mut scene_rows = Vec::new();
         for (knob, value, setting) in knobs(&sizes) {
             let (ms, image) = render_setting(&mut renderer, &scene, &camera, sizes.size, setting)?;
-            let path = matches!(setting, Setting::Path { .. });
             let denoised = matches!(setting, Setting::Path { denoise: true, .. });
-            let raw_path = path && !denoised;
+            let spp_only = matches!(setting, Setting::Path { bounces: 3, shadow_samples: 1, render_scale, .. } if render_scale == 1.0);
             scene_rows.push(QualityRow {
                 scene: name,
                 knob,
@@ -150,8 +162,9 @@ pub fn bench_quality(quick: bool, out: &Path) -> anyhow::Result<(String, String)
                 flip: flip(&reference_image, &image),
                 psnr: psnr(&reference_image, &image),
                 denoised,
-                noise_estimate: if raw_path { renderer.noise_estimate()? } else { None },
-                rms_error: rms_error(&reference_image, &image),
+                noise_flip: spp_only.then(|| flip(&converged, &image)),
+                noise_rms: spp_only.then(|| rms_error(&converged, &image)),
+                noise_estimate: if spp_only && !denoised { renderer.noise_estimate()? } else { None },
                 pareto: false,
             });
         }
@@ -164,7 +177,7 @@ pub fn bench_quality(quick: bool, out: &Path) -> anyhow::Result<(String, String)
             }
         }
         rows.extend(scene_rows);
-        targets.extend(target_rows(&mut renderer, &scene, &camera, name, &sizes, &reference_image)?);
+        targets.extend(target_rows(&mut renderer, &scene, &camera, name, &sizes, &converged)?);
     }
     std::fs::create_dir_all(out)?;
     super::quality_plot::plot(&rows_for_plot(&rows), &out.join("quality.png"))?;
@@ -239,13 +252,13 @@ fn rms_error(reference: &image::RgbaImage, test: &image::RgbaImage) -> f64 {
     psnr(reference, test).map_or(0.0, |db| 10f64.powf(-db / 20.0))
 }
 
-/// The raw FLIP of `scene` at `ms`, interpolated along its raw spp rows
-/// (log time); `None` outside them.
+/// The raw FLIP against the converged base of `scene` at `ms`,
+/// interpolated along its raw spp rows (log time); `None` outside them.
 fn raw_flip_at(rows: &[QualityRow], scene: &str, ms: f64) -> Option<f64> {
     let mut curve: Vec<(f64, f64)> = rows
         .iter()
-        .filter(|r| r.scene == scene && !r.denoised && (r.knob == "--spp" || r.knob == "base"))
-        .map(|r| (r.ms_per_frame.ln(), f64::from(r.flip)))
+        .filter(|r| r.scene == scene && !r.denoised)
+        .filter_map(|r| r.noise_flip.map(|f| (r.ms_per_frame.ln(), f64::from(f))))
         .collect();
     curve.sort_by(|a, b| a.0.total_cmp(&b.0));
     let t = ms.ln();
@@ -255,6 +268,7 @@ fn raw_flip_at(rows: &[QualityRow], scene: &str, ms: f64) -> Option<f64> {
     })
 }
 
+/// The time and FLIP against the converged base of a spp row.
 fn flip_of(rows: &[QualityRow], scene: &str, denoised: bool, spp: u32) -> Option<(f64, f32)> {
     rows.iter()
         .find(|r| {
@@ -263,29 +277,29 @@ fn flip_of(rows: &[QualityRow], scene: &str, denoised: bool, spp: u32) -> Option
                 value.split(' ').next() == Some(spp.to_string().as_str())
             }
         })
-        .map(|r| (r.ms_per_frame, r.flip))
+        .and_then(|r| Some((r.ms_per_frame, r.noise_flip?)))
 }
 
 fn denoise_markdown(rows: &[QualityRow], unbiased: &[UnbiasedRow]) -> String {
     let mut md = String::from(
-        "\n## Denoised against raw\n\nEach denoised row against the raw path tracer at the same wall time (the raw FLIP interpolated between its spp rows on a log time axis; blank where the denoised frame is faster than raw 1 spp or slower than the last raw row). Target: ratio ≤ 0.6 at 4–16 spp.\n\n| scene | spp | denoised ms | denoised FLIP | raw FLIP at that time | ratio |\n|---|---|---|---|---|---|\n",
+        "\n## Denoised against raw\n\nThe rows that differ from the base in their samples alone, raw and denoised, against the base setting converged (the reference's samples at the base's 3 bounces and 1 shadow sample): the error left is noise and what the filter did to it, not the bias of fewer bounces (which is in the table above). Each denoised row against the raw path tracer at the same wall time: the raw FLIP interpolated between its rows on a log time axis, blank where the denoised frame is faster than raw 1 spp or slower than the last raw row. Target: ratio ≤ 0.6 at 4–16 spp.\n\n| scene | spp | denoised ms | denoised FLIP | raw FLIP at that time | ratio | denoised RMS |\n|---|---|---|---|---|---|---|\n",
     );
     let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene).collect();
     scenes.dedup();
     for scene in &scenes {
         for r in rows.iter().filter(|r| r.scene == *scene && r.denoised) {
+            let (Some(flip), Some(rms)) = (r.noise_flip, r.noise_rms) else { continue };
             let raw = raw_flip_at(rows, scene, r.ms_per_frame);
             md += &format!(
-                "| {scene} | {} | {:.1} | {:.4} | {} | {} |\n",
+                "| {scene} | {} | {:.1} | {flip:.4} | {} | {} | {rms:.4} |\n",
                 r.value.trim_start_matches("--spp "),
                 r.ms_per_frame,
-                r.flip,
                 raw.map_or(String::new(), |f| format!("{f:.4}")),
-                raw.map_or(String::new(), |f| format!("{:.2}", f64::from(r.flip) / f)),
+                raw.map_or(String::new(), |f| format!("{:.2}", f64::from(flip) / f)),
             );
         }
     }
-    md += "\nDenoised 8 spp against raw 32 spp:\n\n| scene | denoised 8 spp: ms, FLIP | raw 32 spp: ms, FLIP |\n|---|---|---|\n";
+    md += "\nDenoised 8 spp against raw 32 spp (FLIP against the converged base):\n\n| scene | denoised 8 spp: ms, FLIP | raw 32 spp: ms, FLIP |\n|---|---|---|\n";
     for scene in &scenes {
         let cell = |v: Option<(f64, f32)>| v.map_or("–".into(), |(ms, f)| format!("{ms:.1} ms, {f:.4}"));
         md += &format!(
@@ -303,16 +317,15 @@ fn denoise_markdown(rows: &[QualityRow], unbiased: &[UnbiasedRow]) -> String {
             u.reference_noise.map_or("–".into(), |n| format!("{n:.4}"))
         );
     }
-    md += "\nThe noise estimate against the measured error, raw path-traced rows: the estimate is the RMS standard error of the displayed pixels from each pixel's own samples; the measured error is the RMS difference from the reference, which has noise of its own (its estimate above) and 8-bit rounding.\n\n| scene | knob | value | estimate | measured RMS | measured / estimate |\n|---|---|---|---|---|---|\n";
-    for r in rows.iter().filter(|r| r.noise_estimate.is_some()) {
-        let estimate = f64::from(r.noise_estimate.unwrap_or(0.0));
+    md += "\nThe noise estimate against the measured error, raw rows: the estimate is the RMS standard error of the displayed pixels from each pixel's own samples; the measured error is the RMS difference from the converged base, which has noise of its own (about the estimate of the reference above) and 8-bit rounding.\n\n| scene | spp | estimate | measured RMS | measured / estimate |\n|---|---|---|---|---|\n";
+    for r in rows.iter().filter(|r| !r.denoised) {
+        let (Some(estimate), Some(measured)) = (r.noise_estimate, r.noise_rms) else { continue };
+        let estimate = f64::from(estimate);
         md += &format!(
-            "| {} | {} | {} | {estimate:.4} | {:.4} | {:.2} |\n",
+            "| {} | {} | {estimate:.4} | {measured:.4} | {:.2} |\n",
             r.scene,
-            r.knob,
-            r.value,
-            r.rms_error,
-            r.rms_error / estimate.max(1e-9)
+            r.value.split(' ').nth(if r.knob == "base" { 1 } else { 0 }).unwrap_or(""),
+            measured / estimate.max(1e-9)
         );
     }
     md
@@ -320,7 +333,7 @@ fn denoise_markdown(rows: &[QualityRow], unbiased: &[UnbiasedRow]) -> String {
 
 fn target_markdown(rows: &[TargetRow]) -> String {
     let mut md = String::from(
-        "\n## Renders that stop at an error\n\n`render --target-error E` on the base setting: samples until the estimate is below E, and the error measured against the reference then.\n\n| scene | target | samples | estimate at stop | measured RMS | measured / target | FLIP |\n|---|---|---|---|---|---|---|\n",
+        "\n## Renders that stop at an error\n\n`render --target-error E` on the base setting: samples until the estimate is below E, and the error measured then against the converged base.\n\n| scene | target | samples | estimate at stop | measured RMS | measured / target | FLIP |\n|---|---|---|---|---|---|---|\n",
     );
     for r in rows {
         md += &format!(

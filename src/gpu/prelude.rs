@@ -48,8 +48,8 @@ pub fn shared_constants() -> String {
     line("SPATIAL_VARIANCE_BELOW", "u32", format!("{}u", denoise::SPATIAL_VARIANCE_BELOW));
     line("MIN_ALBEDO", "f32", format!("{:?}", denoise::MIN_ALBEDO));
     line("LUMINANCE", "vec3<f32>", vec3(denoise::LUMINANCE.to_array()));
-    let kernel = denoise::KERNEL.map(|k| format!("{k:?}")).join(", ");
-    line("KERNEL", "array<f32, 3>", format!("array<f32, 3>({kernel})"));
+    line("KERNEL_CENTRE", "f32", format!("{:?}", denoise::KERNEL_CENTRE));
+    line("KERNEL_SIDE", "f32", format!("{:?}", denoise::KERNEL_SIDE));
     for view in View::ALL {
         line(view.wgsl_name(), "u32", format!("{}u", view.code()));
     }

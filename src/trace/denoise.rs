@@ -14,7 +14,7 @@
 //! the light on it, and a pixel across such an edge keeps its mix), averages it with
 //! neighbours near the same face plane whose light is within a few
 //! standard deviations (facing the same way, unless voxels are smaller than
-//! a pixel), five times with taps 1, 2, 4, 8 and 16 pixels apart, and
+//! a pixel), five times with 3×3 taps 1, 2, 4, 8 and 16 pixels apart, and
 //! multiplies the colour back. Pixels whose first hit is the sky, a lamp,
 //! glass or metal are left to their samples: their light does not lie on
 //! the face the guide describes.
@@ -37,8 +37,17 @@ pub const MIXED_NORMALS_FROM: f32 = 2.0;
 /// Below this many samples a pixel's variance is taken from its neighbours:
 /// its own sum of squares says too little.
 pub const SPATIAL_VARIANCE_BELOW: u32 = 4;
-/// The 5-tap B3 spline of the à-trous kernel, from the centre out.
-pub const KERNEL: [f32; 3] = [3.0 / 8.0, 1.0 / 4.0, 1.0 / 16.0];
+/// The 3-tap B-spline (1/4, 1/2, 1/4) of the à-trous kernel and of the
+/// variance's blur: its centre and side weights. Dammertz et al. use 5
+/// taps; 3×3 taps instead of 5×5 cost a third as much for the same reach
+/// (taps up to 16 pixels apart; `docs/bench/denoise.md`).
+pub const KERNEL_CENTRE: f32 = 0.5;
+pub const KERNEL_SIDE: f32 = 0.25;
+
+/// The kernel's weight `d` taps from the centre (−1, 0 or 1).
+fn kernel(d: i32) -> f32 {
+    if d == 0 { KERNEL_CENTRE } else { KERNEL_SIDE }
+}
 /// Albedo channels below this are divided by it (a black voxel has no
 /// light to demodulate).
 pub const MIN_ALBEDO: f32 = 1.0 / 255.0;
@@ -215,12 +224,14 @@ fn prepare(frame: &Frame, sums: &[Sums], guides: &[Guide]) -> Vec<Light> {
 }
 
 /// The variance at `p` blurred over its 3×3 neighbours on the same surface
-/// (SVGF's prefilter: one pixel's estimate is itself noisy).
+/// (SVGF's prefilter: one pixel's estimate is itself noisy). SVGF blurs
+/// before every pass; here only the first, which halved the filter's time
+/// on lavapipe.
 fn blurred_variance(frame: &Frame, guides: &[Guide], light: &[Light], x: u32, y: u32) -> f32 {
     let p = &guides[(y * frame.width + x) as usize];
     let (mut sum, mut weight) = (0.0f32, 0.0f32);
     for (q, dx, dy) in taps(frame, x, y, 1, 1).filter(|&(q, _, _)| same_surface(p, &guides[q])) {
-        let w = [0.5f32, 0.25][dx.unsigned_abs() as usize] * [0.5f32, 0.25][dy.unsigned_abs() as usize];
+        let w = kernel(dx) * kernel(dy);
         sum += w * light[q].variance;
         weight += w;
     }
@@ -237,7 +248,9 @@ fn atrous(frame: &Frame, guides: &[Guide], light: &[Light], step: u32) -> Vec<Li
             if !p.is_filtered() {
                 continue;
             }
-            let variance_p = blurred_variance(frame, guides, light, x, y);
+            // The first pass blurs the pixels' own estimates; later ones
+            // read what the passes before filtered.
+            let variance_p = if step == 1 { blurred_variance(frame, guides, light, x, y) } else { light[i].variance };
             let luminance = light[i].rgb.dot(LUMINANCE);
             let point = Vec3::from(p.point);
             let normal = crate::trace::normal_from_code(p.normal_code()).as_vec3();
@@ -245,7 +258,7 @@ fn atrous(frame: &Frame, guides: &[Guide], light: &[Light], step: u32) -> Vec<Li
             let plane_scale = SIGMA_PLANE * pixel_width * step as f32;
             let mixed = mixed_normal_weight(pixel_width);
             let (mut rgb, mut variance, mut weight) = (Vec3::ZERO, 0.0f32, 0.0f32);
-            for (q, dx, dy) in taps(frame, x, y, 2, step as i32).filter(|&(q, _, _)| guides[q].is_filtered()) {
+            for (q, dx, dy) in taps(frame, x, y, 1, step as i32).filter(|&(q, _, _)| guides[q].is_filtered()) {
                 let w_normal = if guides[q].normal_code() == p.normal_code() { 1.0 } else { mixed };
                 let off_plane = normal.dot(Vec3::from(guides[q].point) - point).abs();
                 let distance = ((dx * dx + dy * dy) as f32).sqrt();
@@ -255,9 +268,7 @@ fn atrous(frame: &Frame, guides: &[Guide], light: &[Light], step: u32) -> Vec<Li
                 // in, so its light is spread, not lost.
                 let sigma = SIGMA_LIGHT * (variance_p + light[q].variance).sqrt() + 1e-6;
                 let w_light = (-(light[q].rgb.dot(LUMINANCE) - luminance).abs() / sigma).exp();
-                let w = KERNEL[dx.unsigned_abs() as usize]
-                    * KERNEL[dy.unsigned_abs() as usize]
-                    * (w_normal * w_plane * w_light);
+                let w = kernel(dx) * kernel(dy) * (w_normal * w_plane * w_light);
                 rgb += w * light[q].rgb;
                 variance += w * w * light[q].variance;
                 weight += w;
