@@ -20,7 +20,9 @@ struct DenoiseUniforms {
     per_t: f32,
     // Pixels between the taps of this `atrous` dispatch.
     step: u32,
-    _pad: u32,
+    // 1: `prepare` writes the light (the filter follows); 0: only the noise
+    // estimate's sums.
+    light: u32,
 }
 
 @group(0) @binding(0) var<storage, read> constants: DenoiseUniforms;
@@ -56,10 +58,6 @@ fn same_surface(p: u32, q: u32) -> bool {
     return is_filtered(q) && normal_of(q) == normal_of(p);
 }
 
-// Twin of `mixed_normal_weight`.
-fn mixed_normal_weight(pixel_width: f32) -> f32 {
-    return clamp((pixel_width - 1.0) / (MIXED_NORMALS_FROM - 1.0), 0.0, 1.0);
-}
 
 // Twin of `normal_from_code`.
 fn normal_vector(code: u32) -> vec3<f32> {
@@ -156,7 +154,9 @@ fn prepare(
     if (gid.x < du.width && gid.y < du.height) {
         let px = vec2<i32>(gid.xy);
         shown = displayed_variance(pixel_index(px.x, px.y));
-        light_out[pixel_index(px.x, px.y)] = prepared(px);
+        if (du.light != 0u) {
+            light_out[pixel_index(px.x, px.y)] = prepared(px);
+        }
     }
     scratch[local] = shown;
     workgroupBarrier();
@@ -219,7 +219,6 @@ fn atrous(@builtin(global_invocation_id) gid: vec3<u32>) {
     let pixel_width = du.at_start + du.per_t * max(dot(point - du.eye, du.forward), 0.0);
     let step = i32(du.step);
     let plane_scale = SIGMA_PLANE * pixel_width * f32(step);
-    let mixed = mixed_normal_weight(pixel_width);
     var rgb = vec3<f32>(0.0);
     var variance = 0.0;
     var weight = 0.0;
@@ -230,17 +229,15 @@ fn atrous(@builtin(global_invocation_id) gid: vec3<u32>) {
                 continue;
             }
             let j = pixel_index(q.x, q.y);
-            let q_code = code_of(j);
-            if (!is_filtered(q_code)) {
+            if (!same_surface(p, code_of(j))) {
                 continue;
             }
-            let w_normal = select(mixed, 1.0, normal_of(q_code) == normal_of(p));
             let off_plane = abs(dot(normal, point_of(j) - point));
             let distance = sqrt(f32(dx * dx + dy * dy));
             let w_plane = exp(-off_plane / (plane_scale * distance + 1e-6));
             let sigma = SIGMA_LIGHT * sqrt(variance_p + light_in[j].w) + 1e-6;
             let w_light = exp(-abs(dot(light_in[j].rgb, LUMINANCE) - luminance) / sigma);
-            let w = kernel(dx) * kernel(dy) * (w_normal * w_plane * w_light);
+            let w = kernel(dx) * kernel(dy) * w_plane * w_light;
             rgb += w * light_in[j].rgb;
             variance += w * w * light_in[j].w;
             weight += w;

@@ -140,7 +140,8 @@ impl DenoisePass {
         let Some(target) = &self.target else { return };
         let steps = std::iter::once(0).chain((0..ITERATIONS).map(|i| 1 << i)).chain([0]);
         for (stage, step) in target.stages.iter().zip(steps) {
-            gpu.queue.write_buffer(&stage.constants, 0, bytemuck::bytes_of(&DenoiseUniforms::new(frame, step)));
+            let uniforms = DenoiseUniforms::new(frame, step, filter);
+            gpu.queue.write_buffer(&stage.constants, 0, bytemuck::bytes_of(&uniforms));
         }
         let mut pass =
             encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("denoise"), ..Default::default() });

@@ -123,11 +123,13 @@ pub struct DenoiseUniforms {
     pub per_t: f32,
     /// Pixels between the taps of an `atrous` dispatch.
     pub step: u32,
-    pub _pad: u32,
+    /// 1: `prepare` writes the light (the filter follows); 0: only the
+    /// noise estimate's sums.
+    pub light: u32,
 }
 
 impl DenoiseUniforms {
-    pub fn new(frame: &crate::trace::denoise::Frame, step: u32) -> DenoiseUniforms {
+    pub fn new(frame: &crate::trace::denoise::Frame, step: u32, light: bool) -> DenoiseUniforms {
         DenoiseUniforms {
             eye: frame.eye.into(),
             width: frame.width,
@@ -136,7 +138,7 @@ impl DenoiseUniforms {
             at_start: frame.footprint.at_start,
             per_t: frame.footprint.per_t,
             step,
-            _pad: 0,
+            light: u32::from(light),
         }
     }
 }

@@ -44,7 +44,6 @@ pub fn shared_constants() -> String {
     line("DENOISE_ITERATIONS", "u32", format!("{}u", denoise::ITERATIONS));
     line("SIGMA_LIGHT", "f32", format!("{:?}", denoise::SIGMA_LIGHT));
     line("SIGMA_PLANE", "f32", format!("{:?}", denoise::SIGMA_PLANE));
-    line("MIXED_NORMALS_FROM", "f32", format!("{:?}", denoise::MIXED_NORMALS_FROM));
     line("SPATIAL_VARIANCE_BELOW", "u32", format!("{}u", denoise::SPATIAL_VARIANCE_BELOW));
     line("MIN_ALBEDO", "f32", format!("{:?}", denoise::MIN_ALBEDO));
     line("LUMINANCE", "vec3<f32>", vec3(denoise::LUMINANCE.to_array()));

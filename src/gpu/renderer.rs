@@ -146,7 +146,8 @@ pub struct Renderer {
     /// resting view); headless renders leave it unbounded.
     pub sample_target: u32,
     /// Whether path-traced frames show the accumulation denoised (the
-    /// window); headless renders call [`Renderer::denoise_now`] once instead.
+    /// window: after samples 1, 2, 4, 8, … and the `sample_target`th);
+    /// headless renders call [`Renderer::denoise_now`] once instead.
     pub denoise: bool,
     /// Whether each path-traced sample measures the image's noise for
     /// [`Renderer::noise_estimate`] (denoised frames always do).
@@ -410,8 +411,13 @@ impl Renderer {
         let completes = band + 1 == bands;
         let prepared = completes && (self.denoise || self.estimate_noise);
         if prepared {
-            self.denoiser.encode(&self.gpu, encoder, &Frame::of(&key.basis), self.denoise);
-            self.denoised_fresh |= self.denoise;
+            // The filter runs after samples 1, 2, 4, 8, … and the last: on a
+            // slow adapter it costs about a sample (docs/bench/denoise.md),
+            // and one frame cannot be split into bands as a sample is.
+            let done = acc.samples + 1;
+            let filter = self.denoise && (done.is_power_of_two() || done >= self.sample_target);
+            self.denoiser.encode(&self.gpu, encoder, &Frame::of(&key.basis), filter);
+            self.denoised_fresh |= filter;
         }
         self.shown = if acc.samples + u32::from(completes) > 0 { self.accumulation_shown() } else { Shown::Trace };
         Ok(Recorded::Path { kernel, effects, prepared })
