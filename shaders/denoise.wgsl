@@ -120,8 +120,8 @@ fn prepared(px: vec2<i32>) -> vec4<f32> {
         var m1 = 0.0;
         var m2 = 0.0;
         var n = 0.0;
-        for (var dy = -2; dy <= 2; dy += 1) {
-            for (var dx = -2; dx <= 2; dx += 1) {
+        for (var dy = -1; dy <= 1; dy += 1) {
+            for (var dx = -1; dx <= 1; dx += 1) {
                 let q = px + vec2<i32>(dx, dy);
                 if (inside(q.x, q.y) && same_surface(p, code_of(pixel_index(q.x, q.y)))) {
                     let l = dot(demodulated(pixel_index(q.x, q.y)), LUMINANCE);

@@ -33,6 +33,9 @@ pub(super) struct FrameClock {
     /// The last frame traced the preview in place of a path-traced frame
     /// that would have started the accumulation over; the next one starts it.
     pub preview_before_path: bool,
+    /// Whether the stdout line `path: N samples` was written for the view
+    /// shown: its samples done and, with Denoise on, filtered.
+    pub path_reported: bool,
     /// The editor's revision (`Editor::revision`) the dense grid of grid
     /// mode was built from, and the one the path tracer's accumulation
     /// holds: a frame redoes what is older than the scene. `None`: nothing
@@ -53,6 +56,7 @@ impl FrameClock {
             motion: motion::MotionScale::default(),
             moving_frames: args.frame_stats.then(motion::MovingFrames::default),
             preview_before_path: false,
+            path_reported: false,
             grid_drawn: None,
             path_drawn: None,
         }

@@ -289,18 +289,23 @@ impl App {
             {
                 report!("noise: {noise:.5} at {} samples", frame.samples);
             }
-            if frame.samples == gfx.renderer.sample_target {
-                let effects = frame.effects.names().join(" ");
-                report!("path: {} samples, effects [{effects}]", frame.samples);
-            }
         }
+        // Once the view is final: the samples done and, with Denoise on,
+        // their filter (which runs a stage a frame after the last sample).
+        let done = frame.samples >= gfx.renderer.sample_target && !gfx.renderer.denoise_pending();
+        if done && !self.frames.path_reported {
+            let effects = frame.effects.names().join(" ");
+            report!("path: {} samples, effects [{effects}]", frame.samples);
+        }
+        self.frames.path_reported = done;
         self.readouts.stats.path = Some(frame);
     }
 
     /// Keeps drawing while something moves; otherwise waits for input (or
     /// for when egui asks to be drawn again).
     fn schedule_repaint(&mut self, repaint_delay: Option<Duration>) {
-        let accumulating = self.readouts.stats.path.is_some_and(|p| p.samples < self.state.sample_target);
+        let filtering = self.gfx.as_ref().is_some_and(|gfx| gfx.renderer.denoise_pending());
+        let accumulating = self.readouts.stats.path.is_some_and(|p| p.samples < self.state.sample_target || filtering);
         let animating = accumulating
             || self.frames.preview_before_path
             || self.doc.loading.is_some()

@@ -11,6 +11,8 @@ use super::{GpuContext, GpuError, PathPass};
 use crate::trace::denoise::{Frame, ITERATIONS};
 
 const DENOISE_WGSL: &str = include_str!("../../shaders/denoise.wgsl");
+/// The dispatches of a filter: `prepare`, the iterations, `finish`.
+pub const STAGES: usize = ITERATIONS as usize + 2;
 /// The side of a workgroup, in pixels (`@workgroup_size(8, 8)`).
 const GROUP: u32 = 8;
 
@@ -137,20 +139,35 @@ impl DenoisePass {
     /// and, with `filter`, the iterations and `finish` (the denoised
     /// image) for the accumulation seen from `frame`.
     pub fn encode(&self, gpu: &GpuContext, encoder: &mut wgpu::CommandEncoder, frame: &Frame, filter: bool) {
+        let stages = if filter { 0..STAGES } else { 0..1 };
+        self.encode_stages(gpu, encoder, frame, stages, filter);
+    }
+
+    /// Records the dispatches `stages` of [`STAGES`] (0 `prepare`, then the
+    /// iterations, the last `finish`); `light`: `prepare` writes the light
+    /// for a filter to follow. The window records one stage a frame.
+    pub fn encode_stages(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        frame: &Frame,
+        stages: std::ops::Range<usize>,
+        light: bool,
+    ) {
         let Some(target) = &self.target else { return };
         let steps = std::iter::once(0).chain((0..ITERATIONS).map(|i| 1 << i)).chain([0]);
-        for (stage, step) in target.stages.iter().zip(steps) {
-            let uniforms = DenoiseUniforms::new(frame, step, filter);
+        let chosen = || target.stages.iter().zip(steps.clone()).enumerate().filter(|(i, _)| stages.contains(i));
+        for (_, (stage, step)) in chosen() {
+            let uniforms = DenoiseUniforms::new(frame, step, light);
             gpu.queue.write_buffer(&stage.constants, 0, bytemuck::bytes_of(&uniforms));
         }
         let mut pass =
             encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("denoise"), ..Default::default() });
         let (gx, gy) = groups(target.width, target.height);
-        let count = if filter { target.stages.len() } else { 1 };
-        for (i, stage) in target.stages.iter().enumerate().take(count) {
+        for (i, (stage, _)) in chosen() {
             let pipeline = match i {
                 0 => &self.prepare,
-                i if i == target.stages.len() - 1 => &self.finish,
+                i if i == STAGES - 1 => &self.finish,
                 _ => &self.atrous,
             };
             pass.set_pipeline(pipeline);

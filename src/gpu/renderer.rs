@@ -5,6 +5,7 @@
 use glam::IVec3;
 
 use super::context::validated;
+use super::denoise_pass::STAGES;
 use super::path_pass::PathKey;
 use super::scene_buffers::UploadStats;
 use super::timer::PassTimer;
@@ -146,7 +147,8 @@ pub struct Renderer {
     /// resting view); headless renders leave it unbounded.
     pub sample_target: u32,
     /// Whether path-traced frames show the accumulation denoised (the
-    /// window: after samples 1, 2, 4, 8, … and the `sample_target`th);
+    /// window: filtered after samples 1, 2, 4, 8, … and the
+    /// `sample_target`th, a stage a frame);
     /// headless renders call [`Renderer::denoise_now`] once instead.
     pub denoise: bool,
     /// Whether each path-traced sample measures the image's noise for
@@ -154,8 +156,11 @@ pub struct Renderer {
     pub estimate_noise: bool,
     /// The sample count the last noise measurement saw.
     noise_of: Option<u32>,
-    /// Whether the denoised output is of the current accumulation.
-    denoised_fresh: bool,
+    /// The samples of the current accumulation the denoised output shows.
+    denoised_of: Option<u32>,
+    /// A filter under way, one stage a frame (the window's): the next
+    /// stage and the samples it filters.
+    filtering: Option<(usize, u32)>,
     /// Whether frames write the per-pixel hit records that
     /// [`Renderer::read_hits`] returns; off by default, as they cost time.
     pub hit_records: bool,
@@ -187,7 +192,8 @@ impl Renderer {
             denoise: false,
             estimate_noise: false,
             noise_of: None,
-            denoised_fresh: false,
+            denoised_of: None,
+            filtering: None,
             path_bands: 1,
             sample_target: u32::MAX,
             wait_for_frames: true,
@@ -363,8 +369,7 @@ impl Renderer {
             acc.samples = 0;
             acc.key = Some(key);
             acc.band.0 = 0;
-            self.denoised_fresh = false;
-            self.noise_of = None;
+            (self.denoised_of, self.filtering, self.noise_of) = (None, None, None);
         }
         if acc.band.0 == 0 {
             acc.band = (0, self.path_bands.clamp(1, size.1.max(1)));
@@ -372,9 +377,14 @@ impl Renderer {
         }
         self.path.accumulation = acc;
         if acc.samples >= self.sample_target && self.shown != Shown::Trace {
-            if self.denoise && !self.denoised_fresh {
-                self.denoiser.encode(gpu, encoder, &Frame::of(&key.basis), true);
-                (self.denoised_fresh, self.noise_of) = (true, Some(acc.samples));
+            // The last sample's filter, if the one under way when it came
+            // was of an earlier one.
+            let behind = self.filtering.is_none() && self.denoised_of != Some(acc.samples);
+            if self.denoise && behind {
+                self.denoiser.encode_stages(gpu, encoder, &Frame::of(&key.basis), 0..1, true);
+                self.filtering = Some((1, acc.samples));
+            } else {
+                self.advance_filter(encoder, &key);
             }
             self.shown = self.accumulation_shown();
             let (lights, samples) = (acc.lights, acc.samples);
@@ -410,22 +420,46 @@ impl Renderer {
         // What this band completes is shown by the frame that records it.
         let completes = band + 1 == bands;
         let prepared = completes && (self.denoise || self.estimate_noise);
+        let mut started = false;
         if prepared {
-            // The filter runs after samples 1, 2, 4, 8, … and the last: on a
-            // slow adapter it costs about a sample (docs/bench/denoise.md),
-            // and one frame cannot be split into bands as a sample is.
+            // A filter starts after samples 1, 2, 4, 8, … and the last, and
+            // runs a stage a frame: on a slow adapter the whole filter costs
+            // about a sample (docs/bench/denoise.md), and a frame that must
+            // show a moved camera waits for one stage, as for one band.
             let done = acc.samples + 1;
-            let filter = self.denoise && (done.is_power_of_two() || done >= self.sample_target);
-            self.denoiser.encode(&self.gpu, encoder, &Frame::of(&key.basis), filter);
-            self.denoised_fresh |= filter;
+            started =
+                self.denoise && self.filtering.is_none() && (done.is_power_of_two() || done >= self.sample_target);
+            self.denoiser.encode_stages(&self.gpu, encoder, &Frame::of(&key.basis), 0..1, started);
+            if started {
+                self.filtering = Some((1, done));
+            }
+        }
+        if !started {
+            self.advance_filter(encoder, &key);
         }
         self.shown = if acc.samples + u32::from(completes) > 0 { self.accumulation_shown() } else { Shown::Trace };
         Ok(Recorded::Path { kernel, effects, prepared })
     }
 
+    /// Records the next stage of the filter under way, if any.
+    fn advance_filter(&mut self, encoder: &mut wgpu::CommandEncoder, key: &PathKey) {
+        let Some((stage, samples)) = self.filtering else { return };
+        self.denoiser.encode_stages(&self.gpu, encoder, &Frame::of(&key.basis), stage..stage + 1, true);
+        self.filtering = Some((stage + 1, samples));
+        if stage + 1 == STAGES {
+            (self.filtering, self.denoised_of) = (None, Some(samples));
+        }
+    }
+
+    /// Whether the window should keep drawing for the filter: one is under
+    /// way, or the last sample's has not run.
+    pub fn denoise_pending(&self) -> bool {
+        self.denoise && (self.filtering.is_some() || self.denoised_of != Some(self.path.accumulation.samples))
+    }
+
     /// How the accumulation is shown: denoised when asked and done.
     fn accumulation_shown(&self) -> Shown {
-        if self.denoise && self.denoised_fresh { Shown::Denoised } else { Shown::Path }
+        if self.denoise && self.denoised_of.is_some() { Shown::Denoised } else { Shown::Path }
     }
 
     /// Denoises the accumulation as it stands and shows it; returns the
@@ -449,7 +483,8 @@ impl Renderer {
             self.gpu.wait()
         })?;
         let ms = start.elapsed().as_secs_f64() * 1e3;
-        (self.denoised_fresh, self.noise_of, self.shown) = (true, Some(acc.samples), Shown::Denoised);
+        (self.denoised_of, self.filtering) = (Some(acc.samples), None);
+        (self.noise_of, self.shown) = (Some(acc.samples), Shown::Denoised);
         Ok(ms)
     }
 

@@ -25,7 +25,7 @@ pub const ITERATIONS: u32 = 5;
 /// How many standard deviations of a pixel's light a neighbour's may differ
 /// by and still weigh `1/e` (SVGF's σ_l). SVGF's 4 smoothed away the shading
 /// of voxels a pixel wide: 2 took FLIP at 16 spp on teapot256 from 0.0102
-/// to 0.0088, and on the interior from 0.083 to 0.085.
+/// to 0.0088, and on the interior from 0.083 to 0.085 (docs/bench/denoise.md).
 pub const SIGMA_LIGHT: f32 = 2.0;
 /// How far off a pixel's face plane a neighbour's point may lie, in pixel
 /// footprints per pixel of distance, and still weigh `1/e`.
@@ -35,7 +35,7 @@ pub const SIGMA_PLANE: f32 = 1.0;
 pub const SPATIAL_VARIANCE_BELOW: u32 = 4;
 /// The 3-tap B-spline (1/4, 1/2, 1/4) of the à-trous kernel and of the
 /// variance's blur: its centre and side weights. Dammertz et al. use 5
-/// taps; 3×3 taps instead of 5×5 cost a third as much for the same reach
+/// taps; 3×3 taps instead of 5×5 cost less than half as much for the same reach
 /// (taps up to 16 pixels apart; `docs/bench/denoise.md`).
 pub const KERNEL_CENTRE: f32 = 0.5;
 pub const KERNEL_SIDE: f32 = 0.25;
@@ -183,7 +183,7 @@ fn same_surface(p: &Guide, q: &Guide) -> bool {
 }
 
 /// Demodulated light and its variance per pixel; below
-/// [`SPATIAL_VARIANCE_BELOW`] samples the variance of the 5×5 neighbours'
+/// [`SPATIAL_VARIANCE_BELOW`] samples the variance of the 3×3 neighbours'
 /// light on the same surface.
 fn prepare(frame: &Frame, sums: &[Sums], guides: &[Guide]) -> Vec<Light> {
     let demodulated = |i: usize| sums[i].mean() / sums[i].albedo();
@@ -198,7 +198,7 @@ fn prepare(frame: &Frame, sums: &[Sums], guides: &[Guide]) -> Vec<Light> {
             }
             let variance = if s.count < SPATIAL_VARIANCE_BELOW {
                 let (mut m1, mut m2, mut n) = (0.0f32, 0.0f32, 0.0f32);
-                for (q, _, _) in taps(frame, x, y, 2, 1).filter(|&(q, _, _)| same_surface(g, &guides[q])) {
+                for (q, _, _) in taps(frame, x, y, 1, 1).filter(|&(q, _, _)| same_surface(g, &guides[q])) {
                     let l = demodulated(q).dot(LUMINANCE);
                     (m1, m2, n) = (m1 + l, m2 + l * l, n + 1.0);
                 }

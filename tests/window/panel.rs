@@ -33,6 +33,9 @@ fn choosing_a_brush_moves_no_palette_swatch() {
     let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
     let window = find_window(&display, &mut app, &stderr_path);
     lines.wait_for("octovox: ready", Duration::from_secs(90));
+    // Past the path tracer's first samples and filters (whose first frames
+    // compile the denoiser's kernels on lavapipe).
+    lines.wait_for("noise: ", Duration::from_secs(90));
     xdotool(&display, &["windowfocus", "--sync", &window]);
     let shot = |name: &str| {
         xdotool(&display, &["mousemove", "--window", &window, "790", "590"]);
@@ -53,7 +56,14 @@ fn choosing_a_brush_moves_no_palette_swatch() {
         xdotool(&display, &["mousedown", "1"]);
         std::thread::sleep(Duration::from_millis(100));
         xdotool(&display, &["mouseup", "1"]);
-        let after = shot(name);
+        // The frame that shows the click may come after a path-traced one
+        // (a band, or a stage of the denoiser): look for up to 10 s.
+        let mut after = shot(name);
+        let deadline = std::time::Instant::now() + Duration::from_secs(10);
+        while after.get_pixel(x, y) == voxel.get_pixel(x, y) && std::time::Instant::now() < deadline {
+            std::thread::sleep(Duration::from_millis(200));
+            after = shot(name);
+        }
         assert_ne!(after.get_pixel(x, y), voxel.get_pixel(x, y), "the {name} button is selected");
         let moved = palette_pixels(&after).iter().zip(&swatches).filter(|(a, b)| a != b).count();
         assert_eq!(moved, 0, "choosing {name} changed {moved} pixels of the palette");
