@@ -107,13 +107,11 @@ pub struct Accumulated {
     pub last: PathFrame,
     /// The milliseconds of all the samples.
     pub ms: f64,
-    /// The noise estimate at the last sample (with `estimate_noise` on).
-    pub noise: Option<f32>,
 }
 
 /// Path traces `view` from a fresh accumulation: `cap` samples, or fewer
-/// once the noise estimate is below `target` (which needs the renderer's
-/// `estimate_noise`). `each` sees every sample's frame.
+/// once the noise estimate is below `target` (measured after every sample
+/// only then). `each` sees every sample's frame.
 ///
 /// # Errors
 /// A failed frame.
@@ -124,21 +122,20 @@ pub fn accumulate(
     target: Option<f32>,
     mut each: impl FnMut(&PathFrame),
 ) -> Result<Accumulated, crate::gpu::GpuError> {
-    let (mut ms, mut last, mut noise) = (0.0, None, None);
+    let (mut ms, mut last) = (0.0, None);
     for sample in 0..cap {
         let frame = renderer.render_path(view, sample == 0)?;
         ms += frame.ms;
         each(&frame);
         last = Some(frame);
-        if renderer.estimate_noise {
-            noise = renderer.noise_estimate()?;
-        }
-        if target.zip(noise).is_some_and(|(target, noise)| noise < target) {
+        if let Some(target) = target
+            && renderer.noise_estimate()?.is_some_and(|noise| noise < target)
+        {
             break;
         }
     }
     let last = last.ok_or_else(|| crate::gpu::GpuError::Readback("no samples were asked for".into()))?;
-    Ok(Accumulated { last, ms, noise })
+    Ok(Accumulated { last, ms })
 }
 
 /// For each (time, error) point, whether no other point is at least as good

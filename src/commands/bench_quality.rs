@@ -124,8 +124,6 @@ pub fn bench_quality(quick: bool, out: &Path) -> anyhow::Result<(String, String)
         Sizes { size: (320, 180), reference_spp: 256, base_spp: 16 }
     };
     let mut renderer = Renderer::headless()?;
-    // As `render` does: every sample measures the noise.
-    renderer.estimate_noise = true;
     let (mut rows, mut unbiased, mut targets) = (Vec::new(), Vec::new(), Vec::new());
     for (name, mut scene, camera) in scenes(quick)? {
         renderer.sync(&mut scene.tree, &scene.palette);
@@ -239,7 +237,7 @@ fn target_rows(
             scene: name,
             target,
             samples: done.last.samples,
-            noise_estimate: done.noise,
+            noise_estimate: renderer.noise_estimate()?,
             rms_error: rms_error(reference, &image),
             flip: flip(reference, &image),
         });

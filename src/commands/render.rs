@@ -149,13 +149,12 @@ fn path_traced(
     let mut renderer = Renderer::headless().context("no GPU for rendering (try --cpu)")?;
     log::info!("path tracing on {}", renderer.gpu.adapter_name);
     renderer.sync(&mut scene.tree, &scene.palette);
-    renderer.estimate_noise = true;
     let (cap, target) = (args.path.samples(), args.path.target_error);
     let view = PathView { tree: &scene.tree, palette: &scene.palette, camera, size, settings: &settings };
     let bar = super::progress_bar::bar("path tracing", u64::from(cap));
-    let Accumulated { last: frame, ms: total_ms, noise } =
-        accumulate(&mut renderer, &view, cap, target, |_| bar.inc(1))?;
+    let Accumulated { last: frame, ms: total_ms } = accumulate(&mut renderer, &view, cap, target, |_| bar.inc(1))?;
     bar.finish_and_clear();
+    let noise = renderer.noise_estimate()?;
     let denoise_ms = if args.path.denoise { Some(renderer.denoise_now()?) } else { None };
     let stats = Stats {
         effects: frame.effects.names(),

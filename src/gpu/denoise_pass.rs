@@ -4,7 +4,9 @@
 //! filter itself is explained in `crate::trace::denoise`, its CPU twin.
 
 use super::context::compute_pipeline;
-use super::layout::{DenoiseUniforms, buffer_entry, constants_buffer, constants_entry, output_entry, output_texture};
+use super::layout::{
+    DenoiseUniforms, buffer_entry, buffer_resource, constants_buffer, constants_entry, output_entry, output_texture,
+};
 use super::prelude::with_prelude;
 use super::readback::{read_storage, read_texture_rgba8};
 use super::{GpuContext, GpuError, PathPass};
@@ -49,10 +51,6 @@ fn light_buffer(device: &wgpu::Device, pixels: u64) -> wgpu::Buffer {
         usage: wgpu::BufferUsages::STORAGE,
         mapped_at_creation: false,
     })
-}
-
-fn resource(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-    wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() }
 }
 
 fn groups(width: u32, height: u32) -> (u32, u32) {
@@ -120,13 +118,13 @@ impl DenoisePass {
                     label: Some("denoise bind group"),
                     layout: &self.layout,
                     entries: &[
-                        resource(0, &constants),
-                        resource(1, accum),
-                        resource(2, guides),
-                        resource(3, &light[1 - out]),
-                        resource(4, &light[out]),
+                        buffer_resource(0, &constants),
+                        buffer_resource(1, accum),
+                        buffer_resource(2, guides),
+                        buffer_resource(3, &light[1 - out]),
+                        buffer_resource(4, &light[out]),
                         wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&view) },
-                        resource(6, &partials),
+                        buffer_resource(6, &partials),
                     ],
                 });
                 Stage { constants, bind_group }

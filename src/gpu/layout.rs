@@ -209,6 +209,11 @@ pub fn output_texture(
     (texture, view)
 }
 
+/// A bind group's entry binding all of `buffer`.
+pub fn buffer_resource(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() }
+}
+
 pub fn buffer_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,

@@ -16,7 +16,8 @@ use glam::Vec3;
 
 use super::context::compute_pipeline;
 use super::layout::{
-    FrameUniforms, PathUniforms, buffer_entry, constants_buffer, constants_entry, output_entry, output_texture,
+    FrameUniforms, PathUniforms, buffer_entry, buffer_resource, constants_buffer, constants_entry, output_entry,
+    output_texture,
 };
 use super::prelude::with_prelude;
 use super::readback::{read_storage, read_texture_rgba8};
@@ -121,10 +122,6 @@ impl Accumulation {
     }
 }
 
-fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-    wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() }
-}
-
 /// The pass's own buffers that its bind group holds.
 struct BindParts<'a> {
     frame: &'a wgpu::Buffer,
@@ -144,15 +141,15 @@ fn make_bind_group(
         label: Some("path bind group"),
         layout,
         entries: &[
-            entry(0, parts.frame),
-            entry(1, &buffers.pool_buf),
-            entry(3, &buffers.palette_buf),
+            buffer_resource(0, parts.frame),
+            buffer_resource(1, &buffers.pool_buf),
+            buffer_resource(3, &buffers.palette_buf),
             wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&target.view) },
-            entry(8, parts.path),
-            entry(9, parts.materials),
-            entry(10, parts.emitters),
-            entry(11, &target.accum),
-            entry(12, &target.guides),
+            buffer_resource(8, parts.path),
+            buffer_resource(9, parts.materials),
+            buffer_resource(10, parts.emitters),
+            buffer_resource(11, &target.accum),
+            buffer_resource(12, &target.guides),
         ],
     })
 }

@@ -151,8 +151,10 @@ pub struct Renderer {
     /// `sample_target`th, a stage a frame);
     /// headless renders call [`Renderer::denoise_now`] once instead.
     pub denoise: bool,
-    /// Whether each path-traced sample measures the image's noise for
-    /// [`Renderer::noise_estimate`] (denoised frames always do).
+    /// Whether each path-traced sample measures the image's noise in its
+    /// own frame (the window, which shows it after every sample; denoised
+    /// frames always do). Without it [`Renderer::noise_estimate`] measures
+    /// when asked.
     pub estimate_noise: bool,
     /// The sample count the last noise measurement saw.
     noise_of: Option<u32>,
@@ -489,15 +491,27 @@ impl Renderer {
     }
 
     /// The remaining noise of the accumulation, estimated from its samples
-    /// (`crate::trace::denoise::noise_estimate`): `None` below two samples
-    /// or when the last sample was not measured ([`Renderer::estimate_noise`]).
+    /// (`crate::trace::denoise::noise_estimate`): `None` below two samples.
+    /// Measured now (the denoiser's `prepare`, without the light) unless the
+    /// last sample's frame did ([`Renderer::estimate_noise`]).
     ///
     /// # Errors
-    /// A failed readback.
-    pub fn noise_estimate(&self) -> Result<Option<f32>, GpuError> {
-        let samples = self.path.accumulation.samples;
-        if samples < 2 || self.noise_of != Some(samples) {
-            return Ok(None);
+    /// A failed measurement or readback.
+    pub fn noise_estimate(&mut self) -> Result<Option<f32>, GpuError> {
+        let acc = self.path.accumulation;
+        let Some(key) = acc.key.filter(|_| acc.samples >= 2) else { return Ok(None) };
+        if self.noise_of != Some(acc.samples) {
+            let device = self.gpu.device.clone();
+            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("noise") });
+            validated(&device, || {
+                self.denoiser.encode_stages(&self.gpu, &mut encoder, &Frame::of(&key.basis), 0..1, false);
+                Ok(())
+            })?;
+            self.gpu.checked(|| {
+                self.gpu.queue.submit([encoder.finish()]);
+                Ok(())
+            })?;
+            self.noise_of = Some(acc.samples);
         }
         let (w, h) = self.path.size();
         let sum = self.denoiser.read_variance_sum(&self.gpu)?;
