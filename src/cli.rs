@@ -406,7 +406,7 @@ pub fn parse_camera(s: &str) -> Result<(DVec3, DVec3), String> {
 pub fn camera_or_framing(camera: Option<(DVec3, DVec3)>, fov: f32, scene: &octovox::scene::Scene) -> Camera {
     match camera {
         Some((eye, target)) => Camera { eye, target, fov_y_deg: fov, ortho: None },
-        None => match scene.tree.solid_bounds() {
+        None => match scene.solid_bounds() {
             Some((lo, hi)) => Camera::framing(lo, hi, fov),
             None => Camera { fov_y_deg: fov, ..Camera::default() },
         },

@@ -91,11 +91,11 @@ impl Editor {
     /// next flush uploads all of it (what it was flushed to before, if
     /// anything, is not this editor's GPU buffer).
     pub fn set_scene(&mut self, mut scene: Scene) {
-        scene.tree.pool_mut().forget_uploads();
+        scene.forget_uploads();
         self.scene = scene;
         self.history.clear();
         self.selection = None;
-        self.ground = self.scene.tree.solid_voxels() == 0 && self.scene.objects.is_none();
+        self.ground = self.scene.solid_voxels() == 0 && self.scene.objects().is_none();
         self.revision += 1;
     }
 
@@ -136,11 +136,11 @@ impl Editor {
             // Fills and extrudes are not mirrored: their regions follow the
             // colours and faces, not the brush.
             Command::Fill(p) => {
-                let edits = crate::edit::fill::fill_edits(&self.scene.tree, *p, tools.color)?;
+                let edits = crate::edit::fill::fill_edits(self.scene.drawn(), *p, tools.color)?;
                 self.commit(edits)?
             }
             Command::Extrude(p, normal, layers) => {
-                let edits = crate::edit::extrude::extrude_edits(&self.scene.tree, *p, *normal, *layers)?;
+                let edits = crate::edit::extrude::extrude_edits(self.scene.drawn(), *p, *normal, *layers)?;
                 self.commit(edits)?
             }
             Command::Rgb(..) | Command::Material(..) => match palette_edit(command, &self.scene.palette) {
@@ -172,12 +172,12 @@ impl Editor {
                 self.set(|e| e.selection = Some(region))
             }
             Command::Copy => {
-                let block = selection::copy(&self.scene.tree, self.selected()?)?;
+                let block = selection::copy(self.scene.drawn(), self.selected()?)?;
                 self.set(|e| e.clipboard = Some(block))
             }
             Command::Cut => {
                 let region = self.selected()?;
-                let block = selection::copy(&self.scene.tree, region)?;
+                let block = selection::copy(self.scene.drawn(), region)?;
                 let changed = self.commit(vec![region.clear_edit()])?;
                 self.clipboard = Some(block);
                 changed
@@ -194,11 +194,11 @@ impl Editor {
             Command::Rotate(axis) => self.turn_selection(*axis, false)?,
             Command::Flip(axis) => self.turn_selection(*axis, true)?,
             Command::ExpectVoxel(p, want) => {
-                let got = self.scene.tree.get(*p);
+                let got = self.scene.voxel(*p);
                 return Ok(checked(got == *want, format!("voxel {p} = {want}"), got));
             }
             Command::ExpectCount(want) => {
-                let got = self.scene.tree.solid_voxels();
+                let got = self.scene.solid_voxels();
                 return Ok(checked(got == *want, format!("{want} voxels"), got));
             }
             Command::ExpectEffects(want) => {
@@ -215,11 +215,11 @@ impl Editor {
                 self.commit(vec![Edit::Graph(Box::new(change))])?
             }
             Command::ExpectObjects(want) => {
-                let got = self.scene.objects.as_ref().map_or(1, |o| o.list().len());
+                let got = self.scene.objects().map_or(1, |o| o.list().len());
                 return Ok(checked(got == *want, format!("{want} objects"), got));
             }
             Command::ExpectModels(want) => {
-                let got = self.scene.objects.as_ref().map_or(1, |o| o.models.len());
+                let got = self.scene.objects().map_or(1, |o| o.models.len());
                 return Ok(checked(got == *want, format!("{want} models"), got));
             }
             Command::Load(_)
@@ -240,7 +240,7 @@ impl Editor {
     /// its name or the path of names down to it. A scene of one model is
     /// object 0.
     fn object_named(&self, which: &ObjectRef) -> Result<usize, EditorError> {
-        let Some(objects) = &self.scene.objects else {
+        let Some(objects) = self.scene.objects() else {
             return match which {
                 ObjectRef::Index(0) => Ok(0),
                 _ => Err(EditorError::Object("the scene is one model: object 0 is all there is".to_owned())),
@@ -279,7 +279,7 @@ impl Editor {
     /// The `object N` line that picks the object drawn at `voxel`, when that
     /// is not the picked one already (what a click runs before its edit).
     pub fn object_line_at(&self, voxel: IVec3) -> Option<Command> {
-        let objects = self.scene.objects.as_ref()?;
+        let objects = self.scene.objects()?;
         let owner = objects.owner_at(voxel).filter(|&i| objects.selected != Some(i))?;
         Some(Command::Object(ObjectLine::Pick(ObjectRef::Index(owner))))
     }
@@ -287,7 +287,7 @@ impl Editor {
     /// The objects of a scene of several, or why an `object`/`layer` line
     /// cannot change anything.
     fn objects(&self) -> Result<&Objects, EditorError> {
-        self.scene.objects.as_deref().ok_or_else(|| {
+        self.scene.objects().ok_or_else(|| {
             EditorError::Object("the scene is one model: it has no objects or layers to change".to_owned())
         })
     }
@@ -306,9 +306,7 @@ impl Editor {
         let (edits, picks) = match line {
             ObjectLine::Pick(which) => {
                 let index = self.object_named(which)?;
-                if let Some(objects) = &mut self.scene.objects {
-                    objects.selected = Some(index);
-                }
+                self.scene.select_object(Some(index));
                 return Ok(false);
             }
             ObjectLine::New(name) => {
@@ -318,12 +316,13 @@ impl Editor {
             line => self.picked_object_edits(line)?,
         };
         let changed = self.commit(edits)?;
-        if let Some(objects) = &mut self.scene.objects {
-            objects.selected = match picks {
+        if let Some(objects) = self.scene.objects() {
+            let selected = match picks {
                 Picks::Same => objects.selected,
                 Picks::None => None,
                 Picks::Transform(id) => objects.index_of_transform(id),
             };
+            self.scene.select_object(selected);
         }
         Ok(changed)
     }
@@ -395,7 +394,7 @@ impl Editor {
     /// `target` is outside the world. Whether the voxels changed.
     fn relocate_selection(&mut self, region: Region, target: Region, map: &CellMap) -> Result<bool, EditorError> {
         let target = target.inside_world()?;
-        let block = selection::copy(&self.scene.tree, region)?.mapped(map, target.size());
+        let block = selection::copy(self.scene.drawn(), region)?.mapped(map, target.size());
         let mut edits = vec![region.clear_edit()];
         edits.extend(block.place_edits(target.min));
         let changed = self.commit(edits)?;
@@ -486,7 +485,7 @@ fn palette_colors(palette: &Palette, first: u8, colors: &[[u8; 3]]) -> Vec<Edit>
 
 /// `pick X Y Z`: the colour of the voxel there, or why there is none.
 fn picked_color(scene: &Scene, at: IVec3) -> Result<u8, EditorError> {
-    match scene.tree.get(at) {
+    match scene.voxel(at) {
         0 => Err(EditorError::NothingToPick(at)),
         value => Ok(value),
     }
@@ -496,7 +495,7 @@ fn picked_color(scene: &Scene, at: IVec3) -> Result<u8, EditorError> {
 /// default path settings, so a script means one thing in every host) is
 /// exactly `want` (in any order), and the set's names.
 fn effects_match(scene: &Scene, want: &[String]) -> (bool, Vec<&'static str>) {
-    let names = crate::trace::path::effects_for(&scene.tree, &scene.palette, &PathSettings::default()).names();
+    let names = crate::trace::path::effects_for(scene, &PathSettings::default()).names();
     let mut got = names.clone();
     let mut expected: Vec<&str> = want.iter().map(String::as_str).collect();
     got.sort_unstable();
@@ -530,11 +529,11 @@ mod tests {
         let limit = crate::scene::octree::WORLD_LIMIT - 1;
         let err = run(&mut editor, &format!("paste {limit} 0 0")).unwrap_err().to_string();
         assert!(err.contains("outside the world"), "{err}");
-        assert_eq!(editor.scene.tree.solid_voxels(), 2);
+        assert_eq!(editor.scene.solid_voxels(), 2);
         assert_eq!(editor.selection, Some(Region { min: IVec3::ZERO, max: IVec3::X }));
         assert_eq!(editor.history.usage().0, 2);
         assert!(run(&mut editor, &format!("move {limit} 0 0")).is_err());
-        assert_eq!((editor.scene.tree.get(IVec3::ZERO), editor.scene.tree.get(IVec3::X)), (1, 1));
+        assert_eq!((editor.scene.voxel(IVec3::ZERO), editor.scene.voxel(IVec3::X)), (1, 1));
     }
 
     /// Issue 27, bug 1: a scene recovered from a journal (replayed on the
@@ -547,11 +546,11 @@ mod tests {
             run(&mut replayed, line).unwrap();
         }
         // A flush elsewhere (the CPU runner counts its flushes so).
-        let _ = replayed.scene.tree.pool_mut().flush();
-        let live = replayed.scene.tree.pool().live_bytes();
+        let _ = replayed.scene.take_uploads();
+        let live = replayed.scene.drawn_pool_bytes();
         let mut window = Editor::default();
         window.set_scene(replayed.scene);
-        let upload = window.scene.tree.pool_mut().flush();
+        let upload = window.scene.take_uploads();
         assert!(upload.byte_count() >= live, "{} of {live} bytes uploaded", upload.byte_count());
     }
 
@@ -579,7 +578,7 @@ mod tests {
 
     /// Every solid voxel of the editor's scene with its colour, in one order.
     fn voxels(editor: &Editor) -> Vec<(IVec3, u8)> {
-        let mut out = editor.scene.tree.voxels();
+        let mut out = editor.scene.voxels();
         out.sort_by_key(|(p, _)| (p.x, p.y, p.z));
         out
     }
@@ -628,10 +627,10 @@ mod tests {
         run(&mut editor, "rotate y").unwrap();
         assert_eq!(editor.selection, Some(Region { min: IVec3::new(2, 0, -2), max: IVec3::new(3, 2, 2) }));
         // Counter-clockwise seen from +y: +x turns to −z, +z to +x.
-        assert_eq!(editor.scene.tree.get(IVec3::new(2, 0, 2)), 1, "(0, 0, 0) went to the far +z end");
-        assert_eq!(editor.scene.tree.get(IVec3::new(2, 0, -2)), 3, "(4, 0, 0) went to the −z end");
-        assert_eq!(editor.scene.tree.get(IVec3::new(3, 2, -2)), 4, "(4, 2, 1) went +x of it");
-        assert_eq!(editor.scene.tree.solid_voxels(), 5);
+        assert_eq!(editor.scene.voxel(IVec3::new(2, 0, 2)), 1, "(0, 0, 0) went to the far +z end");
+        assert_eq!(editor.scene.voxel(IVec3::new(2, 0, -2)), 3, "(4, 0, 0) went to the −z end");
+        assert_eq!(editor.scene.voxel(IVec3::new(3, 2, -2)), 4, "(4, 2, 1) went +x of it");
+        assert_eq!(editor.scene.solid_voxels(), 5);
     }
 
     #[test]
@@ -645,15 +644,12 @@ mod tests {
         {
             run(&mut editor, &line).unwrap();
         }
-        let column = |e: &Editor| (0..8).filter(|&y| e.scene.tree.get(IVec3::new(edge, y, 0)) != 0).count();
-        let before = (column(&editor), editor.scene.tree.solid_voxels(), editor.selection, editor.history.steps());
+        let column = |e: &Editor| (0..8).filter(|&y| e.scene.voxel(IVec3::new(edge, y, 0)) != 0).count();
+        let before = (column(&editor), editor.scene.solid_voxels(), editor.selection, editor.history.steps());
         assert_eq!(before.0, 8);
         let err = run(&mut editor, "rotate z").unwrap_err().to_string();
         assert!(err.contains("outside the world"), "{err}");
-        assert_eq!(
-            (column(&editor), editor.scene.tree.solid_voxels(), editor.selection, editor.history.steps()),
-            before
-        );
+        assert_eq!((column(&editor), editor.scene.solid_voxels(), editor.selection, editor.history.steps()), before);
     }
 
     #[test]
@@ -663,8 +659,8 @@ mod tests {
             run(&mut editor, line).unwrap();
         }
         assert!(run(&mut editor, "undo 3").unwrap_err().to_string().contains("only 2 step(s) to undo"));
-        assert_eq!(editor.scene.tree.solid_voxels(), 2, "nothing was undone");
+        assert_eq!(editor.scene.solid_voxels(), 2, "nothing was undone");
         assert_eq!(run(&mut editor, "undo 2"), Ok(Outcome::Changed));
-        assert_eq!(editor.scene.tree.solid_voxels(), 0);
+        assert_eq!(editor.scene.solid_voxels(), 0);
     }
 }

@@ -327,7 +327,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let document = dir.path().join("doc.vox");
         let mut scene = Scene::default();
-        scene.tree.apply_brush(&crate::scene::Shape::Voxel(glam::IVec3::ZERO), crate::scene::Op::Place(3)).unwrap();
+        scene.apply_brush(&crate::scene::Shape::Voxel(glam::IVec3::ZERO), crate::scene::Op::Place(3)).unwrap();
         crate::io::save_scene(&document, &scene, Default::default()).unwrap();
         let journal = journal_path(&document);
         (dir, std::fs::canonicalize(&document).unwrap(), journal)
@@ -349,7 +349,7 @@ mod tests {
         std::fs::write(&journal, format!("new\n{}", journal_text(&document, "", "place 0 1 0\n"))).unwrap();
         assert!(recover(&document, Checks::default()).is_err(), "a scene line before the load is refused too");
         std::fs::write(&journal, journal_text(&document, "", "place 0 1 0\n")).unwrap();
-        assert_eq!(recover(&document, Checks::default()).unwrap().tree.solid_voxels(), 2);
+        assert_eq!(recover(&document, Checks::default()).unwrap().solid_voxels(), 2);
     }
 
     #[test]
@@ -358,17 +358,17 @@ mod tests {
         let stamp = FileStamp::of(&document).unwrap();
         let text = journal_text(&document, &format!("#@ {}\n", stamp.note()), "place 0 1 0\n");
         std::fs::write(&journal, &text).unwrap();
-        assert_eq!(recover(&document, Checks::default()).unwrap().tree.solid_voxels(), 2, "the same content");
+        assert_eq!(recover(&document, Checks::default()).unwrap().solid_voxels(), 2, "the same content");
         // Another program rewrites the document after the journal started.
         let mut scene = crate::io::load_scene(&document, 0).unwrap();
-        scene.tree.apply_brush(&crate::scene::Shape::Voxel(glam::IVec3::X), crate::scene::Op::Place(4)).unwrap();
+        scene.apply_brush(&crate::scene::Shape::Voxel(glam::IVec3::X), crate::scene::Op::Place(4)).unwrap();
         crate::io::save_scene(&document, &scene, Default::default()).unwrap();
         let err = recover(&document, Checks::default()).unwrap_err();
         assert!(matches!(err, RecoverError::Changed { .. }), "{err}");
         let message = err.to_string();
         assert!(message.contains(&format!("{} bytes", stamp.size)) && message.contains("nothing was applied"));
         let checks = Checks { allow_changed_source: true };
-        assert_eq!(recover(&document, checks).unwrap().tree.solid_voxels(), 3, "applied when the user says so");
+        assert_eq!(recover(&document, checks).unwrap().solid_voxels(), 3, "applied when the user says so");
         assert_eq!(std::fs::read_to_string(&journal).unwrap(), text, "the journal is left as it was");
     }
 
@@ -378,7 +378,7 @@ mod tests {
         let stamp = FileStamp::of(&document).unwrap();
         // The save noted itself, then renamed its file over the document.
         let mut scene = crate::io::load_scene(&document, 0).unwrap();
-        scene.tree.apply_brush(&crate::scene::Shape::Voxel(glam::IVec3::Y), crate::scene::Op::Place(3)).unwrap();
+        scene.apply_brush(&crate::scene::Shape::Voxel(glam::IVec3::Y), crate::scene::Op::Place(3)).unwrap();
         crate::io::save_scene(&document, &scene, Default::default()).unwrap();
         let saved = crate::io::atomic::sha256_of(&document).unwrap();
         let edits = format!("place 0 1 0\n#@ {}\n", saved_note(&saved, &document));
@@ -390,7 +390,7 @@ mod tests {
         unfinished.replace_range(..1, if saved.starts_with('0') { "1" } else { "0" });
         let edits = format!("place 0 1 0\n#@ {}\n", saved_note(&unfinished, &document));
         std::fs::write(&journal, journal_text(&document, "", &edits)).unwrap();
-        assert_eq!(recover(&document, Checks::default()).unwrap().tree.solid_voxels(), 2);
+        assert_eq!(recover(&document, Checks::default()).unwrap().solid_voxels(), 2);
     }
 
     #[test]

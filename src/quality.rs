@@ -72,10 +72,9 @@ pub fn render_setting(
         Setting::Path { spp, bounces, shadow_samples, render_scale, denoise } => {
             let settings = PathSettings { bounces, shadow_samples, ..PathSettings::default() };
             let traced = scaled_size(size, render_scale);
-            renderer.compile_path_kernel(&scene.tree, &scene.palette, &settings)?;
+            renderer.compile_path_kernel(scene, &settings)?;
             let start = std::time::Instant::now();
-            let view =
-                PathView { tree: &scene.tree, palette: &scene.palette, camera, size: traced, settings: &settings };
+            let view = PathView { scene, camera, size: traced, settings: &settings };
             accumulate(renderer, &view, spp, None, |_| ())?;
             if denoise {
                 renderer.denoise_now()?;
@@ -87,14 +86,14 @@ pub fn render_setting(
             let settings = RenderSettings { mode, view: View::Shaded, shadows: true, render_scale: 1.0, lod };
             let traced = scaled_size(size, render_scale);
             if mode == TraceMode::Grid {
-                let grid = crate::trace::grid::DenseGrid::from_octree(&scene.tree)
+                let grid = crate::trace::grid::DenseGrid::from_octree(scene.drawn())
                     .map_err(|e| crate::gpu::GpuError::TooLarge(e.to_string()))?;
                 renderer.set_grid(&grid)?;
             }
             // The first frame compiles nothing but warms caches; time the second.
-            renderer.render(&scene.tree, camera, traced, &settings, None)?;
+            renderer.render(scene, camera, traced, &settings, None)?;
             let start = std::time::Instant::now();
-            renderer.render(&scene.tree, camera, traced, &settings, None)?;
+            renderer.render(scene, camera, traced, &settings, None)?;
             let ms = start.elapsed().as_secs_f64() * 1e3;
             Ok((ms, upscale(renderer.read_image()?, size)))
         }

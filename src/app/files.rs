@@ -298,12 +298,12 @@ impl App {
             Ok((scene, stamp)) => {
                 self.doc.recent.add(&loading.path);
                 let seconds = loading.started.elapsed().as_secs_f64();
-                report!("loaded: {} ({} voxels, {seconds:.2} s)", loading.path.display(), scene.tree.solid_voxels());
+                report!("loaded: {} ({} voxels, {seconds:.2} s)", loading.path.display(), scene.solid_voxels());
                 self.replace_scene(scene, Load(loading.path.clone()), stamp);
                 // A camera from the command line wins for the file it came with.
                 let keep_camera = self.args.camera.is_some() && self.args.file.as_ref() == Some(&loading.path);
                 if !keep_camera {
-                    self.frame_box(self.doc.editor.scene.tree.solid_bounds());
+                    self.frame_box(self.doc.editor.scene.solid_bounds());
                 }
                 self.ui.info(format!("opened {}", loading.path.display()));
                 if let Some(document) = self.state.path.clone()

@@ -12,6 +12,7 @@ use octovox::settings::{Shading, TraceMode, View};
 use octovox::trace::grid::DenseGrid;
 
 use super::gesture::Gesture;
+use super::state::Mode;
 use super::{App, Gfx, camera_control, capture, motion, ui};
 
 /// Most bands a path-traced sample is split into.
@@ -65,8 +66,7 @@ impl App {
             // A hover over a ray that gave up highlights nothing; a click says why.
             Some((x, y)) if !self.hover.pointer_over_ui && self.doc.loading.is_none() => {
                 // What builds on the ground shows where it lands there too.
-                let on_ground =
-                    self.state.tool == super::state::Tool::Attach || self.state.line_mode || self.state.select_mode;
+                let on_ground = self.state.tool == super::state::Tool::Attach || self.state.mode != Mode::Brush;
                 if on_ground { self.pick_or_ground(x, y) } else { self.pick_at(x, y) }.ok().flatten()
             }
             _ => None,
@@ -121,7 +121,8 @@ impl App {
         let mut full = {
             let info = ui::Info {
                 palette: &self.doc.editor.scene.palette,
-                tree: &self.doc.editor.scene.tree,
+                scene: &self.doc.editor.scene,
+                line_start: self.gesture.line_start(),
                 stats: self.readouts.shown_stats.take(&ctx, &self.readouts.stats),
                 adapter: &gfx.renderer.gpu.adapter_name,
                 timestamps: gfx.renderer.timed_by_gpu(),
@@ -140,7 +141,7 @@ impl App {
                 fill: self.hover.fill_preview.as_ref().map(|p| p.region),
                 paste,
                 eyedropper,
-                objects: self.doc.editor.scene.objects.as_deref(),
+                objects: self.doc.editor.scene.objects(),
                 ground: self.doc.editor.ground,
             };
             let (state, ui_state, tools) = (&mut self.state, &mut self.ui, &mut self.doc.editor.tools);
@@ -151,7 +152,7 @@ impl App {
                 ui::draw_selection(ui, state, &info);
                 if let Some((voxels, normal, layers)) = info.extrude {
                     ui::draw_extrude(ui, state, &info, voxels, normal, layers);
-                } else if let Some(pick) = pick.filter(|_| !state.select_mode && info.fill.is_none()) {
+                } else if let Some(pick) = pick.filter(|_| state.mode != Mode::Select && info.fill.is_none()) {
                     ui::draw_brush_outline(ui, state, tools, &pick, &info);
                 }
                 ui::draw_action_previews(ui, state, &info);
@@ -205,13 +206,7 @@ impl App {
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         let wants_path = path_traced(&self.state, self.frames.motion.moving());
         let (scene, state) = (&self.doc.editor.scene, &self.state);
-        let view = PathView {
-            tree: &scene.tree,
-            palette: &scene.palette,
-            camera: &state.camera,
-            size: trace_size,
-            settings: &state.path_settings,
-        };
+        let view = PathView { scene, camera: &state.camera, size: trace_size, settings: &state.path_settings };
         let revision = self.doc.editor.revision();
         let scene_changed = self.frames.path_drawn != Some(revision);
         let restarts = wants_path && gfx.renderer.path_restarts(&view, scene_changed);
@@ -224,12 +219,14 @@ impl App {
             FrameInput::Path { view, scene_changed }
         } else {
             // Select mode tints the selected voxels; the other modes what the brush would touch.
-            let highlight = if self.state.select_mode {
+            let highlight = if self.state.mode == Mode::Select {
                 selection.map(|r| (r.min, r.max))
             } else {
-                self.hover.pick.map(|pick| self.state.preview_box(&self.doc.editor.tools, &pick))
+                self.hover
+                    .pick
+                    .map(|pick| self.state.preview_box(&self.doc.editor.tools, &pick, self.gesture.line_start()))
             };
-            FrameInput::preview(&scene.tree, &state.camera, trace_size, &state.settings, highlight)
+            FrameInput::preview(scene, &state.camera, trace_size, &state.settings, highlight)
         };
         if let Err(err) = gfx.renderer.encode(&mut encoder, &input) {
             log::error!("trace failed: {err}");
@@ -333,7 +330,7 @@ impl App {
             return;
         }
         let Some(gfx) = &mut self.gfx else { return };
-        match DenseGrid::from_octree(&self.doc.editor.scene.tree) {
+        match DenseGrid::from_octree(self.doc.editor.scene.drawn()) {
             Ok(grid) => match gfx.renderer.set_grid(&grid) {
                 Ok(()) => self.frames.grid_drawn = Some(revision),
                 Err(err) => {

@@ -1,6 +1,8 @@
-//! The drag or held control under way, one at a time.
+//! The drag or held control under way, one at a time (the mode a drag
+//! starts in is `EditorState::mode`).
 
 use glam::IVec3;
+use octovox::edit::selection::Region;
 
 use super::state::{Pick, Tool};
 
@@ -13,8 +15,10 @@ pub(super) enum Gesture {
     Stroke(Stroke),
     /// A palette control is held: its changes are one undo step.
     Palette,
-    /// A box-select drag (select mode).
-    Select(SelectDrag),
+    /// A line drag (line mode) from the cell in front of the pressed face.
+    Line { start: IVec3 },
+    /// A box-select drag (select mode), and the box it would select now.
+    Select { drag: SelectDrag, preview: Option<Region> },
     /// A Ctrl+drag extrude: the face it started on and where the drag began.
     Extrude { face: Pick, start: (f64, f64) },
 }
@@ -56,6 +60,22 @@ impl Gesture {
     pub fn stroke(&self) -> Option<&Stroke> {
         match self {
             Gesture::Stroke(stroke) => Some(stroke),
+            _ => None,
+        }
+    }
+
+    /// Where the line being dragged starts.
+    pub fn line_start(&self) -> Option<IVec3> {
+        match self {
+            Gesture::Line { start } => Some(*start),
+            _ => None,
+        }
+    }
+
+    /// The box the selection drag would select now.
+    pub fn select_preview(&self) -> Option<Region> {
+        match self {
+            Gesture::Select { preview, .. } => *preview,
             _ => None,
         }
     }

@@ -150,8 +150,7 @@ impl App {
             .doc
             .editor
             .scene
-            .objects
-            .as_ref()
+            .objects()
             .and_then(|o| o.selected)
             .map(|i| Line::Object(octovox::script::ObjectLine::Pick(octovox::script::ObjectRef::Index(i))));
         let selection = selection.into_iter().chain(picked);

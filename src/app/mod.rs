@@ -67,7 +67,7 @@ use egui_layers::EguiLayers;
 use gesture::{Gesture, Stroke};
 use input::Input;
 use preview::Hover;
-use state::{EditorState, Pick, Tool};
+use state::{EditorState, Mode, Pick, Tool};
 use ui::{DialogKind, Readouts, UiState};
 
 /// Where screenshots and the journal of an untitled scene go, relative to
@@ -162,7 +162,7 @@ impl App {
                 let built_in = app.args.demo.unwrap_or_default();
                 app.replace_scene(built_in.scene(), octovox::script::Command::Demo(built_in), None);
                 if app.args.camera.is_none() {
-                    app.frame_box(app.doc.editor.scene.tree.solid_bounds());
+                    app.frame_box(app.doc.editor.scene.solid_bounds());
                 }
                 // An untitled scene of a session that died: offer it back.
                 if let Some(journal) = octovox::journal::orphaned_untitled(std::path::Path::new(SAVES_DIR)).first() {
@@ -287,7 +287,7 @@ impl App {
     /// which palette edits change) to the GPU buffers; the stats count the pool.
     fn upload(&mut self) -> UploadStats {
         match &mut self.gfx {
-            Some(gfx) => gfx.renderer.sync(&mut self.doc.editor.scene.tree, &self.doc.editor.scene.palette),
+            Some(gfx) => gfx.renderer.sync(&mut self.doc.editor.scene),
             // No device yet: the ranges stay dirty and go up with the first frame.
             None => UploadStats::default(),
         }
@@ -339,8 +339,8 @@ impl App {
                 }
             }
             Command::MeasurePresets => self.measure_presets(),
-            Command::ToggleLine => self.state.toggle_line_mode(),
-            Command::ToggleSelect => self.state.toggle_select_mode(),
+            Command::ToggleLine => self.toggle_mode(Mode::Line),
+            Command::ToggleSelect => self.toggle_mode(Mode::Select),
             Command::Copy => match self.run_line(&octovox::script::Command::Copy) {
                 Ok(_) => {
                     let voxels = self.doc.editor.clipboard().map_or(0, octovox::edit::selection::Block::voxels);
@@ -381,10 +381,10 @@ impl App {
             }
             Command::ToggleProjection => camera_control::toggle_projection(&mut self.state.camera),
             Command::ViewFrom(side) => camera_control::view_from(&mut self.state.camera, side.as_dvec3()),
-            Command::FrameModel => self.frame_box(self.doc.editor.scene.tree.solid_bounds()),
+            Command::FrameModel => self.frame_box(self.doc.editor.scene.solid_bounds()),
             Command::FrameSelection => {
                 let selected = self.doc.editor.selection.map(|r| (r.min, r.max));
-                self.frame_box(selected.or_else(|| self.doc.editor.scene.tree.solid_bounds()));
+                self.frame_box(selected.or_else(|| self.doc.editor.scene.solid_bounds()));
             }
             Command::New => self.guard_unsaved(Pending::New, event_loop),
             Command::Open(path) => self.guard_unsaved(Pending::Open(path), event_loop),
@@ -476,7 +476,7 @@ impl App {
         }
         let px = ((x * f64::from(w) / f64::from(window_w)) as u32).min(w - 1);
         let py = ((y * f64::from(h) / f64::from(window_h)) as u32).min(h - 1);
-        let hit = svo::pick_with_ground(&self.doc.editor.scene.tree, &self.state.camera, (w, h), (px, py), ground)?;
+        let hit = svo::pick_with_ground(&self.doc.editor.scene, &self.state.camera, (w, h), (px, py), ground)?;
         Ok(hit.map(|hit| Pick { voxel: hit.voxel, normal: hit.normal, value: hit.value }))
     }
 
@@ -505,6 +505,23 @@ impl App {
         }
     }
 
+    /// `mode` on, or off when it is on; a line or box drag under way ends.
+    fn toggle_mode(&mut self, mode: Mode) {
+        self.state.toggle_mode(mode);
+        if matches!(self.gesture, Gesture::Line { .. } | Gesture::Select { .. }) {
+            self.gesture = Gesture::Idle;
+        }
+    }
+
+    /// Ends the line drag under way; returns where it started.
+    fn end_line(&mut self) -> Option<IVec3> {
+        let start = self.gesture.line_start();
+        if start.is_some() {
+            self.gesture = Gesture::Idle;
+        }
+        start
+    }
+
     /// Line mode: the press picks the start (in front of the face), the
     /// release the end; the brush is placed along the line as one step.
     fn line_edit(&mut self, phase: StrokePhase, x: f64, y: f64) {
@@ -520,13 +537,13 @@ impl App {
             if self.doc.editor.ground { "no voxel or ground there" } else { "no voxel there, and the ground is off" };
         match phase {
             StrokePhase::Begin => {
-                self.state.line_start = target;
+                self.gesture = target.map_or(Gesture::Idle, |start| Gesture::Line { start });
                 if target.is_none() {
                     self.ui.info(format!("a line starts on a voxel face or the ground: {why}"));
                 }
             }
             StrokePhase::Move => {}
-            StrokePhase::End | StrokePhase::Click => match (self.state.line_start.take().or(target), target) {
+            StrokePhase::End | StrokePhase::Click => match (self.end_line().or(target), target) {
                 (Some(a), Some(b)) => self.act(octovox::script::Command::Line(a, b), "line"),
                 (Some(_), None) => self.ui.info(format!("no line drawn: it ends on the sky ({why})")),
                 (None, _) => {}
@@ -565,7 +582,7 @@ impl App {
     /// The layers a Ctrl+drag from its start to (x, y) covers.
     fn extrude_layers(&self, x: f64, y: f64) -> Option<i32> {
         let Gesture::Extrude { face: pick, start } = self.gesture else { return None };
-        let face = (pick.voxel - self.doc.editor.scene.tree.origin()).as_vec3()
+        let face = (pick.voxel - self.doc.editor.scene.origin()).as_vec3()
             + glam::Vec3::splat(0.5)
             + pick.normal.as_vec3() * 0.5;
         self.screen_steps(face, pick.normal, start, (x, y))
@@ -576,7 +593,7 @@ impl App {
     /// `face` is drawn on screen: extrudes and selection handles.
     fn screen_steps(&self, face: glam::Vec3, normal: IVec3, start: (f64, f64), end: (f64, f64)) -> Option<i32> {
         let (w, h) = self.window_size();
-        let basis = self.state.camera.basis(w, h, self.doc.editor.scene.tree.origin());
+        let basis = self.state.camera.basis(w, h, self.doc.editor.scene.origin());
         let (a, b) = (basis.project(face)?, basis.project(face + normal.as_vec3())?);
         let step = glam::DVec2::new(f64::from(b.0 - a.0), f64::from(b.1 - a.1));
         let drag = glam::DVec2::new(end.0 - start.0, end.1 - start.1);
@@ -647,11 +664,10 @@ impl App {
     }
 
     fn pointer_edit(&mut self, phase: StrokePhase, tool: Tool, x: f64, y: f64) {
-        if self.state.line_mode {
-            return self.line_edit(phase, x, y);
-        }
-        if self.state.select_mode {
-            return self.select_drag(phase, x, y);
+        match self.state.mode {
+            Mode::Line => return self.line_edit(phase, x, y),
+            Mode::Select => return self.select_drag(phase, x, y),
+            Mode::Brush => {}
         }
         match phase {
             StrokePhase::Begin => {
@@ -742,7 +758,7 @@ impl App {
 
 /// The palette index used most often is a better first colour than 1.
 fn first_used_color(scene: &Scene) -> Option<u8> {
-    let counts = scene.tree.counts();
+    let counts = scene.counts();
     counts.present().max_by_key(|v| counts.get(*v))
 }
 

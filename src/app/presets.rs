@@ -168,10 +168,10 @@ mod tests {
     #[test]
     fn presets_cost_more_time_for_less_error() {
         let mut scene = octovox::scene::demo::BuiltIn::Terrain.scene();
-        let (lo, hi) = scene.tree.solid_bounds().unwrap_or_default();
+        let (lo, hi) = scene.solid_bounds().unwrap_or_default();
         let camera = Camera::framing(lo, hi, 50.0);
         let Ok(mut renderer) = Renderer::headless() else { return };
-        renderer.sync(&mut scene.tree, &scene.palette);
+        renderer.sync(&mut scene);
         let measured = measure(&mut renderer, &scene, &camera, (1280, 720)).unwrap_or_default();
         assert_eq!(measured.len(), PRESETS.len());
         let (draft, reference) = (measured[0], measured[PRESETS.len() - 1]);

@@ -10,7 +10,7 @@ use octovox::edit::selection::Region;
 
 use super::App;
 use super::gesture::Gesture;
-use super::state::Tool;
+use super::state::{Mode, Tool};
 
 /// The faces an extrude would move: those of the region around `face`
 /// (voxel, normal), and the layers the drag covers so far.
@@ -54,7 +54,7 @@ impl App {
     fn update_extrude_preview(&mut self) {
         let face = match self.gesture {
             Gesture::Extrude { face, .. } => Some(face),
-            _ if self.input.ctrl_held() && !self.state.line_mode && !self.state.select_mode => self.hover.pick,
+            _ if self.input.ctrl_held() && self.state.mode == Mode::Brush => self.hover.pick,
             _ => None,
         }
         .filter(|p| p.normal != IVec3::ZERO && p.value != 0)
@@ -65,7 +65,7 @@ impl App {
         };
         if self.hover.extrude_preview.as_ref().is_none_or(|p| p.face != face) {
             // A region too large to extrude previews nothing; the release says why.
-            let region = octovox::edit::extrude::face_region(&self.doc.editor.scene.tree, face.0, face.1);
+            let region = octovox::edit::extrude::face_region(self.doc.editor.scene.drawn(), face.0, face.1);
             let voxels = region.map(|r| r.into_iter().map(|(p, _)| p).collect()).unwrap_or_default();
             self.hover.extrude_preview = Some(ExtrudePreview { face, voxels, layers: 0 });
         }
@@ -78,7 +78,7 @@ impl App {
     /// Keeps the fill preview up to date: the region a Shift+click with
     /// Paint would recolour.
     fn update_fill_preview(&mut self) {
-        let plain_mode = !self.state.line_mode && !self.state.select_mode;
+        let plain_mode = self.state.mode == Mode::Brush;
         let start = self
             .hover
             .pick
@@ -91,7 +91,7 @@ impl App {
         if self.hover.fill_preview.as_ref().is_some_and(|p| p.start == start) {
             return;
         }
-        let region = octovox::edit::fill::fill_region(&self.doc.editor.scene.tree, start).ok().map(|voxels| {
+        let region = octovox::edit::fill::fill_region(self.doc.editor.scene.drawn(), start).ok().map(|voxels| {
             let lo = voxels.iter().copied().reduce(IVec3::min).unwrap_or(start);
             let hi = voxels.iter().copied().reduce(IVec3::max).unwrap_or(start);
             ((lo, hi), voxels.len())
@@ -102,7 +102,7 @@ impl App {
     /// The box Ctrl+V would fill: in select mode, the clipboard's block in
     /// front of the face under the cursor.
     pub(super) fn paste_preview(&self) -> Option<Region> {
-        let pick = self.hover.pick.filter(|_| self.state.select_mode)?;
+        let pick = self.hover.pick.filter(|_| self.state.mode == Mode::Select)?;
         Some(self.doc.editor.clipboard()?.region_at(pick.voxel + pick.normal))
     }
 

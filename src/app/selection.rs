@@ -25,14 +25,13 @@ impl App {
                         pick.map(|p| SelectDrag::NewBox(p.cell()))
                     }
                 };
-                self.gesture = drag.map_or(Gesture::Idle, Gesture::Select);
-                self.state.select_preview = self.dragged_box(x, y);
+                self.gesture = drag.map_or(Gesture::Idle, |drag| Gesture::Select { drag, preview: None });
+                self.update_select_preview(x, y);
             }
-            StrokePhase::Move => self.state.select_preview = self.dragged_box(x, y),
+            StrokePhase::Move => self.update_select_preview(x, y),
             StrokePhase::End => {
                 let region = self.dragged_box(x, y);
                 self.gesture = Gesture::Idle;
-                self.state.select_preview = None;
                 if let Some(r) = region {
                     self.act(Line::Select(Some((r.min, r.max))), "select");
                 }
@@ -44,12 +43,19 @@ impl App {
     /// The box to show as the selection: the one being dragged, else the
     /// selected one.
     pub(super) fn shown_selection(&self) -> Option<Region> {
-        self.state.select_preview.or(self.doc.editor.selection)
+        self.gesture.select_preview().or(self.doc.editor.selection)
+    }
+
+    fn update_select_preview(&mut self, x: f64, y: f64) {
+        let dragged = self.dragged_box(x, y);
+        if let Gesture::Select { preview, .. } = &mut self.gesture {
+            *preview = dragged;
+        }
     }
 
     /// The box the drag so far would select.
     fn dragged_box(&self, x: f64, y: f64) -> Option<Region> {
-        let Gesture::Select(drag) = self.gesture else { return None };
+        let Gesture::Select { drag, .. } = self.gesture else { return None };
         match drag {
             SelectDrag::NewBox(from) => {
                 let to = self.pick_or_ground(x, y).ok().flatten().map_or(from, |pick| pick.cell());
@@ -57,7 +63,7 @@ impl App {
             }
             SelectDrag::Face { normal, start } => {
                 let region = self.doc.editor.selection?;
-                let (lo, hi) = box_corners(&region, self.doc.editor.scene.tree.origin());
+                let (lo, hi) = box_corners(&region, self.doc.editor.scene.origin());
                 let face = (lo + hi) * 0.5 + normal.as_vec3() * (hi - lo) * 0.5;
                 let steps = self.screen_steps(face, normal, start, (x, y))?;
                 // The face moves along its normal; the box never turns inside out.
@@ -77,7 +83,7 @@ impl App {
     fn handle_at(&self, x: f64, y: f64) -> Option<IVec3> {
         let region = self.doc.editor.selection?;
         let (w, h) = self.window_size();
-        let origin = self.doc.editor.scene.tree.origin();
+        let origin = self.doc.editor.scene.origin();
         let (eye, dir) = self.state.camera.basis(w, h, origin).ray_through(x as f32, y as f32);
         let (lo, hi) = box_corners(&region, origin);
         entry_face(eye, dir, lo, hi)

@@ -11,7 +11,6 @@ use glam::IVec3;
 use octovox::camera::Camera;
 use octovox::edit::Edit;
 pub use octovox::edit::brush::{Brush, Tool, click_edit};
-use octovox::edit::selection::Region;
 use octovox::editor::Tools;
 use octovox::settings::{PathSettings, RenderSettings, Shading};
 
@@ -74,17 +73,21 @@ pub struct EditorState {
     /// Whether the path-traced view is shown denoised (the raw samples
     /// when off).
     pub denoise: bool,
-    /// Line mode (L): a press-drag-release places the brush along a line.
-    pub line_mode: bool,
-    /// Where the line being dragged starts (the cell in front of the face).
-    pub line_start: Option<IVec3>,
-    /// Box select mode (B): a left drag selects a box or moves a face of it.
-    pub select_mode: bool,
-    /// The box a selection drag would select, while it is dragged.
-    pub select_preview: Option<Region>,
+    /// What a left drag does (the drag under way is the `Gesture`).
+    pub mode: Mode,
     /// Side of the working volume outlined on the ground (voxels): x and z
     /// in -side/2..side/2, y in 0..side.
     pub volume: i32,
+}
+
+/// What a left drag does: apply the tool, place the brush along a line
+/// (L), or select a box and move its faces (B).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Mode {
+    #[default]
+    Brush,
+    Line,
+    Select,
 }
 
 /// The working volume's side in a new scene (MagicaVoxel opens on 40³,
@@ -110,10 +113,7 @@ impl Default for EditorState {
             path_settings: PathSettings::default(),
             sample_target: octovox::settings::DEFAULT_SAMPLE_TARGET,
             denoise: true,
-            line_mode: false,
-            line_start: None,
-            select_mode: false,
-            select_preview: None,
+            mode: Mode::Brush,
         }
     }
 }
@@ -134,16 +134,23 @@ impl EditorState {
         click_edit(tool, &tools.brush, tools.color.max(1), pick.voxel, pick.normal)
     }
 
-    /// Inclusive world box of the cells the brush would touch at `pick`.
     /// The brush's shape where a click at `pick` would apply it (not while
-    /// a line is dragged: then [`EditorState::preview_box`] spans it).
-    pub fn preview_shape(&self, tools: &Tools, pick: &Pick) -> Option<octovox::scene::Shape> {
+    /// a line from `line_start` is dragged: then [`EditorState::preview_box`]
+    /// spans it).
+    pub fn preview_shape(
+        &self,
+        tools: &Tools,
+        pick: &Pick,
+        line_start: Option<IVec3>,
+    ) -> Option<octovox::scene::Shape> {
         let (center, _) = self.edit_at(tools, self.tool, pick);
-        self.line_start.is_none().then(|| tools.brush.shape_at(center))
+        line_start.is_none().then(|| tools.brush.shape_at(center))
     }
 
-    pub fn preview_box(&self, tools: &Tools, pick: &Pick) -> (IVec3, IVec3) {
-        if let Some(start) = self.line_start {
+    /// Inclusive world box of the cells the brush would touch at `pick`,
+    /// or that a line dragged from `line_start` to `pick` would.
+    pub fn preview_box(&self, tools: &Tools, pick: &Pick, line_start: Option<IVec3>) -> (IVec3, IVec3) {
+        if let Some(start) = line_start {
             // While a line is dragged: the box from its start to here.
             let end = pick.voxel + pick.normal;
             let ((a, b), (c, d)) = (tools.brush.shape_at(start).bounds(), tools.brush.shape_at(end).bounds());
@@ -153,21 +160,9 @@ impl EditorState {
         tools.brush.shape_at(center).bounds()
     }
 
-    /// Line mode on or off; it ends select mode.
-    pub fn toggle_line_mode(&mut self) {
-        self.line_mode = !self.line_mode;
-        self.line_start = None;
-        self.select_mode &= !self.line_mode;
-    }
-
-    /// Select mode on or off; it ends line mode.
-    pub fn toggle_select_mode(&mut self) {
-        self.select_mode = !self.select_mode;
-        self.select_preview = None;
-        if self.select_mode {
-            self.line_mode = false;
-            self.line_start = None;
-        }
+    /// `mode` on, or back to the brush when it is on already.
+    pub fn toggle_mode(&mut self, mode: Mode) {
+        self.mode = if self.mode == mode { Mode::Brush } else { mode };
     }
 
     /// Title-bar text: file name and an asterisk for unsaved changes.
@@ -203,11 +198,11 @@ mod tests {
         let mut state = EditorState { box_size: 4, ..EditorState::default() };
         let mut tools = Tools { brush: state.brush_of(BrushKind::Box), ..Tools::default() };
         let pick = Pick { voxel: IVec3::ZERO, normal: IVec3::X, value: 1 };
-        assert_eq!(state.preview_box(&tools, &pick), (IVec3::new(-1, -2, -2), IVec3::new(2, 1, 1)));
+        assert_eq!(state.preview_box(&tools, &pick, None), (IVec3::new(-1, -2, -2), IVec3::new(2, 1, 1)));
         state.sphere_radius = 2;
         tools.brush = state.brush_of(BrushKind::Sphere);
         state.tool = Tool::Paint;
-        assert_eq!(state.preview_box(&tools, &pick), (IVec3::splat(-2), IVec3::splat(2)));
+        assert_eq!(state.preview_box(&tools, &pick, None), (IVec3::splat(-2), IVec3::splat(2)));
         assert_eq!(BrushKind::of(tools.brush), BrushKind::Sphere);
     }
 }

@@ -11,11 +11,11 @@ use std::path::{Path, PathBuf};
 use egui::{Color32, Sense, Stroke, Vec2};
 
 use octovox::scene::objects::Objects;
-use octovox::scene::{Material, MaterialKind, Octree, Palette};
+use octovox::scene::{Material, MaterialKind, Palette, Scene};
 use octovox::settings::{EffectsChoice, Shading, Sky, TraceMode, View};
 
 use super::command::{Choice, Command, Pending};
-use super::state::{BrushKind, EditorState, Pick, Tool};
+use super::state::{BrushKind, EditorState, Mode, Pick, Tool};
 use glam::{IVec3, Vec3};
 use octovox::edit::brush::Brush;
 use octovox::edit::selection::Region;
@@ -96,7 +96,9 @@ impl ShownStats {
 /// Read-only facts the panels show.
 pub struct Info<'a> {
     pub palette: &'a Palette,
-    pub tree: &'a Octree,
+    pub scene: &'a Scene,
+    /// Where the line being dragged starts.
+    pub line_start: Option<IVec3>,
     pub stats: &'a Stats,
     pub adapter: &'a str,
     pub timestamps: bool,
@@ -248,7 +250,7 @@ pub fn show(
     egui::Panel::top("menu").show(ui, |ui| menu_bar(ui, info, ui_state, &mut out));
     egui::Panel::left("tools").resizable(false).exact_size(PANEL_WIDTH).show(ui, |ui| {
         egui::ScrollArea::vertical().show(ui, |ui| {
-            tool_panel(ui, state, tools);
+            tool_panel(ui, state, tools, &mut out);
             mirror(ui, tools);
             ground(ui, state, info.ground, &mut out);
             ui.separator();
@@ -361,7 +363,7 @@ fn mirror(ui: &mut egui::Ui, tools: &mut Tools) {
     });
 }
 
-fn tool_panel(ui: &mut egui::Ui, state: &mut EditorState, tools: &mut Tools) {
+fn tool_panel(ui: &mut egui::Ui, state: &mut EditorState, tools: &mut Tools, commands: &mut Vec<Command>) {
     ui.heading("Tool");
     ui.horizontal(|ui| {
         for tool in Tool::ALL {
@@ -369,14 +371,14 @@ fn tool_panel(ui: &mut egui::Ui, state: &mut EditorState, tools: &mut Tools) {
         }
     });
     ui.horizontal(|ui| {
-        let line = ui.selectable_label(state.line_mode, "Line (L)");
+        let line = ui.selectable_label(state.mode == Mode::Line, "Line (L)");
         if line.on_hover_text("press, drag and release: the brush along a line").clicked() {
-            state.toggle_line_mode();
+            commands.push(Command::ToggleLine);
         }
-        let select = ui.selectable_label(state.select_mode, "Select (B)");
+        let select = ui.selectable_label(state.mode == Mode::Select, "Select (B)");
         let hint = "drag a box; drag a face of it to resize; Ctrl+C/X/V, Delete, arrows move it";
         if select.on_hover_text(hint).clicked() {
-            state.toggle_select_mode();
+            commands.push(Command::ToggleSelect);
         }
     });
     ui.label("Brush");
@@ -742,7 +744,7 @@ fn path_knobs(ui: &mut egui::Ui, state: &mut EditorState) {
 
 fn stats(ui: &mut egui::Ui, info: &Info) {
     let s = info.stats;
-    let tree = info.tree;
+    let tree = info.scene.drawn();
     let pool = tree.pool();
     let trace = if info.timestamps { "GPU" } else { "wall" };
     egui::Grid::new("stats").num_columns(2).show(ui, |ui| {
@@ -976,14 +978,14 @@ pub fn take_scene_overlays(ctx: &egui::Context) -> Vec<egui::epaint::ClippedShap
 /// and so cannot be tinted by the shader.
 pub fn draw_brush_outline(ui: &egui::Ui, state: &EditorState, tools: &Tools, pick: &Pick, info: &Info) {
     use octovox::scene::Shape;
-    let (lo, hi) = state.preview_box(tools, pick);
+    let (lo, hi) = state.preview_box(tools, pick, info.line_start);
     let color = match state.tool {
         Tool::Attach => egui::Color32::from_rgb(120, 255, 140),
         Tool::Erase => egui::Color32::from_rgb(255, 100, 90),
         Tool::Paint => egui::Color32::from_rgb(255, 220, 90),
     };
     // A sphere is outlined as a sphere, a box (or a line's span) as a box.
-    let shape = state.preview_shape(tools, pick).unwrap_or(Shape::Box { min: lo, max: hi });
+    let shape = state.preview_shape(tools, pick, info.line_start).unwrap_or(Shape::Box { min: lo, max: hi });
     // With mirror planes on, where the images of the edit land too.
     let brush = octovox::edit::Edit::Brush { shape, op: octovox::scene::Op::Remove };
     for image in tools.mirror.edits(brush) {
@@ -1001,8 +1003,9 @@ pub fn draw_brush_outline(ui: &egui::Ui, state: &EditorState, tools: &Tools, pic
 /// centre: a circle about it, facing the camera, and its equator.
 fn outline_sphere(ui: &egui::Ui, state: &EditorState, info: &Info, center: IVec3, radius: i32, color: Color32) {
     let screen = ui.ctx().content_rect();
-    let basis = state.camera.basis(screen.width().max(1.0) as u32, screen.height().max(1.0) as u32, info.tree.origin());
-    let middle = (center - info.tree.origin()).as_vec3() + Vec3::splat(0.5);
+    let basis =
+        state.camera.basis(screen.width().max(1.0) as u32, screen.height().max(1.0) as u32, info.scene.origin());
+    let middle = (center - info.scene.origin()).as_vec3() + Vec3::splat(0.5);
     let (_, right, up) = state.camera.axes();
     let r = radius as f32 + 0.5;
     let ring = |a: Vec3, b: Vec3| -> Option<Vec<egui::Pos2>> {
@@ -1057,8 +1060,9 @@ const MAX_PREVIEW_FACES: usize = 20_000;
 /// `layers` voxels out along `normal` (in, when negative; green out, red in).
 pub fn draw_extrude(ui: &egui::Ui, state: &EditorState, info: &Info, voxels: &[IVec3], normal: IVec3, layers: i32) {
     let screen = ui.ctx().content_rect();
-    let basis = state.camera.basis(screen.width().max(1.0) as u32, screen.height().max(1.0) as u32, info.tree.origin());
-    let origin = info.tree.origin().as_vec3();
+    let basis =
+        state.camera.basis(screen.width().max(1.0) as u32, screen.height().max(1.0) as u32, info.scene.origin());
+    let origin = info.scene.origin().as_vec3();
     let n = normal.as_vec3();
     // The two axes of the face's plane, half a voxel each.
     let (u, v) = match normal.abs() {
@@ -1087,8 +1091,9 @@ pub fn draw_ground(ui: &egui::Ui, state: &EditorState, info: &Info) {
         return;
     }
     let screen = ui.ctx().content_rect();
-    let basis = state.camera.basis(screen.width().max(1.0) as u32, screen.height().max(1.0) as u32, info.tree.origin());
-    let origin = info.tree.origin().as_vec3();
+    let basis =
+        state.camera.basis(screen.width().max(1.0) as u32, screen.height().max(1.0) as u32, info.scene.origin());
+    let origin = info.scene.origin().as_vec3();
     let project = |p: Vec3| basis.project(p - origin).map(|(x, y)| egui::pos2(x, y));
     let half = state.volume / 2;
     // At most 64 lines a side: a large volume gets a coarser grid.
@@ -1124,7 +1129,7 @@ pub fn draw_selection(ui: &egui::Ui, state: &EditorState, info: &Info) {
             info,
             (region.min, region.max),
             egui::Color32::from_rgb(90, 220, 255),
-            state.select_mode,
+            state.mode == Mode::Select,
         );
     }
 }
@@ -1141,8 +1146,8 @@ fn outline_box(
 ) {
     let screen = ui.ctx().content_rect();
     let (w, h) = (screen.width().max(1.0), screen.height().max(1.0));
-    let basis = state.camera.basis(w as u32, h as u32, info.tree.origin());
-    let origin = info.tree.origin().as_vec3();
+    let basis = state.camera.basis(w as u32, h as u32, info.scene.origin());
+    let origin = info.scene.origin().as_vec3();
     let project = |p: Vec3| basis.project(p - origin).map(|(x, y)| egui::pos2(x, y));
     let (a, b) = (lo.as_vec3(), (hi + IVec3::ONE).as_vec3());
     let corner = |i: usize| {

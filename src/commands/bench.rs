@@ -277,10 +277,10 @@ fn bench_render(quick: bool, lod: f32) -> anyhow::Result<(String, String)> {
     let mut rows = Vec::new();
     for model in &MODELS {
         let mut scene = Scene::new(Palette::default(), build(&source(model)?)?);
-        let grid = DenseGrid::from_octree(&scene.tree)?;
-        renderer.sync(&mut scene.tree, &scene.palette);
+        let grid = DenseGrid::from_octree(scene.drawn())?;
+        renderer.sync(&mut scene);
         renderer.set_grid(&grid)?;
-        let (lo, hi) = scene.tree.solid_bounds().context("empty model")?;
+        let (lo, hi) = scene.solid_bounds().context("empty model")?;
         let camera = Camera::framing(lo, hi, 50.0);
         // Shared machines are noisy: enough frames for a steady median.
         let frames = if quick { 2 } else { 9 };
@@ -295,23 +295,23 @@ fn bench_render(quick: bool, lod: f32) -> anyhow::Result<(String, String)> {
         let modes = [TraceMode::Grid, TraceMode::Svo];
         // Warm up all three, then alternate frames so machine noise hits them alike.
         for mode in modes {
-            renderer.render(&scene.tree, &camera, (width, height), &settings(mode), None)?;
+            renderer.render(&scene, &camera, (width, height), &settings(mode), None)?;
         }
-        renderer.render_floor(&scene.tree, &camera, (width, height))?;
+        renderer.render_floor(&scene, &camera, (width, height))?;
         let mut times = [Vec::new(), Vec::new()];
         let mut floor_times = Vec::new();
         for _ in 0..frames {
             for (i, mode) in modes.into_iter().enumerate() {
-                times[i].push(renderer.render(&scene.tree, &camera, (width, height), &settings(mode), None)?);
+                times[i].push(renderer.render(&scene, &camera, (width, height), &settings(mode), None)?);
             }
-            floor_times.push(renderer.render_floor(&scene.tree, &camera, (width, height))?);
+            floor_times.push(renderer.render_floor(&scene, &camera, (width, height))?);
         }
         let floor_ms = median(floor_times);
         // Hit records (for the step counts) only outside the timed frames.
         renderer.hit_records = true;
         let mut mean_iterations = [0.0; 2];
         for (i, mode) in modes.into_iter().enumerate() {
-            renderer.render(&scene.tree, &camera, (width, height), &settings(mode), None)?;
+            renderer.render(&scene, &camera, (width, height), &settings(mode), None)?;
             let hits = renderer.read_hits()?;
             mean_iterations[i] = mean_steps(&hits);
         }

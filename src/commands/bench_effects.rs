@@ -52,7 +52,7 @@ fn run(
     samples: u32,
 ) -> anyhow::Result<(Vec<f64>, Vec<Vec3>)> {
     let mut times = Vec::new();
-    let view = PathView { tree: &scene.tree, palette: &scene.palette, camera, size, settings };
+    let view = PathView { scene, camera, size, settings };
     for sample in 0..samples {
         let frame = renderer.render_path(&view, sample == 0)?;
         anyhow::ensure!(
@@ -70,14 +70,14 @@ pub fn bench_effects(quick: bool) -> anyhow::Result<(String, String)> {
     let mut rows = Vec::new();
     for (name, mut scene, camera) in scenes() {
         let camera = camera.unwrap_or_else(|| crate::cli::camera_or_framing(None, 50.0, &scene));
-        renderer.sync(&mut scene.tree, &scene.palette);
+        renderer.sync(&mut scene);
         let auto = PathSettings::default();
         let all = PathSettings { effects: EffectsChoice::All, ..auto };
         let (mut auto_times, mut all_times) = (Vec::new(), Vec::new());
         let (mut auto_image, mut all_image) = (Vec::new(), Vec::new());
         // Compile both kernels before timing anything.
-        renderer.compile_path_kernel(&scene.tree, &scene.palette, &auto)?;
-        renderer.compile_path_kernel(&scene.tree, &scene.palette, &all)?;
+        renderer.compile_path_kernel(&scene, &auto)?;
+        renderer.compile_path_kernel(&scene, &all)?;
         run(&mut renderer, &scene, &camera, (width, height), &auto, 1)?;
         run(&mut renderer, &scene, &camera, (width, height), &all, 1)?;
         // Interleaved, so that a noisy machine weighs on both alike.
@@ -92,7 +92,7 @@ pub fn bench_effects(quick: bool) -> anyhow::Result<(String, String)> {
         let pairs = auto_image.iter().zip(&all_image);
         let max_difference = pairs.clone().map(|(a, b)| (*a - *b).abs().max_element()).fold(0.0, f32::max);
         let pixels_differing = pairs.filter(|(a, b)| display_rgba(**a) != display_rgba(**b)).count();
-        let effects = octovox::trace::path::effects_for(&scene.tree, &scene.palette, &auto);
+        let effects = octovox::trace::path::effects_for(&scene, &auto);
         rows.push(EffectsRow {
             scene: name,
             adapter: renderer.gpu.adapter_name.clone(),

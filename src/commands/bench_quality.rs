@@ -126,7 +126,7 @@ pub fn bench_quality(quick: bool, out: &Path) -> anyhow::Result<(String, String)
     let mut renderer = Renderer::headless()?;
     let (mut rows, mut unbiased, mut targets) = (Vec::new(), Vec::new(), Vec::new());
     for (name, mut scene, camera) in scenes(quick)? {
-        renderer.sync(&mut scene.tree, &scene.palette);
+        renderer.sync(&mut scene);
         let reference = Setting::Path {
             spp: sizes.reference_spp,
             bounces: 8,
@@ -228,7 +228,7 @@ fn target_rows(
     reference: &image::RgbaImage,
 ) -> anyhow::Result<Vec<TargetRow>> {
     let settings = octovox::settings::PathSettings { bounces: 3, ..Default::default() };
-    let view = PathView { tree: &scene.tree, palette: &scene.palette, camera, size: sizes.size, settings: &settings };
+    let view = PathView { scene, camera, size: sizes.size, settings: &settings };
     let mut rows = Vec::new();
     for target in targets(sizes.reference_spp < 64) {
         let done = accumulate(renderer, &view, sizes.reference_spp * 16, Some(target), |_| ())?;
@@ -382,7 +382,7 @@ fn level_of_detail(renderer: &mut Renderer, quick: bool) -> anyhow::Result<Vec<L
         ];
         (sculpture, views)
     };
-    renderer.sync(&mut scene.tree, &scene.palette);
+    renderer.sync(&mut scene);
     let mut rows = Vec::new();
     for (view, camera, size) in views {
         rows.extend(lod_rows(renderer, &scene, view, &camera, size, if quick { 2 } else { 9 })?);
@@ -405,7 +405,7 @@ fn lod_rows(
     // frames below write none.
     renderer.hit_records = true;
     for lod in LOD_VALUES {
-        renderer.render(&scene.tree, camera, size, &settings(lod), None)?;
+        renderer.render(scene, camera, size, &settings(lod), None)?;
         measured.push((lod, renderer.read_image()?, super::bench::mean_steps(&renderer.read_hits()?), Vec::new()));
     }
     renderer.hit_records = false;
@@ -413,7 +413,7 @@ fn lod_rows(
     for _ in 0..frames {
         for (lod, _, _, times) in &mut measured {
             let start = std::time::Instant::now();
-            renderer.render(&scene.tree, camera, size, &settings(*lod), None)?;
+            renderer.render(scene, camera, size, &settings(*lod), None)?;
             times.push(start.elapsed().as_secs_f64() * 1e3);
         }
     }
@@ -459,7 +459,7 @@ fn lod_markdown(rows: &[LodRow]) -> String {
 
 /// Far away: the statue spans a fifth of the image's height.
 fn far_camera(scene: &Scene) -> Camera {
-    let (lo, hi) = scene.tree.solid_bounds().unwrap_or_default();
+    let (lo, hi) = scene.solid_bounds().unwrap_or_default();
     let centre = (lo + hi).as_dvec3() * 0.5;
     Camera { eye: centre + DVec3::new(1.0, 0.5, 1.4) * 2400.0, target: centre, fov_y_deg: 20.0, ortho: None }
 }

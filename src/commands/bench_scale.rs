@@ -81,23 +81,23 @@ fn measure(renderer: &mut Renderer, mesh: &Path, dir: &Path, height: u32) -> any
     let start = Instant::now();
     let mut scene = octovox::io::ovx::load_ovx(&ovx, &Default::default())?;
     let ovx_load_s = start.elapsed().as_secs_f64();
-    let pool = scene.tree.pool().live_bytes();
+    let pool = scene.drawn_pool_bytes();
     let start = Instant::now();
     let vox_save = octovox::io::save_scene(&dir.join("saved.vox"), &scene, WriteOptions::default())
         .map_or_else(|e| VoxSave::Err(e.to_string()), |()| VoxSave::Ok(start.elapsed().as_secs_f64()));
     let _ = std::fs::remove_file(dir.join("saved.vox"));
-    renderer.sync(&mut scene.tree, &scene.palette);
-    let (lo, hi) = scene.tree.solid_bounds().context("empty import")?;
+    renderer.sync(&mut scene);
+    let (lo, hi) = scene.solid_bounds().context("empty import")?;
     let camera = Camera::framing(lo, hi, 50.0);
     let settings = RenderSettings::default();
-    renderer.render(&scene.tree, &camera, FRAME, &settings, None)?;
+    renderer.render(&scene, &camera, FRAME, &settings, None)?;
     let frames: anyhow::Result<Vec<f64>> =
-        (0..3).map(|_| Ok(renderer.render(&scene.tree, &camera, FRAME, &settings, None)?)).collect();
+        (0..3).map(|_| Ok(renderer.render(&scene, &camera, FRAME, &settings, None)?)).collect();
     // A sphere on the statue's front: half of it cuts in, half adds.
     let centre = IVec3::new((lo.x + hi.x) / 2, (lo.y + hi.y) / 2, hi.z);
     let start = Instant::now();
-    scene.tree.apply_brush(&Shape::Sphere { center: centre, radius: 64 }, Op::Place(2))?;
-    renderer.sync(&mut scene.tree, &scene.palette);
+    scene.apply_brush(&Shape::Sphere { center: centre, radius: 64 }, Op::Place(2))?;
+    renderer.sync(&mut scene);
     let edit_ms = start.elapsed().as_secs_f64() * 1e3;
     Ok(ScaleRow {
         height,

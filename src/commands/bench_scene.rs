@@ -104,8 +104,7 @@ fn forest(count: u32) -> anyhow::Result<Scene> {
     let layer = octovox::scene::graph::Layer { id: 0, attributes: attributes(), reserved: u32::MAX };
     let graph = SceneGraph { nodes, layers: vec![layer] };
     let objects = Objects::new(Some(graph), vec![tree_model()], Vec::new(), 0, usize::MAX)?;
-    let tree = objects.compose()?;
-    Ok(Scene { palette: Palette::default(), tree, objects: Some(Box::new(objects)) })
+    Ok(Scene::compose(Palette::default(), objects)?)
 }
 
 /// Median milliseconds of `runs` calls of `f`.
@@ -123,9 +122,9 @@ pub fn bench_scene(quick: bool) -> anyhow::Result<(String, String)> {
     let count = if quick { 200 } else { 2000 };
     let (width, height, frames, loads) = if quick { (320, 180, 3, 1) } else { (1280, 720, 9, 3) };
     let scene = forest(count)?;
-    let objects = scene.objects.as_ref().context("a scene of objects")?;
+    let objects = scene.objects().context("a scene of objects")?;
     let forest_bytes = encode_objects(&scene.palette, objects)?;
-    let merged_bytes = encode_vox(&scene.palette, &scene.tree.voxels())?;
+    let merged_bytes = encode_vox(&scene.palette, &scene.voxels())?;
     // Loads alternate, so machine noise hits both alike.
     let (mut forest_loads, mut merged_loads) = (Vec::new(), Vec::new());
     for _ in 0..loads {
@@ -134,37 +133,37 @@ pub fn bench_scene(quick: bool) -> anyhow::Result<(String, String)> {
     }
     let mut forest_scene = load_vox_scene(&forest_bytes, 0)?.0;
     let mut merged = load_vox_scene(&merged_bytes, 0)?.0;
-    anyhow::ensure!(forest_scene.tree.voxels() == merged.tree.voxels(), "the forest and the merged model differ");
+    anyhow::ensure!(forest_scene.voxels() == merged.voxels(), "the forest and the merged model differ");
 
     let mut renderer = Renderer::headless().context("bench scene needs a GPU (lavapipe works)")?;
-    let (lo, hi) = merged.tree.solid_bounds().context("an empty forest")?;
+    let (lo, hi) = merged.solid_bounds().context("an empty forest")?;
     let camera = Camera::framing(lo, hi, 50.0);
     let settings =
         RenderSettings { mode: TraceMode::Svo, view: View::Shaded, shadows: false, render_scale: 1.0, lod: 0.0 };
     let (mut forest_frames, mut merged_frames) = (Vec::new(), Vec::new());
     for round in 0..=frames {
         for (scene, times) in [(&mut forest_scene, &mut forest_frames), (&mut merged, &mut merged_frames)] {
-            renderer.sync(&mut scene.tree, &scene.palette);
-            let ms = renderer.render(&scene.tree, &camera, (width, height), &settings, None)?;
+            renderer.sync(scene);
+            let ms = renderer.render(scene, &camera, (width, height), &settings, None)?;
             if round > 0 {
                 times.push(ms);
             }
         }
     }
 
-    let model_pool_bytes = forest_scene.objects.as_ref().map_or(0, |o| o.pool_bytes());
-    let drawn_pool_bytes = forest_scene.tree.pool().live_bytes();
+    let model_pool_bytes = forest_scene.objects().map_or(0, |o| o.pool_bytes());
+    let drawn_pool_bytes = forest_scene.drawn_pool_bytes();
     let mut editor = Editor::default();
     editor.set_scene(forest_scene);
-    let _ = editor.scene.tree.pool_mut().flush();
+    let _ = editor.scene.take_uploads();
     for line in [ObjectLine::Pick(ObjectRef::Index(5)), ObjectLine::Move(IVec3::new(3, 0, 0))] {
         editor.run(&Command::Object(line))?;
     }
-    let move_bytes_written = editor.scene.tree.pool_mut().flush().byte_count();
+    let move_bytes_written = editor.scene.take_uploads().byte_count();
 
     let row = SceneRow {
         objects: count as usize,
-        voxels: merged.tree.solid_voxels(),
+        voxels: merged.solid_voxels(),
         adapter: renderer.gpu.adapter_name.clone(),
         width,
         height,
@@ -176,7 +175,7 @@ pub fn bench_scene(quick: bool) -> anyhow::Result<(String, String)> {
         frame_ms_merged: median(merged_frames),
         model_pool_bytes,
         drawn_pool_bytes,
-        merged_pool_bytes: merged.tree.pool().live_bytes(),
+        merged_pool_bytes: merged.drawn_pool_bytes(),
         move_bytes_written,
     };
     Ok((report(&row), serde_json::to_string_pretty(&[row])?))

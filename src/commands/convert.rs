@@ -17,6 +17,6 @@ pub fn run(input: &Path, output: &Path, frame: usize, force: bool) -> anyhow::Re
             .with_context(|| format!("loading {}", input.display()))?;
     let options = WriteOptions::forced(force);
     octovox::io::save_scene(output, &scene, options).with_context(|| format!("saving {}", output.display()))?;
-    say!("wrote {} voxels to {}", scene.tree.solid_voxels(), output.display())?;
+    say!("wrote {} voxels to {}", scene.solid_voxels(), output.display())?;
     Ok(ExitCode::SUCCESS)
 }

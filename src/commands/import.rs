@@ -28,7 +28,7 @@ pub fn run(args: &ImportArgs) -> anyhow::Result<ExitCode> {
         .with_context(|| format!("saving {}", args.output.display()))?;
     if args.stats {
         let stats = super::bench_scale::ImportStats {
-            voxels: scene.tree.solid_voxels(),
+            voxels: scene.solid_voxels(),
             seconds: start.elapsed().as_secs_f64(),
             peak_bytes: super::bench_scale::peak_resident_bytes(),
         };
@@ -38,7 +38,7 @@ pub fn run(args: &ImportArgs) -> anyhow::Result<ExitCode> {
     say!(
         "{}: {} solid voxels in {}×{}×{} (voxelized in {:.2} s), wrote {}",
         args.mesh.display(),
-        scene.tree.solid_voxels(),
+        scene.solid_voxels(),
         d.x,
         d.y,
         d.z,

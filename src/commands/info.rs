@@ -42,9 +42,9 @@ pub fn run(file: &Path, json: bool, objects: bool, frame: usize) -> anyhow::Resu
 /// model is object 0).
 fn object_lines(scene: &Scene) -> String {
     let corner = |p: glam::IVec3| format!("{} {} {}", p.x, p.y, p.z);
-    let Some(objects) = &scene.objects else {
+    let Some(objects) = scene.objects() else {
         let bounds =
-            scene.tree.solid_bounds().map_or("-".to_owned(), |(lo, hi)| format!("{} .. {}", corner(lo), corner(hi)));
+            scene.solid_bounds().map_or("-".to_owned(), |(lo, hi)| format!("{} .. {}", corner(lo), corner(hi)));
         return format!("0\t-\tmodel 0\tlayer -\tshown\t{bounds}\n");
     };
     let mut out = String::new();
@@ -80,21 +80,21 @@ struct Summary {
 impl Summary {
     /// A scene as loaded (streamed from a .vox, or an .ovx's pool).
     fn of(scene: &Scene, meta: VoxMeta) -> Summary {
-        let used: Vec<u8> = scene.tree.counts().present().collect();
+        let used: Vec<u8> = scene.counts().present().collect();
         let mut materials = BTreeMap::new();
         for &index in &used {
             *materials.entry(scene.palette.material(index).kind).or_insert(0) += 1;
         }
-        let objects = scene.objects.as_deref();
+        let objects = scene.objects();
         Summary {
             models: meta.models,
             stored_models: meta.stored_models,
             layers: objects.map_or_else(Vec::new, |o| o.layers()),
             groups: objects.map_or(0, |o| o.group_count()),
-            pool_bytes: objects.map_or(scene.tree.pool().live_bytes(), |o| o.pool_bytes()),
+            pool_bytes: objects.map_or(scene.drawn_pool_bytes(), |o| o.pool_bytes()),
             warnings: meta.warnings,
-            voxels: scene.tree.solid_voxels(),
-            bounds: scene.tree.solid_bounds().map(|(lo, hi)| (lo.to_array(), hi.to_array())),
+            voxels: scene.solid_voxels(),
+            bounds: scene.solid_bounds().map(|(lo, hi)| (lo.to_array(), hi.to_array())),
             palette_entries: used.len(),
             materials,
         }

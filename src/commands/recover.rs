@@ -25,7 +25,7 @@ pub fn run(file: &Path, output: &Path, force: bool) -> anyhow::Result<ExitCode> 
     octovox::io::save_scene(output, &scene, options).with_context(|| format!("saving {}", output.display()))?;
     say!(
         "recovered {} voxels into {}; the journal {} is left in place",
-        scene.tree.solid_voxels(),
+        scene.solid_voxels(),
         output.display(),
         journal.display()
     )?;

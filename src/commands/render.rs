@@ -113,7 +113,7 @@ fn preview(
         lod: args.lod,
     };
     let grid = match args.mode {
-        TraceMode::Grid => Some(DenseGrid::from_octree(&scene.tree)?),
+        TraceMode::Grid => Some(DenseGrid::from_octree(scene.drawn())?),
         TraceMode::Svo => None,
     };
     let stats = |ms, adapter| Stats { ms_per_sample: ms, adapter, ..Stats::default() };
@@ -124,11 +124,11 @@ fn preview(
     }
     let mut renderer = Renderer::headless().context("no GPU for rendering (try --cpu)")?;
     log::info!("rendering on {}", renderer.gpu.adapter_name);
-    renderer.sync(&mut scene.tree, &scene.palette);
+    renderer.sync(scene);
     if let Some(grid) = &grid {
         renderer.set_grid(grid)?;
     }
-    let ms = renderer.render(&scene.tree, camera, size, &settings, None)?;
+    let ms = renderer.render(scene, camera, size, &settings, None)?;
     log::info!("frame took {ms:.2} ms");
     Ok((renderer.read_image()?, stats(ms, renderer.gpu.adapter_name.clone())))
 }
@@ -148,9 +148,9 @@ fn path_traced(
     }
     let mut renderer = Renderer::headless().context("no GPU for rendering (try --cpu)")?;
     log::info!("path tracing on {}", renderer.gpu.adapter_name);
-    renderer.sync(&mut scene.tree, &scene.palette);
+    renderer.sync(scene);
     let (cap, target) = (args.path.samples(), args.path.target_error);
-    let view = PathView { tree: &scene.tree, palette: &scene.palette, camera, size, settings: &settings };
+    let view = PathView { scene, camera, size, settings: &settings };
     let bar = super::progress_bar::bar("path tracing", u64::from(cap));
     let Accumulated { last: frame, ms: total_ms } = accumulate(&mut renderer, &view, cap, target, |_| bar.inc(1))?;
     bar.finish_and_clear();
@@ -179,11 +179,11 @@ fn path_traced(
 fn path_traced_cpu(scene: &Scene, camera: &Camera, args: &RenderArgs, size: (u32, u32)) -> (image::RgbaImage, Stats) {
     let spp = args.path.samples();
     let start = Instant::now();
-    let frame = render_cpu(&scene.tree, &scene.palette, camera, size, &args.path.settings(), spp);
+    let frame = render_cpu(scene, camera, size, &args.path.settings(), spp);
     let ms = start.elapsed().as_secs_f64() * 1e3 / f64::from(spp);
     let (pixels, denoise_ms) = if args.path.denoise {
         let start = Instant::now();
-        let basis = camera.basis(size.0, size.1, scene.tree.origin());
+        let basis = camera.basis(size.0, size.1, scene.origin());
         let pixels = denoise(&Frame::of(&basis), &frame.sums, &frame.guides);
         (pixels, Some(start.elapsed().as_secs_f64() * 1e3))
     } else {

@@ -90,14 +90,14 @@ mod tests {
         let mut scene = crate::scene::Scene::default();
         let edge = IVec3::new(crate::scene::octree::WORLD_LIMIT - 3, 0, 0);
         for x in 0..3 {
-            scene.tree.apply_brush(&Shape::Voxel(edge + IVec3::new(0, 0, x)), Op::Place(4)).ok();
+            scene.apply_brush(&Shape::Voxel(edge + IVec3::new(0, 0, x)), Op::Place(4)).ok();
         }
-        let before = scene.tree.voxels();
-        let edits = extrude_edits(&scene.tree, edge, IVec3::X, 10).unwrap_or_default();
+        let before = scene.voxels();
+        let edits = extrude_edits(scene.drawn(), edge, IVec3::X, 10).unwrap_or_default();
         assert_eq!(edits.len(), 3);
         let mut history = History::default();
         assert!(history.apply_group(&mut scene, edits).is_err());
-        assert_eq!(scene.tree.voxels(), before);
+        assert_eq!(scene.voxels(), before);
         assert!(!history.can_undo());
     }
 }

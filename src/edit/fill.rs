@@ -80,22 +80,22 @@ mod tests {
     #[test]
     fn a_fill_is_one_step_and_a_huge_region_is_refused() {
         let mut scene = Scene::default();
-        scene.tree.apply_brush(&Shape::Box { min: IVec3::ZERO, max: IVec3::splat(3) }, Op::Place(2)).ok();
-        scene.tree.apply_brush(&Shape::Voxel(IVec3::new(9, 9, 9)), Op::Place(2)).ok();
-        assert_eq!(fill_region(&scene.tree, IVec3::ONE).map(|r| r.len()), Ok(64));
+        scene.apply_brush(&Shape::Box { min: IVec3::ZERO, max: IVec3::splat(3) }, Op::Place(2)).ok();
+        scene.apply_brush(&Shape::Voxel(IVec3::new(9, 9, 9)), Op::Place(2)).ok();
+        assert_eq!(fill_region(scene.drawn(), IVec3::ONE).map(|r| r.len()), Ok(64));
         let mut history = History::default();
-        let edits = fill_edits(&scene.tree, IVec3::ONE, 6).unwrap_or_default();
+        let edits = fill_edits(scene.drawn(), IVec3::ONE, 6).unwrap_or_default();
         history.apply_group(&mut scene, edits).unwrap();
-        assert_eq!((scene.tree.get(IVec3::ZERO), scene.tree.get(IVec3::splat(9))), (6, 2));
+        assert_eq!((scene.voxel(IVec3::ZERO), scene.voxel(IVec3::splat(9))), (6, 2));
         assert!(history.undo(&mut scene).unwrap());
-        assert_eq!(scene.tree.get(IVec3::splat(3)), 2);
+        assert_eq!(scene.voxel(IVec3::splat(3)), 2);
         assert!(!history.can_undo(), "the fill was one step");
-        assert!(fill_region(&scene.tree, IVec3::splat(5)).is_err(), "nothing to fill from");
+        assert!(fill_region(scene.drawn(), IVec3::splat(5)).is_err(), "nothing to fill from");
         let big = Shape::Box { min: IVec3::new(20, 0, 0), max: IVec3::new(147, 127, 64) };
-        scene.tree.apply_brush(&big, Op::Place(4)).ok();
-        let before = scene.tree.voxels().len();
-        let err = fill_edits(&scene.tree, IVec3::new(20, 0, 0), 9).unwrap_err();
+        scene.apply_brush(&big, Op::Place(4)).ok();
+        let before = scene.voxels().len();
+        let err = fill_edits(scene.drawn(), IVec3::new(20, 0, 0), 9).unwrap_err();
         assert!(err.to_string().contains("more than 1048576 voxels"), "{err}");
-        assert_eq!(scene.tree.voxels().len(), before);
+        assert_eq!(scene.voxels().len(), before);
     }
 }

@@ -16,7 +16,7 @@ pub mod selection;
 
 use std::collections::VecDeque;
 
-use crate::scene::objects::{GraphChange, Model, Objects};
+use crate::scene::objects::{GraphChange, Model};
 use crate::scene::{EditError, Material, Op, Patch, Scene, Shape};
 
 /// One change to the scene.
@@ -50,7 +50,7 @@ impl Edit {
     ///
     /// [`Objects::target_at`]: crate::scene::objects::Objects::target_at
     pub fn resolved(self, scene: &Scene) -> Edit {
-        match (self, &scene.objects) {
+        match (self, scene.objects()) {
             (Edit::Brush { shape, op }, Some(objects)) => {
                 let (lo, hi) = shape.bounds();
                 match objects.target_at(lo + (hi - lo) / 2) {
@@ -67,30 +67,22 @@ impl Edit {
     pub fn apply(&self, scene: &mut Scene) -> Result<Edit, EditError> {
         match self {
             // In a scene of objects the drawn tree follows the models: a brush
-            // must go into one (see `Edit::resolved`), or be refused.
-            Edit::Brush { .. } if scene.objects.is_some() => {
-                Err(EditError::Brush("the scene has no object to edit: `object new NAME` makes one".to_owned()))
-            }
-            Edit::Brush { shape, op } => Ok(Edit::Restore(scene.tree.apply_brush(shape, *op)?)),
-            Edit::Restore(patch) => Ok(Edit::Restore(scene.tree.apply_patch(patch)?)),
+            // must go into one (see `Edit::resolved`); the scene refuses it.
+            Edit::Brush { shape, op } => Ok(Edit::Restore(scene.apply_brush(shape, *op)?)),
+            Edit::Restore(patch) => Ok(Edit::Restore(scene.apply_patch(patch)?)),
             Edit::InObject { object, shape, op } => {
-                let (tree, objects) = objects_of(scene)?;
-                let (model, patch) = objects.apply_brush(tree, *object, shape, *op)?;
+                let (model, patch) = scene.apply_in_object(*object, shape, *op)?;
                 Ok(Edit::RestoreModel { model, patch })
             }
             Edit::RestoreModel { model, patch } => {
-                let (tree, objects) = objects_of(scene)?;
-                Ok(Edit::RestoreModel { model: *model, patch: objects.apply_patch(tree, *model, patch)? })
+                Ok(Edit::RestoreModel { model: *model, patch: scene.apply_model_patch(*model, patch)? })
             }
-            Edit::Graph(change) => {
-                let (tree, objects) = objects_of(scene)?;
-                Ok(Edit::Graph(Box::new(objects.apply_change(tree, change)?)))
-            }
+            Edit::Graph(change) => Ok(Edit::Graph(Box::new(scene.apply_graph_change(change)?))),
             Edit::AddModel(model) => {
-                objects_of(scene)?.1.push_model((**model).clone());
+                scene.push_model((**model).clone())?;
                 Ok(Edit::PopModel)
             }
-            Edit::PopModel => Ok(Edit::AddModel(Box::new(objects_of(scene)?.1.pop_model()?))),
+            Edit::PopModel => Ok(Edit::AddModel(Box::new(scene.pop_model()?))),
             Edit::Palette { index, color, material } => {
                 if *index == 0 {
                     return Err(EditError::ZeroColor);
@@ -124,14 +116,6 @@ impl Edit {
     pub fn changes_palette(&self) -> bool {
         matches!(self, Edit::Palette { .. })
     }
-}
-
-/// The drawn tree and the objects of a scene of objects, or why an edit for
-/// one cannot apply.
-fn objects_of(scene: &mut Scene) -> Result<(&mut crate::scene::Octree, &mut Objects), EditError> {
-    let Scene { tree, objects, .. } = scene;
-    let objects = objects.as_deref_mut().ok_or_else(|| EditError::Brush("the scene has no objects".to_owned()))?;
-    Ok((tree, objects))
 }
 
 /// One undo step: a single edit or a whole mouse stroke.

@@ -13,7 +13,7 @@ use super::{
     DenoisePass, FrameUniforms, GpuContext, GpuError, Kernel, PathPass, PathUniforms, SceneBuffers, TracePass,
 };
 use crate::camera::Camera;
-use crate::scene::{Octree, Palette};
+use crate::scene::Scene;
 use crate::settings::{PathSettings, RenderSettings, View};
 use crate::trace::denoise::Frame;
 use crate::trace::grid::DenseGrid;
@@ -62,7 +62,7 @@ pub enum FrameInput<'a> {
 /// A frame of a trace kernel.
 #[derive(Clone, Copy)]
 pub struct Preview<'a> {
-    pub tree: &'a Octree,
+    pub scene: &'a Scene,
     pub camera: &'a Camera,
     pub size: (u32, u32),
     pub view: View,
@@ -73,16 +73,16 @@ pub struct Preview<'a> {
 }
 
 impl<'a> FrameInput<'a> {
-    /// The preview of `tree` with `settings`.
+    /// The preview of `scene` with `settings`.
     pub fn preview(
-        tree: &'a Octree,
+        scene: &'a Scene,
         camera: &'a Camera,
         size: (u32, u32),
         settings: &RenderSettings,
         highlight: Option<(IVec3, IVec3)>,
     ) -> FrameInput<'a> {
         let (view, lod, kernel) = (settings.view, settings.lod, Kernel::from(settings));
-        FrameInput::Trace(Preview { tree, camera, size, view, lod, highlight, kernel })
+        FrameInput::Trace(Preview { scene, camera, size, view, lod, highlight, kernel })
     }
 }
 
@@ -110,17 +110,16 @@ pub struct Submitted {
 /// traced size and the settings. A change to any of them starts it over.
 #[derive(Clone, Copy)]
 pub struct PathView<'a> {
-    pub tree: &'a Octree,
-    pub palette: &'a Palette,
+    pub scene: &'a Scene,
     pub camera: &'a Camera,
     pub size: (u32, u32),
     pub settings: &'a PathSettings,
 }
 
 fn path_key(view: &PathView) -> PathKey {
-    let PathView { tree, palette, camera, size, settings } = *view;
-    let basis = camera.basis(size.0.max(1), size.1.max(1), tree.origin());
-    PathKey { basis, settings: *settings, effects: effects_for(tree, palette, settings) }
+    let PathView { scene, camera, size, settings } = *view;
+    let basis = camera.basis(size.0.max(1), size.1.max(1), scene.origin());
+    PathKey { basis, settings: *settings, effects: effects_for(scene, settings) }
 }
 
 pub struct Renderer {
@@ -214,10 +213,10 @@ impl Renderer {
     /// Sends the pool's changes since the last call and the palette. A pool
     /// too large for one buffer binding is not sent: frames then fail with
     /// [`GpuError::TooLarge`] saying so, until a sync succeeds.
-    pub fn sync(&mut self, tree: &mut Octree, palette: &Palette) -> UploadStats {
-        self.buffers.upload_palette(&self.gpu.queue, palette);
+    pub fn sync(&mut self, scene: &mut Scene) -> UploadStats {
+        self.buffers.upload_palette(&self.gpu.queue, &scene.palette);
         let limit = self.gpu.device.limits().max_storage_buffer_binding_size;
-        match self.buffers.upload_pool(&self.gpu.device, &self.gpu.queue, tree, limit) {
+        match self.buffers.upload_pool(&self.gpu.device, &self.gpu.queue, scene, limit) {
             Ok(stats) => {
                 self.pool_error = None;
                 stats
@@ -252,13 +251,13 @@ impl Renderer {
     /// while the frame is recorded: never a silently blank image.
     pub fn render(
         &mut self,
-        tree: &Octree,
+        scene: &Scene,
         camera: &Camera,
         size: (u32, u32),
         settings: &RenderSettings,
         highlight: Option<(IVec3, IVec3)>,
     ) -> Result<f64, GpuError> {
-        Ok(self.render_frame(&FrameInput::preview(tree, camera, size, settings, highlight))?.ms)
+        Ok(self.render_frame(&FrameInput::preview(scene, camera, size, settings, highlight))?.ms)
     }
 
     /// A frame of the floor kernel (everything but the traversal, see
@@ -266,9 +265,9 @@ impl Renderer {
     ///
     /// # Errors
     /// As [`Renderer::render`].
-    pub fn render_floor(&mut self, tree: &Octree, camera: &Camera, size: (u32, u32)) -> Result<f64, GpuError> {
+    pub fn render_floor(&mut self, scene: &Scene, camera: &Camera, size: (u32, u32)) -> Result<f64, GpuError> {
         let floor =
-            Preview { tree, camera, size, view: View::Shaded, lod: 0.0, highlight: None, kernel: Kernel::Floor };
+            Preview { scene, camera, size, view: View::Shaded, lod: 0.0, highlight: None, kernel: Kernel::Floor };
         let input = FrameInput::Trace(floor);
         Ok(self.render_frame(&input)?.ms)
     }
@@ -325,7 +324,8 @@ impl Renderer {
     }
 
     fn encode_trace(&mut self, encoder: &mut wgpu::CommandEncoder, preview: &Preview) -> Result<(), GpuError> {
-        let Preview { tree, camera, size, view, lod, highlight, kernel } = *preview;
+        let Preview { scene, camera, size, view, lod, highlight, kernel } = *preview;
+        let tree = scene.drawn();
         let gpu = &self.gpu;
         self.pass.resize(gpu, &self.buffers, size, self.hit_records)?;
         self.pass.ensure_kernel(gpu, kernel)?;
@@ -351,7 +351,7 @@ impl Renderer {
         view: &PathView,
         scene_changed: bool,
     ) -> Result<Recorded, GpuError> {
-        let PathView { tree, palette, size, settings, .. } = *view;
+        let PathView { scene, size, settings, .. } = *view;
         let gpu = &self.gpu;
         let resized = self.path.resize(gpu, &self.buffers, size)?;
         if resized {
@@ -363,8 +363,8 @@ impl Renderer {
         // The materials and lights go up again when the scene or the effect set changed.
         let send_scene = scene_changed || resized || acc.key.is_none_or(|k| k.effects != effects);
         if send_scene {
-            let lights = if effects.emit { lights::emitters(tree, palette) } else { Vec::new() };
-            self.path.upload_scene(gpu, &self.buffers, &material_table(palette), &lights);
+            let lights = if effects.emit { lights::emitters(scene.drawn(), &scene.palette) } else { Vec::new() };
+            self.path.upload_scene(gpu, &self.buffers, &material_table(&scene.palette), &lights);
             acc.lights = lights.len();
         }
         if acc.starts_over(&key, resized, scene_changed) {
@@ -413,7 +413,7 @@ impl Renderer {
             first_row,
             end_row,
         };
-        let frame = FrameUniforms::new(&key.basis, tree, &self.buffers, View::Shaded, None, Footprint::EXACT);
+        let frame = FrameUniforms::new(&key.basis, scene.drawn(), &self.buffers, View::Shaded, None, Footprint::EXACT);
         self.path.prepare(gpu, &self.buffers, &frame, &path);
         let kernel = self.path.encode(gpu, encoder, effects, end_row - first_row, self.timer.pass_writes())?;
         self.timer.resolve(encoder);
@@ -583,13 +583,8 @@ impl Renderer {
     ///
     /// # Errors
     /// A kernel that does not compile.
-    pub fn compile_path_kernel(
-        &mut self,
-        tree: &Octree,
-        palette: &Palette,
-        settings: &PathSettings,
-    ) -> Result<(), GpuError> {
-        let effects = effects_for(tree, palette, settings);
+    pub fn compile_path_kernel(&mut self, scene: &Scene, settings: &PathSettings) -> Result<(), GpuError> {
+        let effects = effects_for(scene, settings);
         self.path.compile_now(&self.gpu.device, effects)
     }
 

@@ -7,7 +7,7 @@
 //! over the SIMD lanes.
 
 use crate::gpu_pool::{PoolTooLarge, Region, SlotArena};
-use crate::scene::{Octree, Palette};
+use crate::scene::{Palette, Scene};
 use crate::trace::grid::DenseGrid;
 
 /// Smallest buffer we create; zero-sized bindings are not allowed.
@@ -71,17 +71,17 @@ impl SceneBuffers {
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-        tree: &mut Octree,
+        scene: &mut Scene,
         max_bytes: u64,
     ) -> Result<UploadStats, PoolTooLarge> {
-        let upload = tree.pool_mut().flush_within(max_bytes)?;
+        let upload = scene.take_uploads_within(max_bytes)?;
         let node_capacity = upload.nodes.grow_to_bytes().unwrap_or(self.node_capacity);
         let brick_capacity = upload.bricks.grow_to_bytes().unwrap_or(self.brick_capacity);
         let grew = (node_capacity, brick_capacity) != (self.node_capacity, self.brick_capacity);
         if grew {
             self.grow(device, queue, node_capacity, brick_capacity);
         }
-        let pool = tree.pool();
+        let pool = scene.drawn().pool();
         write_region(queue, &self.pool_buf, 0, &upload.nodes, &pool.nodes);
         write_region(queue, &self.pool_buf, self.node_capacity, &upload.bricks, &pool.bricks);
         Ok(UploadStats {

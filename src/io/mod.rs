@@ -83,8 +83,8 @@ pub fn save_scene(path: &Path, scene: &Scene, options: atomic::WriteOptions) -> 
         let reason = std::io::Error::new(std::io::ErrorKind::InvalidInput, "scenes are saved as .vox or .ovx files");
         return Err(vox::VoxError::Write { path: path.to_path_buf(), source: reason }.into());
     }
-    match &scene.objects {
+    match scene.objects() {
         Some(objects) => Ok(vox::save_objects(path, &scene.palette, objects, options)?),
-        None => Ok(vox::save_tree(path, &scene.palette, &scene.tree, options)?),
+        None => Ok(vox::save_tree(path, &scene.palette, scene.drawn(), options)?),
     }
 }

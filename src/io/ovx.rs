@@ -74,7 +74,7 @@ fn corrupt(what: impl Into<String>) -> OvxError {
 /// [`OvxError::Write`] with the cause; `path` is then unchanged.
 pub fn save_ovx(path: &Path, scene: &Scene, options: WriteOptions) -> Result<(), OvxError> {
     let write_error = |source| OvxError::Write { path: path.to_path_buf(), source };
-    let compact = Compact::of(&scene.tree);
+    let compact = Compact::of(scene.drawn());
     let materials = encode_materials(&scene.palette);
     let objects =
         objects_section(scene).map_err(|e| write_error(io::Error::new(io::ErrorKind::InvalidInput, e.to_string())))?;
@@ -95,7 +95,7 @@ pub fn save_ovx(path: &Path, scene: &Scene, options: WriteOptions) -> Result<(),
         out.write_all(&header(0, payload_len, flags))?;
         let mut encoder = zstd::Encoder::new(&mut out, ZSTD_LEVEL)?;
         encoder.include_checksum(true)?;
-        write_payload(&mut encoder, &scene.tree, &scene.palette, &compact, objects.as_ref(), &materials)?;
+        write_payload(&mut encoder, scene.drawn(), &scene.palette, &compact, objects.as_ref(), &materials)?;
         encoder.finish()?;
         let file_len = out.written + FOOTER_BYTES;
         let file = out.into_inner()?;
@@ -123,7 +123,7 @@ struct ObjectsSection {
 const OBJECTS_HEADER_BYTES: u64 = 16;
 
 fn objects_section(scene: &Scene) -> Result<Option<ObjectsSection>, super::vox::VoxError> {
-    let Some(objects) = &scene.objects else { return Ok(None) };
+    let Some(objects) = scene.objects() else { return Ok(None) };
     let bytes = super::vox::encode_objects(&scene.palette, objects)?;
     Ok(Some(ObjectsSection { bytes, frame: objects.frame as u64 }))
 }
@@ -432,7 +432,10 @@ fn read_payload(input: &mut Payload, with_objects: bool) -> Result<Scene, OvxErr
     };
     palette.materials = decode_materials(&input.items::<u8>(materials_len, |_, _| Ok(()))?)?;
     let tree = Octree::from_parts(origin, depth, root, nodes, bricks).map_err(|e| corrupt(e.to_string()))?;
-    Ok(Scene { palette, tree, objects: objects.map(Box::new) })
+    Ok(match objects {
+        Some(objects) => Scene::with_objects(palette, tree, objects),
+        None => Scene::new(palette, tree),
+    })
 }
 
 /// Reads the objects section (at most `room` bytes, the materials' least
@@ -448,12 +451,12 @@ fn read_objects(input: &mut Payload, room: u64) -> Result<(Objects, u64), OvxErr
     let bytes = input.items::<u8>(len, |_, _| Ok(()))?;
     let frame = usize::try_from(frame).map_err(|_| corrupt(format!("frame {frame}")))?;
     let scene = super::vox::load_vox_scene(&bytes, frame).map_err(|e| corrupt(format!("its objects: {e}")))?.0;
-    let objects = scene.objects.ok_or_else(|| corrupt("its objects section holds a single model"))?;
+    let objects = scene.into_objects().ok_or_else(|| corrupt("its objects section holds a single model"))?;
     let left = room - OBJECTS_HEADER_BYTES - len;
     if left > MAX_MATERIALS_BYTES {
         return Err(corrupt(format!("{left} bytes of materials, past the {MAX_MATERIALS_BYTES} an .ovx holds")));
     }
-    Ok((*objects, OBJECTS_HEADER_BYTES + len))
+    Ok((objects, OBJECTS_HEADER_BYTES + len))
 }
 
 /// What one stored node can be told wrong by on its own, as it is read (a
@@ -574,9 +577,8 @@ mod tests {
     /// behind it, so the pool has free slots to compact away.
     fn scene() -> Scene {
         let mut scene = crate::scene::demo::BuiltIn::Showroom.scene();
-        let patch =
-            scene.tree.apply_brush(&Shape::Sphere { center: IVec3::new(3, 9, 4), radius: 6 }, Op::Remove).unwrap();
-        scene.tree.apply_patch(&patch).unwrap();
+        let patch = scene.apply_brush(&Shape::Sphere { center: IVec3::new(3, 9, 4), radius: 6 }, Op::Remove).unwrap();
+        scene.apply_patch(&patch).unwrap();
         scene
     }
 
@@ -591,15 +593,15 @@ mod tests {
     fn a_scene_comes_back_as_it_was() {
         let scene = scene();
         let loaded = decode_ovx(&saved(&scene), &Progress::default()).unwrap();
-        assert_eq!(loaded.tree.voxels(), scene.tree.voxels());
+        assert_eq!(loaded.voxels(), scene.voxels());
         assert_eq!(loaded.palette, scene.palette);
-        assert_eq!((loaded.tree.origin(), loaded.tree.depth()), (scene.tree.origin(), scene.tree.depth()));
-        assert_eq!(loaded.tree.counts(), scene.tree.counts());
-        assert_eq!(loaded.tree.node_count(), scene.tree.node_count());
-        assert_eq!(loaded.tree.pool().nodes.len(), scene.tree.node_count(), "no free slots stored");
-        loaded.tree.check_invariants().unwrap();
+        assert_eq!((loaded.origin(), loaded.drawn().depth()), (scene.origin(), scene.drawn().depth()));
+        assert_eq!(loaded.counts(), scene.counts());
+        assert_eq!(loaded.drawn().node_count(), scene.drawn().node_count());
+        assert_eq!(loaded.drawn().pool().nodes.len(), scene.drawn().node_count(), "no free slots stored");
+        loaded.drawn().check_invariants().unwrap();
         let empty = decode_ovx(&saved(&Scene::default()), &Progress::default()).unwrap();
-        assert_eq!(empty.tree.solid_voxels(), 0);
+        assert_eq!(empty.solid_voxels(), 0);
     }
 
     #[test]

@@ -144,15 +144,15 @@ impl Runner {
     /// Sends the pool's dirty ranges; returns the bytes written.
     fn flush(&mut self) -> u64 {
         match &mut self.mode {
-            RunnerMode::Gpu(renderer) => renderer.sync(&mut self.editor.scene.tree, &self.editor.scene.palette).bytes,
-            RunnerMode::Cpu => self.editor.scene.tree.pool_mut().flush().byte_count(),
+            RunnerMode::Gpu(renderer) => renderer.sync(&mut self.editor.scene).bytes,
+            RunnerMode::Cpu => self.editor.scene.take_uploads().byte_count(),
         }
     }
 
     fn render_image(&mut self) -> Result<image::RgbaImage, HostError> {
         match &mut self.mode {
             RunnerMode::Gpu(renderer) => {
-                renderer.render(&self.editor.scene.tree, &self.camera, self.viewport, &self.settings, None)?;
+                renderer.render(&self.editor.scene, &self.camera, self.viewport, &self.settings, None)?;
                 Ok(renderer.read_image()?)
             }
             RunnerMode::Cpu => {
@@ -187,8 +187,8 @@ impl Host for Runner {
     }
 
     fn pick(&mut self, x: u32, y: u32) -> Result<Option<(IVec3, IVec3, u8)>, svo::GaveUp> {
-        let (tree, ground) = (&self.editor.scene.tree, self.editor.ground);
-        let hit = svo::pick_with_ground(tree, &self.camera, self.viewport, (x, y), ground)?;
+        let (scene, ground) = (&self.editor.scene, self.editor.ground);
+        let hit = svo::pick_with_ground(scene, &self.camera, self.viewport, (x, y), ground)?;
         Ok(hit.map(|hit| (hit.voxel, hit.normal, hit.value)))
     }
 

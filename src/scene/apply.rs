@@ -1,5 +1,6 @@
-//! Applying edits to the octree: brushes, restoring saved cells (undo), and
-//! growing or shrinking the root.
+//! Applying edits to a scene and its octree: brushes, restoring saved
+//! cells (undo), growing or shrinking the root, and handing the changed
+//! node slots on to the GPU.
 //!
 //! Every path visits only the cells a shape overlaps: a cell fully inside
 //! becomes one uniform word, a cell outside is returned untouched. Every
@@ -7,9 +8,11 @@
 
 use glam::IVec3;
 
+use super::Scene;
+use super::objects::{GraphChange, Model, Objects};
 use super::octree::{MAX_DEPTH, Octree, WORLD_LIMIT, octant_offset};
 use super::shape::{Op, Overlap, Shape};
-use crate::gpu_pool::{Brick, Node, is_pointer};
+use crate::gpu_pool::{Brick, Node, PoolTooLarge, Upload, is_pointer};
 
 /// Why an edit was refused. The tree is unchanged when one is returned.
 #[derive(Debug, thiserror::Error, Clone, PartialEq, Eq)]
@@ -32,6 +35,79 @@ pub enum EditError {
 /// nodes, the undo patch and the dirty lists (a radius-4096 sphere, 2·10^8
 /// surface voxels, took 3.8 GB).
 pub const EDIT_BYTES_PER_SURFACE_VOXEL: u64 = 24;
+
+impl Scene {
+    /// Bytes of the drawn node pool that are in use.
+    pub fn drawn_pool_bytes(&self) -> u64 {
+        self.tree.pool().live_bytes()
+    }
+
+    /// The node slots changed since the last call, to send to the GPU.
+    pub fn take_uploads(&mut self) -> Upload {
+        self.tree.pool_mut().flush()
+    }
+
+    /// The same within `max_bytes` of pool, or the pool's size when larger.
+    pub fn take_uploads_within(&mut self, max_bytes: u64) -> Result<Upload, PoolTooLarge> {
+        self.tree.pool_mut().flush_within(max_bytes)
+    }
+
+    /// Marks the whole pool as not uploaded (it goes to a new GPU buffer).
+    pub fn forget_uploads(&mut self) {
+        self.tree.pool_mut().forget_uploads();
+    }
+
+    /// Applies a brush to the one model; returns the patch that undoes it.
+    /// A scene of objects refuses it: a brush goes into an object's model.
+    pub fn apply_brush(&mut self, shape: &Shape, op: Op) -> Result<Patch, EditError> {
+        if self.objects.is_some() {
+            return Err(EditError::Brush("the scene has no object to edit: `object new NAME` makes one".to_owned()));
+        }
+        self.tree.apply_brush(shape, op)
+    }
+
+    /// Puts back the one model's cells from an undo patch.
+    pub fn apply_patch(&mut self, patch: &Patch) -> Result<Patch, EditError> {
+        self.tree.apply_patch(patch)
+    }
+
+    /// Applies a world brush to object `index`'s model (every placement of
+    /// it shows the change); returns the model and its undo patch.
+    pub fn apply_in_object(&mut self, index: usize, shape: &Shape, op: Op) -> Result<(usize, Patch), EditError> {
+        let (objects, tree) = self.objects_and_drawn_mut()?;
+        objects.apply_brush(tree, index, shape, op)
+    }
+
+    /// Puts back model `model`'s cells from an undo patch.
+    pub fn apply_model_patch(&mut self, model: usize, patch: &Patch) -> Result<Patch, EditError> {
+        let (objects, tree) = self.objects_and_drawn_mut()?;
+        objects.apply_patch(tree, model, patch)
+    }
+
+    /// Changes the scene graph; returns the change that undoes it.
+    pub fn apply_graph_change(&mut self, change: &GraphChange) -> Result<GraphChange, EditError> {
+        let (objects, tree) = self.objects_and_drawn_mut()?;
+        objects.apply_change(tree, change)
+    }
+
+    /// Stores a model that nothing places yet.
+    pub fn push_model(&mut self, model: Model) -> Result<usize, EditError> {
+        Ok(self.objects_and_drawn_mut()?.0.push_model(model))
+    }
+
+    /// Takes the last model out, unless it is placed.
+    pub fn pop_model(&mut self) -> Result<Model, EditError> {
+        self.objects_and_drawn_mut()?.0.pop_model()
+    }
+
+    /// The objects and the drawn tree, for a change to the objects that
+    /// composes what it changes; an error when the scene has none.
+    fn objects_and_drawn_mut(&mut self) -> Result<(&mut Objects, &mut Octree), EditError> {
+        let Scene { tree, objects, .. } = self;
+        let objects = objects.as_deref_mut().ok_or_else(|| EditError::Brush("the scene has no objects".to_owned()))?;
+        Ok((objects, tree))
+    }
+}
 
 /// Serialized-subtree tag for a node: eight child subtrees follow.
 const NODE_TAG: u32 = 0x8000_0000;

@@ -59,15 +59,18 @@ pub fn grow_bounds(bounds: Option<(IVec3, IVec3)>, p: IVec3) -> (IVec3, IVec3) {
     bounds.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p)))
 }
 
-/// What the sandbox edits: a palette and an octree of palette indices.
+/// What the sandbox edits: a palette and the voxels, which are one model
+/// or a scene of objects. The octree that is drawn is kept behind methods:
+/// callers ask the scene for voxels, bounds and uploads, and edits go
+/// through it, so what is drawn can change shape without touching them.
 #[derive(Clone, Debug, Default)]
 pub struct Scene {
     pub palette: Palette,
     /// What is drawn: the one model, or the visible objects composed.
-    pub tree: Octree,
+    tree: Octree,
     /// The objects and models of a scene of several (`None`: the tree is
     /// the one model).
-    pub objects: Option<Box<objects::Objects>>,
+    objects: Option<Box<objects::Objects>>,
 }
 
 impl Scene {
@@ -76,8 +79,74 @@ impl Scene {
         Scene { palette, tree, objects: None }
     }
 
+    /// A scene of objects whose visible ones `tree` draws, composed (what a
+    /// loader that stores the composed tree reads back).
+    pub fn with_objects(palette: Palette, tree: Octree, objects: objects::Objects) -> Scene {
+        Scene { palette, tree, objects: Some(Box::new(objects)) }
+    }
+
+    /// A scene of objects, its drawn tree composed from them.
+    pub fn compose(palette: Palette, objects: objects::Objects) -> Result<Scene, EditError> {
+        let tree = objects.compose()?;
+        Ok(Scene::with_objects(palette, tree, objects))
+    }
+
     /// Builds the octree of a loaded model.
     pub fn from_model(model: &VoxelModel) -> Result<Scene, BuildError> {
         Ok(Scene::new(model.palette.clone(), Octree::from_voxels(&model.voxels)?))
+    }
+
+    /// The objects of a scene of several; `None` for one model.
+    pub fn objects(&self) -> Option<&objects::Objects> {
+        self.objects.as_deref()
+    }
+
+    /// Takes the objects out (a loader that keeps only them).
+    pub fn into_objects(self) -> Option<objects::Objects> {
+        self.objects.map(|o| *o)
+    }
+
+    /// The octree the renderers draw, read-only: the one model, or the
+    /// visible objects composed. Its origin is where ray coordinates start.
+    pub fn drawn(&self) -> &Octree {
+        &self.tree
+    }
+
+    /// The palette index drawn at world cell `at` (0: empty).
+    pub fn voxel(&self, at: IVec3) -> u8 {
+        self.tree.get(at)
+    }
+
+    /// Every drawn solid voxel, in the tree's order.
+    pub fn voxels(&self) -> Vec<Voxel> {
+        self.tree.voxels()
+    }
+
+    /// How many voxels are drawn solid.
+    pub fn solid_voxels(&self) -> u64 {
+        self.tree.solid_voxels()
+    }
+
+    /// The inclusive box of the drawn voxels; `None` when there are none.
+    pub fn solid_bounds(&self) -> Option<(IVec3, IVec3)> {
+        self.tree.solid_bounds()
+    }
+
+    /// Drawn voxels per palette index.
+    pub fn counts(&self) -> &VoxelCounts {
+        self.tree.counts()
+    }
+
+    /// The world cell the drawn tree's corner is at: cameras give rays
+    /// relative to it.
+    pub fn origin(&self) -> IVec3 {
+        self.tree.origin()
+    }
+
+    /// Picks the object edits go to (no effect on a scene of one model).
+    pub fn select_object(&mut self, index: Option<usize>) {
+        if let Some(objects) = &mut self.objects {
+            objects.selected = index;
+        }
     }
 }

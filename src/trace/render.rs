@@ -136,9 +136,9 @@ pub fn render_scene_cpu(
 ) -> image::RgbaImage {
     let tracer = match grid {
         Some(grid) => Tracer::Grid(grid),
-        None => Tracer::Svo(&scene.tree),
+        None => Tracer::Svo(scene.drawn()),
     };
-    let basis = camera.basis(size.0, size.1, scene.tree.origin());
+    let basis = camera.basis(size.0, size.1, scene.origin());
     let footprint = Footprint::of_pixels(&basis, settings.lod);
     let hits = trace_image(tracer, &basis, footprint);
     let gave_up = hits.iter().filter(|hit| hit.gave_up()).count();

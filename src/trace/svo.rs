@@ -16,6 +16,7 @@ use glam::{IVec3, Vec3};
 use super::{Footprint, Hit, NO_AXIS, Ray, argmin, iteration_bound};
 use crate::camera::Camera;
 use crate::gpu_pool::{is_pointer, slot_of};
+use crate::scene::Scene;
 use crate::scene::octree::{MAX_DEPTH, Octree};
 
 // The GPU beam's octant path holds 20 levels of 3 bits in two words.
@@ -24,7 +25,8 @@ const _: () = assert!(MAX_DEPTH <= 20);
 /// The voxel and face under pixel (x, y) of a `size` view, with the voxel in
 /// world coordinates: the one CPU pick that the window's mouse and replay's
 /// `click` share.
-pub fn pick(tree: &Octree, camera: &Camera, size: (u32, u32), x: u32, y: u32) -> Result<Option<Hit>, GaveUp> {
+pub fn pick(scene: &Scene, camera: &Camera, size: (u32, u32), x: u32, y: u32) -> Result<Option<Hit>, GaveUp> {
+    let tree = scene.drawn();
     let basis = camera.basis(size.0, size.1, tree.origin());
     let (origin, dir) = basis.ray(x, y);
     let hit = trace(tree, &Ray::new(origin, dir));
@@ -39,13 +41,13 @@ pub fn pick(tree: &Octree, camera: &Camera, size: (u32, u32), x: u32, y: u32) ->
 /// above it, crosses it (value 0, normal +y: Attach places on (x, 0, z)).
 /// The ground of an empty scene is what a first click builds on.
 pub fn pick_with_ground(
-    tree: &Octree,
+    scene: &Scene,
     camera: &Camera,
     size: (u32, u32),
     (x, y): (u32, u32),
     ground: bool,
 ) -> Result<Option<Hit>, GaveUp> {
-    match pick(tree, camera, size, x, y)? {
+    match pick(scene, camera, size, x, y)? {
         Some(hit) => Ok(Some(hit)),
         None if ground => Ok(ground_pick(camera, size, x, y)),
         None => Ok(None),

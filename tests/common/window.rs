@@ -233,7 +233,7 @@ pub fn same_layer_pixel(tree: &Octree, camera: &Camera, from: (u32, u32), voxel:
 
 pub fn voxel_set(path: &Path) -> HashSet<IVec3> {
     let scene = octovox::io::load_scene(path, 0).expect("the saved file loads");
-    scene.tree.voxels().into_iter().map(|(p, _)| p).collect()
+    scene.voxels().into_iter().map(|(p, _)| p).collect()
 }
 
 /// Mean and variance of the grey level of a rectangle of an image.
@@ -346,7 +346,7 @@ pub fn torus_document() -> (tempfile::TempDir, PathBuf, octovox::scene::Scene, C
     let file = dir.path().join("torus.vox");
     super::copy_writable(&source, &file);
     let original = octovox::io::load_scene(&file, 0).unwrap();
-    let (lo, hi) = original.tree.solid_bounds().unwrap();
+    let (lo, hi) = original.solid_bounds().unwrap();
     let camera = Camera::framing(lo, hi, 50.0);
     (dir, file, original, camera)
 }

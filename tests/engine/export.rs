@@ -177,7 +177,7 @@ fn sculpture_file(dir: &Path) -> (std::path::PathBuf, u64) {
     let path = dir.join("sculpture.vox");
     let scene = octovox::scene::Scene::new(Default::default(), tree);
     octovox::io::save_scene(&path, &scene, Default::default()).unwrap();
-    (path, scene.tree.solid_voxels())
+    (path, scene.solid_voxels())
 }
 
 #[test]
@@ -255,7 +255,7 @@ fn glb_materials_follow_matl_and_pass_the_khronos_validator() {
     let out = octovox(&["export", vox.to_str().unwrap(), "-o", glb.to_str().unwrap()]);
     assert!(out.status.success(), "{}", text(&out));
     let Glb { json, positions, triangles } = read_glb(&glb);
-    assert_eq!(closed_volume(&positions, &triangles).round() as u64, scene.tree.solid_voxels());
+    assert_eq!(closed_volume(&positions, &triangles).round() as u64, scene.solid_voxels());
     let close = |value: &serde_json::Value, expected: f32| {
         value.as_f64().is_some_and(|v| (v - f64::from(expected)).abs() < 1e-6)
     };

@@ -324,11 +324,13 @@ fn the_comb_ray_reaches_the_wall_in_the_pick() {
         fov_y_deg: 1.0,
         ortho: None,
     };
-    let hit = octovox::trace::svo::pick(&tree, &camera, (1, 1), 0, 0).unwrap().expect("the wall");
+    let depth = tree.depth();
+    let scene = octovox::scene::Scene::new(Default::default(), tree);
+    let hit = octovox::trace::svo::pick(&scene, &camera, (1, 1), 0, 0).unwrap().expect("the wall");
     assert_eq!(hit.voxel.x, 4010);
     println!("the comb ray took {} iterations", hit.iterations);
     assert!(hit.iterations > 4096, "{} iterations", hit.iterations);
-    assert!(hit.iterations < octovox::trace::iteration_bound(tree.depth()));
+    assert!(hit.iterations < octovox::trace::iteration_bound(depth));
     // Were a ray ever to give up, it is drawn magenta, not as sky.
     let gave_up = octovox::trace::Hit { gave_up: true, iterations: 7, ..Default::default() };
     let color = octovox::trace::render::shade(&gave_up, glam::Vec3::X, &Default::default(), Default::default(), false);

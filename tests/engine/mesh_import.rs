@@ -184,7 +184,7 @@ fn import_writes_a_vox_that_reads_back() {
     assert_eq!(model.voxels.len(), 300 * 20 * 30);
     // The window and `render` open .obj files directly too.
     let scene = octovox::io::load_scene(&obj, 0).unwrap();
-    assert_eq!(scene.tree.solid_voxels(), 256 * 17 * 26);
+    assert_eq!(scene.solid_voxels(), 256 * 17 * 26);
 
     // Saving never writes .vox bytes over a mesh.
     let e = octovox::io::save_scene(&obj, &scene, Default::default()).unwrap_err();

@@ -116,23 +116,23 @@ proptest! {
         let base: Vec<(IVec3, u8)> = (0..300)
             .map(|i| (IVec3::new(i % 17 - 8, (i / 17) % 5, i % 13 - 6), (i % 7 + 1) as u8))
             .collect();
-        let mut scene = Scene { tree: Octree::from_voxels(&base).unwrap(), ..Scene::default() };
-        let before = scene.tree.voxels();
-        let (nodes, bricks) = (scene.tree.node_count(), scene.tree.brick_count());
+        let mut scene = Scene::new(Default::default(), Octree::from_voxels(&base).unwrap());
+        let before = scene.voxels();
+        let (nodes, bricks) = (scene.drawn().node_count(), scene.drawn().brick_count());
         let mut history = History::default();
         for (shape, op) in &edits {
             history.apply(&mut scene, Edit::Brush { shape: *shape, op: *op }).unwrap();
         }
-        let after = scene.tree.voxels();
-        let after_counts = (scene.tree.node_count(), scene.tree.brick_count());
+        let after = scene.voxels();
+        let after_counts = (scene.drawn().node_count(), scene.drawn().brick_count());
         while history.undo(&mut scene).unwrap() {}
-        scene.tree.check_invariants().unwrap();
-        prop_assert_eq!(sorted(scene.tree.voxels()), sorted(before));
-        prop_assert_eq!((scene.tree.node_count(), scene.tree.brick_count()), (nodes, bricks));
+        scene.drawn().check_invariants().unwrap();
+        prop_assert_eq!(sorted(scene.voxels()), sorted(before));
+        prop_assert_eq!((scene.drawn().node_count(), scene.drawn().brick_count()), (nodes, bricks));
         while history.redo(&mut scene).unwrap() {}
-        scene.tree.check_invariants().unwrap();
-        prop_assert_eq!(sorted(scene.tree.voxels()), sorted(after));
-        prop_assert_eq!((scene.tree.node_count(), scene.tree.brick_count()), after_counts);
+        scene.drawn().check_invariants().unwrap();
+        prop_assert_eq!(sorted(scene.voxels()), sorted(after));
+        prop_assert_eq!((scene.drawn().node_count(), scene.drawn().brick_count()), after_counts);
     }
 }
 
@@ -180,23 +180,23 @@ fn duplicate_positions_keep_the_last_value() {
 
 #[test]
 fn edits_far_outside_grow_the_root_and_undo_shrinks_it() {
-    let mut scene = Scene { tree: Octree::from_voxels(&[(IVec3::ZERO, 5)]).unwrap(), ..Scene::default() };
-    let (origin, depth) = (scene.tree.origin(), scene.tree.depth());
+    let mut scene = Scene::new(Default::default(), Octree::from_voxels(&[(IVec3::ZERO, 5)]).unwrap());
+    let (origin, depth) = (scene.origin(), scene.drawn().depth());
     let mut history = History::default();
     let far = IVec3::new(-3000, 40, 9000);
     history.apply(&mut scene, Edit::Brush { shape: Shape::Voxel(far), op: Op::Place(7) }).unwrap();
-    assert_eq!(scene.tree.get(far), 7);
-    assert_eq!(scene.tree.get(IVec3::ZERO), 5);
-    assert!(scene.tree.depth() > depth);
+    assert_eq!(scene.voxel(far), 7);
+    assert_eq!(scene.voxel(IVec3::ZERO), 5);
+    assert!(scene.drawn().depth() > depth);
     history.undo(&mut scene).unwrap();
-    assert_eq!((scene.tree.origin(), scene.tree.depth()), (origin, depth));
-    assert_eq!(scene.tree.get(far), 0);
-    scene.tree.check_invariants().unwrap();
+    assert_eq!((scene.origin(), scene.drawn().depth()), (origin, depth));
+    assert_eq!(scene.voxel(far), 0);
+    scene.drawn().check_invariants().unwrap();
 }
 
 #[test]
 fn bad_edits_are_refused_without_change() {
-    let mut scene = Scene { tree: Octree::from_voxels(&[(IVec3::ZERO, 5)]).unwrap(), ..Scene::default() };
+    let mut scene = Scene::new(Default::default(), Octree::from_voxels(&[(IVec3::ZERO, 5)]).unwrap());
     let huge = Edit::Brush { shape: Shape::Voxel(IVec3::new(1 << 30, 0, 0)), op: Op::Place(1) };
     assert!(huge.apply(&mut scene).is_err());
     let zero = Edit::Brush { shape: Shape::Voxel(IVec3::ONE), op: Op::Place(0) };
@@ -205,7 +205,7 @@ fn bad_edits_are_refused_without_change() {
     assert!(radius.apply(&mut scene).unwrap_err().to_string().contains("radius"));
     let palette_zero = Edit::Palette { index: 0, color: [1, 2, 3, 255], material: Box::default() };
     assert!(palette_zero.apply(&mut scene).is_err());
-    assert_eq!(scene.tree.voxels(), vec![(IVec3::ZERO, 5)]);
+    assert_eq!(scene.voxels(), vec![(IVec3::ZERO, 5)]);
     assert_eq!(scene.palette, Palette::default());
 }
 

@@ -47,7 +47,7 @@ fn vox_to_ovx_and_back_keeps_every_voxel() {
         }
         let original = octovox::io::load_scene(&vox, 0).unwrap();
         let round = octovox::io::load_scene(&back, 0).unwrap();
-        assert_eq!(original.tree.voxels(), round.tree.voxels(), "{name}");
+        assert_eq!(original.voxels(), round.voxels(), "{name}");
         assert_eq!(original.palette.materials, round.palette.materials, "{name}");
     }
 }

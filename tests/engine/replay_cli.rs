@@ -121,7 +121,7 @@ fn the_effect_set_follows_edits_and_undo() {
     let mut glass = octovox::scene::Material::new(octovox::scene::MaterialKind::Glass);
     glass.params.insert("_ri".into(), "1.5".into());
     scene.palette.materials[9] = glass;
-    scene.tree.apply_brush(&octovox::scene::Shape::Voxel(glam::IVec3::ZERO), octovox::scene::Op::Place(3)).unwrap();
+    scene.apply_brush(&octovox::scene::Shape::Voxel(glam::IVec3::ZERO), octovox::scene::Op::Place(3)).unwrap();
     let vox = dir.path().join("diffuse.vox");
     octovox::io::save_scene(&vox, &scene, Default::default()).unwrap();
     let script = "load diffuse.vox\nexpect effects sun sky\ncolor 9\nplace 0 1 0\nexpect effects sun sky glass\n\
@@ -221,7 +221,7 @@ fn fill_recolours_the_connected_region_of_one_colour_in_one_step() {
     let dir = tempfile::tempdir().unwrap();
     let mut scene = Scene::default();
     for (min, max, color) in boxes {
-        scene.tree.apply_brush(&Shape::Box { min, max }, Op::Place(color)).unwrap();
+        scene.apply_brush(&Shape::Box { min, max }, Op::Place(color)).unwrap();
     }
     octovox::io::save_scene(&dir.path().join("boxes.vox"), &scene, Default::default()).unwrap();
     let script = "load boxes.vox\ncolor 7\nfill 1 1 1\nexpect voxel 5 1 1 7\nexpect voxel 10 0 0 3\nexpect voxel 0 4 0 5\n\
@@ -232,7 +232,7 @@ fn fill_recolours_the_connected_region_of_one_colour_in_one_step() {
         replay_passes(&path, cpu, "5 passed, 0 failed");
         // Every voxel, against the boxes: A and B are 7, C and D unchanged.
         let filled = octovox::io::load_scene(&dir.path().join("filled.vox"), 0).unwrap();
-        for (p, c) in filled.tree.voxels() {
+        for (p, c) in filled.voxels() {
             let (_, _, original) =
                 boxes.iter().copied().find(|(lo, hi, _)| p.cmpge(*lo).all() && p.cmple(*hi).all()).unwrap();
             let expected = if p.x <= 5 && original == 3 { 7 } else { original };
@@ -306,7 +306,7 @@ fn select_copy_paste_move_cut_and_delete_in_one_step_each() {
     let dir = tempfile::tempdir().unwrap();
     let mut scene = Scene::default();
     for (p, c) in &base {
-        scene.tree.apply_brush(&Shape::Voxel(*p), Op::Place(*c)).unwrap();
+        scene.apply_brush(&Shape::Voxel(*p), Op::Place(*c)).unwrap();
     }
     octovox::io::save_scene(&dir.path().join("blocks.vox"), &scene, Default::default()).unwrap();
 
@@ -346,7 +346,7 @@ fn select_copy_paste_move_cut_and_delete_in_one_step_each() {
     let path = dir.path().join("select.ovr");
     std::fs::write(&path, script).unwrap();
     let read = |name: &str| -> Voxels {
-        octovox::io::load_scene(&dir.path().join(name), 0).unwrap().tree.voxels().into_iter().collect()
+        octovox::io::load_scene(&dir.path().join(name), 0).unwrap().voxels().into_iter().collect()
     };
     for cpu in [false, true] {
         replay_passes(&path, cpu, "3 passed, 0 failed");

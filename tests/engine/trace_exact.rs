@@ -279,10 +279,11 @@ fn a_tree_two_to_the_twenty_wide() {
 
 /// Each pixel's GPU hit (SVO, no shadows) against the reference for that
 /// pixel's ray as the CPU computes it.
-fn gpu_tally(renderer: &mut Renderer, tree: &Octree, camera: &Camera, size: (u32, u32)) -> Tally {
+fn gpu_tally(renderer: &mut Renderer, scene: &octovox::scene::Scene, camera: &Camera, size: (u32, u32)) -> Tally {
     let settings =
         RenderSettings { mode: TraceMode::Svo, view: View::Shaded, shadows: false, render_scale: 1.0, lod: 0.0 };
-    renderer.render(tree, camera, size, &settings, None).unwrap();
+    renderer.render(scene, camera, size, &settings, None).unwrap();
+    let tree = scene.drawn();
     let basis = camera.basis(size.0, size.1, tree.origin());
     let mut tally = Tally::default();
     for (i, hit) in renderer.read_hits().unwrap().iter().enumerate() {
@@ -300,12 +301,12 @@ fn gpu_tally(renderer: &mut Renderer, tree: &Octree, camera: &Camera, size: (u32
 fn gpu_hard_cases_against_the_reference() {
     use glam::DVec3;
 
-    let mut tree = scene();
+    let mut tree = octovox::scene::Scene::new(Default::default(), scene());
     let far = IVec3::new((1 << 20) - 40, 3, -7);
     tree.apply_brush(&Shape::Box { min: far, max: far + IVec3::new(3, 9, 5) }, Op::Place(8)).unwrap();
     let mut renderer = octovox::gpu::Renderer::headless().expect("a GPU adapter (lavapipe on CI)");
     renderer.hit_records = true;
-    renderer.sync(&mut tree, &octovox::scene::Palette::default());
+    renderer.sync(&mut tree);
     let camera = |eye: [f64; 3], target: [f64; 3], fov: f32| Camera {
         eye: DVec3::from_array(eye),
         target: DVec3::from_array(target),
@@ -335,7 +336,8 @@ fn gpu_hard_cases_against_the_reference() {
         let center = IVec3::new(i * 240 - 1900, 0, (i * 613) % 3800 - 1900);
         terrain.apply_brush(&Shape::Sphere { center, radius: 40 + i * 7 }, Op::Place(3)).unwrap();
     }
-    renderer.sync(&mut terrain, &octovox::scene::Palette::default());
+    let mut terrain = octovox::scene::Scene::new(Default::default(), terrain);
+    renderer.sync(&mut terrain);
     let far_camera = camera([3.0e5, 9.0e5, 3.0e5], [0.0, 0.0, 0.0], 1.0);
     let tally = gpu_tally(&mut renderer, &terrain, &far_camera, (192, 128));
     tally.assert_clean("GPU a million voxels away", 5);

@@ -276,13 +276,13 @@ fn a_streamed_load_equals_the_whole_list_load() {
         let reference = octovox::scene::Scene::from_model(&model).unwrap();
         let (streamed, meta) = octovox::io::vox::load_vox_scene(&bytes, 0).unwrap();
         let name = path.display();
-        assert_eq!(streamed.tree.voxels(), reference.tree.voxels(), "{name}");
-        assert_eq!((streamed.tree.origin(), streamed.tree.depth()), (reference.tree.origin(), reference.tree.depth()));
+        assert_eq!(streamed.voxels(), reference.voxels(), "{name}");
+        assert_eq!((streamed.origin(), streamed.drawn().depth()), (reference.origin(), reference.drawn().depth()));
         assert_eq!(streamed.palette, reference.palette, "{name}");
         assert_eq!(
             (meta.models, meta.stored_models, &meta.warnings),
             (model.models, model.stored_models, &model.warnings)
         );
-        streamed.tree.check_invariants().unwrap();
+        streamed.drawn().check_invariants().unwrap();
     }
 }

@@ -16,16 +16,16 @@ const OBJ_VOXELS: u32 = 24;
 pub fn vox(data: &[u8]) {
     let Ok(model) = octovox::io::vox::load_vox(data, 0) else { return };
     let Ok(scene) = octovox::scene::Scene::from_model(&model) else { return };
-    if let Err(broken) = scene.tree.check_invariants() {
+    if let Err(broken) = scene.drawn().check_invariants() {
         panic!("a loaded scene built a broken octree: {broken}");
     }
-    if scene.tree.solid_voxels() > 1 << 20 {
+    if scene.solid_voxels() > 1 << 20 {
         return; // a valid but large scene: saving it again proves nothing more
     }
     let bytes = octovox::io::vox::encode_vox(&scene.palette, &model.voxels).expect("a loaded scene saves");
     let again = octovox::io::vox::load_vox(&bytes, 0).expect("a saved scene loads");
     // The loader sorts by position (x, then y, then z).
-    let mut expected = scene.tree.voxels();
+    let mut expected = scene.voxels();
     expected.sort_by_key(|(p, _)| (p.x, p.y, p.z));
     assert_eq!(again.voxels, expected, "the voxels changed in a save and load");
 }
@@ -80,7 +80,7 @@ pub fn journal(data: &[u8]) {
         std::fs::create_dir_all(document.parent().expect("a folder")).expect("the document's folder");
         let mut scene = octovox::scene::Scene::default();
         let shape = octovox::scene::Shape::Box { min: glam::IVec3::ZERO, max: glam::IVec3::new(1, 2, 1) };
-        scene.tree.apply_brush(&shape, octovox::scene::Op::Place(3)).expect("a small box");
+        scene.apply_brush(&shape, octovox::scene::Op::Place(3)).expect("a small box");
         // Every process writes the same bytes; the write is atomic.
         let options = octovox::io::atomic::WriteOptions::forced(true);
         octovox::io::save_scene(document, &scene, options).expect("the journal's document saves");
@@ -110,7 +110,7 @@ pub fn ovx(data: &[u8]) {
     let allowed = (2 << 20) + OVX_DECODED_PER_INPUT_BYTE * data.len() as u64;
     assert!(decoded <= allowed, "{} input bytes decoded to {decoded}", data.len());
     let Ok(scene) = loaded else { return };
-    if let Err(broken) = scene.tree.check_invariants() {
+    if let Err(broken) = scene.drawn().check_invariants() {
         panic!("a loaded .ovx is a broken octree: {broken}");
     }
     let path = own_dir("ovx").join("again.ovx");
@@ -123,8 +123,8 @@ pub fn ovx(data: &[u8]) {
         tree.for_each_solid_cell(|min, size, value| cells.push((min, size, value)));
         cells
     };
-    assert_eq!(cells(&again.tree), cells(&scene.tree), "the voxels changed in a save and load");
-    assert_eq!(again.tree.counts(), scene.tree.counts());
-    assert_eq!((again.tree.origin(), again.tree.depth()), (scene.tree.origin(), scene.tree.depth()));
+    assert_eq!(cells(again.drawn()), cells(scene.drawn()), "the voxels changed in a save and load");
+    assert_eq!(again.counts(), scene.counts());
+    assert_eq!((again.origin(), again.drawn().depth()), (scene.origin(), scene.drawn().depth()));
     assert_eq!(again.palette, scene.palette, "the palette or materials changed in a save and load");
 }

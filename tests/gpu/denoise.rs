@@ -7,16 +7,16 @@ use glam::{DVec3, IVec3};
 use octovox::camera::Camera;
 use octovox::gpu::{PathView, Renderer};
 use octovox::quality::{accumulate, flip, psnr};
-use octovox::scene::{Octree, Op, Palette, Shape};
+use octovox::scene::{Octree, Op, Scene, Shape};
 use octovox::settings::PathSettings;
 use octovox::trace::denoise::{Frame, LUMINANCE, denoise, noise_estimate};
 use octovox::trace::path::{render_cpu, to_image};
 
 use crate::path_trace::{build, look, material_scene, palette};
 
-fn renderer_for(tree: &mut Octree, palette: &Palette) -> Renderer {
+fn renderer_for(scene: &mut Scene) -> Renderer {
     let mut renderer = Renderer::headless().expect("a GPU adapter (lavapipe on CI)");
-    renderer.sync(tree, palette);
+    renderer.sync(scene);
     renderer.estimate_noise = true;
     renderer
 }
@@ -47,12 +47,12 @@ fn grey_variance(image: &image::RgbaImage) -> f64 {
 fn the_gpu_filter_matches_its_cpu_twin() {
     // Every effect in view, so some pixels are left to their samples; 3
     // samples take the variance from the neighbours, 6 from the pixel's own.
-    let (mut tree, palette) = material_scene();
+    let mut scene = material_scene();
     let camera = look(DVec3::new(18.0, 14.0, 26.0), DVec3::new(0.0, 3.0, 0.0));
     let settings = PathSettings { bounces: 3, ..PathSettings::default() };
     let size = (48, 32);
-    let mut renderer = renderer_for(&mut tree, &palette);
-    let view = PathView { tree: &tree, palette: &palette, camera: &camera, size, settings: &settings };
+    let mut renderer = renderer_for(&mut scene);
+    let view = PathView { scene: &scene, camera: &camera, size, settings: &settings };
     for spp in [3, 6] {
         sample(&mut renderer, &view, spp);
         let raw = renderer.read_image().unwrap();
@@ -60,7 +60,7 @@ fn the_gpu_filter_matches_its_cpu_twin() {
         let gpu = renderer.read_image().unwrap();
         let sums = renderer.path.read_sums(&renderer.gpu).unwrap();
         let guides = renderer.path.read_guides(&renderer.gpu).unwrap();
-        let frame = Frame::of(&camera.basis(size.0, size.1, tree.origin()));
+        let frame = Frame::of(&camera.basis(size.0, size.1, scene.origin()));
         let cpu = to_image(&denoise(&frame, &sums, &guides), size.0, size.1);
         // exp and sqrt differ in their last bits; one byte of rounding.
         let off = share_differing(&gpu, &cpu, 1);
@@ -79,13 +79,13 @@ fn the_gpu_filter_matches_its_cpu_twin() {
 
 #[test]
 fn the_gpu_guides_and_noise_estimate_match_the_cpu() {
-    let (mut tree, palette) = material_scene();
+    let mut scene = material_scene();
     let camera = look(DVec3::new(-20.0, 10.0, 22.0), DVec3::new(0.0, 2.0, 0.0));
     let settings = PathSettings { bounces: 2, ..PathSettings::default() };
     let size = (40, 30);
-    let cpu = render_cpu(&tree, &palette, &camera, size, &settings, 1);
-    let mut renderer = renderer_for(&mut tree, &palette);
-    let view = PathView { tree: &tree, palette: &palette, camera: &camera, size, settings: &settings };
+    let cpu = render_cpu(&scene, &camera, size, &settings, 1);
+    let mut renderer = renderer_for(&mut scene);
+    let view = PathView { scene: &scene, camera: &camera, size, settings: &settings };
     sample(&mut renderer, &view, 1);
     let gpu = renderer.path.read_guides(&renderer.gpu).unwrap();
     let same = gpu.iter().zip(&cpu.guides).filter(|(g, c)| g.code == c.code).count();
@@ -113,7 +113,7 @@ fn the_gpu_guides_and_noise_estimate_match_the_cpu() {
 
 /// A floor of one-voxel checker squares in two colours under the sun, seen
 /// from straight above; the light and dark squares' cells.
-fn checker() -> (Octree, Palette, Camera) {
+fn checker() -> (Scene, Camera) {
     let mut palette = palette();
     palette.colors[8] = [110, 110, 110, 255];
     palette.colors[9] = [30, 30, 30, 255];
@@ -134,7 +134,7 @@ fn checker() -> (Octree, Palette, Camera) {
         fov_y_deg: 50.0,
         ortho: Some(24.0),
     };
-    (build(&edits), palette, camera)
+    (Scene::new(palette, build(&edits)), camera)
 }
 
 /// (light − dark) / (light + dark) of the mean luminance of the squares.
@@ -162,11 +162,11 @@ fn contrast(image: &image::RgbaImage, tree: &Octree, camera: &Camera) -> f64 {
 
 #[test]
 fn a_one_voxel_checker_keeps_its_contrast_and_the_filter_adds_no_bias() {
-    let (mut tree, palette, camera) = checker();
+    let (mut scene, camera) = checker();
     let settings = PathSettings { bounces: 2, ..PathSettings::default() };
     let size = (96, 96);
-    let mut renderer = renderer_for(&mut tree, &palette);
-    let view = PathView { tree: &tree, palette: &palette, camera: &camera, size, settings: &settings };
+    let mut renderer = renderer_for(&mut scene);
+    let view = PathView { scene: &scene, camera: &camera, size, settings: &settings };
     // The converged image, and the one the filter is asked not to bias: 8
     // times fewer samples, raw and denoised.
     sample(&mut renderer, &view, 1024);
@@ -179,7 +179,7 @@ fn a_one_voxel_checker_keeps_its_contrast_and_the_filter_adds_no_bias() {
     let raw = renderer.read_image().unwrap();
     renderer.denoise_now().unwrap();
     let denoised = renderer.read_image().unwrap();
-    let (want, got) = (contrast(&converged, &tree, &camera), contrast(&denoised, &tree, &camera));
+    let (want, got) = (contrast(&converged, scene.drawn(), &camera), contrast(&denoised, scene.drawn(), &camera));
     println!("checker contrast: converged {want:.4}, denoised at 2 spp {got:.4}");
     assert!(want > 0.5, "the converged image shows no checker: {want}");
     assert!((got - want).abs() < 0.02 * want, "contrast {got} against the converged image's {want}");
@@ -212,20 +212,13 @@ fn a_render_to_a_target_error_stops_near_it() {
     // the target (the reference's own noise included).
     let scenes = [
         ("materials", material_scene(), look(DVec3::new(18.0, 14.0, 26.0), DVec3::new(0.0, 3.0, 0.0))),
-        (
-            "checker",
-            {
-                let (t, p, _) = checker();
-                (t, p)
-            },
-            look(DVec3::new(30.0, 20.0, 36.0), DVec3::new(12.0, 0.0, 12.0)),
-        ),
+        ("checker", checker().0, look(DVec3::new(30.0, 20.0, 36.0), DVec3::new(12.0, 0.0, 12.0))),
     ];
     let settings = PathSettings { bounces: 2, ..PathSettings::default() };
     let size = (48, 32);
-    for (name, (mut tree, palette), camera) in scenes {
-        let mut renderer = renderer_for(&mut tree, &palette);
-        let view = PathView { tree: &tree, palette: &palette, camera: &camera, size, settings: &settings };
+    for (name, mut scene, camera) in scenes {
+        let mut renderer = renderer_for(&mut scene);
+        let view = PathView { scene: &scene, camera: &camera, size, settings: &settings };
         sample(&mut renderer, &view, 256);
         let reference = renderer.read_image().unwrap();
         let mut taken = Vec::new();

@@ -10,7 +10,7 @@ use crate::common;
 use glam::{DVec3, IVec3, Vec3};
 use octovox::camera::Camera;
 use octovox::gpu::{PathView, Renderer};
-use octovox::scene::{Material, MaterialKind, Octree, Op, Palette, Shape};
+use octovox::scene::{Material, MaterialKind, Octree, Op, Palette, Scene, Shape};
 use octovox::settings::{PathSettings, Sky};
 use octovox::trace::path::{CpuRender, render_cpu};
 
@@ -72,17 +72,22 @@ fn white_furnace_converges_to_the_sky_on_the_cpu() {
     // Albedo 1 everywhere under a sky of radiance 1: every path carries 1,
     // however many times it bounces between the sphere's voxel steps and
     // the floor.
-    let tree = build(&[
-        (Shape::Sphere { center: IVec3::new(0, 6, 0), radius: 6 }, Op::Place(WHITE)),
-        (Shape::Box { min: IVec3::new(-12, -2, -12), max: IVec3::new(12, -1, 12) }, Op::Place(WHITE)),
-    ]);
+    let scene = Scene::new(palette(), furnace_tree());
     // The second camera sees the faces on the root cube's own faces.
     for camera in furnace_cameras() {
         let size = (48, 36);
-        let CpuRender { pixels, effects, .. } = render_cpu(&tree, &palette(), &camera, size, &furnace(), 16);
+        let CpuRender { pixels, effects, .. } = render_cpu(&scene, &camera, size, &furnace(), 16);
         assert_eq!(effects.names(), ["sky"]);
-        assert_furnace(&tree, &camera, size, &pixels);
+        assert_furnace(scene.drawn(), &camera, size, &pixels);
     }
+}
+
+/// A white sphere on a white floor.
+fn furnace_tree() -> Octree {
+    build(&[
+        (Shape::Sphere { center: IVec3::new(0, 6, 0), radius: 6 }, Op::Place(WHITE)),
+        (Shape::Box { min: IVec3::new(-12, -2, -12), max: IVec3::new(12, -1, 12) }, Op::Place(WHITE)),
+    ])
 }
 
 fn furnace_cameras() -> [Camera; 2] {
@@ -103,7 +108,7 @@ fn assert_furnace(tree: &Octree, camera: &Camera, size: (u32, u32), pixels: &[Ve
 
 /// A closed 9³ room (walls one voxel thick) with one lamp voxel on the
 /// ceiling, seen from inside.
-fn lamp_room(lamp: Material) -> (Octree, Palette, Camera) {
+fn lamp_room(lamp: Material) -> (Scene, Camera) {
     let tree = build(&[
         (Shape::Box { min: IVec3::splat(-5), max: IVec3::splat(5) }, Op::Place(WHITE)),
         (Shape::Box { min: IVec3::splat(-4), max: IVec3::splat(4) }, Op::Remove),
@@ -112,22 +117,22 @@ fn lamp_room(lamp: Material) -> (Octree, Palette, Camera) {
     ]);
     let mut palette = palette();
     palette.materials[usize::from(SPECIAL)] = lamp;
-    (tree, palette, look(DVec3::new(3.5, 0.5, 3.5), DVec3::new(-3.0, -1.0, -2.0)))
+    (Scene::new(palette, tree), look(DVec3::new(3.5, 0.5, 3.5), DVec3::new(-3.0, -1.0, -2.0)))
 }
 
 #[test]
 fn a_closed_room_is_lit_by_its_emitter_and_dark_without() {
     let settings = PathSettings { bounces: 4, ..PathSettings::default() };
     let emit = material(MaterialKind::Emit, &[("_emit", "1")]);
-    let (tree, palette, camera) = lamp_room(emit);
-    let CpuRender { pixels: lit, effects, .. } = render_cpu(&tree, &palette, &camera, (32, 24), &settings, 8);
+    let (scene, camera) = lamp_room(emit);
+    let CpuRender { pixels: lit, effects, .. } = render_cpu(&scene, &camera, (32, 24), &settings, 8);
     assert_eq!(effects.names(), ["sun", "sky", "emit"]);
     let m = mean(&lit);
     assert!(m.min_element() > 0.05, "the lit room's mean {m}");
     // The red wall shows red.
     assert!(m.x > m.y, "{m}");
-    let (tree, palette, camera) = lamp_room(Material::new(MaterialKind::Diffuse));
-    let CpuRender { pixels: dark, effects, .. } = render_cpu(&tree, &palette, &camera, (32, 24), &settings, 8);
+    let (scene, camera) = lamp_room(Material::new(MaterialKind::Diffuse));
+    let CpuRender { pixels: dark, effects, .. } = render_cpu(&scene, &camera, (32, 24), &settings, 8);
     assert_eq!(effects.names(), ["sun", "sky"]);
     assert!(dark.iter().all(|p| *p == Vec3::ZERO), "sun and sky cannot reach into a closed box");
 }
@@ -151,9 +156,10 @@ fn clear_glass_of_index_one_shows_what_is_behind_it_unchanged() {
     let mut palette = palette();
     palette.materials[usize::from(SPECIAL)] = material(MaterialKind::Glass, &[("_ri", "1"), ("_trans", "1")]);
     let size = (32, 32);
-    let CpuRender { pixels: without, .. } = render_cpu(&stripes_with(None), &palette, &camera, size, &settings, 64);
+    let CpuRender { pixels: without, .. } =
+        render_cpu(&Scene::new(palette.clone(), stripes_with(None)), &camera, size, &settings, 64);
     let CpuRender { pixels: with, effects, .. } =
-        render_cpu(&stripes_with(Some(SPECIAL)), &palette, &camera, size, &settings, 64);
+        render_cpu(&Scene::new(palette, stripes_with(Some(SPECIAL))), &camera, size, &settings, 64);
     assert_eq!(effects.names(), ["sky", "glass"]);
     // The pane covers the middle of the view: compare there.
     let centre = |v: &[Vec3]| -> Vec<Vec3> {
@@ -177,14 +183,15 @@ fn a_mirror_shows_the_reflected_colour() {
     let mirror = material(MaterialKind::Metal, &[("_rough", "0"), ("_metal", "1")]);
     let mut palette = palette();
     palette.materials[usize::from(SPECIAL)] = mirror;
-    let tree =
+    let floor =
         build(&[(Shape::Box { min: IVec3::new(-40, -1, -40), max: IVec3::new(40, -1, 40) }, Op::Place(SPECIAL))]);
+    let scene = Scene::new(palette, floor);
     let settings = PathSettings { bounces: 3, sun: false, ..PathSettings::default() };
     let camera = look(DVec3::new(0.5, 10.0, 6.0), DVec3::new(0.5, -1.0, -3.0));
     let size = (16, 16);
-    let CpuRender { pixels, effects, .. } = render_cpu(&tree, &palette, &camera, size, &settings, 16);
+    let CpuRender { pixels, effects, .. } = render_cpu(&scene, &camera, size, &settings, 16);
     assert_eq!(effects.names(), ["sky", "metal"]);
-    let basis = camera.basis(size.0, size.1, tree.origin());
+    let basis = camera.basis(size.0, size.1, scene.origin());
     let (horizon, zenith) = Sky::Gradient.colors();
     for (x, y) in [(8, 8), (2, 13), (13, 3)] {
         let d = basis.ray(x, y).1.normalize();
@@ -197,17 +204,16 @@ fn a_mirror_shows_the_reflected_colour() {
 
 /// Renders `spp` samples on the GPU and returns the mean radiance.
 fn render_gpu(
-    tree: &mut Octree,
-    palette: &Palette,
+    scene: &mut Scene,
     camera: &Camera,
     size: (u32, u32),
     settings: &PathSettings,
     spp: u32,
 ) -> (Vec<Vec3>, octovox::trace::path::materials::Effects) {
     let mut renderer = Renderer::headless().expect("a GPU adapter (lavapipe on CI)");
-    renderer.sync(tree, palette);
+    renderer.sync(scene);
     let mut effects = None;
-    let view = PathView { tree, palette, camera, size, settings };
+    let view = PathView { scene, camera, size, settings };
     for i in 0..spp {
         let frame = renderer.render_path(&view, i == 0).unwrap();
         assert_eq!(frame.samples, i + 1);
@@ -218,20 +224,17 @@ fn render_gpu(
 
 #[test]
 fn gpu_white_furnace_converges_to_the_sky() {
-    let mut tree = build(&[
-        (Shape::Sphere { center: IVec3::new(0, 6, 0), radius: 6 }, Op::Place(WHITE)),
-        (Shape::Box { min: IVec3::new(-12, -2, -12), max: IVec3::new(12, -1, 12) }, Op::Place(WHITE)),
-    ]);
+    let mut scene = Scene::new(palette(), furnace_tree());
     for camera in furnace_cameras() {
         let size = (48, 36);
-        let (pixels, effects) = render_gpu(&mut tree, &palette(), &camera, size, &furnace(), 16);
+        let (pixels, effects) = render_gpu(&mut scene, &camera, size, &furnace(), 16);
         assert_eq!(effects.names(), ["sky"]);
-        assert_furnace(&tree, &camera, size, &pixels);
+        assert_furnace(scene.drawn(), &camera, size, &pixels);
     }
 }
 
 /// A scene with every material: diffuse floor, metal, glass, a lamp.
-pub(crate) fn material_scene() -> (Octree, Palette) {
+pub(crate) fn material_scene() -> Scene {
     let mut palette = palette();
     palette.materials[5] = material(MaterialKind::Metal, &[("_rough", "0.3"), ("_metal", "0.8")]);
     palette.materials[6] = material(MaterialKind::Glass, &[("_ri", "1.5"), ("_trans", "0.9"), ("_rough", "0.05")]);
@@ -245,7 +248,7 @@ pub(crate) fn material_scene() -> (Octree, Palette) {
         (Shape::Box { min: IVec3::new(2, 0, -2), max: IVec3::new(10, 9, 1) }, Op::Place(6)),
         (Shape::Box { min: IVec3::new(-2, 0, 6), max: IVec3::new(0, 2, 8) }, Op::Place(7)),
     ]);
-    (tree, palette)
+    Scene::new(palette, tree)
 }
 
 #[test]
@@ -253,14 +256,13 @@ fn gpu_and_cpu_path_tracers_agree() {
     // The same random numbers feed both; rounding differences (sin and cos
     // are not bit-identical) can send a path another way, so compare the
     // means and the share of pixels that differ by more than the noise.
-    let (mut tree, palette) = material_scene();
+    let mut scene = material_scene();
     let camera = look(DVec3::new(18.0, 14.0, 26.0), DVec3::new(0.0, 3.0, 0.0));
     let settings = PathSettings { bounces: 3, ..PathSettings::default() };
     let size = (40, 30);
     let spp = 8;
-    let CpuRender { pixels: cpu, effects: cpu_effects, .. } =
-        render_cpu(&tree, &palette, &camera, size, &settings, spp);
-    let (gpu, gpu_effects) = render_gpu(&mut tree, &palette, &camera, size, &settings, spp);
+    let CpuRender { pixels: cpu, effects: cpu_effects, .. } = render_cpu(&scene, &camera, size, &settings, spp);
+    let (gpu, gpu_effects) = render_gpu(&mut scene, &camera, size, &settings, spp);
     assert_eq!(cpu_effects, gpu_effects);
     assert_eq!(gpu_effects.names(), ["sun", "sky", "emit", "metal", "glass"]);
     let (mc, mg) = (mean(&cpu), mean(&gpu));
@@ -278,8 +280,8 @@ fn all_finite(pixels: &[Vec3]) -> bool {
 fn no_nan_or_infinity_from_the_hard_case_cameras() {
     // Every effect on, cameras inside solid voxels, on boundaries, grazing,
     // from below and a million voxels away.
-    let (mut tree, palette) = material_scene();
-    let (lo, hi) = tree.solid_bounds().unwrap();
+    let mut scene = material_scene();
+    let (lo, hi) = scene.solid_bounds().unwrap();
     let mut cameras = common::cameras_for(lo, hi);
     cameras.push(look(DVec3::new(1.0e6, 3.0e5, -2.0e5), DVec3::new(0.0, 0.0, 0.0)));
     // On the floor's top plane, grazing along it; inside a solid voxel; on
@@ -289,11 +291,11 @@ fn no_nan_or_infinity_from_the_hard_case_cameras() {
     cameras.push(look(DVec3::new(4.0, 3.0, -1.0), DVec3::new(-4.0, 3.0, 8.0)));
     let settings = PathSettings { bounces: 6, shadow_samples: 2, ..PathSettings::default() };
     let mut renderer = Renderer::headless().expect("a GPU adapter (lavapipe on CI)");
-    renderer.sync(&mut tree, &palette);
+    renderer.sync(&mut scene);
     for (i, camera) in cameras.iter().enumerate() {
-        let CpuRender { pixels: cpu, .. } = render_cpu(&tree, &palette, camera, (24, 18), &settings, 2);
+        let CpuRender { pixels: cpu, .. } = render_cpu(&scene, camera, (24, 18), &settings, 2);
         assert!(all_finite(&cpu), "camera {i}: the CPU's accumulation holds NaN, infinity or a negative");
-        let view = PathView { tree: &tree, palette: &palette, camera, size: (24, 18), settings: &settings };
+        let view = PathView { scene: &scene, camera, size: (24, 18), settings: &settings };
         for sample in 0..2 {
             renderer.render_path(&view, sample == 0).unwrap();
         }
@@ -312,13 +314,13 @@ fn a_scene_of_255_emissive_materials_renders() {
     for index in 1..=255i32 {
         edits.push((Shape::Voxel(IVec3::new(index % 16 * 2, index / 16 * 2, 4)), Op::Place(index as u8)));
     }
-    let mut tree = build(&edits);
+    let mut scene = Scene::new(palette, build(&edits));
     let camera = look(DVec3::new(16.0, 20.0, 40.0), DVec3::new(16.0, 10.0, 4.0));
     let settings = PathSettings::default();
-    let (gpu, effects) = render_gpu(&mut tree, &palette, &camera, (32, 24), &settings, 2);
+    let (gpu, effects) = render_gpu(&mut scene, &camera, (32, 24), &settings, 2);
     assert!(effects.emit);
     assert!(all_finite(&gpu));
-    let lights = octovox::trace::path::lights::emitters(&tree, &palette);
+    let lights = octovox::trace::path::lights::emitters(scene.drawn(), &scene.palette);
     assert!(lights.len() >= 255, "{} lights", lights.len());
     assert!(mean(&gpu).min_element() > 0.1, "{}", mean(&gpu));
 }
@@ -329,25 +331,25 @@ fn a_new_effect_set_is_compiled_off_the_frame_path() {
     // compiled (on a worker thread), frames run the all-effects kernel.
     let mut palette = palette();
     palette.materials[usize::from(SPECIAL)] = material(MaterialKind::Glass, &[("_ri", "1.5"), ("_trans", "1")]);
-    let mut tree = build(&[(Shape::Box { min: IVec3::ZERO, max: IVec3::splat(7) }, Op::Place(WHITE))]);
+    let mut scene =
+        Scene::new(palette, build(&[(Shape::Box { min: IVec3::ZERO, max: IVec3::splat(7) }, Op::Place(WHITE))]));
     let camera = look(DVec3::new(20.0, 16.0, 24.0), DVec3::new(4.0, 4.0, 4.0));
     let settings = PathSettings::default();
     let mut renderer = Renderer::headless().unwrap();
-    renderer.sync(&mut tree, &palette);
+    renderer.sync(&mut scene);
     let size = (16, 12);
-    let frame = renderer
-        .render_path(&PathView { tree: &tree, palette: &palette, camera: &camera, size, settings: &settings }, true)
-        .unwrap();
+    let frame =
+        renderer.render_path(&PathView { scene: &scene, camera: &camera, size, settings: &settings }, true).unwrap();
     assert_eq!((frame.effects.names(), frame.kernel), (vec!["sun", "sky"], frame.effects));
     let all = PathSettings { effects: octovox::settings::EffectsChoice::All, ..settings };
-    renderer.compile_path_kernel(&tree, &palette, &all).unwrap();
-    tree.apply_brush(&Shape::Voxel(IVec3::new(3, 8, 3)), Op::Place(SPECIAL)).unwrap();
-    renderer.sync(&mut tree, &palette);
-    let view = PathView { tree: &tree, palette: &palette, camera: &camera, size, settings: &settings };
+    renderer.compile_path_kernel(&scene, &all).unwrap();
+    scene.apply_brush(&Shape::Voxel(IVec3::new(3, 8, 3)), Op::Place(SPECIAL)).unwrap();
+    renderer.sync(&mut scene);
+    let view = PathView { scene: &scene, camera: &camera, size, settings: &settings };
     let frame = renderer.render_path(&view, true).unwrap();
     assert_eq!(frame.effects.names(), ["sun", "sky", "glass"]);
     assert_eq!(frame.kernel, octovox::trace::path::materials::Effects::ALL, "the stand-in runs while glass compiles");
-    renderer.compile_path_kernel(&tree, &palette, &settings).unwrap();
+    renderer.compile_path_kernel(&scene, &settings).unwrap();
     let frame = renderer.render_path(&view, false).unwrap();
     assert_eq!(frame.kernel, frame.effects);
 }
@@ -359,16 +361,16 @@ fn a_sample_split_in_bands_equals_a_whole_one() {
     // accumulation is the whole-sample one, and a sample counts once all
     // its bands are in. A band of 9 or 10 rows does not fill its
     // workgroups, whose extra threads must not trace the next band's rows.
-    let (mut tree, palette) = material_scene();
+    let mut scene = material_scene();
     let camera = look(DVec3::new(3.0, 8.0, 14.0), DVec3::new(0.0, 1.0, 0.0));
     let (size, settings) = ((40, 37), PathSettings { bounces: 3, ..PathSettings::default() });
-    let (whole, _) = render_gpu(&mut tree, &palette, &camera, size, &settings, 3);
+    let (whole, _) = render_gpu(&mut scene, &camera, size, &settings, 3);
     // A second renderer needs the whole pool: a sync uploads what changed since the last.
-    let (mut tree, palette) = material_scene();
+    let mut scene = material_scene();
     let mut renderer = Renderer::headless().expect("a GPU adapter (lavapipe on CI)");
-    renderer.sync(&mut tree, &palette);
+    renderer.sync(&mut scene);
     // The window traces the preview first when an accumulation would start over.
-    let view = PathView { tree: &tree, palette: &palette, camera: &camera, size, settings: &settings };
+    let view = PathView { scene: &scene, camera: &camera, size, settings: &settings };
     assert!(renderer.path_restarts(&view, false), "nothing accumulated yet");
     renderer.render_path(&view, true).unwrap();
     assert!(!renderer.path_restarts(&view, false), "the same accumulation goes on");

@@ -15,11 +15,11 @@ use octovox::trace::Footprint;
 use octovox::trace::grid::DenseGrid;
 use octovox::trace::render::{Tracer, trace_image};
 
-fn renderer_for(tree: &mut Octree) -> Renderer {
+fn renderer_for(scene: &mut Scene) -> Renderer {
     let mut renderer = Renderer::headless().expect("a GPU adapter (lavapipe on CI)");
     renderer.hit_records = true;
-    renderer.sync(tree, &Palette::default());
-    if let Ok(grid) = DenseGrid::from_octree(tree) {
+    renderer.sync(scene);
+    if let Ok(grid) = DenseGrid::from_octree(scene.drawn()) {
         renderer.set_grid(&grid).unwrap();
     }
     renderer
@@ -27,29 +27,29 @@ fn renderer_for(tree: &mut Octree) -> Renderer {
 
 fn gpu_hits(
     renderer: &mut Renderer,
-    tree: &Octree,
+    scene: &Scene,
     camera: &Camera,
     size: (u32, u32),
     mode: TraceMode,
 ) -> Vec<octovox::trace::Hit> {
     let settings = RenderSettings { mode, view: View::Shaded, shadows: true, render_scale: 1.0, lod: 0.0 };
-    renderer.render(tree, camera, size, &settings, None).unwrap();
+    renderer.render(scene, camera, size, &settings, None).unwrap();
     renderer.read_hits().unwrap()
 }
 
 /// GPU SVO, GPU grid, CPU SVO and CPU grid all agree on every camera.
-fn check_scene(tree: &mut Octree, cameras: &[Camera], size: (u32, u32)) {
-    let mut renderer = renderer_for(tree);
-    let grid = DenseGrid::from_octree(tree).unwrap();
+fn check_scene(scene: &mut Scene, cameras: &[Camera], size: (u32, u32)) {
+    let mut renderer = renderer_for(scene);
+    let grid = DenseGrid::from_octree(scene.drawn()).unwrap();
     let mut vs_cpu_svo = Agreement::default();
     let mut vs_cpu_grid = Agreement::default();
     let mut gpu_grid_vs_svo = Agreement::default();
     for camera in cameras {
-        let basis = camera.basis(size.0, size.1, tree.origin());
-        let gpu_svo = gpu_hits(&mut renderer, tree, camera, size, TraceMode::Svo);
-        let gpu_grid = gpu_hits(&mut renderer, tree, camera, size, TraceMode::Grid);
+        let basis = camera.basis(size.0, size.1, scene.origin());
+        let gpu_svo = gpu_hits(&mut renderer, scene, camera, size, TraceMode::Svo);
+        let gpu_grid = gpu_hits(&mut renderer, scene, camera, size, TraceMode::Grid);
         assert!(gpu_svo.iter().chain(&gpu_grid).all(|h| !h.gave_up()));
-        vs_cpu_svo.add(&gpu_svo, &trace_image(Tracer::Svo(tree), &basis, Footprint::EXACT));
+        vs_cpu_svo.add(&gpu_svo, &trace_image(Tracer::Svo(scene.drawn()), &basis, Footprint::EXACT));
         vs_cpu_grid.add(&gpu_svo, &trace_image(Tracer::Grid(&grid), &basis, Footprint::EXACT));
         gpu_grid_vs_svo.add(&gpu_grid, &gpu_svo);
     }
@@ -60,9 +60,9 @@ fn check_scene(tree: &mut Octree, cameras: &[Camera], size: (u32, u32)) {
 
 #[test]
 fn gpu_matches_cpu_on_sculpture() {
-    let mut tree = sculpture();
-    let (lo, hi) = tree.solid_bounds().unwrap();
-    check_scene(&mut tree, &cameras_for(lo, hi), (96, 72));
+    let mut scene = Scene::new(Palette::default(), sculpture());
+    let (lo, hi) = scene.solid_bounds().unwrap();
+    check_scene(&mut scene, &cameras_for(lo, hi), (96, 72));
 }
 
 /// The trace runs only on the tiles the beam lists, in rows of 64 tiles: an
@@ -70,16 +70,16 @@ fn gpu_matches_cpu_on_sculpture() {
 /// and bottom edges, is still traced on every pixel.
 #[test]
 fn gpu_traces_every_listed_tile() {
-    let mut tree = sculpture();
+    let mut scene = Scene::new(Palette::default(), sculpture());
     let camera = Camera { eye: DVec3::new(-10.0, 25.0, -30.0), target: DVec3::ZERO, fov_y_deg: 60.0, ortho: None };
     let size = (333, 211);
-    let cpu = trace_image(Tracer::Svo(&tree), &camera.basis(size.0, size.1, tree.origin()), Footprint::EXACT);
+    let cpu = trace_image(Tracer::Svo(scene.drawn()), &camera.basis(size.0, size.1, scene.origin()), Footprint::EXACT);
     let tiles_with_hits: std::collections::HashSet<(usize, usize)> = (0..cpu.len())
         .filter(|&i| cpu[i].is_hit())
         .map(|i| (i % size.0 as usize / 16, i / size.0 as usize / 16))
         .collect();
     assert!(tiles_with_hits.len() > 2 * 64, "only {} tiles to trace", tiles_with_hits.len());
-    check_scene(&mut tree, &[camera], size);
+    check_scene(&mut scene, &[camera], size);
 }
 
 #[test]
@@ -87,8 +87,8 @@ fn gpu_matches_cpu_on_a_voxelized_scan() {
     let path = common::assets().join("meshes/nefertiti.obj");
     let tree = voxelize_obj(&path, 96, UpAxis::Z, MESH_COLOR).unwrap();
     let mut scene = Scene::new(Palette::default(), tree);
-    let (lo, hi) = scene.tree.solid_bounds().unwrap();
-    check_scene(&mut scene.tree, &cameras_for(lo, hi), (96, 72));
+    let (lo, hi) = scene.solid_bounds().unwrap();
+    check_scene(&mut scene, &cameras_for(lo, hi), (96, 72));
 }
 
 #[test]
@@ -96,7 +96,7 @@ fn gpu_hard_cases() {
     // Axis-parallel rays along voxel faces, 45° diagonals from integer
     // positions, a grazing floor camera, a camera inside a voxel and one on a
     // boundary plane.
-    let mut tree = sculpture();
+    let mut scene = Scene::new(Palette::default(), sculpture());
     let cameras = [
         Camera { eye: DVec3::new(4.0, 7.0, -40.0), target: DVec3::new(4.0, 7.0, 0.0), fov_y_deg: 30.0, ortho: None },
         Camera { eye: DVec3::new(-30.0, 30.0, 0.0), target: DVec3::new(0.0, 0.0, 0.0), fov_y_deg: 60.0, ortho: None },
@@ -112,35 +112,35 @@ fn gpu_hard_cases() {
         },
         Camera { eye: DVec3::new(7.0, 40.0, 7.0), target: DVec3::new(7.0, 0.0, 7.0), fov_y_deg: 50.0, ortho: None },
     ];
-    check_scene(&mut tree, &cameras, (64, 64));
+    check_scene(&mut scene, &cameras, (64, 64));
 }
 
 #[test]
 fn gpu_far_camera_deep_tree_empty_and_full() {
     // One voxel 2^16 away from another: a deep, sparse tree, seen from 100 000 voxels.
-    let mut tree = Octree::default();
+    let mut scene = Scene::default();
     let far = IVec3::new(40_000, -20_000, 50_000);
-    tree.apply_brush(&Shape::Voxel(IVec3::ZERO), Op::Place(4)).unwrap();
-    tree.apply_brush(&Shape::Voxel(far), Op::Place(5)).unwrap();
+    scene.apply_brush(&Shape::Voxel(IVec3::ZERO), Op::Place(4)).unwrap();
+    scene.apply_brush(&Shape::Voxel(far), Op::Place(5)).unwrap();
     let camera = Camera {
         eye: far.as_dvec3() + DVec3::new(0.5, 100_000.0, 0.5),
         target: far.as_dvec3() + DVec3::splat(0.5),
         fov_y_deg: 0.01,
         ortho: None,
     };
-    let mut renderer = renderer_for(&mut tree);
-    let hits = gpu_hits(&mut renderer, &tree, &camera, (9, 9), TraceMode::Svo);
+    let mut renderer = renderer_for(&mut scene);
+    let hits = gpu_hits(&mut renderer, &scene, &camera, (9, 9), TraceMode::Svo);
     assert_eq!(hits[4 * 9 + 4].value, 5);
-    assert_eq!(hits[4 * 9 + 4].voxel + tree.origin(), far);
+    assert_eq!(hits[4 * 9 + 4].voxel + scene.origin(), far);
 
-    let mut empty = Octree::default();
+    let mut empty = Scene::default();
     let mut renderer = renderer_for(&mut empty);
     let hits = gpu_hits(&mut renderer, &empty, &Camera::default(), (16, 16), TraceMode::Svo);
     assert!(hits.iter().all(|h| !h.is_hit()));
     let image = renderer.read_image().unwrap();
     assert!(image.pixels().all(|p| p.0[3] == 255 && p.0[2] > 150), "sky everywhere");
 
-    let mut full = Octree::empty(IVec3::ZERO, 4);
+    let mut full = Scene::new(Palette::default(), Octree::empty(IVec3::ZERO, 4));
     full.apply_brush(&Shape::Box { min: IVec3::ZERO, max: IVec3::splat(15) }, Op::Place(2)).unwrap();
     let cameras = cameras_for(IVec3::ZERO, IVec3::splat(15));
     check_scene(&mut full, &cameras, (32, 32));
@@ -148,9 +148,9 @@ fn gpu_far_camera_deep_tree_empty_and_full() {
 
 #[test]
 fn gpu_flat_wall_has_no_holes() {
-    let mut tree = Octree::default();
-    tree.apply_brush(&Shape::Box { min: IVec3::new(0, 0, 0), max: IVec3::new(63, 63, 0) }, Op::Place(9)).unwrap();
-    let mut renderer = renderer_for(&mut tree);
+    let mut scene = Scene::default();
+    scene.apply_brush(&Shape::Box { min: IVec3::new(0, 0, 0), max: IVec3::new(63, 63, 0) }, Op::Place(9)).unwrap();
+    let mut renderer = renderer_for(&mut scene);
     let mut seed = 99u64;
     let mut rand = move || {
         seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
@@ -160,7 +160,7 @@ fn gpu_flat_wall_has_no_holes() {
         let target = DVec3::new(16.0 + rand() * 32.0, 16.0 + rand() * 32.0, 0.0);
         let dir = DVec3::new(rand() - 0.5, rand() - 0.5, -0.3 - rand()).normalize();
         let camera = Camera { eye: target + dir * (10.0 + rand() * 50.0), target, fov_y_deg: 10.0, ortho: None };
-        let hits = gpu_hits(&mut renderer, &tree, &camera, (8, 8), TraceMode::Svo);
+        let hits = gpu_hits(&mut renderer, &scene, &camera, (8, 8), TraceMode::Svo);
         // The narrow view sees only wall: any miss is a hole.
         assert!(hits.iter().all(|h| h.is_hit() && h.normal == IVec3::new(0, 0, -1)), "hole from {camera:?}");
     }
@@ -171,9 +171,9 @@ fn gpu_flat_wall_has_no_holes() {
 /// GPU still sees exactly the tree the CPU sees.
 #[test]
 fn gpu_pool_growth_keeps_the_picture() {
-    let mut tree = Octree::default();
-    tree.apply_brush(&Shape::Sphere { center: IVec3::splat(8), radius: 6 }, Op::Place(3)).unwrap();
-    let mut renderer = renderer_for(&mut tree);
+    let mut scene = Scene::default();
+    scene.apply_brush(&Shape::Sphere { center: IVec3::splat(8), radius: 6 }, Op::Place(3)).unwrap();
+    let mut renderer = renderer_for(&mut scene);
     let camera = Camera {
         eye: DVec3::new(-150.0, 120.0, -160.0),
         target: DVec3::new(40.0, 10.0, 40.0),
@@ -185,12 +185,14 @@ fn gpu_pool_growth_keeps_the_picture() {
     for i in 0..6 {
         // Scattered spheres add nodes and bricks in both regions.
         let center = IVec3::new(20 * i, (i * 7) % 13, 80 - 16 * i);
-        tree.apply_brush(&Shape::Sphere { center, radius: 4 + 5 * i }, Op::Place(4 + i as u8)).unwrap();
-        let stats = renderer.sync(&mut tree, &Palette::default());
+        scene.apply_brush(&Shape::Sphere { center, radius: 4 + 5 * i }, Op::Place(4 + i as u8)).unwrap();
+        let stats = renderer.sync(&mut scene);
+        let tree = scene.drawn();
         eprintln!("edit {i}: {} nodes, {} bricks, {stats:?}", tree.node_count(), tree.brick_count());
         growths += u32::from(stats.grew);
-        let gpu = gpu_hits(&mut renderer, &tree, &camera, size, TraceMode::Svo);
-        let cpu = trace_image(Tracer::Svo(&tree), &camera.basis(size.0, size.1, tree.origin()), Footprint::EXACT);
+        let gpu = gpu_hits(&mut renderer, &scene, &camera, size, TraceMode::Svo);
+        let cpu =
+            trace_image(Tracer::Svo(scene.drawn()), &camera.basis(size.0, size.1, scene.origin()), Footprint::EXACT);
         let mut agreement = Agreement::default();
         agreement.add(&gpu, &cpu);
         agreement.assert_good(&format!("after edit {i}"));
@@ -214,11 +216,11 @@ fn gpu_matches_cpu_on_every_shared_model() {
     assert!(models.len() >= 14, "{models:?}");
     for path in models {
         let mut scene = octovox::io::load_scene(&path, 0).unwrap();
-        let (lo, hi) = scene.tree.solid_bounds().unwrap();
+        let (lo, hi) = scene.solid_bounds().unwrap();
         let cameras = cameras_for(lo, hi);
         assert!(cameras.len() >= 8);
         eprintln!("{}", path.display());
-        check_scene(&mut scene.tree, &cameras, (64, 48));
+        check_scene(&mut scene, &cameras, (64, 48));
     }
 }
 
@@ -228,19 +230,19 @@ fn gpu_matches_cpu_on_every_shared_model() {
 fn teapot_picture_and_iteration_counts() {
     let path = common::assets().join("vox/seed/teapot256.vox");
     let mut scene = octovox::io::load_scene(&path, 0).unwrap();
-    let mut renderer = renderer_for(&mut scene.tree);
-    let (lo, hi) = scene.tree.solid_bounds().unwrap();
+    let mut renderer = renderer_for(&mut scene);
+    let (lo, hi) = scene.solid_bounds().unwrap();
     let camera = Camera::framing(lo, hi, 50.0);
     let settings =
         RenderSettings { mode: TraceMode::Svo, view: View::Shaded, shadows: true, render_scale: 1.0, lod: 0.0 };
-    renderer.render(&scene.tree, &camera, (200, 150), &settings, None).unwrap();
+    renderer.render(&scene, &camera, (200, 150), &settings, None).unwrap();
     let image = renderer.read_image().unwrap();
     let distinct: std::collections::HashSet<[u8; 4]> = image.pixels().map(|p| p.0).collect();
     let teapot_pixels = renderer.read_hits().unwrap().iter().filter(|h| h.is_hit()).count();
     assert!(distinct.len() > 20, "only {} colours", distinct.len());
     assert!(teapot_pixels > 200 * 150 / 10, "teapot covers {teapot_pixels} pixels");
     let mut mean = |mode| {
-        let hits = gpu_hits(&mut renderer, &scene.tree, &camera, (200, 150), mode);
+        let hits = gpu_hits(&mut renderer, &scene, &camera, (200, 150), mode);
         hits.iter().map(|h| f64::from(h.iterations)).sum::<f64>() / hits.len() as f64
     };
     let (svo, grid) = (mean(TraceMode::Svo), mean(TraceMode::Grid));
@@ -254,16 +256,16 @@ fn teapot_picture_and_iteration_counts() {
 /// those of frames that wait.
 #[test]
 fn frames_that_do_not_wait_report_their_times_later() {
-    let mut tree = sculpture();
-    let (lo, hi) = tree.solid_bounds().unwrap();
+    let mut scene = Scene::new(Palette::default(), sculpture());
+    let (lo, hi) = scene.solid_bounds().unwrap();
     let camera = Camera::framing(lo, hi, 50.0);
     let settings = RenderSettings::default();
     let mut renderer = Renderer::headless().unwrap();
     renderer.wait_for_frames = false;
-    renderer.sync(&mut tree, &Palette::default());
+    renderer.sync(&mut scene);
     let mut times = Vec::new();
     for _ in 0..12 {
-        times.push(renderer.render(&tree, &camera, (96, 64), &settings, None).unwrap());
+        times.push(renderer.render(&scene, &camera, (96, 64), &settings, None).unwrap());
     }
     assert!(times.iter().all(|ms| ms.is_finite() && *ms >= 0.0), "{times:?}");
     if renderer.gpu.timestamps {
@@ -273,7 +275,7 @@ fn frames_that_do_not_wait_report_their_times_later() {
     let unwaited = renderer.read_image().unwrap();
     // Waiting again works after frames that did not, and draws the same.
     renderer.wait_for_frames = true;
-    assert!(renderer.render(&tree, &camera, (96, 64), &settings, None).unwrap() > 0.0);
+    assert!(renderer.render(&scene, &camera, (96, 64), &settings, None).unwrap() > 0.0);
     assert_eq!(renderer.read_image().unwrap(), unwaited);
 }
 
@@ -286,17 +288,17 @@ fn frame_times_stay_plausible_after_path_traced_frames() {
     let mut scene = octovox::scene::demo::BuiltIn::Interior.scene();
     let camera = octovox::scene::showroom::interior_camera();
     let mut renderer = Renderer::headless().unwrap();
-    renderer.sync(&mut scene.tree, &scene.palette);
-    renderer.set_grid(&DenseGrid::from_octree(&scene.tree).unwrap()).unwrap();
+    renderer.sync(&mut scene);
+    renderer.set_grid(&DenseGrid::from_octree(scene.drawn()).unwrap()).unwrap();
     let settings = RenderSettings { mode: TraceMode::Grid, ..RenderSettings::default() };
     let size = (480, 270);
-    renderer.render(&scene.tree, &camera, size, &settings, None).unwrap();
+    renderer.render(&scene, &camera, size, &settings, None).unwrap();
     let path_settings = octovox::settings::PathSettings::default();
-    let view = PathView { tree: &scene.tree, palette: &scene.palette, camera: &camera, size, settings: &path_settings };
+    let view = PathView { scene: &scene, camera: &camera, size, settings: &path_settings };
     renderer.render_path(&view, true).unwrap();
     for _ in 0..3 {
         let start = std::time::Instant::now();
-        let ms = renderer.render(&scene.tree, &camera, size, &settings, None).unwrap();
+        let ms = renderer.render(&scene, &camera, size, &settings, None).unwrap();
         let wall = start.elapsed().as_secs_f64() * 1e3;
         if wall > 10.0 {
             assert!(ms > wall * 0.05, "a {wall:.1} ms frame timed as {ms:.3} ms");
@@ -312,21 +314,21 @@ fn gpu_level_of_detail_matches_cpu() {
     let path = common::assets().join("meshes/nefertiti.obj");
     let tree = voxelize_obj(&path, 96, UpAxis::Z, MESH_COLOR).unwrap();
     let mut scene = Scene::new(Palette::default(), tree);
-    scene.tree.apply_brush(&Shape::Sphere { center: IVec3::new(40, 60, 40), radius: 12 }, Op::Paint(9)).unwrap();
-    let (lo, hi) = scene.tree.solid_bounds().unwrap();
+    scene.apply_brush(&Shape::Sphere { center: IVec3::new(40, 60, 40), radius: 12 }, Op::Paint(9)).unwrap();
+    let (lo, hi) = scene.solid_bounds().unwrap();
     let size = (96, 72);
-    let mut renderer = renderer_for(&mut scene.tree);
-    renderer.sync(&mut scene.tree, &scene.palette);
+    let mut renderer = renderer_for(&mut scene);
+    renderer.sync(&mut scene);
     for lod in [4.0, 8.0] {
         let settings = RenderSettings { lod, ..RenderSettings::default() };
         let (mut vs_cpu, mut vs_exact) = (Agreement::default(), Agreement::default());
         let (mut steps, mut exact_steps) = (0u64, 0u64);
         for camera in cameras_for(lo, hi) {
-            let basis = camera.basis(size.0, size.1, scene.tree.origin());
-            renderer.render(&scene.tree, &camera, size, &settings, None).unwrap();
+            let basis = camera.basis(size.0, size.1, scene.origin());
+            renderer.render(&scene, &camera, size, &settings, None).unwrap();
             let gpu = renderer.read_hits().unwrap();
-            let cpu = trace_image(Tracer::Svo(&scene.tree), &basis, Footprint::of_pixels(&basis, lod));
-            let exact = trace_image(Tracer::Svo(&scene.tree), &basis, Footprint::EXACT);
+            let cpu = trace_image(Tracer::Svo(scene.drawn()), &basis, Footprint::of_pixels(&basis, lod));
+            let exact = trace_image(Tracer::Svo(scene.drawn()), &basis, Footprint::EXACT);
             vs_cpu.add(&gpu, &cpu);
             vs_exact.add(&gpu, &exact);
             steps += gpu.iter().map(|h| u64::from(h.iterations)).sum::<u64>();

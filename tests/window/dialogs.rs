@@ -15,9 +15,9 @@ use octovox::scene::{Op, Scene, Shape};
 
 fn save_box(path: &Path, max: IVec3) -> u64 {
     let mut scene = Scene::default();
-    scene.tree.apply_brush(&Shape::Box { min: IVec3::ZERO, max }, Op::Place(12)).unwrap();
+    scene.apply_brush(&Shape::Box { min: IVec3::ZERO, max }, Op::Place(12)).unwrap();
     octovox::io::save_scene(path, &scene, Default::default()).unwrap();
-    scene.tree.solid_voxels()
+    scene.solid_voxels()
 }
 
 #[test]
@@ -60,7 +60,7 @@ fn open_and_save_as_go_through_the_native_dialog_or_the_path_field() {
     xdotool(&display, &["key", "ctrl+shift+s"]);
     let saved = lines.wait_for("saved:", Duration::from_secs(30));
     assert!(saved.ends_with("c.vox"), "{saved}");
-    assert_eq!(octovox::io::load_scene(&c, 0).unwrap().tree.solid_voxels(), b_count);
+    assert_eq!(octovox::io::load_scene(&c, 0).unwrap().solid_voxels(), b_count);
     let log = std::fs::read_to_string(root.join("zenity.log")).unwrap();
     assert!(log.contains("--file-selection") && log.contains("--save"), "{log}");
 

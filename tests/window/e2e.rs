@@ -46,10 +46,10 @@ fn click_attach_save_erase_save_in_a_real_window() {
 
     // The CPU reference decides where to click and what must happen.
     let original = octovox::io::load_scene(&file, 0).unwrap();
-    let original_voxels: HashSet<IVec3> = original.tree.voxels().into_iter().map(|(p, _)| p).collect();
-    let (lo, hi) = original.tree.solid_bounds().unwrap();
+    let original_voxels: HashSet<IVec3> = original.voxels().into_iter().map(|(p, _)| p).collect();
+    let (lo, hi) = original.solid_bounds().unwrap();
     let camera = Camera::framing(lo, hi, 50.0);
-    let (x, y, hit_voxel, normal) = stable_pixel(&original.tree, &camera, |_, _| true);
+    let (x, y, hit_voxel, normal) = stable_pixel(original.drawn(), &camera, |_, _| true);
     let placed = hit_voxel + normal;
     assert!(!original_voxels.contains(&placed));
     eprintln!("click at ({x}, {y}): hits {hit_voxel} through face {normal}; attach goes to {placed}");
@@ -95,10 +95,10 @@ fn click_attach_save_erase_save_in_a_real_window() {
 
     // The same pixel now hits the new voxel (the ray passed through its cell).
     let edited = octovox::io::load_scene(&file, 0).unwrap();
-    let basis = camera.basis(WIDTH, HEIGHT, edited.tree.origin());
+    let basis = camera.basis(WIDTH, HEIGHT, edited.origin());
     let (o, d) = basis.ray(x, y);
-    let again = svo::trace(&edited.tree, &Ray::new(o, d));
-    assert_eq!(again.voxel + edited.tree.origin(), placed);
+    let again = svo::trace(edited.drawn(), &Ray::new(o, d));
+    assert_eq!(again.voxel + edited.origin(), placed);
 
     // Erase it with the R tool, save, and the file is the original again.
     // The panels are kept between frames while they do not change
@@ -117,8 +117,8 @@ fn click_attach_save_erase_save_in_a_real_window() {
     // A drag is a stroke: several edits, one undo step. It ends on a pixel
     // that (after the first attach) still hits another voxel of the same face
     // layer, so the stroke must place there too.
-    let (x, y, top_voxel, _) = stable_pixel(&original.tree, &camera, |v, n| n == IVec3::Y && v.y == hi.y);
-    let mut stroked = original.tree.clone();
+    let (x, y, top_voxel, _) = stable_pixel(original.drawn(), &camera, |v, n| n == IVec3::Y && v.y == hi.y);
+    let mut stroked = original.drawn().clone();
     let first = octovox::scene::Shape::Voxel(top_voxel + IVec3::Y);
     stroked.apply_brush(&first, octovox::scene::Op::Place(1)).unwrap();
     let (ex, ey) = same_layer_pixel(&stroked, &camera, (x, y), top_voxel, IVec3::Y);
@@ -304,7 +304,7 @@ fn alt_click_picks_a_colour_and_shift_click_paint_fills_with_it() {
         (Shape::Box { min: IVec3::new(x0, 0, 0), max: IVec3::new(x0 + 7, 7, 7) }, Op::Place(color))
     };
     for (shape, op) in [box_of(0, 12), box_of(8, 77)] {
-        scene.tree.apply_brush(&shape, op).unwrap();
+        scene.apply_brush(&shape, op).unwrap();
     }
     octovox::io::save_scene(&file, &scene, Default::default()).unwrap();
     let camera = Camera {
@@ -313,7 +313,7 @@ fn alt_click_picks_a_colour_and_shift_click_paint_fills_with_it() {
         fov_y_deg: 50.0,
         ortho: None,
     };
-    let (x, y, voxel, normal) = stable_pixel(&scene.tree, &camera, |v, n| scene.tree.get(v) == 77 && n == IVec3::Z);
+    let (x, y, voxel, normal) = stable_pixel(scene.drawn(), &camera, |v, n| scene.voxel(v) == 77 && n == IVec3::Z);
     let args = document_args(&file, &camera, &["--shading", "preview"]);
     let (_xvfb, display) = start_xvfb(4);
     let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
@@ -326,11 +326,11 @@ fn alt_click_picks_a_colour_and_shift_click_paint_fills_with_it() {
     click(&display, &window, &mut lines, x, y);
     save(&display, &mut lines, &file);
     let saved = octovox::io::load_scene(&file, 0).unwrap();
-    assert_eq!(saved.tree.get(voxel + normal), 77, "the attached voxel has the picked colour");
+    assert_eq!(saved.voxel(voxel + normal), 77, "the attached voxel has the picked colour");
 
     // Shift+click with Paint floods the 77 region (the attached voxel
     // included) with the colour picked from the other box: all is 12 then.
-    let (x12, y12, _, _) = stable_pixel(&scene.tree, &camera, |v, n| scene.tree.get(v) == 12 && n == IVec3::Z);
+    let (x12, y12, _, _) = stable_pixel(scene.drawn(), &camera, |v, n| scene.voxel(v) == 12 && n == IVec3::Z);
     xdotool(&display, &["mousemove", "--window", &window, &x12.to_string(), &y12.to_string()]);
     xdotool(&display, &["keydown", "alt", "click", "1", "keyup", "alt"]);
     assert_eq!(lines.wait_for("picked colour", Duration::from_secs(30)), "picked colour 12");
@@ -340,8 +340,8 @@ fn alt_click_picks_a_colour_and_shift_click_paint_fills_with_it() {
     lines.wait_for("fill:", Duration::from_secs(30));
     save(&display, &mut lines, &file);
     let filled = octovox::io::load_scene(&file, 0).unwrap();
-    assert_eq!(filled.tree.solid_voxels(), 1025);
-    assert!(filled.tree.voxels().iter().all(|(_, c)| *c == 12), "the 77 region was filled with 12");
+    assert_eq!(filled.solid_voxels(), 1025);
+    assert!(filled.voxels().iter().all(|(_, c)| *c == 12), "the 77 region was filled with 12");
 }
 
 /// A mirrored stroke: with `mirror x 8` (the floor's middle) in force (set
@@ -357,8 +357,8 @@ fn a_mirrored_stroke_places_both_sides_and_undoes_in_one_step() {
     std::fs::write(&script, "mirror x 8\n").unwrap();
     // A floor voxel left of the plane, hit from above, and another of the
     // same layer a little away from it: the stroke goes from one to the other.
-    let (x, y, voxel, normal) = stable_pixel(&scene.tree, &camera, |v, n| n == IVec3::Y && v.x < 6);
-    let (ex, ey) = same_layer_pixel(&scene.tree, &camera, (x, y), voxel, normal);
+    let (x, y, voxel, normal) = stable_pixel(scene.drawn(), &camera, |v, n| n == IVec3::Y && v.x < 6);
+    let (ex, ey) = same_layer_pixel(scene.drawn(), &camera, (x, y), voxel, normal);
     let placed = voxel + normal;
     let image = |p: IVec3| IVec3::new(15 - p.x, p.y, p.z);
     let args = document_args(&file, &camera, &["--shading", "preview", "--replay", &script.display().to_string()]);
@@ -379,14 +379,14 @@ fn a_mirrored_stroke_places_both_sides_and_undoes_in_one_step() {
     xdotool(&display, &["mouseup", "1"]);
     save(&display, &mut lines, &file);
     let saved = octovox::io::load_scene(&file, 0).unwrap();
-    let added: Vec<IVec3> = saved.tree.voxels().into_iter().map(|(p, _)| p).filter(|p| p.y == 1).collect();
+    let added: Vec<IVec3> = saved.voxels().into_iter().map(|(p, _)| p).filter(|p| p.y == 1).collect();
     assert!(added.contains(&placed) && added.contains(&image(placed)), "{placed} and its image: {added:?}");
     assert!(added.len() >= 4, "the stroke passed over at least two cells: {added:?}");
     assert!(added.iter().all(|p| added.contains(&image(*p))), "every voxel has its image: {added:?}");
     xdotool(&display, &["key", "ctrl+z"]);
     lines.wait_for("undo:", Duration::from_secs(30));
     save(&display, &mut lines, &file);
-    assert_eq!(octovox::io::load_scene(&file, 0).unwrap().tree.solid_voxels(), 256, "one undo took the stroke away");
+    assert_eq!(octovox::io::load_scene(&file, 0).unwrap().solid_voxels(), 256, "one undo took the stroke away");
 }
 
 /// Line mode (L): a real press-drag-release across the floor places one
@@ -397,8 +397,8 @@ fn a_dragged_line_in_line_mode() {
     require_window_tools();
     let dir = tempfile::tempdir().unwrap();
     let (file, scene, camera) = floor_scene(dir.path());
-    let (xa, ya, va, na) = stable_pixel(&scene.tree, &camera, |v, n| n == IVec3::Y && v.x < 4);
-    let (xb, yb, vb, nb) = stable_pixel(&scene.tree, &camera, |v, n| n == IVec3::Y && v.x > 11);
+    let (xa, ya, va, na) = stable_pixel(scene.drawn(), &camera, |v, n| n == IVec3::Y && v.x < 4);
+    let (xb, yb, vb, nb) = stable_pixel(scene.drawn(), &camera, |v, n| n == IVec3::Y && v.x > 11);
     let (a, b) = (va + na, vb + nb);
     let args = document_args(&file, &camera, &["--shading", "preview"]);
     let (_xvfb, display) = start_xvfb(6);
@@ -418,7 +418,7 @@ fn a_dragged_line_in_line_mode() {
     lines.wait_for("line:", Duration::from_secs(30));
     save(&display, &mut lines, &file);
     let saved = octovox::io::load_scene(&file, 0).unwrap();
-    let added: Vec<IVec3> = saved.tree.voxels().into_iter().map(|(p, _)| p).filter(|p| p.y == 1).collect();
+    let added: Vec<IVec3> = saved.voxels().into_iter().map(|(p, _)| p).filter(|p| p.y == 1).collect();
     let steps = (b - a).abs().max_element();
     assert_eq!(added.len() as i32, steps + 1, "{a} to {b}: {added:?}");
     assert!(added.contains(&a) && added.contains(&b), "both ends: {added:?}");
@@ -427,7 +427,7 @@ fn a_dragged_line_in_line_mode() {
     xdotool(&display, &["key", "ctrl+z"]);
     lines.wait_for("undo:", Duration::from_secs(30));
     save(&display, &mut lines, &file);
-    assert_eq!(octovox::io::load_scene(&file, 0).unwrap().tree.solid_voxels(), 256, "one undo took the line away");
+    assert_eq!(octovox::io::load_scene(&file, 0).unwrap().solid_voxels(), 256, "one undo took the line away");
 }
 
 /// A 16×16 floor of colour 20 saved as `floor.vox` in `dir`, and a camera
@@ -435,7 +435,7 @@ fn a_dragged_line_in_line_mode() {
 fn floor_scene(dir: &std::path::Path) -> (PathBuf, octovox::scene::Scene, Camera) {
     let file = dir.join("floor.vox");
     let mut scene = octovox::scene::Scene::default();
-    scene.tree.apply_brush(&Shape::Box { min: IVec3::ZERO, max: IVec3::new(15, 0, 15) }, Op::Place(20)).unwrap();
+    scene.apply_brush(&Shape::Box { min: IVec3::ZERO, max: IVec3::new(15, 0, 15) }, Op::Place(20)).unwrap();
     octovox::io::save_scene(&file, &scene, Default::default()).unwrap();
     let camera = Camera {
         eye: glam::DVec3::new(8.0, 20.0, 24.0),

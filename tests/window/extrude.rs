@@ -35,9 +35,9 @@ fn face_region(solid: &HashSet<IVec3>, start: IVec3, normal: IVec3) -> HashSet<I
 #[test]
 fn ctrl_drag_extrudes_a_face_in_a_real_window() {
     let (dir, file, original, camera) = torus_document();
-    let solid: HashSet<IVec3> = original.tree.voxels().into_iter().map(|(p, _)| p).collect();
+    let solid: HashSet<IVec3> = original.voxels().into_iter().map(|(p, _)| p).collect();
     // A face pointing up, seen from above, so the drag has room.
-    let (x, y, voxel, normal) = stable_pixel(&original.tree, &camera, |_, n| n == IVec3::Y);
+    let (x, y, voxel, normal) = stable_pixel(original.drawn(), &camera, |_, n| n == IVec3::Y);
     let region = face_region(&solid, voxel, normal);
     let layers = 2;
     let expected: HashSet<IVec3> =
@@ -45,8 +45,8 @@ fn ctrl_drag_extrudes_a_face_in_a_real_window() {
     assert!(expected.len() > solid.len() + 2 * layers as usize, "a region of several faces");
 
     // The drag: two on-screen steps of the face's normal.
-    let basis = camera.basis(WIDTH, HEIGHT, original.tree.origin());
-    let face = (voxel - original.tree.origin()).as_vec3() + glam::Vec3::new(0.5, 1.0, 0.5);
+    let basis = camera.basis(WIDTH, HEIGHT, original.origin());
+    let face = (voxel - original.origin()).as_vec3() + glam::Vec3::new(0.5, 1.0, 0.5);
     let (a, b) = (basis.project(face).unwrap(), basis.project(face + glam::Vec3::Y).unwrap());
     let end = (x as f32 + 2.0 * (b.0 - a.0), y as f32 + 2.0 * (b.1 - a.1));
     assert!(end.1 > 40.0, "the drag stays in the window: {end:?}");

@@ -10,7 +10,6 @@ use std::time::Duration;
 use common::window::*;
 use glam::IVec3;
 use octovox::camera::Camera;
-use octovox::scene::Octree;
 use octovox::trace::svo;
 
 /// The working volume of a new scene (`DEFAULT_VOLUME` in src/app/state.rs).
@@ -26,7 +25,7 @@ fn new_scene_camera() -> Camera {
 /// A pixel clear of the panels whose 5×5 neighbourhood lands on one ground
 /// cell, and that cell.
 fn stable_ground_pixel(camera: &Camera) -> (u32, u32, IVec3) {
-    let empty = Octree::default();
+    let empty = octovox::scene::Scene::default();
     let cell = |x: u32, y: u32| {
         svo::pick_with_ground(&empty, camera, (WIDTH, HEIGHT), (x, y), true).unwrap().map(|hit| hit.voxel)
     };
@@ -85,5 +84,5 @@ fn new_then_a_click_on_the_ground_places_a_voxel_at_y_0() {
     assert_eq!(data.models.len(), 1);
     assert_eq!(data.models[0].voxels.len(), 1, "one voxel");
     let placed = octovox::io::load_scene(&file, 0).unwrap();
-    assert_eq!(placed.tree.voxels().into_iter().map(|(p, _)| p).collect::<Vec<_>>(), vec![ground + IVec3::Y]);
+    assert_eq!(placed.voxels().into_iter().map(|(p, _)| p).collect::<Vec<_>>(), vec![ground + IVec3::Y]);
 }

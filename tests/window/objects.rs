@@ -29,13 +29,13 @@ fn groups_document() -> (tempfile::TempDir, std::path::PathBuf, octovox::scene::
 #[test]
 fn a_click_picks_the_object_it_hits_and_edits_its_model() {
     let (dir, file, scene) = groups_document();
-    let objects = scene.objects.as_ref().expect("test_groups.vox is a scene of objects");
-    let (lo, hi) = scene.tree.solid_bounds().unwrap();
+    let objects = scene.objects().expect("test_groups.vox is a scene of objects");
+    let (lo, hi) = scene.solid_bounds().unwrap();
     let camera = Camera::framing(lo, hi, 50.0);
     // A pixel on a face of an object that is not the last one (so that
     // the pick is not the default target by chance).
     let last = objects.list().len() - 1;
-    let (x, y, voxel, _) = stable_pixel(&scene.tree, &camera, |v, _| objects.owner_at(v).is_some_and(|o| o != last));
+    let (x, y, voxel, _) = stable_pixel(scene.drawn(), &camera, |v, _| objects.owner_at(v).is_some_and(|o| o != last));
     let owner = objects.owner_at(voxel).unwrap();
     let model = objects.list()[owner].placement.model;
     let before = model_sizes(&file);
@@ -65,20 +65,20 @@ fn a_click_picks_the_object_it_hits_and_edits_its_model() {
 fn ctrl_h_hides_the_picked_object_and_the_file_keeps_it() {
     use octovox::trace::{Ray, svo};
     let (dir, file, scene) = groups_document();
-    let objects = scene.objects.as_ref().unwrap();
-    let (lo, hi) = scene.tree.solid_bounds().unwrap();
+    let objects = scene.objects().unwrap();
+    let (lo, hi) = scene.solid_bounds().unwrap();
     let camera = Camera::framing(lo, hi, 50.0);
-    let (x, y, voxel, _) = stable_pixel(&scene.tree, &camera, |v, _| objects.owner_at(v).is_some());
+    let (x, y, voxel, _) = stable_pixel(scene.drawn(), &camera, |v, _| objects.owner_at(v).is_some());
     let owner = objects.owner_at(voxel).unwrap();
     // The pixels that show the object, by the CPU tracer.
-    let basis = camera.basis(WIDTH, HEIGHT, scene.tree.origin());
+    let basis = camera.basis(WIDTH, HEIGHT, scene.origin());
     let shows: Vec<(u32, u32)> = (FREE_Y..HEIGHT)
         .step_by(2)
         .flat_map(|py| (FREE_X..WIDTH).step_by(2).map(move |px| (px, py)))
         .filter(|&(px, py)| {
             let (o, d) = basis.ray(px, py);
-            let hit = svo::trace(&scene.tree, &Ray::new(o, d));
-            hit.is_hit() && objects.owner_at(hit.voxel + scene.tree.origin()) == Some(owner)
+            let hit = svo::trace(scene.drawn(), &Ray::new(o, d));
+            hit.is_hit() && objects.owner_at(hit.voxel + scene.origin()) == Some(owner)
         })
         .collect();
     assert!(shows.len() > 20, "object {owner} covers {} pixels", shows.len());
@@ -128,10 +128,10 @@ fn ctrl_h_hides_the_picked_object_and_the_file_keeps_it() {
 #[test]
 fn object_edits_survive_a_kill() {
     let (dir, file, scene) = groups_document();
-    let objects = scene.objects.as_ref().unwrap();
-    let (lo, hi) = scene.tree.solid_bounds().unwrap();
+    let objects = scene.objects().unwrap();
+    let (lo, hi) = scene.solid_bounds().unwrap();
     let camera = Camera::framing(lo, hi, 50.0);
-    let (x, y, voxel, _) = stable_pixel(&scene.tree, &camera, |v, _| objects.owner_at(v).is_some());
+    let (x, y, voxel, _) = stable_pixel(scene.drawn(), &camera, |v, _| objects.owner_at(v).is_some());
     let owner = objects.owner_at(voxel).unwrap();
     let model = objects.list()[owner].placement.model;
     let before = model_sizes(&file);

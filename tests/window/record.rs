@@ -18,7 +18,7 @@ fn wait_exit(app: &mut KillOnDrop) {
 #[test]
 fn recorded_window_session_replays_to_the_same_voxels() {
     let (dir, file, original, camera) = torus_document();
-    let (x, y, _, _) = stable_pixel(&original.tree, &camera, |_, _| true);
+    let (x, y, _, _) = stable_pixel(original.drawn(), &camera, |_, _| true);
 
     let (_xvfb, display) = start_xvfb(17);
     let script = dir.path().join("session.ovr");
@@ -52,8 +52,8 @@ fn recorded_window_session_replays_to_the_same_voxels() {
 
     let window_scene = octovox::io::load_scene(&file, 0).unwrap();
     let replay_scene = octovox::io::load_scene(&replayed, 0).unwrap();
-    assert_eq!(window_scene.tree.solid_voxels(), original.tree.solid_voxels() + 2);
-    assert_eq!(window_scene.tree.voxels(), replay_scene.tree.voxels(), "replay differs from the window session");
+    assert_eq!(window_scene.solid_voxels(), original.solid_voxels() + 2);
+    assert_eq!(window_scene.voxels(), replay_scene.voxels(), "replay differs from the window session");
 }
 
 #[test]
@@ -95,12 +95,12 @@ fn window_plays_a_script_through_the_edit_path() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stdout));
     let replayed = octovox::io::load_scene(&dir.path().join("replayed.vox"), 0).unwrap();
     let saved = octovox::io::load_scene(&dir.path().join("out.vox"), 0).unwrap();
-    assert_eq!(saved.tree.solid_voxels(), 27);
+    assert_eq!(saved.solid_voxels(), 27);
     // Palette edits went through the window's edit path, undo included.
     assert_eq!(saved.palette.color(9), [200, 100, 50, 255]);
     assert_eq!(saved.palette.material(9).kind, octovox::scene::MaterialKind::Metal);
     assert_eq!(saved.palette.material(9).roughness(), 0.2);
-    assert_eq!(replayed.tree.voxels(), saved.tree.voxels(), "the recording replays to the same voxels");
+    assert_eq!(replayed.voxels(), saved.voxels(), "the recording replays to the same voxels");
     assert_eq!(
         (replayed.palette.color(9), replayed.palette.material(9)),
         (saved.palette.color(9), saved.palette.material(9))

@@ -32,7 +32,7 @@ fn a_killed_window_loses_no_finished_edit() {
     let mut used: Vec<IVec3> = Vec::new();
     for _ in 0..3 {
         let (x, y, voxel, _) =
-            stable_pixel(&original.tree, &camera, |v, _| !used.iter().any(|u| (*u - v).abs().max_element() < 3));
+            stable_pixel(original.drawn(), &camera, |v, _| !used.iter().any(|u| (*u - v).abs().max_element() < 3));
         used.push(voxel);
         pixels.push((x, y));
     }
@@ -51,11 +51,7 @@ fn a_killed_window_loses_no_finished_edit() {
     // A crash: no chance to clean up or save.
     app.0.kill().unwrap();
     app.0.wait().unwrap();
-    assert_eq!(
-        octovox::io::load_scene(&file, 0).unwrap().tree.voxels(),
-        original.tree.voxels(),
-        "the document is untouched"
-    );
+    assert_eq!(octovox::io::load_scene(&file, 0).unwrap().voxels(), original.voxels(), "the document is untouched");
 
     // What the session held: the same clicks replayed headless.
     let expected_file = dir.path().join("expected.vox");
@@ -83,7 +79,7 @@ fn a_killed_window_loses_no_finished_edit() {
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
     let voxels = voxel_colors;
     assert_eq!(voxels(&recovered), voxels(&expected_file), "recover gives the session's voxels");
-    assert_eq!(voxels(&recovered).len(), original.tree.voxels().len() + 3);
+    assert_eq!(voxels(&recovered).len(), original.voxels().len() + 3);
     assert!(journal.is_file(), "recover leaves the journal in place");
 
     // Opening the document again offers to recover; Recover applies it.
@@ -144,7 +140,7 @@ fn an_untitled_scene_is_recovered_after_a_kill() {
         .collect();
     std::fs::write(dir.path().join("edits.ovr"), script).unwrap();
     let demo = octovox::scene::demo::BuiltIn::Terrain.scene();
-    let mut expected: HashSet<(IVec3, u8)> = demo.tree.voxels().into_iter().collect();
+    let mut expected: HashSet<(IVec3, u8)> = demo.voxels().into_iter().collect();
     expected.extend(edits.iter().map(|p| (*p, 5)));
 
     let (_xvfb, display) = start_xvfb(11);
@@ -206,7 +202,7 @@ fn undo_past_a_save_selections_and_old_clipboards_survive_a_kill() {
     for dir in [window_dir.path(), headless_dir.path()] {
         let mut scene = octovox::scene::Scene::default();
         let floor = octovox::scene::Shape::Box { min: IVec3::ZERO, max: IVec3::new(15, 0, 15) };
-        scene.tree.apply_brush(&floor, octovox::scene::Op::Place(20)).unwrap();
+        scene.apply_brush(&floor, octovox::scene::Op::Place(20)).unwrap();
         octovox::io::save_scene(&dir.join("doc.vox"), &scene, Default::default()).unwrap();
     }
     std::fs::write(window_dir.path().join("play.ovr"), script).unwrap();
@@ -262,7 +258,7 @@ fn replayed(document: &Path, script: &str) -> HashSet<(IVec3, u8)> {
 }
 
 fn voxel_colors(path: &Path) -> HashSet<(IVec3, u8)> {
-    octovox::io::load_scene(path, 0).unwrap().tree.voxels().into_iter().collect()
+    octovox::io::load_scene(path, 0).unwrap().voxels().into_iter().collect()
 }
 
 /// Issue 24, items 1 and 5: the journal of a `move` made as the first edit
@@ -293,7 +289,7 @@ fn a_move_as_the_first_edit_is_recovered_and_a_changed_document_refused() {
     let journal = octovox::journal::journal_path(&file);
     let journal_text = std::fs::read_to_string(&journal).unwrap();
     let mut scene = octovox::io::load_scene(&file, 0).unwrap();
-    scene.tree.apply_brush(&octovox::scene::Shape::Voxel(IVec3::new(0, 40, 0)), octovox::scene::Op::Place(9)).unwrap();
+    scene.apply_brush(&octovox::scene::Shape::Voxel(IVec3::new(0, 40, 0)), octovox::scene::Op::Place(9)).unwrap();
     octovox::io::save_scene(&file, &scene, Default::default()).unwrap();
     let run = octovox(&["recover", s(&file), "-o", s(&recovered)]);
     let message = String::from_utf8_lossy(&run.stderr);

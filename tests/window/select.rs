@@ -50,15 +50,15 @@ fn a_box_selection_moves_with_the_arrows_resizes_by_a_handle_and_copies() {
     let floor = cells(IVec3::ZERO, IVec3::new(15, 0, 15));
     let block = cells(IVec3::new(4, 1, 4), IVec3::new(5, 2, 5));
     let mut scene = Scene::default();
-    scene.tree.apply_brush(&Shape::Box { min: IVec3::ZERO, max: IVec3::new(15, 0, 15) }, Op::Place(20)).unwrap();
-    scene.tree.apply_brush(&Shape::Box { min: IVec3::new(4, 1, 4), max: IVec3::new(5, 2, 5) }, Op::Place(30)).unwrap();
+    scene.apply_brush(&Shape::Box { min: IVec3::ZERO, max: IVec3::new(15, 0, 15) }, Op::Place(20)).unwrap();
+    scene.apply_brush(&Shape::Box { min: IVec3::new(4, 1, 4), max: IVec3::new(5, 2, 5) }, Op::Place(30)).unwrap();
     octovox::io::save_scene(&file, &scene, Default::default()).unwrap();
     // From the front (looking along -z): → is +x, ↑ is -z.
     let camera =
         Camera { eye: DVec3::new(8.0, 20.0, 24.0), target: DVec3::new(8.0, 0.0, 8.0), fov_y_deg: 50.0, ortho: None };
-    let (xa, ya, ..) = stable_pixel(&scene.tree, &camera, |v, n| v == IVec3::new(4, 2, 4) && n == IVec3::Y);
-    let (xb, yb, ..) = stable_pixel(&scene.tree, &camera, |v, n| v == IVec3::new(5, 1, 5) && n == IVec3::Z);
-    let (xf, yf, ..) = stable_pixel(&scene.tree, &camera, |v, n| v == IVec3::new(12, 0, 10) && n == IVec3::Y);
+    let (xa, ya, ..) = stable_pixel(scene.drawn(), &camera, |v, n| v == IVec3::new(4, 2, 4) && n == IVec3::Y);
+    let (xb, yb, ..) = stable_pixel(scene.drawn(), &camera, |v, n| v == IVec3::new(5, 1, 5) && n == IVec3::Z);
+    let (xf, yf, ..) = stable_pixel(scene.drawn(), &camera, |v, n| v == IVec3::new(12, 0, 10) && n == IVec3::Y);
 
     let (_xvfb, display) = start_xvfb(9);
     let args = document_args(&file, &camera, &["--shading", "preview"]);

@@ -431,7 +431,7 @@ mod tests {
     #[test]
     fn the_sparse_mesher_matches_the_dense_one() {
         let mut scenes = vec![
-            crate::scene::demo::BuiltIn::Showroom.scene().tree,
+            crate::scene::demo::BuiltIn::Showroom.scene().drawn().clone(),
             boxed(IVec3::new(-2, 0, 1), IVec3::new(4, 3, 9)),
             boxed(IVec3::new(0, 0, 0), IVec3::new(31, 31, 31)),
         ];

@@ -98,8 +98,8 @@ pub fn load_vox_scene(bytes: &[u8], frame: usize) -> Result<(Scene, VoxMeta), Vo
     let (palette, meta) = parsed.palette_and_meta();
     if parsed.keeps_objects() {
         let objects = parsed.into_objects(frame)?;
-        let tree = objects.compose().map_err(|e| VoxError::BadSceneGraph(e.to_string()))?;
-        return Ok((Scene { palette, tree, objects: Some(Box::new(objects)) }, meta));
+        let scene = Scene::compose(palette, objects).map_err(|e| VoxError::BadSceneGraph(e.to_string()))?;
+        return Ok((scene, meta));
     }
     // The bounds first, so the root is placed as a build from the whole list places it.
     let mut bounds: Option<(IVec3, IVec3)> = None;

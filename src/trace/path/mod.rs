@@ -28,7 +28,7 @@ use super::render::GAVE_UP_COLOR;
 use super::svo::{Crossing, trace_through};
 use super::{Hit, Ray, argmin, normal_code};
 use crate::camera::{Camera, RayBasis};
-use crate::scene::{Octree, Palette};
+use crate::scene::{Octree, Scene};
 use crate::settings::{EffectsChoice, PathSettings, SUN_DIR};
 
 /// Angular radius of the sun (radians): soft shadows of a few voxels.
@@ -53,10 +53,10 @@ pub fn sun_radiance() -> f32 {
 }
 
 /// The effect set of a frame: the scene's, or all of them.
-pub fn effects_for(tree: &Octree, palette: &Palette, settings: &PathSettings) -> Effects {
+pub fn effects_for(scene: &Scene, settings: &PathSettings) -> Effects {
     let sky = settings.sky != crate::settings::Sky::Black;
     match settings.effects {
-        EffectsChoice::Auto => Effects::of_scene(tree.counts(), palette, settings.sun, sky),
+        EffectsChoice::Auto => Effects::of_scene(scene.counts(), &scene.palette, settings.sun, sky),
         EffectsChoice::All => Effects::ALL,
     }
 }
@@ -72,8 +72,9 @@ pub struct PathScene<'a> {
 }
 
 impl PathScene<'_> {
-    pub fn new<'a>(tree: &'a Octree, palette: &Palette, settings: &PathSettings) -> PathScene<'a> {
-        let effects = effects_for(tree, palette, settings);
+    pub fn new<'a>(scene: &'a Scene, settings: &PathSettings) -> PathScene<'a> {
+        let (tree, palette) = (scene.drawn(), &scene.palette);
+        let effects = effects_for(scene, settings);
         let lights = if effects.emit { lights::emitters(tree, palette) } else { Vec::new() };
         PathScene {
             tree,
@@ -507,16 +508,9 @@ pub struct CpuRender {
 
 /// The mean radiance of `spp` samples of every pixel: the CPU reference for
 /// path-traced frames (`render --cpu --spp N`).
-pub fn render_cpu(
-    tree: &Octree,
-    palette: &Palette,
-    camera: &Camera,
-    size: (u32, u32),
-    settings: &PathSettings,
-    spp: u32,
-) -> CpuRender {
-    let scene = PathScene::new(tree, palette, settings);
-    let basis = camera.basis(size.0, size.1, tree.origin());
+pub fn render_cpu(scene: &Scene, camera: &Camera, size: (u32, u32), settings: &PathSettings, spp: u32) -> CpuRender {
+    let basis = camera.basis(size.0, size.1, scene.origin());
+    let scene = PathScene::new(scene, settings);
     let (sums, guides): (Vec<Sums>, Vec<Guide>) = (0..basis.height)
         .into_par_iter()
         .flat_map_iter(|y| {
