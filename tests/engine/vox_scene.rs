@@ -74,7 +74,7 @@ fn load(bytes: &[u8]) -> Scene {
 }
 
 fn saved(scene: &Scene) -> Vec<u8> {
-    encode_objects(&scene.palette, scene.objects.as_ref().expect("a scene of objects")).unwrap()
+    encode_objects(&scene.palette, scene.objects().expect("a scene of objects")).unwrap()
 }
 
 #[test]
@@ -85,7 +85,7 @@ fn every_scene_file_of_the_assets_round_trips_without_loss() {
         let scene = load(&bytes);
         let name = path.display().to_string();
         let parsed = dot_vox::load_bytes(&bytes).unwrap();
-        if scene.objects.is_none() {
+        if scene.objects().is_none() {
             assert!(parsed.models.len() <= 1, "{name}: {} models flattened", parsed.models.len());
             continue;
         }
@@ -94,7 +94,7 @@ fn every_scene_file_of_the_assets_round_trips_without_loss() {
         assert_same_scene(&name, &bytes, &again);
         // And what is drawn is the same.
         let reloaded = load(&again);
-        assert_eq!(reloaded.tree.voxels(), scene.tree.voxels(), "{name}: drawn voxels");
+        assert_eq!(reloaded.voxels(), scene.voxels(), "{name}: drawn voxels");
     }
     assert!(scenes >= 4, "only {scenes} scene files among the assets");
 }
@@ -199,18 +199,18 @@ fn append_chunks(bytes: &mut Vec<u8>, chunks: &[([u8; 4], Vec<u8>)]) {
 fn a_written_scene_of_thousands_of_references_round_trips_and_hides_what_is_hidden() {
     let bytes = written_scene(2000);
     let scene = load(&bytes);
-    let objects = scene.objects.as_ref().unwrap();
+    let objects = scene.objects().unwrap();
     assert_eq!((objects.list().len(), objects.models.len()), (2000, 3));
     assert_same_scene("written", &bytes, &saved(&scene));
     // Hidden: layer 2 (every third) and k % 11 == 5. Each model's voxels
     // land on their own cells (the placements are 9 apart, at most 6 wide).
     let per_model = [5 * 5 + 1, 4 * 4 + 1, 6 * 6 + 1];
     let visible: u64 = (0..2000).filter(|k| k % 3 != 2 && k % 11 != 5).map(|k| per_model[k % 3] as u64).sum();
-    assert_eq!(scene.tree.solid_voxels(), visible);
+    assert_eq!(scene.solid_voxels(), visible);
     // At frame 3 the keyframed ones have moved up by 100 (MagicaVoxel z, octovox y).
     let at_3 = load_vox_scene(&bytes, 3).unwrap().0;
-    assert_eq!(at_3.tree.solid_voxels(), visible);
-    assert!(at_3.tree.solid_bounds().unwrap().1.y > scene.tree.solid_bounds().unwrap().1.y + 90);
+    assert_eq!(at_3.solid_voxels(), visible);
+    assert!(at_3.solid_bounds().unwrap().1.y > scene.solid_bounds().unwrap().1.y + 90);
 }
 
 /// Two placements of one model (a reference), the second turned a quarter
@@ -247,27 +247,27 @@ fn an_edit_goes_into_the_model_of_the_object_and_every_reference_shows_it() {
     data.write_vox(&mut bytes).unwrap();
     let mut editor = Editor::default();
     editor.set_scene(load(&bytes));
-    let before = editor.scene.tree.solid_voxels();
+    let before = editor.scene.solid_voxels();
     assert_eq!(before, 2 * 17);
     // Model cell (0, 0, 1) is the marked corner; a (pivot 2, 2, 1) lands it
     // at scene (−2, −2, 0) = world (−2, 0, 2). Put a voxel on top of it.
     // (`dot_vox` counts colour indices from 0: its 11 is the file's 12.)
-    assert_eq!(editor.scene.tree.get(IVec3::new(-2, 0, 2)), 12);
+    assert_eq!(editor.scene.voxel(IVec3::new(-2, 0, 2)), 12);
     let script =
         octovox::script::parse_script(std::path::Path::new("t.ovr"), "object a\ncolor 7\nplace -2 1 2").unwrap();
     for line in &script.lines {
         editor.run(&line.command).unwrap();
     }
-    assert_eq!(editor.scene.tree.solid_voxels(), before + 2, "both placements show the new voxel");
+    assert_eq!(editor.scene.solid_voxels(), before + 2, "both placements show the new voxel");
     let saved_once = saved(&editor.scene);
     let parsed = dot_vox::load_bytes(&saved_once).unwrap();
     assert_eq!(parsed.models.len(), 1);
     assert_eq!(parsed.models[0].voxels.len(), 18);
     // Reading the saved file back gives what was drawn.
-    assert_eq!(load(&saved_once).tree.voxels(), editor.scene.tree.voxels());
+    assert_eq!(load(&saved_once).voxels(), editor.scene.voxels());
     editor.run(&octovox::script::Command::Undo(1)).unwrap();
-    assert_eq!(editor.scene.tree.solid_voxels(), before);
-    assert_eq!(editor.scene.objects.as_ref().unwrap().models[0].tree.solid_voxels(), 17);
+    assert_eq!(editor.scene.solid_voxels(), before);
+    assert_eq!(editor.scene.objects().unwrap().models[0].tree.solid_voxels(), 17);
 }
 
 /// A voxel placed below a model's grid moves its origin: the saved file
@@ -277,13 +277,13 @@ fn a_model_that_grows_on_one_side_keeps_its_voxels_where_they_were() {
     let bytes = written_scene(6);
     let mut editor = Editor::default();
     editor.set_scene(load(&bytes));
-    let lo = editor.scene.objects.as_ref().unwrap().world_box(1).unwrap().0;
+    let lo = editor.scene.objects().unwrap().world_box(1).unwrap().0;
     let place = format!("place {} {} {}", lo.x - 1, lo.y - 1, lo.z - 1);
     for line in ["object 1", "brush box 3 3 3", place.as_str()] {
         let script = octovox::script::parse_script(std::path::Path::new("t.ovr"), line).unwrap();
         editor.run(&script.lines[0].command).unwrap();
     }
-    let drawn = editor.scene.tree.voxels();
+    let drawn = editor.scene.voxels();
     let again = saved(&editor.scene);
     let grown = &dot_vox::load_bytes(&again).unwrap().models[1];
     assert!(grown.size.x > 4 || grown.size.y > 4 || grown.size.z > 2, "{:?}", grown.size);
@@ -295,6 +295,82 @@ fn a_model_that_grows_on_one_side_keeps_its_voxels_where_they_were() {
     assert_eq!(placed, expected);
 }
 
+/// A model edited past 256 voxels a side is saved as pieces of at most
+/// 256³, each its own model, under a group in the place of its shape: each
+/// placement (here a plain one and a turned reference) shows them where
+/// the model's voxels were, and the file's other models stay as they are.
+#[test]
+fn a_model_grown_past_256_is_saved_in_pieces_that_load_back_as_drawn() {
+    let mut bytes = Vec::new();
+    let placed = |name: &str, t: &str, r: Option<&str>, child: u32| {
+        let mut frame = vec![("_t", t.to_owned())];
+        frame.extend(r.map(|r| ("_r", r.to_owned())));
+        SceneNode::Transform {
+            attributes: dict(&[("_name", name.into())]),
+            frames: vec![Frame::new(dict(&frame))],
+            child,
+            layer_id: 0,
+        }
+    };
+    let shape = |model_id| SceneNode::Shape {
+        attributes: dict(&[]),
+        models: vec![ShapeModel { model_id, attributes: dict(&[]) }],
+    };
+    let data = DotVoxData {
+        version: 200,
+        index_map: Vec::new(),
+        models: vec![model(4, 10), model(3, 40)],
+        palette: dot_vox::DEFAULT_PALETTE.to_vec(),
+        materials: Vec::new(),
+        scenes: vec![
+            SceneNode::Transform { attributes: dict(&[]), frames: vec![], child: 1, layer_id: u32::MAX },
+            SceneNode::Group { attributes: dict(&[]), children: vec![2, 4, 5] },
+            placed("a", "0 0 0", None, 3),
+            shape(0),
+            placed("b", "20 -30 4", Some("17"), 3),
+            placed("c", "-9 9 0", None, 6),
+            shape(1),
+        ],
+        layers: vec![Layer { attributes: dict(&[("_name", "0".into())]) }],
+    };
+    data.write_vox(&mut bytes).unwrap();
+    let mut editor = Editor::default();
+    editor.set_scene(load(&bytes));
+    let script = "object a\ncolor 7\nplace 300 0 2\nplace -250 6 -270\nplace 1 1 1";
+    for line in &octovox::script::parse_script(std::path::Path::new("t.ovr"), script).unwrap().lines {
+        editor.run(&line.command).unwrap();
+    }
+    let drawn = editor.scene.voxels();
+    let again = saved(&editor.scene);
+    let parsed = dot_vox::load_bytes(&again).unwrap();
+    for (m, model) in parsed.models.iter().enumerate() {
+        let size = [model.size.x, model.size.y, model.size.z];
+        assert!(size.iter().all(|&s| (1..=256).contains(&s)), "model {m} is {size:?}");
+    }
+    assert!(parsed.models.len() >= 4, "{} models: the grown one was not cut", parsed.models.len());
+    assert!(voxel_set(&parsed.models[1]) == voxel_set(&data.models[1]), "the other model changed");
+    let names: Vec<String> = parsed
+        .scenes
+        .iter()
+        .filter_map(|n| match n {
+            SceneNode::Transform { attributes, .. } => attributes.get("_name").cloned(),
+            _ => None,
+        })
+        .collect();
+    for name in ["a", "a 1", "a 2", "b", "b 1", "b 2", "c"] {
+        assert!(names.iter().any(|n| n == name), "no transform named '{name}' in {names:?}");
+    }
+    // The pieces make a differently shaped tree, so voxels come in another order.
+    let sorted = |mut v: Vec<(glam::IVec3, u8)>| {
+        v.sort_by_key(|(p, _)| (p.x, p.y, p.z));
+        v
+    };
+    let expected = sorted(drawn);
+    assert_eq!(sorted(load(&again).voxels()), expected, "what loads back is what was drawn");
+    let flat = sorted(load_vox(&again, 0).unwrap().voxels);
+    assert_eq!(flat, expected, "the flat loader places the pieces alike");
+}
+
 /// 100,000 objects: they load, a referenced model placed 33,334 times
 /// takes an edit in every placement, and undo takes it back.
 #[test]
@@ -304,8 +380,8 @@ fn a_hundred_thousand_objects_load_and_edit() {
     let mut editor = Editor::default();
     editor.set_scene(load(&bytes));
     let loaded = started.elapsed();
-    let before = editor.scene.tree.solid_voxels();
-    let objects = editor.scene.objects.as_ref().unwrap();
+    let before = editor.scene.solid_voxels();
+    let objects = editor.scene.objects().unwrap();
     assert_eq!(objects.list().len(), 100_000);
     // Object 0 shows model 0; the cell beside its marked corner is empty in every placement.
     let visible = (0..100_000).filter(|k| k % 3 == 0 && k % 11 != 5).count() as u64;
@@ -318,9 +394,9 @@ fn a_hundred_thousand_objects_load_and_edit() {
     for line in &script.lines {
         editor.run(&line.command).unwrap();
     }
-    assert_eq!(editor.scene.tree.solid_voxels(), before + visible);
+    assert_eq!(editor.scene.solid_voxels(), before + visible);
     editor.run(&octovox::script::Command::Undo(1)).unwrap();
-    assert_eq!(editor.scene.tree.solid_voxels(), before);
+    assert_eq!(editor.scene.solid_voxels(), before);
     assert!(started.elapsed().as_secs() < 120, "loaded in {loaded:?}, all in {:?}", started.elapsed());
 }
 
@@ -371,9 +447,9 @@ fn an_ovx_file_keeps_the_objects() {
     let path = dir.path().join("groups.ovx");
     octovox::io::save_scene(&path, &editor.scene, Default::default()).unwrap();
     let again = octovox::io::load_scene(&path, 0).unwrap();
-    assert_eq!(again.tree.voxels(), editor.scene.tree.voxels());
+    assert_eq!(again.voxels(), editor.scene.voxels());
     assert_same_scene("ovx", &saved(&editor.scene), &saved(&again));
-    assert!(again.objects.as_ref().unwrap().list()[3].hidden);
+    assert!(again.objects().unwrap().list()[3].hidden);
 }
 
 /// With every object deleted, an edit is refused (it would change what is
@@ -388,12 +464,12 @@ fn an_edit_with_no_object_left_is_refused_and_a_new_object_takes_it() {
         script.lines.iter().try_for_each(|l| editor.run(&l.command).map(|_| ()))
     };
     run(&mut editor, "object 0\nobject delete\nobject 0\nobject delete").unwrap();
-    assert_eq!(editor.scene.objects.as_ref().unwrap().list().len(), 0);
-    assert_eq!(editor.scene.tree.solid_voxels(), 0);
+    assert_eq!(editor.scene.objects().unwrap().list().len(), 0);
+    assert_eq!(editor.scene.solid_voxels(), 0);
     let refused = run(&mut editor, "place 0 0 0").unwrap_err().to_string();
     assert!(refused.contains("no object to edit"), "{refused}");
-    assert_eq!(editor.scene.tree.solid_voxels(), 0, "a refused edit changes nothing");
+    assert_eq!(editor.scene.solid_voxels(), 0, "a refused edit changes nothing");
     run(&mut editor, "object new fresh\nplace 0 0 0").unwrap();
-    assert_eq!(editor.scene.tree.solid_voxels(), 1);
-    assert_eq!(load(&saved(&editor.scene)).tree.solid_voxels(), 1, "saved in the new object's model");
+    assert_eq!(editor.scene.solid_voxels(), 1);
+    assert_eq!(load(&saved(&editor.scene)).solid_voxels(), 1, "saved in the new object's model");
 }

@@ -14,6 +14,7 @@
 mod chunk;
 mod load;
 mod save;
+mod stored;
 mod validate;
 
 use std::path::PathBuf;

@@ -6,11 +6,12 @@ use std::path::Path;
 
 use glam::IVec3;
 
+use super::stored;
 use super::validate::MAX_MODEL_EDGE;
 use super::{MAX_FILE_BYTES, MAX_VOXELS, VoxError};
 use crate::io::atomic::{WriteOptions, write_atomically};
-use crate::scene::graph::{self, Attributes, Node, NodeKind, SceneGraph};
-use crate::scene::objects::{Model, Objects};
+use crate::scene::graph::{Attributes, Node, NodeKind};
+use crate::scene::objects::Objects;
 use crate::scene::{Material, Octree, Palette, Voxel};
 
 /// Level of the octree cells that become one model: 2^8 = 256 voxels, the
@@ -322,8 +323,10 @@ fn materials(palette: &Palette) -> Vec<(u32, Vec<(String, String)>)> {
 /// with the palette and materials of the document.
 ///
 /// # Errors
-/// [`VoxError::Unsavable`] before anything is written when a model no
-/// longer fits a `.vox` model; [`VoxError::Write`] naming `path` otherwise.
+/// [`VoxError::Unsavable`] before anything is written when the scene cannot
+/// be written as a `.vox` (a model past 256 voxels a side is cut into
+/// pieces, except in a file of animation frames without a scene graph);
+/// [`VoxError::Write`] naming `path` otherwise.
 pub fn save_objects(path: &Path, palette: &Palette, objects: &Objects, options: WriteOptions) -> Result<(), VoxError> {
     let bytes = encode_objects(palette, objects)?;
     write_atomically(path, options, |file| {
@@ -338,14 +341,13 @@ pub fn save_objects(path: &Path, palette: &Palette, objects: &Objects, options: 
 /// # Errors
 /// As [`save_objects`].
 pub fn encode_objects(palette: &Palette, objects: &Objects) -> Result<Vec<u8>, VoxError> {
-    let grids: Vec<Grid> =
-        objects.models.iter().enumerate().map(|(m, model)| Grid::of(m, model)).collect::<Result<_, _>>()?;
+    let (stored, cuts) = stored::layout(&objects.models);
     let mut children = Vec::new();
-    for (model, grid) in objects.models.iter().zip(&grids) {
-        grid.write(&mut children, &model.tree);
+    for entry in &stored {
+        write_stored(&mut children, entry, &objects.models[entry.model].tree);
     }
     if let Some(graph) = &objects.graph {
-        for node in &shifted_graph(graph, &grids)?.nodes {
+        for node in &stored::written_graph(graph, &objects.models, &stored, &cuts)?.nodes {
             let (id, content) = node_chunk(node);
             push_chunk(&mut children, id, &content, 0);
         }
@@ -355,6 +357,11 @@ pub fn encode_objects(palette: &Palette, objects: &Objects) -> Result<Vec<u8>, V
             content.extend_from_slice(&layer.reserved.to_le_bytes());
             push_chunk(&mut children, b"LAYR", &content, 0);
         }
+    } else if cuts.iter().any(Option::is_some) {
+        return Err(VoxError::Unsavable(
+            "a frame of an animation grew past 256 voxels a side: a file without a scene graph cannot hold its pieces"
+                .to_owned(),
+        ));
     }
     push_chunk(&mut children, b"RGBA", &rgba_chunk(palette), 0);
     for (id, material) in materials(palette) {
@@ -378,104 +385,28 @@ pub fn encode_objects(palette: &Palette, objects: &Objects) -> Result<Vec<u8>, V
     Ok(out)
 }
 
-/// Where a model's voxels go in the file: the grid `0..size` that holds
-/// them, `shift` cells from the grid they were loaded in (an edit that
-/// reaches below the grid moves its origin; one past its end grows it).
-struct Grid {
-    size: [u32; 3],
-    shift: IVec3,
-    /// The size the model was loaded with, whose half was the pivot.
-    loaded: [u32; 3],
-}
-
-impl Grid {
-    fn of(index: usize, model: &Model) -> Result<Grid, VoxError> {
-        let loaded = model.size;
-        let top = IVec3::new(loaded[0] as i32, loaded[1] as i32, loaded[2] as i32) - IVec3::ONE;
-        let (lo, hi) =
-            model.tree.solid_bounds().map_or((IVec3::ZERO, top), |(lo, hi)| (lo.min(IVec3::ZERO), hi.max(top)));
-        let edge = hi - lo + IVec3::ONE;
-        if edge.max_element() > MAX_MODEL_EDGE as i32 {
-            return Err(VoxError::Unsavable(format!(
-                "model {index} is now {} x {} x {} voxels; a .vox model holds at most {MAX_MODEL_EDGE} a side \
-                 (splitting it into several is not written yet)",
-                edge.x, edge.y, edge.z
-            )));
-        }
-        Ok(Grid { size: [edge.x as u32, edge.y as u32, edge.z as u32], shift: lo, loaded })
-    }
-
-    fn moved(&self) -> bool {
-        self.shift != IVec3::ZERO || self.size != self.loaded
-    }
-
-    /// The SIZE and XYZI chunks.
-    fn write(&self, out: &mut Vec<u8>, tree: &Octree) {
-        let size: Vec<u8> = self.size.iter().flat_map(|s| s.to_le_bytes()).collect();
-        push_chunk(out, b"SIZE", &size, 0);
-        let mut voxels: Vec<[u8; 4]> = Vec::new();
-        tree.for_each_solid_cell(|min, edge, index| {
-            for z in 0..edge {
-                for y in 0..edge {
-                    for x in 0..edge {
-                        let p = min + IVec3::new(x, y, z) - self.shift;
-                        // Inside 0..size ≤ 256 by `Grid::of`.
-                        voxels.push([p.x as u8, p.y as u8, p.z as u8, index]);
-                    }
+/// The SIZE and XYZI chunks of one model as written: the cells of `tree` in
+/// `entry`'s box, shifted to its grid.
+fn write_stored(out: &mut Vec<u8>, entry: &stored::Stored, tree: &Octree) {
+    let size: Vec<u8> = entry.size.iter().flat_map(|s| s.to_le_bytes()).collect();
+    push_chunk(out, b"SIZE", &size, 0);
+    let hi = entry.lo + IVec3::from_array(entry.size.map(|s| s as i32)) - IVec3::ONE;
+    let mut voxels: Vec<[u8; 4]> = Vec::new();
+    tree.for_each_solid_cell_in(entry.lo, hi, |min, edge, index| {
+        let (a, b) = (min.max(entry.lo), (min + IVec3::splat(edge - 1)).min(hi));
+        for z in a.z..=b.z {
+            for y in a.y..=b.y {
+                for x in a.x..=b.x {
+                    // Inside 0..size ≤ 256 by `stored::layout`.
+                    let p = IVec3::new(x, y, z) - entry.lo;
+                    voxels.push([p.x as u8, p.y as u8, p.z as u8, index]);
                 }
             }
-        });
-        let mut content = u32::try_from(voxels.len()).unwrap_or(u32::MAX).to_le_bytes().to_vec();
-        content.extend_from_slice(voxels.as_flattened());
-        push_chunk(out, b"XYZI", &content, 0);
-    }
-}
-
-/// The graph with the translations that keep every voxel of a model whose
-/// grid moved at its world position: a placement puts model cell `v` at
-/// `R · (v − floor(size / 2)) + t` (see `scene::transform`), so the cell now
-/// stored at `v − shift` under the new pivot needs
-/// `t' = t + R · (shift + pivot' − pivot)`, in every keyframe.
-fn shifted_graph(graph: &SceneGraph, grids: &[Grid]) -> Result<SceneGraph, VoxError> {
-    let mut out = graph.clone();
-    let moved_model = |node: &Node| -> Result<Option<usize>, VoxError> {
-        let NodeKind::Shape { models } = &node.kind else { return Ok(None) };
-        let moved: Vec<usize> =
-            models.iter().map(|m| m.0 as usize).filter(|&m| grids.get(m).is_some_and(Grid::moved)).collect();
-        match moved.first() {
-            None => Ok(None),
-            Some(&m) if models.iter().all(|other| other.0 as usize == m) => Ok(Some(m)),
-            Some(&m) => Err(VoxError::Unsavable(format!(
-                "model {m} grew, and shape node {} shows other models in other frames: their placement cannot follow",
-                node.id
-            ))),
         }
-    };
-    let mut shifts = std::collections::HashMap::new();
-    for node in &graph.nodes {
-        if let Some(m) = moved_model(node)? {
-            shifts.insert(node.id, m);
-        }
-    }
-    for node in &mut out.nodes {
-        let NodeKind::Transform { child, frames, .. } = &mut node.kind else { continue };
-        let Some(&m) = shifts.get(child) else { continue };
-        let grid = &grids[m];
-        let pivot = |size: [u32; 3]| IVec3::new((size[0] / 2) as i32, (size[1] / 2) as i32, (size[2] / 2) as i32);
-        let offset = grid.shift + pivot(grid.size) - pivot(grid.loaded);
-        if frames.is_empty() {
-            frames.push(Attributes::new());
-        }
-        for frame in frames.iter_mut() {
-            let mut transform = graph::parse_transform(frame, node.id)?;
-            let moved = transform.rotation.apply([offset.x, offset.y, offset.z].map(i64::from));
-            for (t, m) in transform.translation.iter_mut().zip(moved) {
-                *t += m;
-            }
-            graph::write_transform(frame, transform);
-        }
-    }
-    Ok(out)
+    });
+    let mut content = u32::try_from(voxels.len()).unwrap_or(u32::MAX).to_le_bytes().to_vec();
+    content.extend_from_slice(voxels.as_flattened());
+    push_chunk(out, b"XYZI", &content, 0);
 }
 
 /// An nTRN, nGRP or nSHP chunk's id and content.
