@@ -143,6 +143,11 @@ impl Objects {
         &self.objects
     }
 
+    /// The map from object `index`'s model cells to world cells.
+    pub fn map(&self, index: usize) -> CellMap {
+        self.maps[index]
+    }
+
     /// The world box of object `index`'s voxels; `None` when its model is empty.
     pub fn world_box(&self, index: usize) -> Option<(IVec3, IVec3)> {
         let (lo, hi) = self.models[self.objects[index].placement.model].tree.solid_bounds()?;

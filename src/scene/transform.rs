@@ -196,6 +196,17 @@ impl CellMap {
         map
     }
 
+    /// The same map on points measured in half voxels (cell `v` is the
+    /// cube from `2v` to `2v + 2`): row `i` is `(axis, sign, offset)` with
+    /// `w[i] = sign · p[axis] + offset`. A mirrored axis moves the cube's
+    /// low corner, hence its offset's extra cell.
+    pub fn half_voxel_rows(&self) -> [(usize, i32, i32); 3] {
+        [0, 1, 2].map(|i| {
+            let corner = if self.sign[i] < 0 { 2 } else { 0 };
+            (self.axis[i], self.sign[i], self.offset[i].wrapping_mul(2).wrapping_add(corner))
+        })
+    }
+
     /// The world cell of model cell `v`.
     pub fn apply(&self, v: IVec3) -> IVec3 {
         IVec3::from_array([0, 1, 2].map(|i| self.sign[i].wrapping_mul(v[self.axis[i]]).wrapping_add(self.offset[i])))

@@ -7,16 +7,16 @@ use std::collections::HashMap;
 use std::path::Path;
 use std::process::{Command, Output};
 
-fn octovox(args: &[&str]) -> Output {
+pub(crate) fn octovox(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_octovox")).args(args).output().unwrap()
 }
 
-fn text(out: &Output) -> String {
+pub(crate) fn text(out: &Output) -> String {
     format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr))
 }
 
 /// Positions and triangles (0-based) of an .obj's `v` and `f` lines.
-fn read_obj(path: &Path) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
+pub(crate) fn read_obj(path: &Path) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
     let mut positions = Vec::new();
     let mut triangles = Vec::new();
     for line in std::fs::read_to_string(path).unwrap().lines() {
@@ -34,13 +34,15 @@ fn read_obj(path: &Path) -> (Vec<[f64; 3]>, Vec<[usize; 3]>) {
 }
 
 /// Positions, colours and triangles of a binary little-endian .ply.
-struct Ply {
-    positions: Vec<[f64; 3]>,
-    colors: Vec<[u8; 3]>,
-    triangles: Vec<[usize; 3]>,
+pub(crate) struct Ply {
+    pub positions: Vec<[f64; 3]>,
+    pub colors: Vec<[u8; 3]>,
+    pub triangles: Vec<[usize; 3]>,
+    /// Each face's `object` property, when the header declares one.
+    pub objects: Vec<u32>,
 }
 
-fn read_ply(path: &Path) -> Ply {
+pub(crate) fn read_ply(path: &Path) -> Ply {
     let bytes = std::fs::read(path).unwrap();
     let end = bytes.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
     let header = std::str::from_utf8(&bytes[..end]).unwrap();
@@ -63,25 +65,32 @@ fn read_ply(path: &Path) -> Ply {
         let c = take(3);
         colors.push([c[0], c[1], c[2]]);
     }
+    let with_objects = header.contains("property list uchar uint vertex_indices\nproperty uint object\n");
     let mut triangles = Vec::new();
+    let mut objects = Vec::new();
     for _ in 0..nf {
         assert_eq!(take(1)[0], 3);
         let index = |b: Vec<u8>| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize;
         triangles.push([index(take(4)), index(take(4)), index(take(4))]);
+        if with_objects {
+            objects.push(index(take(4)) as u32);
+        }
     }
     assert_eq!(at, bytes.len(), "trailing bytes");
-    Ply { positions, colors, triangles }
+    Ply { positions, colors, triangles, objects }
 }
 
 /// A .glb read back: its JSON, and the positions and triangles of all its
 /// primitives together.
-struct Glb {
-    json: serde_json::Value,
-    positions: Vec<[f64; 3]>,
-    triangles: Vec<[usize; 3]>,
+pub(crate) struct Glb {
+    pub json: serde_json::Value,
+    pub positions: Vec<[f64; 3]>,
+    pub triangles: Vec<[usize; 3]>,
+    /// Each mesh's triangles (indices into `positions`), in mesh order.
+    pub mesh_triangles: Vec<Vec<[usize; 3]>>,
 }
 
-fn read_glb(path: &Path) -> Glb {
+pub(crate) fn read_glb(path: &Path) -> Glb {
     let bytes = std::fs::read(path).unwrap();
     let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
     assert_eq!((&bytes[..4], word(4), word(8)), (&b"glTF"[..], 2, bytes.len()), "GLB header");
@@ -115,7 +124,9 @@ fn read_glb(path: &Path) -> Glb {
     };
     let mut positions = Vec::new();
     let mut triangles = Vec::new();
+    let mut mesh_triangles = Vec::new();
     for mesh in json["meshes"].as_array().unwrap() {
+        let first = triangles.len();
         for primitive in mesh["primitives"].as_array().unwrap() {
             assert_eq!(primitive["mode"], 4, "triangles");
             let base = positions.len();
@@ -124,14 +135,15 @@ fn read_glb(path: &Path) -> Glb {
             let indices = accessor(&primitive["indices"]);
             triangles.extend(indices.chunks_exact(3).map(|t| [0, 1, 2].map(|k| base + t[k] as usize)));
         }
+        mesh_triangles.push(triangles[first..].to_vec());
     }
-    Glb { json, positions, triangles }
+    Glb { json, positions, triangles, mesh_triangles }
 }
 
 /// Runs the Khronos glTF validator (`tests/gltf/validate.js`) on `files`
 /// and prints its report; fails on any error or warning, and when Node.js
 /// or the validator is missing.
-fn validate_gltf(files: &[&Path]) {
+pub(crate) fn validate_gltf(files: &[&Path]) {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/gltf/validate.js");
     let out = Command::new("node").arg(script).args(files).output().unwrap_or_else(|err| {
         panic!(
@@ -152,7 +164,7 @@ fn linear(byte: u8) -> f64 {
 
 /// Every directed edge between two positions has as many reverse edges
 /// (closed and consistently oriented); returns the signed volume.
-fn closed_volume(positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> f64 {
+pub(crate) fn closed_volume(positions: &[[f64; 3]], triangles: &[[usize; 3]]) -> f64 {
     let key = |i: usize| positions[i].map(|c| (c * 2.0).round() as i64);
     let mut edges: HashMap<([i64; 3], [i64; 3]), i64> = HashMap::new();
     let mut volume = 0.0;
@@ -197,7 +209,7 @@ fn a_box_is_twelve_triangles() {
     let glb = dir.path().join("box.glb");
     let out = octovox(&["export", dir.path().join("box.vox").to_str().unwrap(), "-o", glb.to_str().unwrap()]);
     assert!(out.status.success(), "{}", text(&out));
-    let Glb { json, positions, triangles } = read_glb(&glb);
+    let Glb { json, positions, triangles, .. } = read_glb(&glb);
     // A corner per face that meets there: each copy has its face's normal.
     assert_eq!((positions.len(), triangles.len()), (24, 12));
     assert_eq!(closed_volume(&positions, &triangles).round() as i64, 5 * 3 * 4);
@@ -216,7 +228,7 @@ fn obj_ply_and_glb_exports_are_closed_outward_and_hold_the_voxels() {
     }
     let (positions, triangles) = read_obj(&obj);
     assert_eq!(closed_volume(&positions, &triangles).round() as u64, voxels);
-    let Ply { positions, colors, triangles } = read_ply(&ply);
+    let Ply { positions, colors, triangles, .. } = read_ply(&ply);
     // Half a unit per voxel: an eighth of the volume.
     assert_eq!((closed_volume(&positions, &triangles) * 8.0).round() as u64, voxels);
     let palette = octovox::scene::Palette::default();
@@ -225,7 +237,7 @@ fn obj_ply_and_glb_exports_are_closed_outward_and_hold_the_voxels() {
         let c = palette.color(index);
         assert!(used.contains(&[c[0], c[1], c[2]]), "colour of palette index {index} missing");
     }
-    let Glb { json, positions, triangles } = read_glb(&glb);
+    let Glb { json, positions, triangles, .. } = read_glb(&glb);
     // Two units per voxel: eight times the volume.
     assert_eq!((closed_volume(&positions, &triangles) / 8.0).round() as u64, voxels);
     // One diffuse material per palette index, its colour made linear.
@@ -254,7 +266,7 @@ fn glb_materials_follow_matl_and_pass_the_khronos_validator() {
     let glb = dir.path().join("showroom.glb");
     let out = octovox(&["export", vox.to_str().unwrap(), "-o", glb.to_str().unwrap()]);
     assert!(out.status.success(), "{}", text(&out));
-    let Glb { json, positions, triangles } = read_glb(&glb);
+    let Glb { json, positions, triangles, .. } = read_glb(&glb);
     assert_eq!(closed_volume(&positions, &triangles).round() as u64, scene.solid_voxels());
     let close = |value: &serde_json::Value, expected: f32| {
         value.as_f64().is_some_and(|v| (v - f64::from(expected)).abs() < 1e-6)

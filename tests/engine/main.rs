@@ -10,6 +10,7 @@ mod common;
 
 mod bench_cli;
 mod export;
+mod export_scene;
 mod fuzz_corpus;
 mod hostile_input;
 mod mesh_import;

@@ -12,7 +12,7 @@ use octovox::editor::Editor;
 use octovox::io::vox::{encode_objects, load_vox, load_vox_scene};
 use octovox::scene::Scene;
 
-fn assets() -> PathBuf {
+pub(crate) fn assets() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/vox")
 }
 
@@ -119,7 +119,7 @@ fn dict(pairs: &[(&str, String)]) -> dot_vox::Dict {
 /// models with every one of the 48 rotations, two keyframes on some,
 /// names, a hidden layer and a hidden object, and the chunks a viewer or
 /// a later MagicaVoxel adds, which octovox does not read.
-fn written_scene(count: usize) -> Vec<u8> {
+pub(crate) fn written_scene(count: usize) -> Vec<u8> {
     let rotations: Vec<u8> = (0..128u8)
         .filter(|b| {
             let (first, second) = (b & 3, (b >> 2) & 3);

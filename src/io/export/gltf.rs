@@ -1,6 +1,9 @@
-//! glTF 2.0 binary (.glb): one mesh with a primitive per palette index used,
-//! each with a metallic-roughness material made from the palette colour and
-//! its MATL entry as the path tracer reads it (`docs/export.md` has the table).
+//! glTF 2.0 binary (.glb): a mesh per model with a primitive per palette
+//! index used, each with a metallic-roughness material made from the palette
+//! colour and its MATL entry as the path tracer reads it (`docs/export.md`
+//! has the table). A scene of objects is a node per visible object under
+//! nodes for its groups, placed by its exact transform; the placements of
+//! one model share its mesh.
 
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 
@@ -8,6 +11,7 @@ use glam::IVec3;
 use serde_json::{Map, Value, json};
 
 use super::VoxelMesh;
+use super::parts::Exported;
 use crate::scene::Palette;
 use crate::trace::path::materials::{MATERIAL_EMIT, MATERIAL_GLASS, MATERIAL_METAL, gpu_material};
 
@@ -19,66 +23,147 @@ const ARRAY_BUFFER: u32 = 34962;
 const ELEMENT_ARRAY_BUFFER: u32 = 34963;
 const TRIANGLES: u32 = 4;
 
-/// The .glb of `mesh`, one unit (metre) per voxel times `scale`; `None`
+/// The .glb of `exported`, one unit (metre) per voxel times `scale`; `None`
 /// when it would pass the 4 GiB a .glb can hold (its lengths are 32-bit).
-pub fn glb(mesh: &VoxelMesh, palette: &Palette, scale: f32) -> Option<Vec<u8>> {
-    let mut by_color: BTreeMap<u8, Vec<[u32; 3]>> = BTreeMap::new();
-    for (triangle, color) in &mesh.triangles {
-        by_color.entry(*color).or_default().push(*triangle);
-    }
-    let mut bin = Vec::new();
-    let mut views = Vec::new();
-    let mut accessors = Vec::new();
-    let mut primitives = Vec::new();
-    let mut materials = Vec::new();
+pub fn glb(exported: &Exported, palette: &Palette, scale: f32) -> Option<Vec<u8>> {
+    let mut buffers = Buffers::default();
     let mut extensions_used = BTreeSet::new();
-    for (color, triangles) in &by_color {
-        let part = Part::of(mesh, triangles, scale);
-        let first = accessors.len();
-        // The validator requires the bounds of POSITION, and checks them
-        // against the data: both are the same f32 values.
-        let lo = part.positions.iter().fold([f32::INFINITY; 3], |lo, p| [0, 1, 2].map(|k| lo[k].min(p[k])));
-        let hi = part.positions.iter().fold([f32::NEG_INFINITY; 3], |hi, p| [0, 1, 2].map(|k| hi[k].max(p[k])));
-        let count = part.positions.len();
-        let view = push_view(&mut bin, &mut views, le_floats(&part.positions), ARRAY_BUFFER);
-        accessors.push(json!({
-            "bufferView": view, "componentType": FLOAT, "count": count, "type": "VEC3", "min": lo, "max": hi
-        }));
-        let view = push_view(&mut bin, &mut views, le_floats(&part.normals), ARRAY_BUFFER);
-        accessors.push(json!({"bufferView": view, "componentType": FLOAT, "count": count, "type": "VEC3"}));
-        let view = push_view(&mut bin, &mut views, part.indices.iter().map(|i| i.to_le_bytes()), ELEMENT_ARRAY_BUFFER);
-        accessors.push(
-            json!({"bufferView": view, "componentType": UNSIGNED_INT, "count": part.indices.len(), "type": "SCALAR"}),
-        );
-        primitives.push(json!({
-            "attributes": {"POSITION": first, "NORMAL": first + 1},
-            "indices": first + 2,
-            "material": materials.len(),
-            "mode": TRIANGLES,
-        }));
-        materials.push(material(palette, *color, &mut extensions_used));
+    let mut material_of = HashMap::new();
+    let mut materials = Vec::new();
+    for color in exported.colors() {
+        material_of.insert(color, materials.len());
+        materials.push(material(palette, color, &mut extensions_used));
     }
+    // glTF allows no empty mesh: a mesh without triangles has no index.
+    let mut meshes = Vec::new();
+    let mut gltf_mesh = Vec::new();
+    for named in &exported.meshes {
+        let primitives = buffers.primitives(&named.mesh, scale, &material_of);
+        gltf_mesh.push((!primitives.is_empty()).then_some(meshes.len()));
+        if !primitives.is_empty() {
+            meshes.push(json!({"name": named.name, "primitives": primitives}));
+        }
+    }
+    let (nodes, roots) = nodes(exported, &gltf_mesh, scale);
 
-    let mut node = json!({"name": "voxels"});
     let mut root = Map::new();
     root.insert("asset".into(), json!({"version": "2.0", "generator": "octovox"}));
     root.insert("scene".into(), json!(0));
-    root.insert("scenes".into(), json!([{"nodes": [0]}]));
+    root.insert("scenes".into(), json!([{"nodes": roots}]));
     // An empty scene is a node without a mesh: glTF allows no empty mesh,
     // array or buffer.
-    if !primitives.is_empty() {
-        node["mesh"] = json!(0);
-        root.insert("meshes".into(), json!([{"name": "voxels", "primitives": primitives}]));
+    if !meshes.is_empty() {
+        root.insert("meshes".into(), Value::Array(meshes));
         root.insert("materials".into(), Value::Array(materials));
-        root.insert("accessors".into(), Value::Array(accessors));
-        root.insert("bufferViews".into(), Value::Array(views));
-        root.insert("buffers".into(), json!([{"byteLength": bin.len()}]));
+        root.insert("accessors".into(), Value::Array(buffers.accessors));
+        root.insert("bufferViews".into(), Value::Array(buffers.views));
+        root.insert("buffers".into(), json!([{"byteLength": buffers.bin.len()}]));
     }
-    root.insert("nodes".into(), json!([node]));
+    root.insert("nodes".into(), Value::Array(nodes));
     if !extensions_used.is_empty() {
         root.insert("extensionsUsed".into(), json!(extensions_used));
     }
-    container(Value::Object(root).to_string().as_bytes(), &bin)
+    container(Value::Object(root).to_string().as_bytes(), &buffers.bin)
+}
+
+/// The nodes: one per part (with its mesh and, unless it is the identity,
+/// its matrix) under one per group on its path, in the order first met;
+/// and the indices of the scene's root nodes.
+fn nodes(exported: &Exported, gltf_mesh: &[Option<usize>], scale: f32) -> (Vec<Value>, Vec<usize>) {
+    let mut nodes: Vec<Value> = Vec::new();
+    let mut roots = Vec::new();
+    let mut group_nodes: HashMap<Vec<String>, usize> = HashMap::new();
+    for part in &exported.parts {
+        let mut parent = None;
+        for depth in 1..=part.groups.len() {
+            let key = part.groups[..depth].to_vec();
+            let node = match group_nodes.get(&key) {
+                Some(&node) => node,
+                None => {
+                    nodes.push(json!({"name": key[depth - 1], "children": []}));
+                    let node = nodes.len() - 1;
+                    attach(&mut nodes, &mut roots, parent, node);
+                    group_nodes.insert(key, node);
+                    node
+                }
+            };
+            parent = Some(node);
+        }
+        let mut node = json!({"name": part.name});
+        if let Some(mesh) = gltf_mesh[part.mesh] {
+            node["mesh"] = json!(mesh);
+        }
+        if let Some(matrix) = part.place.matrix(scale) {
+            node["matrix"] = json!(matrix);
+        }
+        nodes.push(node);
+        let node = nodes.len() - 1;
+        attach(&mut nodes, &mut roots, parent, node);
+    }
+    (nodes, roots)
+}
+
+/// Makes node `child` a child of `parent`, or a root of the scene.
+fn attach(nodes: &mut [Value], roots: &mut Vec<usize>, parent: Option<usize>, child: usize) {
+    match parent.and_then(|parent| nodes[parent]["children"].as_array_mut()) {
+        Some(children) => children.push(json!(child)),
+        None => roots.push(child),
+    }
+}
+
+/// The binary buffer and the views and accessors into it.
+#[derive(Default)]
+struct Buffers {
+    bin: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+impl Buffers {
+    /// A primitive per palette index `mesh` uses, its data appended.
+    fn primitives(&mut self, mesh: &VoxelMesh, scale: f32, material_of: &HashMap<u8, usize>) -> Vec<Value> {
+        let mut by_color: BTreeMap<u8, Vec<[u32; 3]>> = BTreeMap::new();
+        for (triangle, color) in &mesh.triangles {
+            by_color.entry(*color).or_default().push(*triangle);
+        }
+        let mut primitives = Vec::new();
+        for (color, triangles) in &by_color {
+            let part = Part::of(mesh, triangles, scale);
+            let first = self.accessors.len();
+            // The validator requires the bounds of POSITION, and checks them
+            // against the data: both are the same f32 values.
+            let lo = part.positions.iter().fold([f32::INFINITY; 3], |lo, p| [0, 1, 2].map(|k| lo[k].min(p[k])));
+            let hi = part.positions.iter().fold([f32::NEG_INFINITY; 3], |hi, p| [0, 1, 2].map(|k| hi[k].max(p[k])));
+            let count = part.positions.len();
+            let view = self.push_view(le_floats(&part.positions), ARRAY_BUFFER);
+            self.accessors.push(json!({
+                "bufferView": view, "componentType": FLOAT, "count": count, "type": "VEC3", "min": lo, "max": hi
+            }));
+            let view = self.push_view(le_floats(&part.normals), ARRAY_BUFFER);
+            self.accessors.push(json!({"bufferView": view, "componentType": FLOAT, "count": count, "type": "VEC3"}));
+            let view = self.push_view(part.indices.iter().map(|i| i.to_le_bytes()), ELEMENT_ARRAY_BUFFER);
+            let count = part.indices.len();
+            self.accessors
+                .push(json!({"bufferView": view, "componentType": UNSIGNED_INT, "count": count, "type": "SCALAR"}));
+            primitives.push(json!({
+                "attributes": {"POSITION": first, "NORMAL": first + 1},
+                "indices": first + 2,
+                "material": material_of.get(color).copied().unwrap_or(0),
+                "mode": TRIANGLES,
+            }));
+        }
+        primitives
+    }
+
+    /// Appends `words` (little-endian, as glTF stores numbers) as a buffer
+    /// view of its own; returns the view's index.
+    fn push_view(&mut self, words: impl Iterator<Item = [u8; 4]>, target: u32) -> usize {
+        let offset = self.bin.len();
+        self.bin.extend(words.flatten());
+        let length = self.bin.len() - offset;
+        self.views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": length, "target": target}));
+        self.views.len() - 1
+    }
 }
 
 /// One primitive's vertices: a copy of a mesh vertex per face direction
@@ -111,15 +196,6 @@ impl Part {
         }
         part
     }
-}
-
-/// Appends `words` (little-endian, as glTF stores numbers) to the binary
-/// buffer as a buffer view of its own; returns the view's index.
-fn push_view(bin: &mut Vec<u8>, views: &mut Vec<Value>, words: impl Iterator<Item = [u8; 4]>, target: u32) -> usize {
-    let offset = bin.len();
-    bin.extend(words.flatten());
-    views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": bin.len() - offset, "target": target}));
-    views.len() - 1
 }
 
 fn le_floats(vectors: &[[f32; 3]]) -> impl Iterator<Item = [u8; 4]> {

@@ -1,12 +1,13 @@
-//! Mesh export: the scene's visible faces, greedy-meshed ([`greedy`]),
-//! as Wavefront .obj (with an .mtl of one material per palette colour),
-//! binary .ply (with vertex colours) or glTF binary .glb (with a PBR
+//! Mesh export: the scene's visible faces, greedy-meshed ([`greedy`]) per
+//! model and placed per object ([`parts`]), as Wavefront .obj (with an
+//! .mtl of one material per palette colour), binary .ply (with vertex colours) or glTF binary .glb (with a PBR
 //! material per palette entry used). One unit is one voxel times `scale`;
 //! axes are octovox's (y up, right-handed), which all three formats expect.
 
 mod gltf;
 pub mod greedy;
 mod obj;
+mod parts;
 mod ply;
 
 use std::path::{Path, PathBuf};
@@ -116,8 +117,7 @@ pub fn check_scale(tree: &crate::scene::Octree, scale: f32) -> Result<(), Export
 /// folder) naming the file.
 pub fn export_mesh(path: &Path, scene: &Scene, scale: f32, options: WriteOptions) -> Result<ExportStats, ExportError> {
     let format = MeshFormat::of(path).ok_or_else(|| ExportError::Format { path: path.to_path_buf() })?;
-    check_scale(scene.drawn(), scale)?;
-    let mesh = greedy::mesh_within_budget(scene.drawn())?;
+    let exported = parts::Exported::of(scene, scale)?;
     // Every file's bytes first, so that nothing is written when one of
     // them cannot be made.
     let mut outputs = Vec::new();
@@ -125,13 +125,13 @@ pub fn export_mesh(path: &Path, scene: &Scene, scale: f32, options: WriteOptions
         MeshFormat::Obj => {
             let mtl = path.with_extension("mtl");
             let mtl_name = mtl.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-            let obj = obj::obj(&mesh, scale, &mtl_name);
-            outputs.push((mtl, obj::mtl(&mesh, &scene.palette)));
+            let obj = obj::obj(&exported, scale, &mtl_name);
+            outputs.push((mtl, obj::mtl(&exported, &scene.palette)));
             outputs.push((path.to_path_buf(), obj));
         }
-        MeshFormat::Ply => outputs.push((path.to_path_buf(), ply::ply(&mesh, &scene.palette, scale))),
+        MeshFormat::Ply => outputs.push((path.to_path_buf(), ply::ply(&exported, &scene.palette, scale))),
         MeshFormat::Glb => {
-            let glb = gltf::glb(&mesh, &scene.palette, scale)
+            let glb = gltf::glb(&exported, &scene.palette, scale)
                 .ok_or_else(|| ExportError::TooLarge { path: path.to_path_buf() })?;
             outputs.push((path.to_path_buf(), glb));
         }
@@ -140,12 +140,8 @@ pub fn export_mesh(path: &Path, scene: &Scene, scale: f32, options: WriteOptions
     // The mesh first in the list, as before.
     files.rotate_right(usize::from(format == MeshFormat::Obj));
     write_all_or_none(outputs, options)?;
-    Ok(ExportStats {
-        triangles: mesh.triangles.len(),
-        vertices: mesh.positions_x2.len(),
-        naive_triangles: mesh.exposed_faces * 2,
-        files,
-    })
+    let (triangles, vertices, naive_triangles) = exported.counts();
+    Ok(ExportStats { triangles, vertices, naive_triangles, files })
 }
 
 /// Writes each file atomically; when one fails, removes the files this

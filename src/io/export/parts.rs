@@ -1,0 +1,208 @@
+//! What an export writes, before any format: each model's mesh once, and
+//! the parts that place them. A file of one model is one part, `voxels`, at
+//! its place. A scene of objects is a part per visible object, named by its
+//! path of named transforms, placed by its exact cell map, and sharing its
+//! model's mesh with every other placement of that model (a reference).
+
+use std::collections::HashMap;
+
+use glam::IVec3;
+
+use super::greedy::{VoxelMesh, mesh_within_budget};
+use super::{ExportError, check_scale};
+use crate::scene::Scene;
+use crate::scene::graph::Attributes;
+use crate::scene::objects::Objects;
+use crate::scene::transform::CellMap;
+
+/// The meshes and the parts that place them.
+pub struct Exported {
+    pub meshes: Vec<NamedMesh>,
+    pub parts: Vec<Part>,
+    /// The scene has objects (a file of one model writes exactly what it
+    /// always wrote: no object names, no groups).
+    pub objects: bool,
+}
+
+pub struct NamedMesh {
+    pub name: String,
+    pub mesh: VoxelMesh,
+}
+
+/// One placement of a mesh.
+pub struct Part {
+    /// The groups above it, outermost first (the named transforms above
+    /// its own), and its own name.
+    pub groups: Vec<String>,
+    pub name: String,
+    pub mesh: usize,
+    pub place: Place,
+}
+
+impl Part {
+    /// Its groups and name joined by `/`, as `info --objects` prints them.
+    pub fn path(&self) -> String {
+        let mut path = self.groups.join("/");
+        if !path.is_empty() {
+            path.push('/');
+        }
+        path + &self.name
+    }
+}
+
+/// A signed permutation and an offset on points in half voxels: the exact
+/// map from a mesh's vertices to the world (y up).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Place {
+    rows: [(usize, i32, i32); 3],
+}
+
+impl Place {
+    pub const IDENTITY: Place = Place { rows: [(0, 1, 0), (1, 1, 0), (2, 1, 0)] };
+
+    fn of(map: &CellMap) -> Place {
+        Place { rows: map.half_voxel_rows() }
+    }
+
+    /// The world position of a vertex at `p` (both in half voxels).
+    pub fn apply_x2(&self, p: IVec3) -> IVec3 {
+        IVec3::from_array(self.rows.map(|(axis, sign, offset)| sign * p[axis] + offset))
+    }
+
+    /// Whether the map mirrors (its determinant is −1): a mesh placed by it
+    /// must wind its triangles the other way to stay outward. (glTF does
+    /// this itself from the node's matrix.)
+    pub fn mirrors(&self) -> bool {
+        let [(a, ..), (b, ..), _] = self.rows;
+        // A permutation of three is odd when it swaps two and keeps one:
+        // exactly when its first two rows read axes in falling cyclic order.
+        let odd = (b + 3 - a) % 3 == 2;
+        let negatives = self.rows.iter().filter(|(_, sign, _)| *sign < 0).count();
+        odd != (negatives % 2 == 1)
+    }
+
+    /// A triangle's corners in the order that keeps it outward once placed.
+    pub fn wind(&self, [a, b, c]: [u32; 3]) -> [u32; 3] {
+        if self.mirrors() { [a, c, b] } else { [a, b, c] }
+    }
+
+    /// The map as a column-major 4×4 matrix on coordinates scaled by
+    /// `scale` (glTF's `matrix`); `None` for the identity.
+    pub fn matrix(&self, scale: f32) -> Option<[f32; 16]> {
+        if *self == Place::IDENTITY {
+            return None;
+        }
+        let mut m = [0.0; 16];
+        for (row, (axis, sign, offset)) in self.rows.into_iter().enumerate() {
+            m[axis * 4 + row] = sign as f32;
+            m[12 + row] = offset as f32 * 0.5 * scale;
+        }
+        m[15] = 1.0;
+        Some(m)
+    }
+}
+
+impl Exported {
+    /// Meshes `scene`: the one drawn octree, or each model an object shows.
+    ///
+    /// # Errors
+    /// A scale that no vertex coordinate survives, the memory budget.
+    pub fn of(scene: &Scene, scale: f32) -> Result<Exported, ExportError> {
+        check_scale(scene.drawn(), scale)?;
+        let Some(objects) = scene.objects() else {
+            let mesh = NamedMesh { name: "voxels".into(), mesh: mesh_within_budget(scene.drawn())? };
+            let part = Part { groups: Vec::new(), name: "voxels".into(), mesh: 0, place: Place::IDENTITY };
+            return Ok(Exported { meshes: vec![mesh], parts: vec![part], objects: false });
+        };
+        let mut meshes = Vec::new();
+        let mut mesh_of_model: HashMap<usize, usize> = HashMap::new();
+        let mut parts = Vec::new();
+        for (index, object) in objects.list().iter().enumerate() {
+            if object.hidden {
+                continue;
+            }
+            let model = object.placement.model;
+            let mesh = match mesh_of_model.get(&model) {
+                Some(&mesh) => mesh,
+                None => {
+                    let tree = &objects.models[model].tree;
+                    check_scale(tree, scale)?;
+                    meshes.push(NamedMesh { name: format!("model {model}"), mesh: mesh_within_budget(tree)? });
+                    mesh_of_model.insert(model, meshes.len() - 1);
+                    meshes.len() - 1
+                }
+            };
+            let (groups, name) = names(objects, index);
+            parts.push(Part { groups, name, mesh, place: Place::of(&objects.map(index)) });
+        }
+        Ok(Exported { meshes, parts, objects: true })
+    }
+
+    /// Palette indices any mesh uses, in order.
+    pub fn colors(&self) -> std::collections::BTreeSet<u8> {
+        self.meshes.iter().flat_map(|m| m.mesh.triangles.iter().map(|(_, c)| *c)).collect()
+    }
+
+    /// Triangles and vertices written, and the triangles of one quad per
+    /// face, over every part.
+    pub fn counts(&self) -> (usize, usize, u64) {
+        self.parts.iter().fold((0, 0, 0), |(t, v, n), part| {
+            let mesh = &self.meshes[part.mesh].mesh;
+            (t + mesh.triangles.len(), v + mesh.positions_x2.len(), n + mesh.exposed_faces * 2)
+        })
+    }
+}
+
+/// Object `index`'s groups and name: its path of named transforms, of which
+/// the last is its own when its transform is named; `object N` otherwise.
+fn names(objects: &Objects, index: usize) -> (Vec<String>, String) {
+    let path = &objects.list()[index].path;
+    let mut groups: Vec<String> = path.split('/').filter(|s| !s.is_empty()).map(str::to_owned).collect();
+    let own = objects.transform_node(index).ok().and_then(|node| name_of(&node.attributes));
+    match own {
+        Some(own) if groups.last() == Some(&own) => {
+            groups.pop();
+            (groups, own)
+        }
+        _ => (groups, format!("object {index}")),
+    }
+}
+
+fn name_of(attributes: &Attributes) -> Option<String> {
+    attributes.get("_name").filter(|n| !n.is_empty()).cloned()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The matrix takes each cube's corners where the cell map takes the
+    /// cell: for every one of the 48 turns and mirrors.
+    #[test]
+    fn the_place_of_a_cell_map_moves_cubes_as_cells() {
+        use crate::scene::transform::{Placement, Rotation, Transform};
+        for byte in 0..=u8::MAX {
+            let Some(rotation) = Rotation::from_byte(byte) else { continue };
+            let transform = Transform { rotation, translation: [5, -3, 7] };
+            let placement = Placement { model: 0, transform, centred: true };
+            let map = placement.cell_map([4, 6, 3]).unwrap();
+            let place = Place::of(&map);
+            let m = place.matrix(1.0).unwrap_or([1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1.]);
+            let det =
+                glam::Mat3::from_cols_slice(&[m[0], m[1], m[2], m[4], m[5], m[6], m[8], m[9], m[10]]).determinant();
+            assert_eq!(place.mirrors(), det < 0.0, "rotation byte {byte}");
+            for v in [IVec3::new(0, 0, 0), IVec3::new(3, 5, 2), IVec3::new(1, 4, 0)] {
+                let cell = map.apply(v);
+                let corners: Vec<IVec3> =
+                    (0..8).map(|k| place.apply_x2(2 * v + 2 * IVec3::new(k & 1, (k >> 1) & 1, k >> 2))).collect();
+                let lo = corners.iter().copied().reduce(IVec3::min).unwrap();
+                let hi = corners.iter().copied().reduce(IVec3::max).unwrap();
+                assert_eq!((lo, hi), (2 * cell, 2 * cell + 2), "rotation byte {byte}, cell {v}");
+                // The matrix does what apply_x2 does.
+                let p = (2 * v + IVec3::ONE).as_vec3() * 0.5;
+                let q = [0, 1, 2].map(|r| m[r] * p.x + m[4 + r] * p.y + m[8 + r] * p.z + m[12 + r]);
+                assert_eq!(q, (cell.as_vec3() + 0.5).to_array(), "rotation byte {byte}, cell {v}");
+            }
+        }
+    }
+}
