@@ -32,11 +32,13 @@ fn faces_lie_on_solid_cells(label: &str, positions: &[[f64; 3]], triangles: &[[u
     }
 }
 
-/// The .obj's objects in file order: name, and triangles (0-based into
-/// the file's positions).
-fn read_obj_objects(path: &Path) -> (Vec<[f64; 3]>, Vec<(String, Vec<[usize; 3]>)>) {
+/// An `o` of an .obj: its name and triangles (0-based into the file's positions).
+type ObjObject = (String, Vec<[usize; 3]>);
+
+/// The .obj's positions and its objects in file order.
+fn read_obj_objects(path: &Path) -> (Vec<[f64; 3]>, Vec<ObjObject>) {
     let mut positions = Vec::new();
-    let mut objects: Vec<(String, Vec<[usize; 3]>)> = Vec::new();
+    let mut objects: Vec<ObjObject> = Vec::new();
     for line in std::fs::read_to_string(path).unwrap().lines() {
         let words: Vec<&str> = line.split_whitespace().collect();
         match words.first() {
