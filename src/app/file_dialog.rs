@@ -1,7 +1,7 @@
 //! Native file dialogs (rfd: the desktop portal over D-Bus, else zenity),
 //! run on a thread of their own so the window keeps drawing. Where neither
-//! is there, or a dialog gives up without showing itself, the window's own
-//! path field (`ui::dialog`) asks instead.
+//! is there, or a dialog gives up without showing itself, the file browser
+//! inside the window (`browser`) asks instead.
 
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{self, Receiver, TryRecvError};
@@ -10,6 +10,7 @@ use std::time::{Duration, Instant};
 use winit::event_loop::ActiveEventLoop;
 
 use super::App;
+use super::browser::Browser;
 use super::ui::DialogKind;
 
 /// A dialog that answers faster than this never showed itself: nobody
@@ -19,7 +20,7 @@ const NO_DIALOG_WITHIN: Duration = Duration::from_millis(300);
 /// A native dialog that is open.
 pub struct NativeDialog {
     kind: DialogKind,
-    /// What the path field starts with if the dialog never shows.
+    /// Where the browser starts if the dialog never shows.
     start: String,
     /// The path chosen (`None`: cancelled, or no dialog), and how long the
     /// dialog took, measured by its thread.
@@ -58,14 +59,13 @@ fn dialog(kind: DialogKind, start: &Path) -> rfd::FileDialog {
 
 impl App {
     /// Asks for a path for `kind`: in a native dialog where there is one,
-    /// else in the window's path field, starting at `start`.
+    /// else in the window's file browser, starting at `start`.
     pub(super) fn ask_path(&mut self, kind: DialogKind, start: String) {
         if self.doc.file_dialog.is_some() {
             return self.ui.info("a file dialog is open");
         }
         if !available() {
-            self.ui.dialog = Some((kind, start));
-            return;
+            return self.open_browser(kind, &start);
         }
         let (tx, rx) = mpsc::channel();
         let from = PathBuf::from(&start);
@@ -79,8 +79,16 @@ impl App {
                 report!("file dialog: native");
                 self.doc.file_dialog = Some(NativeDialog { kind, start, answer: rx });
             }
-            Err(_) => self.ui.dialog = Some((kind, start)),
+            Err(_) => self.open_browser(kind, &start),
         }
+    }
+
+    fn open_browser(&mut self, kind: DialogKind, start: &str) {
+        let recent: Vec<PathBuf> = self.doc.recent.files().cloned().collect();
+        self.ui.dialog = Some(Browser::new(kind, start, &recent));
+        // Drawn now, not at the next input: a click meant for it must not reach the scene.
+        self.request_redraw();
+        report!("file dialog: browser");
     }
 
     /// Carries out the answer of the open native dialog, once it came.
@@ -96,7 +104,7 @@ impl App {
             Some(path) => self.execute(open.kind.command(path), event_loop),
             None if took < NO_DIALOG_WITHIN => {
                 report!("file dialog: none showed; asking in the window");
-                self.ui.dialog = Some((open.kind, open.start));
+                self.open_browser(open.kind, &open.start);
             }
             // Cancelled: an action that waited for a path waits no more.
             None => self.ui.pending = None,

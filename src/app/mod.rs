@@ -15,6 +15,7 @@ macro_rules! report {
 }
 
 mod actions;
+mod browser;
 mod camera_control;
 mod capture;
 mod clock;

@@ -14,6 +14,7 @@ use octovox::scene::objects::Objects;
 use octovox::scene::{Material, MaterialKind, Palette, Scene};
 use octovox::settings::{EffectsChoice, Shading, Sky, TraceMode, View};
 
+use super::browser::Answer;
 use super::command::{Choice, Command, Pending};
 use super::state::{BrushKind, EditorState, Mode, Pick, Tool};
 use glam::{IVec3, Vec3};
@@ -183,7 +184,8 @@ pub const INFO_LIFETIME: std::time::Duration = std::time::Duration::from_secs(4)
 /// UI-only state: open dialogs, the prompt, the message line.
 #[derive(Debug, Default)]
 pub struct UiState {
-    pub dialog: Option<(DialogKind, String)>,
+    /// The file browser inside the window, where no native dialog shows.
+    pub dialog: Option<super::browser::Browser>,
     /// An action waiting for the unsaved-changes prompt.
     pub pending: Option<Pending>,
     pub prompt_open: bool,
@@ -807,59 +809,14 @@ fn message(ui: &mut egui::Ui, ui_state: &mut UiState) {
     }
 }
 
-/// Files in the current folder and in `saves/` for a path dialog: .vox,
-/// .ovx and .obj to open, .vox or .ovx to save over.
-fn nearby_files(kind: DialogKind) -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = [Path::new("."), Path::new("saves")]
-        .iter()
-        .filter_map(|dir| std::fs::read_dir(dir).ok())
-        .flatten()
-        .filter_map(Result::ok)
-        .map(|e| e.path())
-        .filter(|p| {
-            let extension = p.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
-            kind.extensions().contains(&extension.as_str())
-        })
-        .collect();
-    files.sort();
-    files
-}
-
 fn dialog(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
-    let Some((kind, path)) = &mut ui_state.dialog else { return };
-    let mut close = false;
-    egui::Window::new(kind.title()).collapsible(false).resizable(false).show(ctx, |ui| {
-        ui.label("Path:");
-        let field = ui.text_edit_singleline(path);
-        let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
-        // Typing goes to the path at once (nothing else has focus while the dialog is up).
-        if !entered && ui.memory(|m| m.focused().is_none()) {
-            field.request_focus();
-        }
-        for file in nearby_files(*kind).into_iter().take(12) {
-            if ui.link(file.display().to_string()).clicked() {
-                *path = file.display().to_string();
-            }
-        }
-        ui.horizontal(|ui| {
-            let verb = match kind {
-                DialogKind::Open | DialogKind::LoadPalette => "Open",
-                DialogKind::SaveAs | DialogKind::SavePalette => "Save",
-                DialogKind::Export => "Export",
-            };
-            let ok = ui.button(verb).clicked();
-            if (ok || entered) && !path.trim().is_empty() {
-                out.push(kind.command(PathBuf::from(path.trim())));
-                close = true;
-            }
-            if ui.button("Cancel").clicked() {
-                close = true;
-            }
-        });
-    });
-    if close {
-        ui_state.dialog = None;
+    let Some(browser) = &mut ui_state.dialog else { return };
+    match browser.show(ctx) {
+        Answer::Waiting => return,
+        Answer::Chosen(path) => out.push(browser.kind().command(path)),
+        Answer::Cancelled => {}
     }
+    ui_state.dialog = None;
 }
 
 fn prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {

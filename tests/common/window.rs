@@ -271,6 +271,36 @@ pub fn click(display: &str, window: &str, lines: &mut Lines, x: u32, y: u32) -> 
     line.split_whitespace().nth(1).and_then(|n| n.parse().ok()).expect("edit line: `edit: N bytes written …`")
 }
 
+/// Answers the window's file browser (tests turn native dialogs off):
+/// waits for it and types `path` into it ([`type_in_browser`]).
+pub fn answer_browser(display: &str, window: &str, lines: &mut Lines, size: (u32, u32), path: &Path) {
+    wait_for_browser(lines);
+    type_in_browser(display, window, size, path);
+}
+
+/// Waits until the file browser is up and drawn.
+pub fn wait_for_browser(lines: &mut Lines) {
+    lines.wait_for("file dialog: browser", Duration::from_secs(30));
+    std::thread::sleep(Duration::from_millis(700));
+}
+
+/// Clicks the open browser's file-name field, types `path` over what is
+/// there and presses Return. The browser is centred 20 px below the middle
+/// of a window of `size` and is 300 px tall, its name field 105 px below
+/// its centre (`src/app/browser.rs`).
+pub fn type_in_browser(display: &str, window: &str, size: (u32, u32), path: &Path) {
+    let (x, y) = (size.0 / 2 - 30, size.1 / 2 + 20 + 105);
+    xdotool(display, &["mousemove", "--window", window, &x.to_string(), &y.to_string()]);
+    // A frame with the pointer over the browser first: egui decides from
+    // the last frame whether a click is its own or the scene's.
+    std::thread::sleep(Duration::from_millis(300));
+    xdotool(display, &["click", "1"]);
+    std::thread::sleep(Duration::from_millis(300));
+    xdotool(display, &["key", "ctrl+a"]);
+    xdotool(display, &["type", &path.display().to_string()]);
+    xdotool(display, &["key", "Return"]);
+}
+
 /// Ctrl+S, until the app says it saved `file`. Sent again after a while:
 /// on a loaded machine an Escape that takes the keyboard focus from a panel
 /// widget and the Ctrl+S after it can reach the window before egui's next

@@ -184,10 +184,7 @@ fn slow_load_keeps_the_window_live() {
 
     // Open the FIFO through the Open dialog: the reader blocks until we write.
     xdotool(&display, &["key", "ctrl+o"]);
-    std::thread::sleep(Duration::from_millis(700));
-    xdotool(&display, &["key", "ctrl+a"]);
-    xdotool(&display, &["type", "slow.vox"]);
-    xdotool(&display, &["key", "Return"]);
+    answer_browser(&display, &window, &mut lines, (640, 480), &dir.path().join("slow.vox"));
     std::thread::sleep(Duration::from_millis(1500));
 
     // While the load hangs, an orbit still changes the picture.

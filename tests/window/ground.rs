@@ -73,10 +73,7 @@ fn new_then_a_click_on_the_ground_places_a_voxel_at_y_0() {
     click(&display, &window, &mut lines, x, y);
     let file = dir.path().join("first.vox");
     xdotool(&display, &["key", "ctrl+shift+s"]);
-    std::thread::sleep(Duration::from_millis(500));
-    xdotool(&display, &["key", "ctrl+a"]);
-    xdotool(&display, &["type", file.to_str().unwrap()]);
-    xdotool(&display, &["key", "Return"]);
+    answer_browser(&display, &window, &mut lines, (WIDTH, HEIGHT), &file);
     lines.wait_for("saved:", Duration::from_secs(30));
 
     // dot_vox's reading: one model of one voxel; where it is, octovox's.

@@ -173,12 +173,9 @@ fn an_untitled_scene_is_recovered_after_a_kill() {
     assert!(octovox::journal::untitled_journal_path(&dir.path().join("saves"), app.0.id()).is_file());
     xdotool(&display, &["key", "Escape"]);
     std::thread::sleep(Duration::from_millis(500));
-    // Save asks for a path (the path field: no native dialogs in tests).
+    // Save asks for a path (the window's browser: no native dialogs in tests).
     xdotool(&display, &["key", "ctrl+s"]);
-    std::thread::sleep(Duration::from_millis(700));
-    xdotool(&display, &["key", "ctrl+a"]);
-    xdotool(&display, &["type", "kept.vox"]);
-    xdotool(&display, &["key", "Return"]);
+    answer_browser(&display, &window, &mut lines, (640, 480), &dir.path().join("kept.vox"));
     lines.wait_for("saved:", Duration::from_secs(30));
     assert_eq!(voxels(&dir.path().join("kept.vox")), expected, "Recover then Save keeps the session's voxels");
     let left = std::fs::read_dir(dir.path().join("saves")).unwrap().count();
