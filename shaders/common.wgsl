@@ -270,7 +270,7 @@ fn write_pixel(px: vec2<u32>, hit: Hit, d: vec3<f32>, in_shadow: bool) {
     // Uniform branches: skipped as a whole when off.
     if (u.highlight_on != 0u) {
         if (in_highlight(hit)) {
-            rgb = mix(rgb, vec3<f32>(1.0, 0.85, 0.2), 0.45);
+            rgb = mix(rgb, HIGHLIGHT_TINT, HIGHLIGHT_MIX);
         }
     }
     textureStore(out_color, vec2<i32>(px), vec4<f32>(rgb, 1.0));

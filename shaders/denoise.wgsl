@@ -255,5 +255,8 @@ fn finish(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = pixel_index(i32(gid.x), i32(gid.y));
     let p = code_of(i);
     let rgb = select(mean_of(i), light_in[i].rgb * albedo_of(i), is_filtered(p));
-    textureStore(out_color, vec2<i32>(gid.xy), vec4<f32>(rgb, 1.0));
+    // The highlight's tint, by the share of samples whose first hit it is
+    // (kept beside the albedo sum; see `path` in path.wgsl).
+    let tint = HIGHLIGHT_MIX * accum[3u * i + 2u].w / max(count_of(i), 1.0);
+    textureStore(out_color, vec2<i32>(gid.xy), vec4<f32>(mix(rgb, HIGHLIGHT_TINT, tint), 1.0));
 }

@@ -68,6 +68,8 @@ var<private> pu: PathUniforms;
 
 // The first hit's `demodulation_albedo` of the path being traced.
 var<private> first_albedo: vec3<f32>;
+// 1 when the sample's first hit is a highlighted voxel (the selection).
+var<private> first_tint: f32;
 
 // Whether the denoiser leaves a pixel whose first hit is of `kind` to its
 // samples (twin of `PathScene::left_to_samples`).
@@ -430,6 +432,7 @@ fn radiance(ray_in: Ray) -> vec3<f32> {
         let m = materials[value];
         if (first) {
             first_albedo = demodulation_albedo(value);
+            first_tint = select(0.0, 1.0, u.highlight_on != 0u && in_highlight(hit));
             first = false;
         }
         var dir: vec3<f32>;
@@ -529,16 +532,20 @@ fn path(@builtin(global_invocation_id) gid: vec3<u32>) {
     let jy = rng_next();
     let r = image_ray(vec2<f32>(px) + vec2<f32>(jx, jy));
     first_albedo = vec3<f32>(1.0);
+    first_tint = 0.0;
     let sample = clamp_sample(radiance(r));
     let first = pu.sample_index == 0u;
     let at = 3u * pixel;
     let sum = select(accum[at].rgb, vec3<f32>(0.0), first) + sample;
     let squares = select(accum[at + 1u].rgb, vec3<f32>(0.0), first) + sample * sample;
-    let albedo = select(accum[at + 2u].rgb, vec3<f32>(0.0), first) + first_albedo;
-    accum[at] = vec4<f32>(sum, f32(pu.sample_index + 1u));
+    let albedo = select(accum[at + 2u], vec4<f32>(0.0), first) + vec4<f32>(first_albedo, first_tint);
+    let n = f32(pu.sample_index + 1u);
+    accum[at] = vec4<f32>(sum, n);
     accum[at + 1u] = vec4<f32>(squares, 0.0);
-    accum[at + 2u] = vec4<f32>(albedo, 0.0);
-    textureStore(out_color, vec2<i32>(px), vec4<f32>(sum / f32(pu.sample_index + 1u), 1.0));
+    accum[at + 2u] = albedo;
+    // The tint by the share of samples whose first hit is highlighted.
+    let shown = mix(sum / n, HIGHLIGHT_TINT, HIGHLIGHT_MIX * albedo.w / n);
+    textureStore(out_color, vec2<i32>(px), vec4<f32>(shown, 1.0));
     if (first) {
         write_guide(px, pixel);
     }

@@ -207,6 +207,11 @@ impl App {
         let wants_path = path_traced(&self.state, self.frames.motion.moving());
         let (scene, state) = (&self.doc.editor.scene, &self.state);
         let view = PathView { scene, camera: &state.camera, size: trace_size, settings: &state.path_settings };
+        // Select mode tints the selected voxels in path-traced frames too
+        // (not the brush's reach, which follows the pointer: every move
+        // would start the accumulation over).
+        let tinted = selection.filter(|_| state.mode == Mode::Select).map(|r| (r.min, r.max));
+        gfx.renderer.path_highlight = tinted;
         let revision = self.doc.editor.revision();
         let scene_changed = self.frames.path_drawn != Some(revision);
         let restarts = wants_path && gfx.renderer.path_restarts(&view, scene_changed);

@@ -27,6 +27,11 @@ pub const ROW_TILES: u64 = 64;
 pub const FLOOR_ROW: u32 = 64;
 
 /// Twin of `FrameUniforms` in `shaders/common.wgsl`.
+/// The colour highlighted voxels (the brush's reach, the selection) are
+/// mixed toward, and by how much.
+pub const HIGHLIGHT_TINT: [f32; 3] = [1.0, 0.85, 0.2];
+pub const HIGHLIGHT_MIX: f32 = 0.45;
+
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct FrameUniforms {

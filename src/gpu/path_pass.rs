@@ -94,6 +94,8 @@ pub struct PathKey {
     pub basis: RayBasis,
     pub settings: PathSettings,
     pub effects: Effects,
+    /// The tree-local box of voxels tinted (`Renderer::path_highlight`).
+    pub highlight: Option<(glam::IVec3, glam::IVec3)>,
 }
 
 /// The path tracer's accumulation: its key, the samples so far, the lights

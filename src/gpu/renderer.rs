@@ -116,10 +116,12 @@ pub struct PathView<'a> {
     pub settings: &'a PathSettings,
 }
 
-fn path_key(view: &PathView) -> PathKey {
+/// The key of `view`'s accumulation; `highlight` is the world box it tints.
+fn path_key(view: &PathView, highlight: Option<(IVec3, IVec3)>) -> PathKey {
     let PathView { scene, camera, size, settings } = *view;
     let basis = camera.basis(size.0.max(1), size.1.max(1), scene.origin());
-    PathKey { basis, settings: *settings, effects: effects_for(scene, settings) }
+    let highlight = highlight.map(|(lo, hi)| (lo - scene.origin(), hi - scene.origin()));
+    PathKey { basis, settings: *settings, effects: effects_for(scene, settings), highlight }
 }
 
 pub struct Renderer {
@@ -150,6 +152,10 @@ pub struct Renderer {
     /// `sample_target`th, a stage a frame);
     /// headless renders call [`Renderer::denoise_now`] once instead.
     pub denoise: bool,
+    /// The world box of voxels path-traced frames tint (the window's
+    /// selection, as the preview tints it); a change starts the
+    /// accumulation over, since each sample counts its tinted first hits.
+    pub path_highlight: Option<(IVec3, IVec3)>,
     /// Whether each path-traced sample measures the image's noise in its
     /// own frame (the window, which shows it after every sample; denoised
     /// frames always do). Without it [`Renderer::noise_estimate`] measures
@@ -191,6 +197,7 @@ impl Renderer {
             timer,
             shown: Shown::Trace,
             denoise: false,
+            path_highlight: None,
             estimate_noise: false,
             noise_of: None,
             denoised_of: None,
@@ -358,7 +365,7 @@ impl Renderer {
             self.denoiser.bind(gpu, &self.path);
         }
         let mut acc = self.path.accumulation;
-        let key = path_key(view);
+        let key = path_key(view, self.path_highlight);
         let effects = key.effects;
         // The materials and lights go up again when the scene or the effect set changed.
         let send_scene = scene_changed || resized || acc.key.is_none_or(|k| k.effects != effects);
@@ -413,7 +420,8 @@ impl Renderer {
             first_row,
             end_row,
         };
-        let frame = FrameUniforms::new(&key.basis, scene.drawn(), &self.buffers, View::Shaded, None, Footprint::EXACT);
+        let (drawn, highlight) = (scene.drawn(), key.highlight);
+        let frame = FrameUniforms::new(&key.basis, drawn, &self.buffers, View::Shaded, highlight, Footprint::EXACT);
         self.path.prepare(gpu, &self.buffers, &frame, &path);
         let kernel = self.path.encode(gpu, encoder, effects, end_row - first_row, self.timer.pass_writes())?;
         self.timer.resolve(encoder);
@@ -575,7 +583,7 @@ impl Renderer {
     /// in bands, is complete.
     pub fn path_restarts(&self, view: &PathView, scene_changed: bool) -> bool {
         let resized = self.path.size() != (view.size.0.max(1), view.size.1.max(1));
-        self.path.accumulation.starts_over(&path_key(view), resized, scene_changed)
+        self.path.accumulation.starts_over(&path_key(view, self.path_highlight), resized, scene_changed)
     }
 
     /// Compiles the path kernel a scene needs with `settings` now, so that the

@@ -411,3 +411,71 @@ fn a_path_traced_render_shows_progress_on_a_terminal_only() {
     assert!(tty.status.success(), "{}", String::from_utf8_lossy(&tty.stdout));
     assert!(String::from_utf8_lossy(&tty.stdout).contains("path tracing ["), "a bar on a terminal");
 }
+
+/// Issue 27, bug 7: the selection's tint showed in the preview only. In a
+/// path-traced frame a pixel is tinted by the share of its samples whose
+/// first hit is selected: the selected half of a box turns toward the tint,
+/// the other half keeps its exact pixels, raw and denoised.
+#[test]
+fn the_selection_is_tinted_in_path_traced_frames() {
+    let mut scene =
+        Scene::new(palette(), build(&[(Shape::Box { min: IVec3::ZERO, max: IVec3::splat(7) }, Op::Place(WHITE))]));
+    let camera = look(DVec3::new(20.0, 16.0, 24.0), DVec3::new(4.0, 4.0, 4.0));
+    let (size, settings) = ((48, 36), PathSettings::default());
+    let mut renderer = Renderer::headless().expect("a GPU adapter (lavapipe on CI)");
+    renderer.sync(&mut scene);
+    let view = PathView { scene: &scene, camera: &camera, size, settings: &settings };
+    let render = |renderer: &mut Renderer| {
+        for sample in 0..4 {
+            renderer.render_path(&view, sample == 0).unwrap();
+        }
+        let raw = renderer.read_image().unwrap();
+        renderer.denoise_now().unwrap();
+        (raw, renderer.read_image().unwrap())
+    };
+    let (plain, plain_denoised) = render(&mut renderer);
+    let selected = (IVec3::ZERO, IVec3::new(3, 7, 7));
+    renderer.path_highlight = Some(selected);
+    assert!(renderer.path_restarts(&view, false), "a new selection starts the accumulation over");
+    let (tinted, tinted_denoised) = render(&mut renderer);
+
+    // Each pixel's first hit through its centre, and whether its
+    // neighbours' agree about being selected (edges mix their samples).
+    let tree = scene.drawn();
+    let basis = camera.basis(size.0, size.1, tree.origin());
+    let hits = octovox::trace::render::trace_image(
+        octovox::trace::render::Tracer::Svo(tree),
+        &basis,
+        octovox::trace::Footprint::EXACT,
+    );
+    let class = |x: i64, y: i64| -> Option<bool> {
+        let hit = hits.get((y * i64::from(size.0) + x) as usize).filter(|h| h.is_hit())?;
+        let v = hit.voxel + tree.origin();
+        Some(v.cmpge(selected.0).all() && v.cmple(selected.1).all())
+    };
+    let (mut inside, mut outside) = (Vec::new(), Vec::new());
+    for y in 1..i64::from(size.1) - 1 {
+        for x in 1..i64::from(size.0) - 1 {
+            let around = [(0, 0), (1, 0), (-1, 0), (0, 1), (0, -1)].map(|(dx, dy)| class(x + dx, y + dy));
+            match around {
+                [Some(true), ..] if around.iter().all(|c| *c == Some(true)) => inside.push((x as u32, y as u32)),
+                [Some(false), ..] if around.iter().all(|c| *c == Some(false)) => outside.push((x as u32, y as u32)),
+                _ => {}
+            }
+        }
+    }
+    assert!(inside.len() > 40 && outside.len() > 40, "{} selected and {} other pixels", inside.len(), outside.len());
+    let blue = |image: &image::RgbaImage, pixels: &[(u32, u32)]| {
+        pixels.iter().map(|&(x, y)| f64::from(image.get_pixel(x, y)[2])).sum::<f64>() / pixels.len() as f64
+    };
+    for &(x, y) in &outside {
+        assert_eq!(tinted.get_pixel(x, y), plain.get_pixel(x, y), "an unselected pixel changed at ({x}, {y})");
+    }
+    for (label, before, after) in [("raw", &plain, &tinted), ("denoised", &plain_denoised, &tinted_denoised)] {
+        let (was, is) = (blue(before, &inside), blue(after, &inside));
+        println!("{label}: selected pixels' blue {was:.1} → {is:.1}");
+        assert!(is < 0.8 * was, "{label}: the selection is not tinted (blue {was:.1} → {is:.1})");
+        let (was, is) = (blue(before, &outside), blue(after, &outside));
+        assert!((is - was).abs() < 0.05 * was, "{label}: the rest changed (blue {was:.1} → {is:.1})");
+    }
+}
