@@ -35,6 +35,16 @@ struct FrameUniforms {
     ortho: u32,
     // Level of detail of orthographic rays: the footprint at every t.
     lod_at_start: f32,
+    // The ground grid (`GroundGrid`), tree-local: lines `ground_step` apart
+    // on the plane y = ground_y over x0..x1, z0..z1; drawn when ground_on.
+    ground_on: u32,
+    ground_step: u32,
+    ground_y: i32,
+    ground_x0: i32,
+    ground_x1: i32,
+    ground_z0: i32,
+    ground_z1: i32,
+    ground_pad: u32,
 }
 
 // Read-only storage, not uniform: see `constants_entry` in src/gpu/trace_pass.rs.
@@ -265,8 +275,37 @@ fn shade(hit: Hit, d: vec3<f32>, in_shadow: bool) -> vec3<f32> {
     }
 }
 
+// How much of a one-pixel-wide ground grid line the ray `r` crosses before
+// t = `until` (where it first hits a voxel): 0 or 1, as a line is either
+// under the pixel's centre or not. Voxels in front of the ground hide it.
+fn ground_line(r: Ray, until: f32) -> f32 {
+    if (u.ground_on == 0u) {
+        return 0.0;
+    }
+    let t = plane_t(r, 1u, f32(u.ground_y));
+    if (!(t > 0.0) || t >= until) {
+        return 0.0;
+    }
+    let p = r.o + r.d * t;
+    let lo = vec2<f32>(f32(u.ground_x0), f32(u.ground_z0));
+    let hi = vec2<f32>(f32(u.ground_x1), f32(u.ground_z1));
+    if (any(p.xz < lo) || any(p.xz > hi)) {
+        return 0.0;
+    }
+    // A pixel's width on the ground's distance: the image plane's pixel
+    // scaled by t (perspective) or not (orthographic).
+    let pixel = 2.0 * length(u.up) / f32(u.height) * select(t, 1.0, u.ortho != 0u);
+    let step = f32(u.ground_step);
+    let off = abs(fract((p.xz - lo) / step + vec2<f32>(0.5)) - vec2<f32>(0.5)) * step;
+    return select(0.0, 1.0, any(off < vec2<f32>(0.5 * pixel)));
+}
+
 fn write_pixel(px: vec2<u32>, hit: Hit, d: vec3<f32>, in_shadow: bool) {
     var rgb = shade(hit, d, in_shadow);
+    if (u.ground_on != 0u) {
+        let until = select(3.0e38, hit.t, hit.value != 0u);
+        rgb = mix(rgb, vec3<f32>(1.0), GRID_MIX * ground_line(pixel_ray(px), until));
+    }
     // Uniform branches: skipped as a whole when off.
     if (u.highlight_on != 0u) {
         if (in_highlight(hit)) {

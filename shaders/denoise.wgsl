@@ -257,6 +257,9 @@ fn finish(@builtin(global_invocation_id) gid: vec3<u32>) {
     let rgb = select(mean_of(i), light_in[i].rgb * albedo_of(i), is_filtered(p));
     // The highlight's tint, by the share of samples whose first hit it is
     // (kept beside the albedo sum; see `path` in path.wgsl).
-    let tint = HIGHLIGHT_MIX * accum[3u * i + 2u].w / max(count_of(i), 1.0);
-    textureStore(out_color, vec2<i32>(gid.xy), vec4<f32>(mix(rgb, HIGHLIGHT_TINT, tint), 1.0));
+    let n = max(count_of(i), 1.0);
+    let tint = HIGHLIGHT_MIX * accum[3u * i + 2u].w / n;
+    // And the ground grid's lines, by the share of samples that crossed one.
+    let grid = GRID_MIX * accum[3u * i + 1u].w / n;
+    textureStore(out_color, vec2<i32>(gid.xy), vec4<f32>(mix(mix(rgb, HIGHLIGHT_TINT, tint), vec3<f32>(1.0), grid), 1.0));
 }

@@ -212,6 +212,7 @@ impl App {
         // would start the accumulation over).
         let tinted = selection.filter(|_| state.mode == Mode::Select).map(|r| (r.min, r.max));
         gfx.renderer.path_highlight = tinted;
+        gfx.renderer.ground = self.doc.editor.ground.then(|| state.ground_grid());
         let revision = self.doc.editor.revision();
         let scene_changed = self.frames.path_drawn != Some(revision);
         let restarts = wants_path && gfx.renderer.path_restarts(&view, scene_changed);

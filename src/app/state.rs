@@ -160,6 +160,15 @@ impl EditorState {
         tools.brush.shape_at(center).bounds()
     }
 
+    /// The ground's grid over the working volume: x and z in
+    /// -volume/2..volume/2 on y = 0, at most 64 lines a side (a large
+    /// volume gets a coarser grid).
+    pub fn ground_grid(&self) -> octovox::gpu::GroundGrid {
+        let half = self.volume / 2;
+        let (lo, hi) = (-half, self.volume - half);
+        octovox::gpu::GroundGrid { y: 0, lo: [lo, lo], hi: [hi, hi], step: (self.volume / 64).max(1) as u32 }
+    }
+
     /// `mode` on, or back to the brush when it is on already.
     pub fn toggle_mode(&mut self, mode: Mode) {
         self.mode = if self.mode == mode { Mode::Brush } else { mode };

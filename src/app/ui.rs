@@ -1040,31 +1040,14 @@ pub fn draw_extrude(ui: &egui::Ui, state: &EditorState, info: &Info, voxels: &[I
     }
 }
 
-/// The ground's grid at y = 0 over the working volume, and the volume's
-/// outline: where a first click in an empty scene builds. Drawn over the
-/// image, faintly (an overlay, not traced: voxels do not hide it).
+/// The working volume's outline over the image: where a first click in an
+/// empty scene builds. (The ground's grid is traced with the voxels,
+/// `EditorState::ground_grid`, so that they hide it.)
 pub fn draw_ground(ui: &egui::Ui, state: &EditorState, info: &Info) {
     if !info.ground {
         return;
     }
-    let screen = ui.ctx().content_rect();
-    let basis =
-        state.camera.basis(screen.width().max(1.0) as u32, screen.height().max(1.0) as u32, info.scene.origin());
-    let origin = info.scene.origin().as_vec3();
-    let project = |p: Vec3| basis.project(p - origin).map(|(x, y)| egui::pos2(x, y));
     let half = state.volume / 2;
-    // At most 64 lines a side: a large volume gets a coarser grid.
-    let step = (state.volume / 64).max(1) as usize;
-    let painter = scene_painter(ui.ctx());
-    let stroke = Stroke::new(1.0, Color32::from_white_alpha(70));
-    for i in (-half..=state.volume - half).step_by(step) {
-        let (i, lo, hi) = (i as f32, -half as f32, (state.volume - half) as f32);
-        for (a, b) in [(Vec3::new(i, 0.0, lo), Vec3::new(i, 0.0, hi)), (Vec3::new(lo, 0.0, i), Vec3::new(hi, 0.0, i))] {
-            if let (Some(p), Some(q)) = (project(a), project(b)) {
-                painter.line_segment([p, q], stroke);
-            }
-        }
-    }
     let (lo, hi) =
         (IVec3::new(-half, 0, -half), IVec3::new(state.volume - half - 1, state.volume - 1, state.volume - half - 1));
     outline_box(ui, state, info, (lo, hi), Color32::from_white_alpha(40), false);

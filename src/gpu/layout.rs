@@ -32,6 +32,20 @@ pub const FLOOR_ROW: u32 = 64;
 pub const HIGHLIGHT_TINT: [f32; 3] = [1.0, 0.85, 0.2];
 pub const HIGHLIGHT_MIX: f32 = 0.45;
 
+/// How far a ground grid line's pixels are mixed toward white.
+pub const GRID_MIX: f32 = 0.27;
+
+/// The ground's grid, traced: lines `step` voxels apart on the plane
+/// `y`, from `lo` to `hi` in x and z (world voxels, inclusive ends). Traced
+/// with the voxels, so that they hide the lines behind them.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GroundGrid {
+    pub y: i32,
+    pub lo: [i32; 2],
+    pub hi: [i32; 2],
+    pub step: u32,
+}
+
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct FrameUniforms {
@@ -61,6 +75,15 @@ pub struct FrameUniforms {
     pub ortho: u32,
     /// Level of detail: [`crate::trace::Footprint::at_start`] of camera rays.
     pub lod_at_start: f32,
+    /// 1: draw the ground grid (`GroundGrid`, tree-local here).
+    pub ground_on: u32,
+    pub ground_step: u32,
+    pub ground_y: i32,
+    pub ground_x0: i32,
+    pub ground_x1: i32,
+    pub ground_z0: i32,
+    pub ground_z1: i32,
+    pub ground_pad: u32,
 }
 
 impl FrameUniforms {
@@ -96,6 +119,23 @@ impl FrameUniforms {
             lod_per_t: lod.per_t,
             ortho: u32::from(basis.ortho),
             lod_at_start: lod.at_start,
+            ..FrameUniforms::default()
+        }
+    }
+
+    /// The same uniforms drawing `ground` (world voxels) in a tree whose
+    /// local coordinates start at `origin`.
+    pub fn with_ground(self, ground: Option<GroundGrid>, origin: IVec3) -> FrameUniforms {
+        let Some(g) = ground else { return self };
+        FrameUniforms {
+            ground_on: 1,
+            ground_step: g.step.max(1),
+            ground_y: g.y - origin.y,
+            ground_x0: g.lo[0] - origin.x,
+            ground_x1: g.hi[0] - origin.x,
+            ground_z0: g.lo[1] - origin.z,
+            ground_z1: g.hi[1] - origin.z,
+            ..self
         }
     }
 }

@@ -16,7 +16,7 @@ pub mod trace_pass;
 pub use blit_pass::{BlitMode, BlitPass};
 pub use context::{GpuContext, GpuError};
 pub use denoise_pass::DenoisePass;
-pub use layout::{FrameUniforms, PathUniforms};
+pub use layout::{FrameUniforms, GroundGrid, PathUniforms};
 pub use path_pass::PathPass;
 pub use renderer::{FrameInput, PathFrame, PathView, Preview, Renderer, Submitted};
 pub use scene_buffers::SceneBuffers;

@@ -96,6 +96,8 @@ pub struct PathKey {
     pub effects: Effects,
     /// The tree-local box of voxels tinted (`Renderer::path_highlight`).
     pub highlight: Option<(glam::IVec3, glam::IVec3)>,
+    /// The ground grid drawn (`Renderer::ground`), in world voxels.
+    pub ground: Option<super::layout::GroundGrid>,
 }
 
 /// The path tracer's accumulation: its key, the samples so far, the lights

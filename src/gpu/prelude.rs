@@ -4,7 +4,7 @@
 
 use std::fmt::Write as _;
 
-use super::layout::{FLOOR_ROW, HIGHLIGHT_MIX, HIGHLIGHT_TINT, ROW_TILES};
+use super::layout::{FLOOR_ROW, GRID_MIX, HIGHLIGHT_MIX, HIGHLIGHT_TINT, ROW_TILES};
 use crate::gpu_pool::{LOD_WORD, NODE_WORDS, POINTER_BIT};
 use crate::settings::{SUN_DIR, View};
 use crate::trace::denoise;
@@ -30,6 +30,7 @@ pub fn shared_constants() -> String {
     line("FLOOR_ROW", "u32", format!("{FLOOR_ROW}u"));
     line("HIGHLIGHT_TINT", "vec3<f32>", vec3(HIGHLIGHT_TINT));
     line("HIGHLIGHT_MIX", "f32", format!("{HIGHLIGHT_MIX:?}"));
+    line("GRID_MIX", "f32", format!("{GRID_MIX:?}"));
     line("SUN_DIR", "vec3<f32>", vec3(SUN_DIR));
     line("GAVE_UP_COLOR", "vec3<f32>", vec3(GAVE_UP_COLOR.to_array()));
     line("SUN_COS", "f32", format!("{:?}", path::sun_cos()));

@@ -10,7 +10,8 @@ use super::path_pass::PathKey;
 use super::scene_buffers::UploadStats;
 use super::timer::PassTimer;
 use super::{
-    DenoisePass, FrameUniforms, GpuContext, GpuError, Kernel, PathPass, PathUniforms, SceneBuffers, TracePass,
+    DenoisePass, FrameUniforms, GpuContext, GpuError, GroundGrid, Kernel, PathPass, PathUniforms, SceneBuffers,
+    TracePass,
 };
 use crate::camera::Camera;
 use crate::scene::Scene;
@@ -116,12 +117,13 @@ pub struct PathView<'a> {
     pub settings: &'a PathSettings,
 }
 
-/// The key of `view`'s accumulation; `highlight` is the world box it tints.
-fn path_key(view: &PathView, highlight: Option<(IVec3, IVec3)>) -> PathKey {
+/// The key of `view`'s accumulation; `highlight` is the world box it
+/// tints, `ground` the grid it draws.
+fn path_key(view: &PathView, highlight: Option<(IVec3, IVec3)>, ground: Option<GroundGrid>) -> PathKey {
     let PathView { scene, camera, size, settings } = *view;
     let basis = camera.basis(size.0.max(1), size.1.max(1), scene.origin());
     let highlight = highlight.map(|(lo, hi)| (lo - scene.origin(), hi - scene.origin()));
-    PathKey { basis, settings: *settings, effects: effects_for(scene, settings), highlight }
+    PathKey { basis, settings: *settings, effects: effects_for(scene, settings), highlight, ground }
 }
 
 pub struct Renderer {
@@ -156,6 +158,10 @@ pub struct Renderer {
     /// selection, as the preview tints it); a change starts the
     /// accumulation over, since each sample counts its tinted first hits.
     pub path_highlight: Option<(IVec3, IVec3)>,
+    /// The ground grid drawn with the voxels (the window's, in a scene
+    /// with its ground on), in preview and path-traced frames; a change
+    /// starts a path-traced accumulation over.
+    pub ground: Option<GroundGrid>,
     /// Whether each path-traced sample measures the image's noise in its
     /// own frame (the window, which shows it after every sample; denoised
     /// frames always do). Without it [`Renderer::noise_estimate`] measures
@@ -198,6 +204,7 @@ impl Renderer {
             shown: Shown::Trace,
             denoise: false,
             path_highlight: None,
+            ground: None,
             estimate_noise: false,
             noise_of: None,
             denoised_of: None,
@@ -341,6 +348,7 @@ impl Renderer {
         let uniforms = FrameUniforms {
             hit_records: u32::from(self.hit_records),
             ..FrameUniforms::new(&basis, tree, &self.buffers, view, local, Footprint::of_pixels(&basis, lod))
+                .with_ground(self.ground, tree.origin())
         };
         self.records_written = self.hit_records;
         self.shown = Shown::Trace;
@@ -365,7 +373,7 @@ impl Renderer {
             self.denoiser.bind(gpu, &self.path);
         }
         let mut acc = self.path.accumulation;
-        let key = path_key(view, self.path_highlight);
+        let key = path_key(view, self.path_highlight, self.ground);
         let effects = key.effects;
         // The materials and lights go up again when the scene or the effect set changed.
         let send_scene = scene_changed || resized || acc.key.is_none_or(|k| k.effects != effects);
@@ -421,7 +429,8 @@ impl Renderer {
             end_row,
         };
         let (drawn, highlight) = (scene.drawn(), key.highlight);
-        let frame = FrameUniforms::new(&key.basis, drawn, &self.buffers, View::Shaded, highlight, Footprint::EXACT);
+        let frame = FrameUniforms::new(&key.basis, drawn, &self.buffers, View::Shaded, highlight, Footprint::EXACT)
+            .with_ground(key.ground, drawn.origin());
         self.path.prepare(gpu, &self.buffers, &frame, &path);
         let kernel = self.path.encode(gpu, encoder, effects, end_row - first_row, self.timer.pass_writes())?;
         self.timer.resolve(encoder);
@@ -583,7 +592,7 @@ impl Renderer {
     /// in bands, is complete.
     pub fn path_restarts(&self, view: &PathView, scene_changed: bool) -> bool {
         let resized = self.path.size() != (view.size.0.max(1), view.size.1.max(1));
-        self.path.accumulation.starts_over(&path_key(view, self.path_highlight), resized, scene_changed)
+        self.path.accumulation.starts_over(&path_key(view, self.path_highlight, self.ground), resized, scene_changed)
     }
 
     /// Compiles the path kernel a scene needs with `settings` now, so that the

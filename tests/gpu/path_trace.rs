@@ -479,3 +479,75 @@ fn the_selection_is_tinted_in_path_traced_frames() {
         assert!((is - was).abs() < 0.05 * was, "{label}: the rest changed (blue {was:.1} → {is:.1})");
     }
 }
+
+/// Issue 27: the ground grid was an overlay drawn over the image, voxels
+/// included. Traced with them, its lines change only pixels whose ray meets
+/// the ground before any voxel, in the preview and in path-traced frames.
+#[test]
+fn the_ground_grid_is_hidden_by_the_voxels_in_front_of_it() {
+    use octovox::settings::{RenderSettings, TraceMode, View};
+    let column = Shape::Box { min: IVec3::ZERO, max: IVec3::new(3, 9, 3) };
+    let mut scene = Scene::new(palette(), build(&[(column, Op::Place(WHITE))]));
+    let camera = look(DVec3::new(14.0, 10.0, 18.0), DVec3::new(1.0, 3.0, 1.0));
+    let size = (64, 48);
+    let grid = octovox::gpu::GroundGrid { y: 0, lo: [-8, -8], hi: [8, 8], step: 1 };
+    let mut renderer = Renderer::headless().expect("a GPU adapter (lavapipe on CI)");
+    renderer.sync(&mut scene);
+
+    // Which pixels' centre rays hit the column (the CPU tracer).
+    let tree = scene.drawn();
+    let basis = camera.basis(size.0, size.1, tree.origin());
+    let hits = octovox::trace::render::trace_image(
+        octovox::trace::render::Tracer::Svo(tree),
+        &basis,
+        octovox::trace::Footprint::EXACT,
+    );
+    let on_column = |i: usize| hits[i].is_hit();
+    let changed = |a: &image::RgbaImage, b: &image::RgbaImage| -> Vec<usize> {
+        a.pixels().zip(b.pixels()).enumerate().filter(|(_, (p, q))| p != q).map(|(i, _)| i).collect()
+    };
+
+    let settings =
+        RenderSettings { mode: TraceMode::Svo, view: View::Shaded, shadows: false, render_scale: 1.0, lod: 0.0 };
+    let preview = |renderer: &mut Renderer| {
+        renderer.render(&scene, &camera, size, &settings, None).unwrap();
+        renderer.read_image().unwrap()
+    };
+    let plain = preview(&mut renderer);
+    renderer.ground = Some(grid);
+    let gridded = preview(&mut renderer);
+    let lines = changed(&plain, &gridded);
+    let over_column = lines.iter().filter(|&&i| on_column(i)).count();
+    println!("preview: {} grid pixels, {over_column} of them on the column", lines.len());
+    assert!(lines.len() > 150, "the grid shows: {} pixels", lines.len());
+    assert!(over_column <= 2, "{over_column} grid pixels drawn over the column");
+
+    let path_settings = PathSettings::default();
+    let view = PathView { scene: &scene, camera: &camera, size, settings: &path_settings };
+    let path = |renderer: &mut Renderer| {
+        for sample in 0..2 {
+            renderer.render_path(&view, sample == 0).unwrap();
+        }
+        renderer.read_image().unwrap()
+    };
+    renderer.ground = None;
+    let plain = path(&mut renderer);
+    renderer.ground = Some(grid);
+    assert!(renderer.path_restarts(&view, false), "the grid starts the accumulation over");
+    let gridded = path(&mut renderer);
+    let lines = changed(&plain, &gridded);
+    // A pixel on the column's edge mixes samples that miss it.
+    let inside = |i: usize| {
+        let (x, y) = ((i % size.0 as usize) as i64, (i / size.0 as usize) as i64);
+        [(0, 0), (1, 0), (-1, 0), (0, 1), (0, -1)].iter().all(|(dx, dy)| {
+            let (x, y) = (x + dx, y + dy);
+            (0..i64::from(size.0)).contains(&x)
+                && (0..i64::from(size.1)).contains(&y)
+                && on_column((y * i64::from(size.0) + x) as usize)
+        })
+    };
+    let over_column = lines.iter().filter(|&&i| inside(i)).count();
+    println!("path: {} grid pixels, {over_column} of them inside the column", lines.len());
+    assert!(lines.len() > 150, "the grid shows in the path tracer: {} pixels", lines.len());
+    assert_eq!(over_column, 0, "grid pixels inside the column");
+}
