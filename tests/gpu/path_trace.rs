@@ -56,14 +56,16 @@ pub(crate) fn look(eye: DVec3, target: DVec3) -> Camera {
     Camera { eye, target, fov_y_deg: 40.0, ortho: None }
 }
 
+/// Each pixel's centre ray as the CPU tracer hits it.
+fn centre_hits(tree: &Octree, camera: &Camera, size: (u32, u32)) -> Vec<octovox::trace::Hit> {
+    let basis = camera.basis(size.0, size.1, tree.origin());
+    let tracer = octovox::trace::render::Tracer::Svo(tree);
+    octovox::trace::render::trace_image(tracer, &basis, octovox::trace::Footprint::EXACT)
+}
+
 /// Pixels whose hit (by the CPU tracer) is a voxel.
 fn object_pixels(tree: &Octree, camera: &Camera, size: (u32, u32), pixels: &[Vec3]) -> Vec<Vec3> {
-    let basis = camera.basis(size.0, size.1, tree.origin());
-    let hits = octovox::trace::render::trace_image(
-        octovox::trace::render::Tracer::Svo(tree),
-        &basis,
-        octovox::trace::Footprint::EXACT,
-    );
+    let hits = centre_hits(tree, camera, size);
     hits.iter().zip(pixels).filter(|(h, _)| h.is_hit()).map(|(_, p)| *p).collect()
 }
 
@@ -442,12 +444,7 @@ fn the_selection_is_tinted_in_path_traced_frames() {
     // Each pixel's first hit through its centre, and whether its
     // neighbours' agree about being selected (edges mix their samples).
     let tree = scene.drawn();
-    let basis = camera.basis(size.0, size.1, tree.origin());
-    let hits = octovox::trace::render::trace_image(
-        octovox::trace::render::Tracer::Svo(tree),
-        &basis,
-        octovox::trace::Footprint::EXACT,
-    );
+    let hits = centre_hits(tree, &camera, size);
     let class = |x: i64, y: i64| -> Option<bool> {
         let hit = hits.get((y * i64::from(size.0) + x) as usize).filter(|h| h.is_hit())?;
         let v = hit.voxel + tree.origin();
@@ -496,12 +493,7 @@ fn the_ground_grid_is_hidden_by_the_voxels_in_front_of_it() {
 
     // Which pixels' centre rays hit the column (the CPU tracer).
     let tree = scene.drawn();
-    let basis = camera.basis(size.0, size.1, tree.origin());
-    let hits = octovox::trace::render::trace_image(
-        octovox::trace::render::Tracer::Svo(tree),
-        &basis,
-        octovox::trace::Footprint::EXACT,
-    );
+    let hits = centre_hits(tree, &camera, size);
     let on_column = |i: usize| hits[i].is_hit();
     let changed = |a: &image::RgbaImage, b: &image::RgbaImage| -> Vec<usize> {
         a.pixels().zip(b.pixels()).enumerate().filter(|(_, (p, q))| p != q).map(|(i, _)| i).collect()
