@@ -52,7 +52,7 @@ const fn object(label: &'static str, code: KeyCode, shift: bool, line: ObjectLin
 }
 
 /// Every keyboard action, in menu order.
-pub static ACTIONS: [Action; 48] = [
+pub static ACTIONS: [Action; 49] = [
     ctrl("New", KeyCode::KeyN, FILE, Command::New),
     ctrl("Open…", KeyCode::KeyO, FILE, Command::AskOpen),
     ctrl("Save", KeyCode::KeyS, FILE, Command::Save),
@@ -79,6 +79,7 @@ pub static ACTIONS: [Action; 48] = [
     key("Paint tool", KeyCode::KeyG, TOOLS, Command::SetTool(Tool::Paint)),
     key("Line mode", KeyCode::KeyL, TOOLS, Command::ToggleLine),
     key("Box select mode", KeyCode::KeyB, TOOLS, Command::ToggleSelect),
+    key("Object mode", KeyCode::Tab, OBJECT, Command::ToggleObject),
     object("Duplicate object", KeyCode::KeyD, false, ObjectLine::Duplicate { reference: false }),
     object("Duplicate object as a reference", KeyCode::KeyD, true, ObjectLine::Duplicate { reference: true }),
     object("Make object unique", KeyCode::KeyU, false, ObjectLine::Unique),

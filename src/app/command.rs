@@ -89,6 +89,8 @@ pub enum Command {
     /// Box select mode on or off (B): a left drag selects a box, or drags
     /// a face of the selected one.
     ToggleSelect,
+    /// Object mode on or off (Tab).
+    ToggleObject,
     /// An `object` line on the picked object (the Object menu's keys).
     Object(octovox::script::ObjectLine),
     /// Script lines a panel or dialog asks for, run in order (the Objects

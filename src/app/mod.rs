@@ -342,6 +342,7 @@ impl App {
             Command::MeasurePresets => self.measure_presets(),
             Command::ToggleLine => self.toggle_mode(Mode::Line),
             Command::ToggleSelect => self.toggle_mode(Mode::Select),
+            Command::ToggleObject => self.toggle_mode(Mode::Object),
             Command::Copy => match self.run_line(&octovox::script::Command::Copy) {
                 Ok(_) => {
                     let voxels = self.doc.editor.clipboard().map_or(0, octovox::edit::selection::Block::voxels);
@@ -668,6 +669,7 @@ impl App {
         match self.state.mode {
             Mode::Line => return self.line_edit(phase, x, y),
             Mode::Select => return self.select_drag(phase, x, y),
+            Mode::Object => return self.object_click(phase, x, y),
             Mode::Brush => {}
         }
         match phase {
@@ -787,7 +789,14 @@ impl ApplicationHandler for App {
         if !matches!(event, WindowEvent::RedrawRequested) {
             log::trace!("window event {event:?}");
         }
-        let response = gfx.egui_state.on_window_event(&gfx.window, &event);
+        // Tab is object mode's key, not egui's focus step, unless a text
+        // field has the keyboard or a dialog asks (its buttons take Tab).
+        let asking = self.ui.prompt_open || self.ui.recover.is_some() || self.ui.read_only.is_some();
+        let to_egui = asking
+            || self.ui.dialog.is_some()
+            || gfx.egui_state.egui_ctx().egui_wants_keyboard_input()
+            || !is_tab_key(&event);
+        let response = if to_egui { gfx.egui_state.on_window_event(&gfx.window, &event) } else { Default::default() };
         if response.repaint && !matches!(event, WindowEvent::RedrawRequested) {
             self.frames.redraw_wanted.set(true);
             gfx.window.request_redraw();
@@ -878,6 +887,12 @@ fn surface_size(size: winit::dpi::PhysicalSize<u32>, gpu: &GpuContext) -> (u32, 
         log::warn!("the window is {}x{}; this GPU draws at most {limit}x{limit}", size.width, size.height);
     }
     (size.width.clamp(1, limit), size.height.clamp(1, limit))
+}
+
+/// Whether `event` is a press or release of the Tab key.
+fn is_tab_key(event: &WindowEvent) -> bool {
+    use winit::keyboard::{KeyCode, PhysicalKey};
+    matches!(event, WindowEvent::KeyboardInput { event, .. } if event.physical_key == PhysicalKey::Code(KeyCode::Tab))
 }
 
 #[cfg(test)]

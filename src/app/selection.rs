@@ -12,6 +12,7 @@ use octovox::edit::selection::Region;
 use octovox::script::Command as Line;
 
 use super::gesture::{Gesture, SelectDrag};
+use super::state::Mode;
 use super::{App, Nudge, StrokePhase};
 
 impl App {
@@ -101,11 +102,32 @@ impl App {
     /// An arrow key: `move` the selection one voxel along the world axis
     /// nearest to that direction as the camera sees it.
     pub(super) fn nudge(&mut self, nudge: Nudge) {
+        let step = nudge_step(&self.state.camera, nudge);
+        if self.state.mode == Mode::Object {
+            return self.act(Line::Object(octovox::script::ObjectLine::Move(step)), "object");
+        }
         if self.doc.editor.selection.is_none() {
             self.ui.info("nothing is selected: B, then drag a box");
             return;
         }
-        self.act(Line::Move(nudge_step(&self.state.camera, nudge)), "move");
+        self.act(Line::Move(step), "move");
+    }
+}
+
+impl App {
+    /// Object mode: a click picks the object it hits (no edit).
+    pub(super) fn object_click(&mut self, phase: StrokePhase, x: f64, y: f64) {
+        if !matches!(phase, StrokePhase::Click | StrokePhase::Begin) {
+            return;
+        }
+        let Ok(Some(pick)) = self.pick_at(x, y) else { return };
+        match self.doc.editor.object_line_at(pick.voxel) {
+            Some(line) => self.act(line, "object"),
+            None if self.doc.editor.scene.objects().is_none() => {
+                self.ui.info("the scene is one model: no objects to pick");
+            }
+            None => {}
+        }
     }
 }
 

@@ -81,13 +81,15 @@ pub struct EditorState {
 }
 
 /// What a left drag does: apply the tool, place the brush along a line
-/// (L), or select a box and move its faces (B).
+/// (L), select a box and move its faces (B), or pick objects (Tab: object
+/// mode, where the arrows and PageUp/PageDown move the picked object).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Mode {
     #[default]
     Brush,
     Line,
     Select,
+    Object,
 }
 
 /// The working volume's side in a new scene (MagicaVoxel opens on 40³,

@@ -194,6 +194,9 @@ pub struct UiState {
     /// A crash-recovery journal found beside the document just opened, and
     /// why applying it needs a second thought (its document changed since).
     pub recover: Option<(PathBuf, Option<String>)>,
+    /// The Objects panel's name field: the object it was filled from, and
+    /// the text (Enter renames the object to it).
+    pub rename: (Option<usize>, String),
     /// The open scene's edits are not journaled, and why: shown until a
     /// journal starts again.
     pub journal_warning: Option<String>,
@@ -260,7 +263,7 @@ pub fn show(
             material_editor(ui, tools.color, info.palette, &mut out);
             ui.separator();
             if let Some(objects) = info.objects {
-                objects_panel(ui, objects, &mut out);
+                objects_panel(ui, objects, &mut ui_state.rename, &mut out);
                 ui.separator();
             }
             // Sections below the palette collapse; none above it changes height.
@@ -382,6 +385,11 @@ fn tool_panel(ui: &mut egui::Ui, state: &mut EditorState, tools: &mut Tools, com
         if select.on_hover_text(hint).clicked() {
             commands.push(Command::ToggleSelect);
         }
+        let object = ui.selectable_label(state.mode == Mode::Object, "Object (Tab)");
+        let hint = "click an object to pick it; arrows and PageUp/PageDown move it, Ctrl+R turns it";
+        if object.on_hover_text(hint).clicked() {
+            commands.push(Command::ToggleObject);
+        }
     });
     ui.label("Brush");
     ui.horizontal(|ui| {
@@ -486,12 +494,13 @@ const MAX_OBJECT_ROWS: usize = 500;
 /// The Objects panel: every object in walk order, an eye to hide or show
 /// it, a click to pick the one edits go to; then the layers, each with an
 /// eye. What they do are the `object` and `layer` script lines.
-fn objects_panel(ui: &mut egui::Ui, objects: &Objects, out: &mut Vec<Command>) {
+fn objects_panel(ui: &mut egui::Ui, objects: &Objects, rename: &mut (Option<usize>, String), out: &mut Vec<Command>) {
     use octovox::script::{Command as Line, LayerLine, ObjectLine, ObjectRef};
     let list = objects.list();
     egui::CollapsingHeader::new(format!("Objects ({}, {} models)", list.len(), objects.models.len()))
         .default_open(true)
         .show(ui, |ui| {
+            rename_row(ui, objects, rename, out);
             egui::ScrollArea::vertical().id_salt("objects").max_height(160.0).show(ui, |ui| {
                 for (index, object) in list.iter().enumerate().take(MAX_OBJECT_ROWS) {
                     let pick = Line::Object(ObjectLine::Pick(ObjectRef::Index(index)));
@@ -527,6 +536,32 @@ fn objects_panel(ui: &mut egui::Ui, objects: &Objects, out: &mut Vec<Command>) {
                 });
             }
         });
+}
+
+/// The picked object's name, editable: Enter renames it (`object rename`,
+/// an undo step). Always there, disabled with no object picked, so that
+/// the rows below stay put.
+fn rename_row(ui: &mut egui::Ui, objects: &Objects, rename: &mut (Option<usize>, String), out: &mut Vec<Command>) {
+    use octovox::script::{Command as Line, ObjectLine, ObjectRef};
+    let picked = objects.selected;
+    if rename.0 != picked {
+        let own = picked.and_then(|i| objects.transform_node(i).ok()).and_then(|node| node.attributes.get("_name"));
+        *rename = (picked, own.cloned().unwrap_or_default());
+    }
+    ui.horizontal(|ui| {
+        ui.label("Name");
+        ui.add_enabled_ui(picked.is_some(), |ui| {
+            let field = ui.add(egui::TextEdit::singleline(&mut rename.1).desired_width(140.0));
+            let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
+            if let (true, Some(index)) = (entered && !rename.1.trim().is_empty(), picked) {
+                out.push(Command::Lines(vec![
+                    Line::Object(ObjectLine::Pick(ObjectRef::Index(index))),
+                    Line::Object(ObjectLine::Rename(rename.1.trim().to_owned())),
+                ]));
+            }
+            field.on_hover_text("object rename NAME (Enter)");
+        });
+    });
 }
 
 /// The selected entry's colour, material kind and the parameters the path

@@ -162,3 +162,57 @@ fn object_edits_survive_a_kill() {
     let dot_vox::SceneNode::Transform { attributes, .. } = &data.scenes[node] else { panic!("node {node}") };
     assert_eq!(attributes.get("_hidden").map(String::as_str), Some("1"), "the Ctrl+H before the kill is kept");
 }
+
+/// Tab is object mode: a click picks the object it hits and edits nothing,
+/// the arrow keys move it (`object move`), the saved file has its
+/// transform moved by as much and no model changed; one Ctrl+Z undoes
+/// each move.
+#[test]
+fn tab_object_mode_picks_with_a_click_and_moves_with_the_arrows() {
+    let (dir, file, scene) = groups_document();
+    let objects = scene.objects().unwrap();
+    let (lo, hi) = scene.solid_bounds().unwrap();
+    let camera = Camera::framing(lo, hi, 50.0);
+    let last = objects.list().len() - 1;
+    let (x, y, voxel, _) = stable_pixel(scene.drawn(), &camera, |v, _| objects.owner_at(v).is_some_and(|o| o != last));
+    let owner = objects.owner_at(voxel).unwrap();
+    let node = objects.list()[owner].transform_node.expect("a transform above the object") as usize;
+    let translation = |file: &std::path::Path| -> [i32; 3] {
+        let data = dot_vox::load_bytes(&std::fs::read(file).unwrap()).unwrap();
+        let dot_vox::SceneNode::Transform { frames, .. } = &data.scenes[node] else { panic!("node {node}") };
+        let t = frames[0].attributes.get("_t").cloned().unwrap_or_default();
+        let v: Vec<i32> = t.split_whitespace().map(|w| w.parse().unwrap()).collect();
+        [v[0], v[1], v[2]]
+    };
+    let (before, sizes) = (translation(&file), model_sizes(&file));
+
+    let (_xvfb, display) = start_xvfb(23);
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &document_args(&file, &camera, &[]));
+    let window = find_window(&display, &mut app, &stderr_path);
+    lines.wait_for("octovox: ready", Duration::from_secs(90));
+    xdotool(&display, &["windowfocus", "--sync", &window]);
+    xdotool(&display, &["key", "Tab"]);
+    xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y.to_string()]);
+    std::thread::sleep(Duration::from_millis(300));
+    xdotool(&display, &["click", "1"]);
+    assert_eq!(lines.wait_for("ran: object", Duration::from_secs(30)), format!("ran: object {owner}"));
+    for _ in 0..2 {
+        xdotool(&display, &["key", "Right"]);
+        // A move composes the cells the object left and reached: `object: N bytes written`.
+        lines.wait_for("object:", Duration::from_secs(30));
+    }
+    save(&display, &mut lines, &file);
+    assert!(!lines.seen.iter().any(|l| l.starts_with("edit:")), "object mode edited: {:?}", lines.seen);
+    assert_eq!(model_sizes(&file), sizes, "no model changed");
+    let after = translation(&file);
+    let moved: i32 = (0..3).map(|k| (after[k] - before[k]).abs()).sum();
+    assert_eq!(moved, 2, "two steps along one axis: {before:?} → {after:?}");
+
+    // One Ctrl+Z undoes each move.
+    for _ in 0..2 {
+        xdotool(&display, &["key", "ctrl+z"]);
+        lines.wait_for("undo:", Duration::from_secs(30));
+    }
+    save(&display, &mut lines, &file);
+    assert_eq!(translation(&file), before, "two Ctrl+Z put it back");
+}
