@@ -311,6 +311,16 @@ impl App {
             Command::ExtrudeDrag { phase, x, y } if !busy_loading => self.extrude_drag(phase, x, y),
             Command::EditPalette { edit, dragging } if !busy_loading => self.palette_edit(edit, dragging),
             Command::Cut if !busy_loading => self.act(octovox::script::Command::Cut, "cut"),
+            // Object mode: Delete and X/Y/Z act on the picked object.
+            Command::DeleteSelection if !busy_loading && self.state.mode == Mode::Object => {
+                self.act(octovox::script::Command::Object(octovox::script::ObjectLine::Delete), "object")
+            }
+            Command::Turn { axis, flip: false } if !busy_loading && self.state.mode == Mode::Object => {
+                self.act(octovox::script::Command::Object(octovox::script::ObjectLine::Rotate(axis)), "object")
+            }
+            Command::Turn { flip: true, .. } if self.state.mode == Mode::Object => {
+                self.ui.info("an object turns (X, Y, Z) but does not flip");
+            }
             Command::DeleteSelection if !busy_loading => self.act(octovox::script::Command::Delete, "delete"),
             Command::PasteAtCursor if !busy_loading => self.paste_at_cursor(),
             Command::Nudge(nudge) if !busy_loading => self.nudge(nudge),

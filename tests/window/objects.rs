@@ -166,7 +166,7 @@ fn object_edits_survive_a_kill() {
 /// Tab is object mode: a click picks the object it hits and edits nothing,
 /// the arrow keys move it (`object move`), the saved file has its
 /// transform moved by as much and no model changed; one Ctrl+Z undoes
-/// each move.
+/// each move; Y turns it and Delete deletes it.
 #[test]
 fn tab_object_mode_picks_with_a_click_and_moves_with_the_arrows() {
     let (dir, file, scene) = groups_document();
@@ -215,4 +215,17 @@ fn tab_object_mode_picks_with_a_click_and_moves_with_the_arrows() {
     }
     save(&display, &mut lines, &file);
     assert_eq!(translation(&file), before, "two Ctrl+Z put it back");
+
+    // Y turns the picked object a quarter about y, Delete deletes it.
+    let transforms = |file: &std::path::Path| {
+        let data = dot_vox::load_bytes(&std::fs::read(file).unwrap()).unwrap();
+        data.scenes.iter().filter(|n| matches!(n, dot_vox::SceneNode::Transform { .. })).count()
+    };
+    let count = transforms(&file);
+    xdotool(&display, &["key", "y"]);
+    lines.wait_for("object:", Duration::from_secs(30));
+    xdotool(&display, &["key", "Delete"]);
+    lines.wait_for("object:", Duration::from_secs(30));
+    save(&display, &mut lines, &file);
+    assert_eq!(transforms(&file), count - 1, "Delete deleted the object");
 }
