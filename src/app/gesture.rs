@@ -21,6 +21,10 @@ pub(super) enum Gesture {
     Select { drag: SelectDrag, preview: Option<Region> },
     /// A Ctrl+drag extrude: the face it started on and where the drag began.
     Extrude { face: Pick, start: (f64, f64) },
+    /// An object dragged (object mode): the tree-local point it was
+    /// grabbed at, the window pixel the drag began at, and how far it has
+    /// moved so far (its moves are one undo step).
+    ObjectDrag { at: glam::Vec3, start: (f64, f64), moved: IVec3 },
 }
 
 /// A selection drag under way.
@@ -47,7 +51,7 @@ impl Gesture {
     /// Whether the gesture groups edits into one undo step (a stroke, a
     /// held palette control).
     pub fn groups_edits(&self) -> bool {
-        matches!(self, Gesture::Stroke(_) | Gesture::Palette)
+        matches!(self, Gesture::Stroke(_) | Gesture::Palette | Gesture::ObjectDrag { .. })
     }
 
     pub fn stroke_mut(&mut self) -> Option<&mut Stroke> {

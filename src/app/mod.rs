@@ -764,6 +764,7 @@ impl App {
                 self.gesture.stroke().is_some_and(|s| s.applying)
             }
             Line::Rgb(..) | Line::Material(..) => matches!(self.gesture, Gesture::Palette),
+            Line::Object(octovox::script::ObjectLine::Move(_)) => matches!(self.gesture, Gesture::ObjectDrag { .. }),
             _ => false,
         }
     }

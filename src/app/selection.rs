@@ -115,19 +115,62 @@ impl App {
 }
 
 impl App {
-    /// Object mode: a click picks the object it hits (no edit).
+    /// Object mode: a press picks the object it hits (no edit), and a drag
+    /// from it moves it over the ground's axes, one undo step.
     pub(super) fn object_click(&mut self, phase: StrokePhase, x: f64, y: f64) {
-        if !matches!(phase, StrokePhase::Click | StrokePhase::Begin) {
+        match phase {
+            StrokePhase::Begin | StrokePhase::Click => {
+                let Ok(Some(pick)) = self.pick_at(x, y) else { return };
+                match self.doc.editor.object_line_at(pick.voxel) {
+                    Some(line) => self.act(line, "object"),
+                    None if self.doc.editor.scene.objects().is_none() => {
+                        return self.ui.info("the scene is one model: no objects to pick");
+                    }
+                    None => {}
+                }
+                if phase == StrokePhase::Begin {
+                    let at = (pick.voxel - self.doc.editor.scene.origin()).as_vec3() + Vec3::splat(0.5);
+                    self.doc.editor.history.begin_stroke();
+                    self.gesture = Gesture::ObjectDrag { at, start: (x, y), moved: IVec3::ZERO };
+                }
+            }
+            StrokePhase::Move => self.drag_object(x, y),
+            StrokePhase::End => self.close_strokes(),
+        }
+    }
+
+    /// Moves the dragged object to where the pointer has dragged its point:
+    /// whole voxels along x and z, as they look on screen.
+    fn drag_object(&mut self, x: f64, y: f64) {
+        let Gesture::ObjectDrag { at, start, moved } = self.gesture else { return };
+        let Some(steps) = self.ground_steps(at, start, (x, y)) else { return };
+        if steps == moved {
             return;
         }
-        let Ok(Some(pick)) = self.pick_at(x, y) else { return };
-        match self.doc.editor.object_line_at(pick.voxel) {
-            Some(line) => self.act(line, "object"),
-            None if self.doc.editor.scene.objects().is_none() => {
-                self.ui.info("the scene is one model: no objects to pick");
-            }
-            None => {}
+        if let Err(err) = self.run_line(&Line::Object(octovox::script::ObjectLine::Move(steps - moved))) {
+            return self.ui.error(format!("object refused: {err}"));
         }
+        if let Gesture::ObjectDrag { moved, .. } = &mut self.gesture {
+            *moved = steps;
+        }
+    }
+
+    /// The whole voxels along x and z that a drag from `start` to `end`
+    /// covers at the tree-local point `at`: the drag in the screen's
+    /// directions of those two axes there.
+    fn ground_steps(&self, at: Vec3, start: (f64, f64), end: (f64, f64)) -> Option<IVec3> {
+        let (w, h) = self.window_size();
+        let basis = self.state.camera.basis(w, h, self.doc.editor.scene.origin());
+        let screen = |p: Vec3| basis.project(p).map(|(x, y)| glam::DVec2::new(f64::from(x), f64::from(y)));
+        let origin = screen(at)?;
+        let (sx, sz) = (screen(at + Vec3::X)? - origin, screen(at + Vec3::Z)? - origin);
+        let det = sx.perp_dot(sz);
+        if det.abs() < 1e-3 {
+            return None; // the ground is seen edge-on
+        }
+        let drag = glam::DVec2::new(end.0 - start.0, end.1 - start.1);
+        let (a, b) = (drag.perp_dot(sz) / det, sx.perp_dot(drag) / det);
+        Some(IVec3::new(a.round() as i32, 0, b.round() as i32))
     }
 }
 

@@ -166,9 +166,10 @@ fn object_edits_survive_a_kill() {
 /// Tab is object mode: a click picks the object it hits and edits nothing,
 /// the arrow keys move it (`object move`), the saved file has its
 /// transform moved by as much and no model changed; one Ctrl+Z undoes
-/// each move; Y turns it and Delete deletes it.
+/// each move; a drag moves it as one undo step; Y turns it and Delete
+/// deletes it.
 #[test]
-fn tab_object_mode_picks_with_a_click_and_moves_with_the_arrows() {
+fn tab_object_mode_picks_moves_drags_turns_and_deletes_objects() {
     let (dir, file, scene) = groups_document();
     let objects = scene.objects().unwrap();
     let (lo, hi) = scene.solid_bounds().unwrap();
@@ -215,6 +216,25 @@ fn tab_object_mode_picks_with_a_click_and_moves_with_the_arrows() {
     }
     save(&display, &mut lines, &file);
     assert_eq!(translation(&file), before, "two Ctrl+Z put it back");
+
+    // A drag from the object moves it, as one undo step.
+    xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y.to_string()]);
+    std::thread::sleep(Duration::from_millis(300));
+    xdotool(&display, &["mousedown", "1"]);
+    for _ in 0..8 {
+        xdotool(&display, &["mousemove_relative", "--", "12", "0"]);
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    xdotool(&display, &["mouseup", "1"]);
+    lines.wait_for("edit:", Duration::from_secs(30));
+    save(&display, &mut lines, &file);
+    let dragged = translation(&file);
+    assert_ne!(dragged, before, "the drag moved the object");
+    assert_eq!(dragged[2], before[2], "along the ground only (MagicaVoxel's z is up)");
+    xdotool(&display, &["key", "ctrl+z"]);
+    lines.wait_for("undo:", Duration::from_secs(30));
+    save(&display, &mut lines, &file);
+    assert_eq!(translation(&file), before, "one Ctrl+Z undoes the whole drag");
 
     // Y turns the picked object a quarter about y, Delete deletes it.
     let transforms = |file: &std::path::Path| {
