@@ -152,7 +152,7 @@ impl App {
                 ui::draw_selection(ui, state, &info);
                 if let Some((voxels, normal, layers)) = info.extrude {
                     ui::draw_extrude(ui, state, &info, voxels, normal, layers);
-                } else if let Some(pick) = pick.filter(|_| state.mode != Mode::Select && info.fill.is_none()) {
+                } else if let Some(pick) = pick.filter(|_| state.mode.uses_brush() && info.fill.is_none()) {
                     ui::draw_brush_outline(ui, state, tools, &pick, &info);
                 }
                 ui::draw_action_previews(ui, state, &info);
@@ -224,13 +224,14 @@ impl App {
             (gfx.renderer.denoise, gfx.renderer.estimate_noise) = (self.state.denoise, true);
             FrameInput::Path { view, scene_changed }
         } else {
-            // Select mode tints the selected voxels; the other modes what the brush would touch.
-            let highlight = if self.state.mode == Mode::Select {
-                selection.map(|r| (r.min, r.max))
-            } else {
-                self.hover
+            // Select mode tints the selected voxels; the brush's modes what it would touch.
+            let highlight = match self.state.mode {
+                Mode::Select => selection.map(|r| (r.min, r.max)),
+                Mode::Object => None,
+                Mode::Brush | Mode::Line => self
+                    .hover
                     .pick
-                    .map(|pick| self.state.preview_box(&self.doc.editor.tools, &pick, self.gesture.line_start()))
+                    .map(|pick| self.state.preview_box(&self.doc.editor.tools, &pick, self.gesture.line_start())),
             };
             FrameInput::preview(scene, &state.camera, trace_size, &state.settings, highlight)
         };

@@ -21,10 +21,10 @@ pub(super) enum Gesture {
     Select { drag: SelectDrag, preview: Option<Region> },
     /// A Ctrl+drag extrude: the face it started on and where the drag began.
     Extrude { face: Pick, start: (f64, f64) },
-    /// An object dragged (object mode): the tree-local point it was
-    /// grabbed at, the window pixel the drag began at, and how far it has
-    /// moved so far (its moves are one undo step).
-    ObjectDrag { at: glam::Vec3, start: (f64, f64), moved: IVec3 },
+    /// An object dragged (object mode): the world voxel it was grabbed
+    /// at, the window pixel the drag began at, and how far it has moved so
+    /// far (its moves are one undo step).
+    ObjectDrag { at: IVec3, start: (f64, f64), moved: IVec3 },
 }
 
 /// A selection drag under way.

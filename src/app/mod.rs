@@ -519,6 +519,10 @@ impl App {
 
     /// `mode` on, or off when it is on; a line or box drag under way ends.
     fn toggle_mode(&mut self, mode: Mode) {
+        // An object drag's undo step closes with it.
+        if matches!(self.gesture, Gesture::ObjectDrag { .. }) {
+            self.close_strokes();
+        }
         self.state.toggle_mode(mode);
         if matches!(self.gesture, Gesture::Line { .. } | Gesture::Select { .. }) {
             self.gesture = Gesture::Idle;

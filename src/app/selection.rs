@@ -129,9 +129,8 @@ impl App {
                     None => {}
                 }
                 if phase == StrokePhase::Begin {
-                    let at = (pick.voxel - self.doc.editor.scene.origin()).as_vec3() + Vec3::splat(0.5);
                     self.doc.editor.history.begin_stroke();
-                    self.gesture = Gesture::ObjectDrag { at, start: (x, y), moved: IVec3::ZERO };
+                    self.gesture = Gesture::ObjectDrag { at: pick.voxel, start: (x, y), moved: IVec3::ZERO };
                 }
             }
             StrokePhase::Move => self.drag_object(x, y),
@@ -156,11 +155,14 @@ impl App {
     }
 
     /// The whole voxels along x and z that a drag from `start` to `end`
-    /// covers at the tree-local point `at`: the drag in the screen's
-    /// directions of those two axes there.
-    fn ground_steps(&self, at: Vec3, start: (f64, f64), end: (f64, f64)) -> Option<IVec3> {
+    /// covers at the world voxel `at`: the drag in the screen's directions
+    /// of those two axes there. (A move can grow the tree and move its
+    /// origin, hence world coordinates until here.)
+    fn ground_steps(&self, at: IVec3, start: (f64, f64), end: (f64, f64)) -> Option<IVec3> {
         let (w, h) = self.window_size();
-        let basis = self.state.camera.basis(w, h, self.doc.editor.scene.origin());
+        let origin = self.doc.editor.scene.origin();
+        let basis = self.state.camera.basis(w, h, origin);
+        let at = (at - origin).as_vec3() + Vec3::splat(0.5);
         let screen = |p: Vec3| basis.project(p).map(|(x, y)| glam::DVec2::new(f64::from(x), f64::from(y)));
         let origin = screen(at)?;
         let (sx, sz) = (screen(at + Vec3::X)? - origin, screen(at + Vec3::Z)? - origin);

@@ -92,6 +92,13 @@ pub enum Mode {
     Object,
 }
 
+impl Mode {
+    /// Whether a left drag applies the brush (so its reach is previewed).
+    pub fn uses_brush(self) -> bool {
+        matches!(self, Mode::Brush | Mode::Line)
+    }
+}
+
 /// The working volume's side in a new scene (MagicaVoxel opens on 40³,
 /// Goxel on a grid plane).
 pub const DEFAULT_VOLUME: i32 = 32;

@@ -233,7 +233,13 @@ impl Octree {
             return;
         }
         if !is_pointer(word) || level <= 1 {
-            return self.visit_cells(word, min, level, f);
+            // A brick's voxels come one by one: only those that meet the box.
+            let mut meeting = |cell: IVec3, edge: i32, value: u8| {
+                if (cell + IVec3::splat(edge - 1)).cmpge(lo).all() && cell.cmple(hi).all() {
+                    f(cell, edge, value);
+                }
+            };
+            return self.visit_cells(word, min, level, &mut meeting);
         }
         let half = 1 << (level - 1);
         for octant in 0..8 {
@@ -545,5 +551,19 @@ mod tests {
             let err = solid(origin).map(|t| t.solid_voxels()).unwrap_err();
             assert!(err.to_string().contains("past the coordinate limit"), "{origin}: {err}");
         }
+    }
+
+    /// The cells reported for a box are those that meet it, also inside a
+    /// brick (whose voxels came all at once: a model cut into pieces on
+    /// save then got a piece of size 0 from a neighbour's voxel).
+    #[test]
+    fn the_cells_in_a_box_are_only_those_that_meet_it() {
+        let mut tree = Octree::default();
+        for p in [IVec3::new(0, 0, 0), IVec3::new(1, 0, 0), IVec3::new(1, 1, 1), IVec3::new(9, 0, 0)] {
+            tree.apply_brush(&super::super::Shape::Voxel(p), super::super::Op::Place(3)).unwrap();
+        }
+        let mut seen = Vec::new();
+        tree.for_each_solid_cell_in(IVec3::new(1, 0, 0), IVec3::new(1, 0, 0), |min, edge, _| seen.push((min, edge)));
+        assert_eq!(seen, [(IVec3::new(1, 0, 0), 1)]);
     }
 }

@@ -192,3 +192,29 @@ fn groups_become_glb_nodes_and_references_share_a_mesh() {
     assert_eq!(names[..2], ["characters/object 0", "characters/object 1"]);
     assert_eq!(names[18], "text/object 18");
 }
+
+/// A scene whose objects are all hidden exports a valid, empty .glb: one
+/// node without a mesh (glTF allows no empty scene).
+#[test]
+fn a_scene_with_every_object_hidden_exports_a_valid_empty_glb() {
+    let dir = tempfile::tempdir().unwrap();
+    let source = assets().join("format/test_groups.vox");
+    let mut script = format!("load {}\n", source.display());
+    for i in 0..19 {
+        script.push_str(&format!("object {i}\nobject hide\n"));
+    }
+    script.push_str("save hidden.vox\n");
+    let path = dir.path().join("hide.ovr");
+    std::fs::write(&path, script).unwrap();
+    let ran = octovox(&["replay", "--cpu", path.to_str().unwrap()]);
+    assert!(ran.status.success(), "{}", text(&ran));
+    let glb = dir.path().join("hidden.glb");
+    let done = octovox(&["export", dir.path().join("hidden.vox").to_str().unwrap(), "-o", glb.to_str().unwrap()]);
+    assert!(done.status.success(), "{}", text(&done));
+    validate_gltf(&[&glb]);
+    let bytes = std::fs::read(&glb).unwrap();
+    let json_length = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    let json: serde_json::Value = serde_json::from_slice(&bytes[20..20 + json_length]).unwrap();
+    assert_eq!(json["nodes"].as_array().unwrap().len(), 1);
+    assert!(json["meshes"].is_null());
+}

@@ -473,3 +473,62 @@ fn an_edit_with_no_object_left_is_refused_and_a_new_object_takes_it() {
     assert_eq!(editor.scene.solid_voxels(), 1);
     assert_eq!(load(&saved(&editor.scene)).solid_voxels(), 1, "saved in the new object's model");
 }
+
+/// Found in review: a model cut into pieces whose last block held only a
+/// voxel of a neighbouring brick got a piece of size 0 there, and the file
+/// did not load. A 256-wide model with its last column empty, grown by
+/// one voxel below its grid, is cut into pieces that all load.
+#[test]
+fn a_cut_model_never_gets_an_empty_piece() {
+    let voxels = (0..255u8).map(|x| Voxel { x, y: 0, z: 0, i: 9 }).collect();
+    let frame = |t: &str| vec![Frame::new(dict(&[("_t", t.to_owned())]))];
+    let data = DotVoxData {
+        version: 200,
+        index_map: Vec::new(),
+        models: vec![Model { size: Size { x: 256, y: 1, z: 1 }, voxels }, model(2, 30)],
+        palette: dot_vox::DEFAULT_PALETTE.to_vec(),
+        materials: Vec::new(),
+        scenes: vec![
+            SceneNode::Transform { attributes: dict(&[]), frames: frame("0 0 0"), child: 1, layer_id: u32::MAX },
+            SceneNode::Group { attributes: dict(&[]), children: vec![2, 4] },
+            SceneNode::Transform {
+                attributes: dict(&[("_name", "a".into())]),
+                frames: frame("0 0 0"),
+                child: 3,
+                layer_id: 0,
+            },
+            SceneNode::Shape { attributes: dict(&[]), models: vec![ShapeModel { model_id: 0, attributes: dict(&[]) }] },
+            SceneNode::Transform {
+                attributes: dict(&[("_name", "b".into())]),
+                frames: frame("0 40 9"),
+                child: 5,
+                layer_id: 0,
+            },
+            SceneNode::Shape { attributes: dict(&[]), models: vec![ShapeModel { model_id: 1, attributes: dict(&[]) }] },
+        ],
+        layers: vec![Layer { attributes: dict(&[("_name", "0".into())]) }],
+    };
+    let mut bytes = Vec::new();
+    data.write_vox(&mut bytes).unwrap();
+    let mut editor = Editor::default();
+    editor.set_scene(load(&bytes));
+    // Model cell x = −1 (the pivot is x = 128): the grid grows to 257.
+    for line in &octovox::script::parse_script(std::path::Path::new("t.ovr"), "object a\ncolor 7\nplace -129 0 0")
+        .unwrap()
+        .lines
+    {
+        editor.run(&line.command).unwrap();
+    }
+    let again = saved(&editor.scene);
+    let parsed = dot_vox::load_bytes(&again).unwrap();
+    // Cut at x = 255, where the model holds nothing: one piece, under a group.
+    let named = |name: &str| {
+        parsed.scenes.iter().any(|n| matches!(n, SceneNode::Transform { attributes, .. } if attributes.get("_name").is_some_and(|v| v == name)))
+    };
+    assert!(named("a 1") && !named("a 2"), "the 257-wide model was cut into one piece");
+    for model in &parsed.models {
+        let size = [model.size.x, model.size.y, model.size.z];
+        assert!(size.iter().all(|&s| (1..=256).contains(&s)), "a piece of size {size:?}");
+    }
+    assert_eq!(load(&again).solid_voxels(), 256 + 5, "every voxel loads back");
+}

@@ -44,7 +44,11 @@ pub fn glb(exported: &Exported, palette: &Palette, scale: f32) -> Option<Vec<u8>
             meshes.push(json!({"name": named.name, "primitives": primitives}));
         }
     }
-    let (nodes, roots) = nodes(exported, &gltf_mesh, scale);
+    let (mut nodes, mut roots) = nodes(exported, &gltf_mesh, scale);
+    // A scene needs a node (every object hidden): one without a mesh.
+    if nodes.is_empty() {
+        (nodes, roots) = (vec![json!({"name": "voxels"})], vec![0]);
+    }
 
     let mut root = Map::new();
     root.insert("asset".into(), json!({"version": "2.0", "generator": "octovox"}));
