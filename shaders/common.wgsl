@@ -275,6 +275,9 @@ fn shade(hit: Hit, d: vec3<f32>, in_shadow: bool) -> vec3<f32> {
     }
 }
 
+// The t of a ray that hits no voxel: the ground grid shows up to it.
+const NO_VOXEL_T: f32 = 3.0e38;
+
 // How much of a one-pixel-wide ground grid line the ray `r` crosses before
 // t = `until` (where it first hits a voxel): 0 or 1, as a line is either
 // under the pixel's centre or not. Voxels in front of the ground hide it.
@@ -303,13 +306,13 @@ fn ground_line(r: Ray, until: f32) -> f32 {
 fn write_pixel(px: vec2<u32>, hit: Hit, d: vec3<f32>, in_shadow: bool) {
     var rgb = shade(hit, d, in_shadow);
     if (u.ground_on != 0u) {
-        let until = select(3.0e38, hit.t, hit.value != 0u);
-        rgb = mix(rgb, vec3<f32>(1.0), GRID_MIX * ground_line(pixel_ray(px), until));
+        let until = select(NO_VOXEL_T, hit.t, hit.value != 0u);
+        rgb = overlaid(rgb, 0.0, ground_line(pixel_ray(px), until));
     }
     // Uniform branches: skipped as a whole when off.
     if (u.highlight_on != 0u) {
         if (in_highlight(hit)) {
-            rgb = mix(rgb, HIGHLIGHT_TINT, HIGHLIGHT_MIX);
+            rgb = overlaid(rgb, 1.0, 0.0);
         }
     }
     textureStore(out_color, vec2<i32>(px), vec4<f32>(rgb, 1.0));

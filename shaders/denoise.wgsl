@@ -255,11 +255,9 @@ fn finish(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = pixel_index(i32(gid.x), i32(gid.y));
     let p = code_of(i);
     let rgb = select(mean_of(i), light_in[i].rgb * albedo_of(i), is_filtered(p));
-    // The highlight's tint, by the share of samples whose first hit it is
-    // (kept beside the albedo sum; see `path` in path.wgsl).
+    // The tint and the grid by the shares of samples that showed them,
+    // counted beside the albedo and squares sums (see `path` in path.wgsl).
     let n = max(count_of(i), 1.0);
-    let tint = HIGHLIGHT_MIX * accum[3u * i + 2u].w / n;
-    // And the ground grid's lines, by the share of samples that crossed one.
-    let grid = GRID_MIX * accum[3u * i + 1u].w / n;
-    textureStore(out_color, vec2<i32>(gid.xy), vec4<f32>(mix(mix(rgb, HIGHLIGHT_TINT, tint), vec3<f32>(1.0), grid), 1.0));
+    let shown = overlaid(rgb, accum[3u * i + 2u].w / n, accum[3u * i + 1u].w / n);
+    textureStore(out_color, vec2<i32>(gid.xy), vec4<f32>(shown, 1.0));
 }

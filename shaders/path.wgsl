@@ -70,7 +70,7 @@ var<private> pu: PathUniforms;
 var<private> first_albedo: vec3<f32>;
 // 1 when the sample's first hit is a highlighted voxel (the selection).
 var<private> first_tint: f32;
-// The t of the camera ray's first voxel (3e38 for none): what hides the ground grid.
+// The t of the camera ray's first voxel (NO_VOXEL_T for none): what hides the ground grid.
 var<private> first_t: f32;
 
 // Whether the denoiser leaves a pixel whose first hit is of `kind` to its
@@ -419,7 +419,7 @@ fn radiance(ray_in: Ray) -> vec3<f32> {
     loop {
         let hit = cross_medium(ray, medium);
         if (first) {
-            first_t = select(3.0e38, hit.t, hit.found && hit.value != 0u);
+            first_t = select(NO_VOXEL_T, hit.t, hit.found && hit.value != 0u);
         }
         if (hit.iterations >= u.max_iterations && !hit.found) {
             return radiance + beta * GAVE_UP_COLOR;
@@ -538,7 +538,7 @@ fn path(@builtin(global_invocation_id) gid: vec3<u32>) {
     let r = image_ray(vec2<f32>(px) + vec2<f32>(jx, jy));
     first_albedo = vec3<f32>(1.0);
     first_tint = 0.0;
-    first_t = 3.0e38;
+    first_t = NO_VOXEL_T;
     let sample = clamp_sample(radiance(r));
     let first = pu.sample_index == 0u;
     let at = 3u * pixel;
@@ -550,10 +550,8 @@ fn path(@builtin(global_invocation_id) gid: vec3<u32>) {
     accum[at] = vec4<f32>(sum, n);
     accum[at + 1u] = squares;
     accum[at + 2u] = albedo;
-    // The tint by the share of samples whose first hit is highlighted.
-    let tinted = mix(sum / n, HIGHLIGHT_TINT, HIGHLIGHT_MIX * albedo.w / n);
-    let shown = mix(tinted, vec3<f32>(1.0), GRID_MIX * squares.w / n);
-    textureStore(out_color, vec2<i32>(px), vec4<f32>(shown, 1.0));
+    // The tint and the grid by the shares of samples that showed them.
+    textureStore(out_color, vec2<i32>(px), vec4<f32>(overlaid(sum / n, albedo.w / n, squares.w / n), 1.0));
     if (first) {
         write_guide(px, pixel);
     }

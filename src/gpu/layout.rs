@@ -88,7 +88,7 @@ pub struct FrameUniforms {
 
 impl FrameUniforms {
     /// Uniforms for a frame: camera basis, tree root and grid placement.
-    /// `highlight` is an inclusive tree-local voxel box to tint.
+    /// `highlight` is an inclusive world voxel box to tint.
     pub fn new(
         basis: &RayBasis,
         tree: &Octree,
@@ -97,7 +97,8 @@ impl FrameUniforms {
         highlight: Option<(IVec3, IVec3)>,
         lod: Footprint,
     ) -> FrameUniforms {
-        let (lo, hi) = highlight.unwrap_or((IVec3::ZERO, IVec3::NEG_ONE));
+        let local = highlight.map(|(lo, hi)| (lo - tree.origin(), hi - tree.origin()));
+        let (lo, hi) = local.unwrap_or((IVec3::ZERO, IVec3::NEG_ONE));
         FrameUniforms {
             eye: basis.eye.into(),
             root: tree.root_word(),

@@ -94,7 +94,7 @@ pub struct PathKey {
     pub basis: RayBasis,
     pub settings: PathSettings,
     pub effects: Effects,
-    /// The tree-local box of voxels tinted (`Renderer::path_highlight`).
+    /// The world box of voxels tinted (`Renderer::path_highlight`).
     pub highlight: Option<(glam::IVec3, glam::IVec3)>,
     /// The ground grid drawn (`Renderer::ground`), in world voxels.
     pub ground: Option<super::layout::GroundGrid>,

@@ -58,9 +58,14 @@ pub fn shared_constants() -> String {
     wgsl
 }
 
-/// A shader's source with the shared constants in front.
+/// The overlay mix over a pixel (`overlaid`), which uses the constants.
+const OVERLAY_WGSL: &str = include_str!("../../shaders/overlay.wgsl");
+
+/// A shader's source with the shared constants and the overlay mix in front.
 pub fn with_prelude(parts: &[&str]) -> String {
     let mut source = shared_constants();
+    source.push('\n');
+    source.push_str(OVERLAY_WGSL);
     for part in parts {
         source.push('\n');
         source.push_str(part);

@@ -122,7 +122,6 @@ pub struct PathView<'a> {
 fn path_key(view: &PathView, highlight: Option<(IVec3, IVec3)>, ground: Option<GroundGrid>) -> PathKey {
     let PathView { scene, camera, size, settings } = *view;
     let basis = camera.basis(size.0.max(1), size.1.max(1), scene.origin());
-    let highlight = highlight.map(|(lo, hi)| (lo - scene.origin(), hi - scene.origin()));
     PathKey { basis, settings: *settings, effects: effects_for(scene, settings), highlight, ground }
 }
 
@@ -344,10 +343,9 @@ impl Renderer {
         self.pass.resize(gpu, &self.buffers, size, self.hit_records)?;
         self.pass.ensure_kernel(gpu, kernel)?;
         let basis = camera.basis(size.0.max(1), size.1.max(1), tree.origin());
-        let local = highlight.map(|(lo, hi)| (lo - tree.origin(), hi - tree.origin()));
         let uniforms = FrameUniforms {
             hit_records: u32::from(self.hit_records),
-            ..FrameUniforms::new(&basis, tree, &self.buffers, view, local, Footprint::of_pixels(&basis, lod))
+            ..FrameUniforms::new(&basis, tree, &self.buffers, view, highlight, Footprint::of_pixels(&basis, lod))
                 .with_ground(self.ground, tree.origin())
         };
         self.records_written = self.hit_records;
