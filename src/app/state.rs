@@ -169,13 +169,20 @@ impl EditorState {
         tools.brush.shape_at(center).bounds()
     }
 
-    /// The ground's grid over the working volume: x and z in
-    /// -volume/2..volume/2 on y = 0, at most 64 lines a side (a large
-    /// volume gets a coarser grid).
-    pub fn ground_grid(&self) -> octovox::gpu::GroundGrid {
+    /// The working volume's cells, inclusive: x and z in
+    /// -volume/2..volume/2, y from 0.
+    pub fn working_volume(&self) -> (IVec3, IVec3) {
         let half = self.volume / 2;
-        let (lo, hi) = (-half, self.volume - half);
-        octovox::gpu::GroundGrid { y: 0, lo: [lo, lo], hi: [hi, hi], step: (self.volume / 64).max(1) as u32 }
+        let lo = IVec3::new(-half, 0, -half);
+        (lo, lo + IVec3::splat(self.volume - 1))
+    }
+
+    /// The ground's grid under the working volume, on its cells' edges at
+    /// y = 0, at most 64 lines a side (a large volume gets a coarser grid).
+    pub fn ground_grid(&self) -> octovox::gpu::GroundGrid {
+        let (lo, hi) = self.working_volume();
+        let step = (self.volume / 64).max(1) as u32;
+        octovox::gpu::GroundGrid { y: 0, lo: [lo.x, lo.z], hi: [hi.x + 1, hi.z + 1], step }
     }
 
     /// `mode` on, or back to the brush when it is on already.

@@ -386,7 +386,7 @@ fn tool_panel(ui: &mut egui::Ui, state: &mut EditorState, tools: &mut Tools, com
             commands.push(Command::ToggleSelect);
         }
         let object = ui.selectable_label(state.mode == Mode::Object, "Object (Tab)");
-        let hint = "click an object to pick it; arrows and PageUp/PageDown move it, Ctrl+R turns it";
+        let hint = "click an object to pick it; drag it, or arrows and PageUp/PageDown, to move it; X/Y/Z turn it, Delete deletes it";
         if object.on_hover_text(hint).clicked() {
             commands.push(Command::ToggleObject);
         }
@@ -545,8 +545,8 @@ fn rename_row(ui: &mut egui::Ui, objects: &Objects, rename: &mut (Option<usize>,
     use octovox::script::{Command as Line, ObjectLine, ObjectRef};
     let picked = objects.selected;
     if rename.0 != picked {
-        let own = picked.and_then(|i| objects.transform_node(i).ok()).and_then(|node| node.attributes.get("_name"));
-        *rename = (picked, own.cloned().unwrap_or_default());
+        let own = picked.and_then(|i| objects.transform_node(i).ok()).and_then(octovox::scene::graph::Node::name);
+        *rename = (picked, own.unwrap_or_default().to_owned());
     }
     ui.horizontal(|ui| {
         ui.label("Name");
@@ -1082,10 +1082,7 @@ pub fn draw_ground(ui: &egui::Ui, state: &EditorState, info: &Info) {
     if !info.ground {
         return;
     }
-    let half = state.volume / 2;
-    let (lo, hi) =
-        (IVec3::new(-half, 0, -half), IVec3::new(state.volume - half - 1, state.volume - 1, state.volume - half - 1));
-    outline_box(ui, state, info, (lo, hi), Color32::from_white_alpha(40), false);
+    outline_box(ui, state, info, state.working_volume(), Color32::from_white_alpha(40), false);
 }
 
 /// Outlines the selected box (or the one being dragged); in select mode

@@ -67,6 +67,13 @@ pub struct Layer {
     pub reserved: u32,
 }
 
+impl Node {
+    /// Its `_name`, when it has one that is not empty.
+    pub fn name(&self) -> Option<&str> {
+        self.attributes.get("_name").map(String::as_str).filter(|n| !n.is_empty())
+    }
+}
+
 impl Layer {
     pub fn name(&self) -> &str {
         self.attributes.get("_name").map_or("", String::as_str)
@@ -276,7 +283,7 @@ impl<'a> Walk<'a> {
             None => Transform::IDENTITY,
         };
         let layer = (layer != u32::MAX).then_some(layer);
-        let name = match node.attributes.get("_name").filter(|n| !n.is_empty()) {
+        let name = match node.name() {
             Some(name) => {
                 self.names.push((context.name, name));
                 Some(self.names.len() - 1)

@@ -16,7 +16,7 @@ pub fn obj(exported: &Exported, scale: f32, mtl_name: &str) -> Vec<u8> {
     let mut first = 1;
     for part in &exported.parts {
         if exported.objects {
-            let _ = writeln!(text, "o {}", part.path().replace(['\n', '\r'], " "));
+            let _ = writeln!(text, "o {}", part.path());
         }
         first += write_part(&mut text, exported, part, scale, first);
     }

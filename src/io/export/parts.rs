@@ -11,7 +11,7 @@ use glam::IVec3;
 use super::greedy::{VoxelMesh, mesh_within_budget};
 use super::{ExportError, check_scale};
 use crate::scene::Scene;
-use crate::scene::graph::Attributes;
+use crate::scene::graph::Node;
 use crate::scene::objects::Objects;
 use crate::scene::transform::CellMap;
 
@@ -40,13 +40,14 @@ pub struct Part {
 }
 
 impl Part {
-    /// Its groups and name joined by `/`, as `info --objects` prints them.
+    /// Its groups and name joined by `/`, as `info --objects` prints them,
+    /// on one line (the text formats name it in a line of their own).
     pub fn path(&self) -> String {
         let mut path = self.groups.join("/");
         if !path.is_empty() {
             path.push('/');
         }
-        path + &self.name
+        (path + &self.name).replace(['\n', '\r'], " ")
     }
 }
 
@@ -158,18 +159,14 @@ impl Exported {
 fn names(objects: &Objects, index: usize) -> (Vec<String>, String) {
     let path = &objects.list()[index].path;
     let mut groups: Vec<String> = path.split('/').filter(|s| !s.is_empty()).map(str::to_owned).collect();
-    let own = objects.transform_node(index).ok().and_then(|node| name_of(&node.attributes));
+    let own = objects.transform_node(index).ok().and_then(Node::name);
     match own {
-        Some(own) if groups.last() == Some(&own) => {
+        Some(own) if groups.last().is_some_and(|last| last == own) => {
             groups.pop();
-            (groups, own)
+            (groups, own.to_owned())
         }
         _ => (groups, format!("object {index}")),
     }
-}
-
-fn name_of(attributes: &Attributes) -> Option<String> {
-    attributes.get("_name").filter(|n| !n.is_empty()).cloned()
 }
 
 #[cfg(test)]

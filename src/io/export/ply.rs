@@ -53,8 +53,7 @@ fn header(exported: &Exported, vertices: usize, faces: usize) -> String {
     // Writing to a String cannot fail.
     if exported.objects {
         for (k, part) in exported.parts.iter().enumerate() {
-            // A comment is one line.
-            let _ = writeln!(header, "comment object {k} {}", part.path().replace(['\n', '\r'], " "));
+            let _ = writeln!(header, "comment object {k} {}", part.path());
         }
     }
     let _ = write!(

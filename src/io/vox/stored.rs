@@ -27,7 +27,7 @@ impl Stored {
 }
 
 /// MagicaVoxel turns a model about `floor(size / 2)`.
-pub(super) fn pivot(size: [u32; 3]) -> IVec3 {
+fn pivot(size: [u32; 3]) -> IVec3 {
     IVec3::new((size[0] / 2) as i32, (size[1] / 2) as i32, (size[2] / 2) as i32)
 }
 
