@@ -44,7 +44,9 @@ struct FrameUniforms {
     ground_x1: i32,
     ground_z0: i32,
     ground_z1: i32,
-    ground_pad: u32,
+    // Nodes of the instance tree in `instances` (0: the pool holds one
+    // model, traced from `root`). See src/scene/instances.rs.
+    instance_nodes: u32,
 }
 
 // Read-only storage, not uniform: see `constants_entry` in src/gpu/trace_pass.rs.
@@ -60,6 +62,8 @@ fn load_constants() {
 }
 // Nodes (NODE_WORDS words each) and then bricks (2 words each) of the node pool.
 @group(0) @binding(1) var<storage, read> pool: array<u32>;
+// The instance tree's nodes, then the instance records (src/scene/instances.rs).
+@group(0) @binding(2) var<storage, read> instances: array<u32>;
 @group(0) @binding(3) var<storage, read> palette: array<u32>;
 @group(0) @binding(4) var<storage, read> grid: array<u32>;
 @group(0) @binding(5) var out_color: texture_storage_2d<rgba8unorm, write>;
@@ -88,6 +92,8 @@ struct Hit {
     // may be empty when the ray walks through a medium: see trace_svo).
     t: f32,
     found: bool,
+    // The instance hit (NO_INSTANCE: a scene of one model).
+    instance: u32,
 }
 
 struct Slab {
@@ -197,6 +203,7 @@ fn entry_normal_code(r: Ray, axis: u32) -> u32 {
 // The crossing into a uniform cell: the voxel where the ray is at t.
 fn hit_cell(r: Ray, value: u32, mn: vec3<i32>, level: u32, t: f32, axis: u32, iterations: u32) -> Hit {
     var hit: Hit;
+    hit.instance = NO_INSTANCE;
     hit.iterations = iterations;
     hit.voxel = voxel_in_box(r, mn, mn + vec3<i32>((1 << level) - 1), t, axis);
     hit.value = value;

@@ -2,7 +2,8 @@
 // an accumulation buffer; the display texture gets the mean. Twin of
 // src/trace/path/mod.rs (the CPU reference): the same draws from the same
 // counter-based random numbers, in the same order, so change both
-// together. Prefixed with common.wgsl and trace_svo.wgsl.
+// together. Prefixed with common.wgsl, trace_svo.wgsl and
+// instances.wgsl.
 //
 // The effects are override constants: a kernel built for a scene of diffuse
 // voxels has no metal, glass or emitter code at all.
@@ -158,32 +159,6 @@ fn ior_of(index: u32) -> f32 {
     return select(materials[index].ior, 1.0, index == 0u);
 }
 
-// A ray inside glass that leaves the root cube crosses into empty space at
-// the root's face (twin of `root_exit`).
-fn root_exit(r: Ray, iterations: u32) -> Hit {
-    let size = f32(1u << u.depth);
-    let far = (select(vec3<f32>(0.0), vec3<f32>(size), r.d > vec3<f32>(0.0)) - r.o) * r.inv;
-    let axis = argmin3(far);
-    let t = max(far[axis], 0.0);
-    let p = r.o + r.d * t;
-    var hit: Hit;
-    hit.voxel = vec3<i32>(floor(p));
-    hit.voxel[axis] = select(-1, i32(1u << u.depth), r.d[axis] > 0.0);
-    hit.normal_code = 1u + 2u * axis + select(0u, 1u, r.d[axis] > 0.0);
-    hit.iterations = iterations;
-    hit.t = t;
-    hit.found = true;
-    return hit;
-}
-
-fn cross_medium(r: Ray, medium: u32) -> Hit {
-    let hit = trace_svo(r, 0.0, medium, vec2<f32>(0.0));
-    if (hit.found || medium == 0u || hit.iterations >= u.max_iterations) {
-        return hit;
-    }
-    return root_exit(r, hit.iterations);
-}
-
 // The point where the ray enters the voxel it found: on the entered face's
 // plane exactly (twin of `surface_point`).
 fn surface_point(r: Ray, hit: Hit) -> vec3<f32> {
@@ -302,7 +277,7 @@ fn emitter_light(p: vec3<f32>, n: vec3<f32>, lobe: Lobe) -> vec3<f32> {
     if (cos_s <= 0.0 || dist2 <= 0.0) {
         return vec3<f32>(0.0);
     }
-    let shadow = cross_medium(make_ray(p, l), 0u);
+    let shadow = trace_scene(make_ray(p, l), 0.0, 0u, NO_INSTANCE, vec2<f32>(0.0));
     let rel = shadow.voxel - e.min;
     if (!shadow.found || any(rel < vec3<i32>(0)) || any(rel >= vec3<i32>(i32(e.size)))) {
         return vec3<f32>(0.0);
@@ -325,7 +300,7 @@ fn direct(p: vec3<f32>, n: vec3<f32>, lobe: Lobe) -> vec3<f32> {
             let u2 = rng_next();
             let l = cone_direction(SUN_DIR, SUN_COS, u1, u2);
             let c = dot(n, l);
-            if (c > 0.0 && !cross_medium(make_ray(p, l), 0u).found) {
+            if (c > 0.0 && !trace_scene(make_ray(p, l), 0.0, 0u, NO_INSTANCE, vec2<f32>(0.0)).found) {
                 sum += SUN_IRRADIANCE * c * lobe_eval(lobe, n, l);
             }
         }
@@ -412,12 +387,14 @@ fn radiance(ray_in: Ray) -> vec3<f32> {
     var radiance = vec3<f32>(0.0);
     var beta = vec3<f32>(1.0);
     var medium = 0u;
+    // The instance whose glass the ray is in.
+    var inside = NO_INSTANCE;
     var lights_counted = false;
     var bounces = 0u;
     var transmissions = 0u;
     var first = true;
     loop {
-        let hit = cross_medium(ray, medium);
+        let hit = trace_scene(ray, 0.0, medium, inside, vec2<f32>(0.0));
         if (first) {
             first_t = select(NO_VOXEL_T, hit.t, hit.found && hit.value != 0u);
         }
@@ -456,6 +433,8 @@ fn radiance(ray_in: Ray) -> vec3<f32> {
                 return radiance;
             }
             dir = s.dir;
+            // Into other glass (or out of it): the instance of the face crossed.
+            inside = select(inside, hit.instance, s.medium != medium);
             medium = s.medium;
             beta *= s.weight;
             lights_counted = false;
@@ -515,7 +494,7 @@ fn clamp_sample(v: vec3<f32>) -> vec3<f32> {
 // may filter it (twin of `PathScene::guide`).
 fn write_guide(px: vec2<u32>, pixel: u32) {
     let r = pixel_ray(px);
-    let hit = cross_medium(r, 0u);
+    let hit = trace_scene(r, 0.0, 0u, NO_INSTANCE, vec2<f32>(0.0));
     var guide = vec4<u32>(0u);
     if (hit.found && hit.normal_code != 0u && !left_to_samples(materials[hit.value].kind)) {
         guide = vec4<u32>(bitcast<vec3<u32>>(surface_point(r, hit)), hit.normal_code | GUIDE_FILTERED);

@@ -42,13 +42,29 @@ fn octant_offset(o: u32) -> vec3<i32> {
     return vec3<i32>(i32(o & 1u), i32((o >> 1u) & 1u), i32((o >> 2u) & 1u));
 }
 
+// One octree in the pool: the scene's one model, or an instance's model.
+struct Tree {
+    root: u32,
+    depth: u32,
+    // Its first node slot, and the word its first brick is at, in `pool`.
+    node_base: u32,
+    brick_base: u32,
+    // `iteration_bound` of its depth: no valid ray takes this many.
+    max_iterations: u32,
+}
+
+// The tree of a scene of one model.
+fn scene_tree() -> Tree {
+    return Tree(u.root, u.depth, 0u, u.brick_base, u.max_iterations);
+}
+
 // Child word of a node (level >= 2) or voxel value of a brick (level 1),
 // with a single load: each load site in the loop costs a scalar loop over
 // the SIMD lanes on CPU-emulated GPUs.
-fn child_word(word: u32, level: u32, octant: u32) -> u32 {
+fn child_word(tree: Tree, word: u32, level: u32, octant: u32) -> u32 {
     let slot = word & ~POINTER_BIT;
     let brick = level == 1u;
-    let loaded = pool[select(slot * NODE_WORDS + octant, u.brick_base + slot * 2u + (octant >> 2u), brick)];
+    let loaded = pool[select((tree.node_base + slot) * NODE_WORDS + octant, tree.brick_base + slot * 2u + (octant >> 2u), brick)];
     return select(loaded, (loaded >> (8u * (octant & 3u))) & 0xffu, brick);
 }
 
@@ -88,9 +104,9 @@ fn below_footprint(lod: vec2<f32>, size: u32, t: f32) -> bool {
 // way out for rays inside glass. With a footprint `lod` (zero: exact), a
 // node cell below it is hit as a solid cell of its summary's palette index.
 // Twin of `walk` in src/trace/svo.rs.
-fn trace_svo(r: Ray, t_min: f32, medium: u32, lod: vec2<f32>) -> Hit {
+fn trace_svo(tree: Tree, r: Ray, t_min: f32, medium: u32, lod: vec2<f32>) -> Hit {
     var miss: Hit;
-    let depth = u.depth;
+    let depth = tree.depth;
     let size = f32(1u << depth);
     let s = slab(r, vec3<f32>(0.0), vec3<f32>(size));
     // t_exit = 0: the ray starts on the root's face and heads out.
@@ -104,18 +120,18 @@ fn trace_svo(r: Ray, t_min: f32, medium: u32, lod: vec2<f32>) -> Hit {
         t = t_min;
         axis = NO_AXIS;
     }
-    if ((u.root & POINTER_BIT) == 0u) {
-        if (u.root == medium) {
+    if ((tree.root & POINTER_BIT) == 0u) {
+        if (tree.root == medium) {
             miss.iterations = 1u;
             return miss;
         }
-        return hit_cell(r, u.root, vec3<i32>(0), depth, t, axis, 1u);
+        return hit_cell(r, tree.root, vec3<i32>(0), depth, t, axis, 1u);
     }
     let positive = r.d > vec3<f32>(0.0);
     let far_side = select(vec3<i32>(0), vec3<i32>(1), positive);
     let below = select(vec3<i32>(-1), vec3<i32>(0), positive);
     var level = depth;
-    var node = u.root;
+    var node = tree.root;
     // The stack: node words one, two and three levels up, `cached` of them
     // valid. A pop past them restarts from the root (see below); a per-thread
     // array would be slower, very much so on CPU-emulated GPUs.
@@ -133,11 +149,11 @@ fn trace_svo(r: Ray, t_min: f32, medium: u32, lod: vec2<f32>) -> Hit {
     // The node word a footprint stopped at (0: none).
     var summarized = 0u;
     loop {
-        if (iterations >= u.max_iterations) {
+        if (iterations >= tree.max_iterations) {
             break;
         }
         iterations += 1u;
-        let word = child_word(node, level, octant_of(cell, level));
+        let word = child_word(tree, node, level, octant_of(cell, level));
         let push = (word & POINTER_BIT) != 0u;
         // Only a node cell the ray newly enters (not an ancestor walked down
         // again after a restart) may stop it; bricks never do.
@@ -175,7 +191,7 @@ fn trace_svo(r: Ray, t_min: f32, medium: u32, lod: vec2<f32>) -> Hit {
         axis = select(a, axis, push);
         cell = select(next & vec3<i32>(~((1 << (new_level - 1u)) - 1)), pushed_cell, vec3<bool>(push));
         known = select(new_level, min(known, child_level), push);
-        node = select(select(popped, u.root, restart), word, push);
+        node = select(select(popped, tree.root, restart), word, push);
         up3 = select(up3, up2, push);
         up2 = select(popped_up2, up1, push);
         up1 = select(popped_up1, parent, push);
@@ -187,7 +203,7 @@ fn trace_svo(r: Ray, t_min: f32, medium: u32, lod: vec2<f32>) -> Hit {
         return miss;
     }
     if (LOD && summarized != 0u) {
-        value = pool[(summarized & ~POINTER_BIT) * NODE_WORDS + LOD_WORD] & 0xffu;
+        value = pool[(tree.node_base + (summarized & ~POINTER_BIT)) * NODE_WORDS + LOD_WORD] & 0xffu;
     }
     return hit_cell(r, value, cell, level - 1u, t, axis, iterations);
 }
@@ -232,6 +248,11 @@ fn beam_search(tile: vec2<u32>) -> f32 {
     let n3 = inward(cross(c01, c00), center);
     var best = BEAM_NONE;
     let depth = u.depth;
+    if (u.instance_nodes != 0u) {
+        // An orthographic view of objects: every ray starts at its origin.
+        let anything = (instances[LEAF_WORD] & EMPTY_BIT) == 0u;
+        return select(select(BEAM_NONE, 0.0, anything), beam_instances(n0, n1, n2, n3), u.ortho == 0u);
+    }
     // Too small to search, or an orthographic view (parallel rays: no
     // pyramid about the eye): every ray starts at its origin.
     if (u.ortho != 0u || (u.root & POINTER_BIT) == 0u || depth <= BEAM_LEVEL) {
@@ -380,14 +401,14 @@ fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_id) lid
     let r = pixel_ray(px);
     let distance = beam_distance[pixel.z];
     let t_start = max(distance - 1.0, 0.0) / length(r.d);
-    let hit = trace_svo(r, t_start, 0u, camera_footprint());
+    let hit = trace_scene(r, t_start, 0u, NO_INSTANCE, camera_footprint());
     var in_shadow = false;
     if (SHADOWS && u.view == VIEW_SHADED && hit.value != 0u && hit.normal_code != 0u) {
         // The shadow ray keeps the footprint the camera ray had at the hit
         // voxel's depth (`hit_depth` in src/trace/render.rs).
         let depth = dot(vec3<f32>(hit.voxel) + vec3<f32>(0.5) - u.eye, u.forward);
         let footprint = u.lod_at_start + u.lod_per_t * depth;
-        in_shadow = trace_svo(shadow_ray(hit), 0.0, 0u, vec2<f32>(footprint, 0.0)).value != 0u;
+        in_shadow = trace_scene(shadow_ray(hit), 0.0, 0u, NO_INSTANCE, vec2<f32>(footprint, 0.0)).value != 0u;
     }
     write_pixel(px, hit, r.d, in_shadow);
 }

@@ -75,6 +75,9 @@ impl GpuContext {
             max_storage_buffer_binding_size: supported.max_storage_buffer_binding_size,
             max_buffer_size: supported.max_buffer_size,
             max_texture_dimension_2d: supported.max_texture_dimension_2d,
+            // The path tracer binds nine storage buffers, one over WebGPU's
+            // baseline of eight; desktop adapters have dozens.
+            max_storage_buffers_per_shader_stage: supported.max_storage_buffers_per_shader_stage,
             ..wgpu::Limits::default()
         };
         let (device, queue) = adapter

@@ -83,7 +83,8 @@ pub struct FrameUniforms {
     pub ground_x1: i32,
     pub ground_z0: i32,
     pub ground_z1: i32,
-    pub ground_pad: u32,
+    /// Nodes of the instance tree (0: the pool holds one model, `root`).
+    pub instance_nodes: u32,
 }
 
 impl FrameUniforms {
@@ -99,9 +100,12 @@ impl FrameUniforms {
     ) -> FrameUniforms {
         let local = highlight.map(|(lo, hi)| (lo - tree.origin(), hi - tree.origin()));
         let (lo, hi) = local.unwrap_or((IVec3::ZERO, IVec3::NEG_ONE));
+        // A scene of objects is traced from its instance tree; the composed
+        // tree is not on the GPU.
+        let instanced = buffers.instance_nodes.is_some();
         FrameUniforms {
             eye: basis.eye.into(),
-            root: tree.root_word(),
+            root: if instanced { 0 } else { tree.root_word() },
             forward: basis.forward.into(),
             depth: tree.depth(),
             right: basis.right.into(),
@@ -120,6 +124,7 @@ impl FrameUniforms {
             lod_per_t: lod.per_t,
             ortho: u32::from(basis.ortho),
             lod_at_start: lod.at_start,
+            instance_nodes: buffers.instance_nodes.unwrap_or(0),
             ..FrameUniforms::default()
         }
     }

@@ -30,6 +30,7 @@ use crate::trace::path::materials::{Effects, GpuMaterial};
 
 const COMMON_WGSL: &str = include_str!("../../shaders/common.wgsl");
 const SVO_WGSL: &str = include_str!("../../shaders/trace_svo.wgsl");
+const INSTANCES_WGSL: &str = include_str!("../../shaders/instances.wgsl");
 const PATH_WGSL: &str = include_str!("../../shaders/path.wgsl");
 
 /// A kernel: compiled, or being compiled on a worker thread.
@@ -147,6 +148,7 @@ fn make_bind_group(
         entries: &[
             buffer_resource(0, parts.frame),
             buffer_resource(1, &buffers.pool_buf),
+            buffer_resource(2, &buffers.instances_buf),
             buffer_resource(3, &buffers.palette_buf),
             wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&target.view) },
             buffer_resource(8, parts.path),
@@ -175,6 +177,7 @@ impl PathPass {
             entries: &[
                 constants_entry(0, std::mem::size_of::<FrameUniforms>()),
                 buffer_entry(1, true),
+                buffer_entry(2, true),
                 buffer_entry(3, true),
                 output_entry(5),
                 constants_entry(8, std::mem::size_of::<PathUniforms>()),
@@ -189,7 +192,7 @@ impl PathPass {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let module = gpu.shader("path.wgsl", &with_prelude(&[COMMON_WGSL, SVO_WGSL, PATH_WGSL]))?;
+        let module = gpu.shader("path.wgsl", &with_prelude(&[COMMON_WGSL, SVO_WGSL, INSTANCES_WGSL, PATH_WGSL]))?;
         let frame_buf = constants_buffer(device, "path frame uniforms", std::mem::size_of::<FrameUniforms>());
         let path_buf = constants_buffer(device, "path uniforms", std::mem::size_of::<PathUniforms>());
         let materials_buf =

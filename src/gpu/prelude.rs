@@ -6,6 +6,7 @@ use std::fmt::Write as _;
 
 use super::layout::{FLOOR_ROW, GRID_MIX, HIGHLIGHT_MIX, HIGHLIGHT_TINT, ROW_TILES};
 use crate::gpu_pool::{LOD_WORD, NODE_WORDS, POINTER_BIT};
+use crate::scene::instances::{BVH_NODE_WORDS, EMPTY_BIT, INSTANCE_WORDS, LEAF_WORD, NO_INSTANCE, TIE_T};
 use crate::settings::{SUN_DIR, View};
 use crate::trace::denoise;
 use crate::trace::path::{self, materials};
@@ -26,6 +27,12 @@ pub fn shared_constants() -> String {
     line("POINTER_BIT", "u32", format!("{POINTER_BIT:#x}u"));
     line("NODE_WORDS", "u32", format!("{NODE_WORDS}u"));
     line("LOD_WORD", "u32", format!("{LOD_WORD}u"));
+    line("BVH_NODE_WORDS", "u32", format!("{BVH_NODE_WORDS}u"));
+    line("LEAF_WORD", "u32", format!("{LEAF_WORD}u"));
+    line("EMPTY_BIT", "u32", format!("{EMPTY_BIT:#x}u"));
+    line("INSTANCE_WORDS", "u32", format!("{INSTANCE_WORDS}u"));
+    line("NO_INSTANCE", "u32", format!("{NO_INSTANCE:#x}u"));
+    line("TIE_T", "f32", format!("{TIE_T:?}"));
     line("ROW_TILES", "u32", format!("{ROW_TILES}u"));
     line("FLOOR_ROW", "u32", format!("{FLOOR_ROW}u"));
     line("HIGHLIGHT_TINT", "vec3<f32>", vec3(HIGHLIGHT_TINT));

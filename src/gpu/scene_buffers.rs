@@ -6,8 +6,9 @@
 //! and on CPU-emulated GPUs every load site in the loop is a scalar loop
 //! over the SIMD lanes.
 
-use crate::gpu_pool::{PoolTooLarge, Region, SlotArena};
-use crate::scene::{Palette, Scene};
+use crate::gpu_pool::{PoolTooLarge, Region, SlotArena, Upload};
+use crate::scene::instances::ObjectsUpload;
+use crate::scene::{Palette, Scene, SceneUpload};
 use crate::trace::grid::DenseGrid;
 
 /// Smallest buffer we create; zero-sized bindings are not allowed.
@@ -29,6 +30,12 @@ pub struct SceneBuffers {
     node_capacity: u64,
     /// Bytes reserved for bricks after them.
     brick_capacity: u64,
+    /// The instance tree and records of a scene of objects
+    /// (`crate::scene::instances`).
+    pub instances_buf: wgpu::Buffer,
+    /// Nodes of the instance tree: `Some` when the pool holds a scene of
+    /// objects (then tracing starts at the tree), `None` for one model.
+    pub instance_nodes: Option<u32>,
     pub palette_buf: wgpu::Buffer,
     pub grid_buf: wgpu::Buffer,
     pub grid_min: glam::IVec3,
@@ -51,6 +58,8 @@ impl SceneBuffers {
             pool_buf: storage_buffer(device, "node pool", 0),
             node_capacity: 0,
             brick_capacity: 0,
+            instances_buf: storage_buffer(device, "instances", 0),
+            instance_nodes: None,
             palette_buf: storage_buffer(device, "palette", 256 * 4),
             grid_buf: storage_buffer(device, "dense grid", 0),
             grid_min: glam::IVec3::ZERO,
@@ -74,21 +83,66 @@ impl SceneBuffers {
         scene: &mut Scene,
         max_bytes: u64,
     ) -> Result<UploadStats, PoolTooLarge> {
-        let upload = scene.take_uploads_within(max_bytes)?;
+        if scene.objects().is_none() && self.instance_nodes.is_some() {
+            // The buffer holds a scene of objects' models: the one model goes up whole.
+            scene.forget_uploads();
+            (self.node_capacity, self.brick_capacity) = (0, 0);
+        }
+        match scene.take_uploads_within(max_bytes)? {
+            SceneUpload::Tree(upload) => Ok(self.write_tree(device, queue, scene, &upload)),
+            SceneUpload::Objects(upload) => Ok(self.write_objects(device, queue, &upload)),
+        }
+    }
+
+    /// The one model's dirty slots (after growing the buffer if it must).
+    fn write_tree(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        scene: &Scene,
+        upload: &Upload,
+    ) -> UploadStats {
         let node_capacity = upload.nodes.grow_to_bytes().unwrap_or(self.node_capacity);
         let brick_capacity = upload.bricks.grow_to_bytes().unwrap_or(self.brick_capacity);
         let grew = (node_capacity, brick_capacity) != (self.node_capacity, self.brick_capacity);
         if grew {
             self.grow(device, queue, node_capacity, brick_capacity);
         }
+        self.instance_nodes = None;
         let pool = scene.drawn().pool();
         write_region(queue, &self.pool_buf, 0, &upload.nodes, &pool.nodes);
         write_region(queue, &self.pool_buf, self.node_capacity, &upload.bricks, &pool.bricks);
-        Ok(UploadStats {
+        UploadStats {
             bytes: upload.byte_count(),
             ranges: upload.nodes.range_count() + upload.bricks.range_count(),
             grew,
-        })
+        }
+    }
+
+    /// The models' changed slots and the instance words that changed, in
+    /// new buffers when the layout or the number of words changed.
+    fn write_objects(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, upload: &ObjectsUpload) -> UploadStats {
+        if let Some((nodes, bricks)) = upload.pool_size {
+            self.pool_buf = storage_buffer(device, "node pool", nodes + bricks);
+            (self.node_capacity, self.brick_capacity) = (nodes, bricks);
+            self.generation += 1;
+        }
+        if let Some(bytes) = upload.instances_size {
+            self.instances_buf = storage_buffer(device, "instances", bytes);
+            self.generation += 1;
+        }
+        for (at, bytes) in &upload.pool {
+            queue.write_buffer(&self.pool_buf, *at, bytes);
+        }
+        for (at, bytes) in &upload.instances {
+            queue.write_buffer(&self.instances_buf, *at, bytes);
+        }
+        self.instance_nodes = Some(upload.instance_nodes);
+        UploadStats {
+            bytes: upload.byte_count(),
+            ranges: upload.range_count(),
+            grew: upload.pool_size.is_some() || upload.instances_size.is_some(),
+        }
     }
 
     /// Where the bricks start in the pool buffer, in 32-bit words.

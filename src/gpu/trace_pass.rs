@@ -13,6 +13,7 @@ use crate::trace::Hit;
 
 const COMMON_WGSL: &str = include_str!("../../shaders/common.wgsl");
 const SVO_WGSL: &str = include_str!("../../shaders/trace_svo.wgsl");
+const INSTANCES_WGSL: &str = include_str!("../../shaders/instances.wgsl");
 const GRID_WGSL: &str = include_str!("../../shaders/trace_grid.wgsl");
 const FLOOR_WGSL: &str = include_str!("../../shaders/floor.wgsl");
 
@@ -94,6 +95,7 @@ impl TracePass {
             entries: &[
                 constants_entry(0, std::mem::size_of::<FrameUniforms>()),
                 buffer_entry(1, true),
+                buffer_entry(2, true),
                 buffer_entry(3, true),
                 buffer_entry(4, true),
                 output_entry(5),
@@ -116,7 +118,7 @@ impl TracePass {
             bind_group_layouts: &[Some(&layout), Some(&args_layout)],
             immediate_size: 0,
         });
-        let svo = gpu.shader("trace_svo.wgsl", &with_prelude(&[COMMON_WGSL, SVO_WGSL]))?;
+        let svo = gpu.shader("trace_svo.wgsl", &with_prelude(&[COMMON_WGSL, SVO_WGSL, INSTANCES_WGSL]))?;
         let grid = gpu.shader("trace_grid.wgsl", &with_prelude(&[COMMON_WGSL, GRID_WGSL]))?;
         let pipeline = |module, entry, constants: &[(&str, f64)], label| {
             compute_pipeline(&gpu.device, &pipeline_layout, module, entry, constants, label)
@@ -221,6 +223,7 @@ impl TracePass {
             entries: &[
                 wgpu::BindGroupEntry { binding: 0, resource: uniform_buf.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 1, resource: buffers.pool_buf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: buffers.instances_buf.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 3, resource: buffers.palette_buf.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 4, resource: buffers.grid_buf.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&target.view) },

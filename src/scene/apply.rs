@@ -9,10 +9,27 @@
 use glam::IVec3;
 
 use super::Scene;
+use super::instances::ObjectsUpload;
 use super::objects::{GraphChange, Model, Objects};
 use super::octree::{MAX_DEPTH, Octree, WORLD_LIMIT, octant_offset};
 use super::shape::{Op, Overlap, Shape};
 use crate::gpu_pool::{Brick, Node, PoolTooLarge, Upload, is_pointer};
+
+/// What a scene sends its GPU copy: see [`Scene::take_uploads_within`].
+#[derive(Debug)]
+pub enum SceneUpload {
+    Tree(Upload),
+    Objects(ObjectsUpload),
+}
+
+impl SceneUpload {
+    pub fn byte_count(&self) -> u64 {
+        match self {
+            SceneUpload::Tree(upload) => upload.byte_count(),
+            SceneUpload::Objects(upload) => upload.byte_count(),
+        }
+    }
+}
 
 /// Why an edit was refused. The tree is unchanged when one is returned.
 #[derive(Debug, thiserror::Error, Clone, PartialEq, Eq)]
@@ -37,24 +54,39 @@ pub enum EditError {
 pub const EDIT_BYTES_PER_SURFACE_VOXEL: u64 = 24;
 
 impl Scene {
-    /// Bytes of the drawn node pool that are in use.
+    /// Bytes the GPU traces that are in use: the one model's pool, or every
+    /// model's pool (each once) and the instance words.
     pub fn drawn_pool_bytes(&self) -> u64 {
-        self.tree.pool().live_bytes()
+        match self.objects.as_deref() {
+            None => self.tree.pool().live_bytes(),
+            Some(objects) => objects.pool_bytes() + super::instances::word_bytes(objects.list().len()),
+        }
     }
 
-    /// The node slots changed since the last call, to send to the GPU.
-    pub fn take_uploads(&mut self) -> Upload {
-        self.tree.pool_mut().flush()
+    /// What changed since the last call, to send to the GPU.
+    pub fn take_uploads(&mut self) -> SceneUpload {
+        match self.take_uploads_within(u64::MAX) {
+            Ok(upload) => upload,
+            Err(_) => unreachable!("no pool exceeds u64::MAX bytes"),
+        }
     }
 
     /// The same within `max_bytes` of pool, or the pool's size when larger.
-    pub fn take_uploads_within(&mut self, max_bytes: u64) -> Result<Upload, PoolTooLarge> {
-        self.tree.pool_mut().flush_within(max_bytes)
+    /// The drawn tree of one model goes as its dirty slots; a scene of
+    /// objects as its models' dirty slots and the instance words that
+    /// changed (the composed tree stays on the CPU, for reading voxels).
+    pub fn take_uploads_within(&mut self, max_bytes: u64) -> Result<SceneUpload, PoolTooLarge> {
+        let origin = self.tree.origin();
+        match self.objects.as_deref_mut() {
+            None => Ok(SceneUpload::Tree(self.tree.pool_mut().flush_within(max_bytes)?)),
+            Some(objects) => Ok(SceneUpload::Objects(self.gpu.take(objects, origin, max_bytes)?)),
+        }
     }
 
     /// Marks the whole pool as not uploaded (it goes to a new GPU buffer).
     pub fn forget_uploads(&mut self) {
         self.tree.pool_mut().forget_uploads();
+        self.gpu.forget();
     }
 
     /// Applies a brush to the one model; returns the patch that undoes it.

@@ -5,6 +5,7 @@ pub mod build;
 pub mod counts;
 pub mod demo;
 pub mod graph;
+pub mod instances;
 pub mod lod;
 pub mod objects;
 pub mod octree;
@@ -14,7 +15,7 @@ pub mod shape;
 pub mod showroom;
 pub mod transform;
 
-pub use apply::{EditError, Patch};
+pub use apply::{EditError, Patch, SceneUpload};
 pub use build::BuildError;
 pub use counts::VoxelCounts;
 pub use octree::Octree;
@@ -71,18 +72,20 @@ pub struct Scene {
     /// The objects and models of a scene of several (`None`: the tree is
     /// the one model).
     objects: Option<Box<objects::Objects>>,
+    /// What the GPU holds of a scene of objects.
+    gpu: instances::GpuCopy,
 }
 
 impl Scene {
     /// A scene of one model.
     pub fn new(palette: Palette, tree: Octree) -> Scene {
-        Scene { palette, tree, objects: None }
+        Scene { palette, tree, objects: None, gpu: instances::GpuCopy::default() }
     }
 
     /// A scene of objects whose visible ones `tree` draws, composed (what a
     /// loader that stores the composed tree reads back).
     pub fn with_objects(palette: Palette, tree: Octree, objects: objects::Objects) -> Scene {
-        Scene { palette, tree, objects: Some(Box::new(objects)) }
+        Scene { palette, tree, objects: Some(Box::new(objects)), gpu: instances::GpuCopy::default() }
     }
 
     /// A scene of objects, its drawn tree composed from them.

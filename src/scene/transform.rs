@@ -207,6 +207,12 @@ impl CellMap {
         })
     }
 
+    /// Row `i` of the map on cells: `(axis, sign, offset)` with
+    /// `w[i] = sign · v[axis] + offset`.
+    pub fn rows(&self) -> [(usize, i32, i32); 3] {
+        [0, 1, 2].map(|i| (self.axis[i], self.sign[i], self.offset[i]))
+    }
+
     /// The world cell of model cell `v`.
     pub fn apply(&self, v: IVec3) -> IVec3 {
         IVec3::from_array([0, 1, 2].map(|i| self.sign[i].wrapping_mul(v[self.axis[i]]).wrapping_add(self.offset[i])))

@@ -4,6 +4,7 @@
 
 pub mod denoise;
 pub mod grid;
+pub mod instanced;
 pub mod path;
 pub mod render;
 pub mod svo;

@@ -5,15 +5,15 @@ use glam::{IVec3, Vec3};
 use rayon::prelude::*;
 
 use super::grid::{self, DenseGrid};
-use super::{Footprint, Hit, Ray, svo};
+use super::instanced::Traced;
+use super::{Footprint, Hit, Ray};
 use crate::camera::{Camera, RayBasis};
-use crate::scene::{Octree, Palette, Scene};
+use crate::scene::{Palette, Scene};
 use crate::settings::{RenderSettings, SUN_DIR, View};
 
 /// The structure a CPU render walks.
-#[derive(Clone, Copy)]
 pub enum Tracer<'a> {
-    Svo(&'a Octree),
+    Svo(Traced<'a>),
     Grid(&'a DenseGrid),
 }
 
@@ -21,14 +21,14 @@ impl Tracer<'_> {
     /// The first hit along `ray`; the grid is always exact.
     pub fn trace(&self, ray: &Ray, footprint: Footprint) -> Hit {
         match self {
-            Tracer::Svo(tree) => svo::trace_lod(tree, ray, footprint),
+            Tracer::Svo(traced) => traced.trace(ray, footprint),
             Tracer::Grid(grid) => grid::trace(grid, ray),
         }
     }
 }
 
 /// Hit records of every pixel, row-major from the top-left.
-pub fn trace_image(tracer: Tracer, basis: &RayBasis, footprint: Footprint) -> Vec<Hit> {
+pub fn trace_image(tracer: &Tracer, basis: &RayBasis, footprint: Footprint) -> Vec<Hit> {
     (0..basis.height)
         .into_par_iter()
         .flat_map_iter(|y| {
@@ -136,11 +136,11 @@ pub fn render_scene_cpu(
 ) -> image::RgbaImage {
     let tracer = match grid {
         Some(grid) => Tracer::Grid(grid),
-        None => Tracer::Svo(scene.drawn()),
+        None => Tracer::Svo(Traced::of(scene)),
     };
     let basis = camera.basis(size.0, size.1, scene.origin());
     let footprint = Footprint::of_pixels(&basis, settings.lod);
-    let hits = trace_image(tracer, &basis, footprint);
+    let hits = trace_image(&tracer, &basis, footprint);
     let gave_up = hits.iter().filter(|hit| hit.gave_up()).count();
     if gave_up > 0 {
         log::warn!(

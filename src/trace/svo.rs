@@ -13,6 +13,7 @@
 
 use glam::{IVec3, Vec3};
 
+use super::instanced::Traced;
 use super::{Footprint, Hit, NO_AXIS, Ray, argmin, iteration_bound};
 use crate::camera::Camera;
 use crate::gpu_pool::{is_pointer, slot_of};
@@ -26,14 +27,13 @@ const _: () = assert!(MAX_DEPTH <= 20);
 /// world coordinates: the one CPU pick that the window's mouse and replay's
 /// `click` share.
 pub fn pick(scene: &Scene, camera: &Camera, size: (u32, u32), x: u32, y: u32) -> Result<Option<Hit>, GaveUp> {
-    let tree = scene.drawn();
-    let basis = camera.basis(size.0, size.1, tree.origin());
+    let basis = camera.basis(size.0, size.1, scene.origin());
     let (origin, dir) = basis.ray(x, y);
-    let hit = trace(tree, &Ray::new(origin, dir));
+    let hit = Traced::of(scene).trace(&Ray::new(origin, dir), Footprint::EXACT);
     if hit.gave_up() {
         return Err(GaveUp { iterations: hit.iterations });
     }
-    Ok(hit.is_hit().then(|| Hit { voxel: hit.voxel + tree.origin(), ..hit }))
+    Ok(hit.is_hit().then(|| Hit { voxel: hit.voxel + scene.origin(), ..hit }))
 }
 
 /// [`pick`], and where it finds no voxel and `ground` is on, the ground:
@@ -99,6 +99,8 @@ pub struct Crossing {
     pub t: f32,
     /// Whether such a voxel lies inside the tree (a miss otherwise).
     pub found: bool,
+    /// The instance it is in, in a scene of objects (`crate::trace::instanced`).
+    pub instance: Option<u32>,
 }
 
 /// The first voxel along `ray` whose value is not `medium` (0 for rays in
@@ -106,6 +108,30 @@ pub struct Crossing {
 /// medium".
 pub fn trace_through(tree: &Octree, ray: &Ray, medium: u8) -> Crossing {
     walk(tree, ray, medium, Footprint::EXACT)
+}
+
+/// [`trace_through`] under `footprint`, where a ray inside glass (`medium`
+/// not 0) that finds no other voxel leaves the glass at the root's face.
+pub fn cross(tree: &Octree, ray: &Ray, medium: u8, footprint: Footprint) -> Crossing {
+    let c = walk(tree, ray, medium, footprint);
+    if c.found || c.hit.gave_up || medium == 0 {
+        return c;
+    }
+    root_exit(ray, tree.size() as f32, c.hit.iterations)
+}
+
+/// Where a ray inside glass leaves the root cube: the empty cell beyond the
+/// face it crosses (twin of `root_exit` in `shaders/instances.wgsl`).
+fn root_exit(ray: &Ray, size: f32, iterations: u32) -> Crossing {
+    let far = (Vec3::select(ray.dir.cmpgt(Vec3::ZERO), Vec3::splat(size), Vec3::ZERO) - ray.origin) * ray.inv;
+    let axis = argmin(far);
+    let t = far[axis].max(0.0);
+    let p = ray.origin + ray.dir * t;
+    let mut voxel = p.floor().as_ivec3();
+    let mut normal = IVec3::ZERO;
+    normal[axis] = if ray.dir[axis] > 0.0 { -1 } else { 1 };
+    voxel[axis] = if ray.dir[axis] > 0.0 { size as i32 } else { -1 };
+    Crossing { hit: Hit { voxel, normal, iterations, ..Hit::default() }, t, found: true, instance: None }
 }
 
 /// The traversal itself. Twin of `trace_svo` in `shaders/trace_svo.wgsl`.
@@ -210,5 +236,6 @@ fn child_cell(ray: &Ray, min: IVec3, level: u32, t: f32, entry_axis: usize) -> I
 fn hit_cell(ray: &Ray, value: u8, min: IVec3, level: u32, t: f32, axis: usize, iterations: u32) -> Crossing {
     let voxel = ray.voxel_in_box(min, min + IVec3::splat((1 << level) - 1), t, axis);
     let normal = if axis == NO_AXIS { IVec3::ZERO } else { ray.entry_normal(axis) };
-    Crossing { hit: Hit { value, voxel, normal, cell_level: level, iterations, gave_up: false }, t, found: true }
+    let hit = Hit { value, voxel, normal, cell_level: level, iterations, gave_up: false };
+    Crossing { hit, t, found: true, instance: None }
 }

@@ -9,6 +9,7 @@ use glam::{DVec3, IVec3, Vec3};
 use octovox::camera::Camera;
 use octovox::scene::{Octree, Op, Shape};
 use octovox::trace::grid::{self, DenseGrid};
+use octovox::trace::instanced::Traced;
 use octovox::trace::render::{Tracer, trace_image};
 use octovox::trace::{Footprint, Ray, svo};
 
@@ -17,8 +18,8 @@ fn compare(tree: &Octree, cameras: &[Camera], size: (u32, u32)) -> Agreement {
     let mut agreement = Agreement::default();
     for camera in cameras {
         let basis = camera.basis(size.0, size.1, tree.origin());
-        let a = trace_image(Tracer::Svo(tree), &basis, Footprint::EXACT);
-        let b = trace_image(Tracer::Grid(&grid), &basis, Footprint::EXACT);
+        let a = trace_image(&Tracer::Svo(Traced::Tree(tree)), &basis, Footprint::EXACT);
+        let b = trace_image(&Tracer::Grid(&grid), &basis, Footprint::EXACT);
         assert!(a.iter().chain(&b).all(|h| !h.gave_up()));
         agreement.add(&a, &b);
     }
@@ -108,7 +109,7 @@ fn far_camera_and_deep_sparse_tree() {
         ortho: None,
     };
     let basis = camera.basis(9, 9, tree.origin());
-    let hits = trace_image(Tracer::Svo(&tree), &basis, Footprint::EXACT);
+    let hits = trace_image(&Tracer::Svo(Traced::Tree(&tree)), &basis, Footprint::EXACT);
     let center = hits[4 * 9 + 4];
     assert_eq!(center.value, 5, "{center:?}");
     assert_eq!(center.voxel + tree.origin(), far);

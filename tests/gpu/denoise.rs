@@ -141,7 +141,7 @@ fn checker() -> (Scene, Camera) {
 fn contrast(image: &image::RgbaImage, tree: &Octree, camera: &Camera) -> f64 {
     let basis = camera.basis(image.width(), image.height(), tree.origin());
     let hits = octovox::trace::render::trace_image(
-        octovox::trace::render::Tracer::Svo(tree),
+        &octovox::trace::render::Tracer::Svo(octovox::trace::instanced::Traced::Tree(tree)),
         &basis,
         octovox::trace::Footprint::EXACT,
     );

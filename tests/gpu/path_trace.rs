@@ -59,8 +59,8 @@ pub(crate) fn look(eye: DVec3, target: DVec3) -> Camera {
 /// Each pixel's centre ray as the CPU tracer hits it.
 fn centre_hits(tree: &Octree, camera: &Camera, size: (u32, u32)) -> Vec<octovox::trace::Hit> {
     let basis = camera.basis(size.0, size.1, tree.origin());
-    let tracer = octovox::trace::render::Tracer::Svo(tree);
-    octovox::trace::render::trace_image(tracer, &basis, octovox::trace::Footprint::EXACT)
+    let tracer = octovox::trace::render::Tracer::Svo(octovox::trace::instanced::Traced::Tree(tree));
+    octovox::trace::render::trace_image(&tracer, &basis, octovox::trace::Footprint::EXACT)
 }
 
 /// Pixels whose hit (by the CPU tracer) is a voxel.

@@ -23,12 +23,14 @@ use rayon::prelude::*;
 use self::lights::Emitter;
 use self::materials::{Effects, GpuMaterial, MATERIAL_EMIT, MATERIAL_GLASS, MATERIAL_METAL};
 use self::rng::Rng;
+use super::Footprint;
 use super::denoise::{Guide, Sums};
+use super::instanced::Traced;
 use super::render::GAVE_UP_COLOR;
-use super::svo::{Crossing, trace_through};
+use super::svo::Crossing;
 use super::{Hit, Ray, argmin, normal_code};
 use crate::camera::{Camera, RayBasis};
-use crate::scene::{Octree, Scene};
+use crate::scene::Scene;
 use crate::settings::{EffectsChoice, PathSettings, SUN_DIR};
 
 /// Angular radius of the sun (radians): soft shadows of a few voxels.
@@ -63,7 +65,7 @@ pub fn effects_for(scene: &Scene, settings: &PathSettings) -> Effects {
 
 /// A scene prepared for path tracing.
 pub struct PathScene<'a> {
-    pub tree: &'a Octree,
+    pub traced: Traced<'a>,
     pub materials: Vec<GpuMaterial>,
     pub albedo: Vec<Vec3>,
     pub lights: Vec<Emitter>,
@@ -73,11 +75,11 @@ pub struct PathScene<'a> {
 
 impl PathScene<'_> {
     pub fn new<'a>(scene: &'a Scene, settings: &PathSettings) -> PathScene<'a> {
-        let (tree, palette) = (scene.drawn(), &scene.palette);
+        let palette = &scene.palette;
         let effects = effects_for(scene, settings);
-        let lights = if effects.emit { lights::emitters(tree, palette) } else { Vec::new() };
+        let lights = if effects.emit { lights::emitters(scene.drawn(), palette) } else { Vec::new() };
         PathScene {
-            tree,
+            traced: Traced::of(scene),
             materials: materials::material_table(palette),
             albedo: (0..=255u8).map(|i| materials::albedo(palette, i)).collect(),
             lights,
@@ -124,7 +126,7 @@ impl PathScene<'_> {
     pub fn guide(&self, basis: &RayBasis, x: u32, y: u32) -> Guide {
         let (origin, dir) = basis.ray(x, y);
         let ray = Ray::new(origin, dir);
-        let c = self.cross(&ray, 0);
+        let c = self.cross(&ray, 0, None);
         if !c.found || c.hit.gave_up || c.hit.normal == IVec3::ZERO {
             return Guide::LEFT;
         }
@@ -140,11 +142,13 @@ impl PathScene<'_> {
         let mut radiance = Vec3::ZERO;
         let mut beta = Vec3::ONE;
         let mut medium = 0u8;
+        // The instance whose glass the ray is in.
+        let mut inside = None;
         let mut lights_counted = false;
         let (mut bounces, mut transmissions) = (0, 0);
         let mut first = true;
         loop {
-            let c = self.cross(&ray, medium);
+            let c = self.cross(&ray, medium, inside);
             if c.hit.gave_up {
                 return radiance + beta * GAVE_UP_COLOR;
             }
@@ -179,6 +183,10 @@ impl PathScene<'_> {
             {
                 transmissions += 1;
                 let Some((next, to)) = self.interface(d, n, medium, value, rng) else { return radiance };
+                // Into other glass (or out of it): the instance of the face crossed.
+                if to.0 != medium {
+                    inside = c.instance;
+                }
                 (dir, medium) = (next, to.0);
                 beta *= to.1;
                 lights_counted = false;
@@ -222,14 +230,10 @@ impl PathScene<'_> {
         }
     }
 
-    /// The next voxel that is not the medium; a ray inside glass that leaves
-    /// the tree leaves the glass at the root's face.
-    fn cross(&self, ray: &Ray, medium: u8) -> Crossing {
-        let c = trace_through(self.tree, ray, medium);
-        if c.found || c.hit.gave_up || medium == 0 {
-            return c;
-        }
-        root_exit(ray, self.tree.size() as f32, c.hit.iterations)
+    /// The next voxel that is not the medium, the glass of instance
+    /// `inside` (see [`Traced::trace_through`]).
+    fn cross(&self, ray: &Ray, medium: u8, inside: Option<u32>) -> Crossing {
+        self.traced.trace_through(ray, medium, inside, Footprint::EXACT)
     }
 
     /// A glass surface between `medium` and `value` (0: empty space):
@@ -273,7 +277,7 @@ impl PathScene<'_> {
             for _ in 0..samples {
                 let l = cone_direction(Vec3::from(SUN_DIR), sun_cos(), rng.uniform(), rng.uniform());
                 let cos = n.dot(l);
-                if cos > 0.0 && !self.cross(&Ray::new(p, l), 0).found {
+                if cos > 0.0 && !self.cross(&Ray::new(p, l), 0, None).found {
                     sum += SUN_IRRADIANCE * cos * lobe.eval(n, l);
                 }
             }
@@ -300,7 +304,7 @@ impl PathScene<'_> {
         if cos_s <= 0.0 || dist2 <= 0.0 {
             return Vec3::ZERO;
         }
-        let c = self.cross(&Ray::new(p, l), 0);
+        let c = self.cross(&Ray::new(p, l), 0, None);
         if !c.found || !lights::contains(&light, c.hit.voxel) {
             return Vec3::ZERO;
         }
@@ -398,20 +402,6 @@ pub fn surface_point(ray: &Ray, c: &Crossing) -> Vec3 {
     let axis = argmin(-hit.normal.abs().as_vec3());
     p[axis] = lo[axis] + if hit.normal[axis] > 0 { 1.0 } else { 0.0 };
     p
-}
-
-/// A ray inside glass that leaves the root cube: it crosses into empty
-/// space at the root's face.
-fn root_exit(ray: &Ray, size: f32, iterations: u32) -> Crossing {
-    let far = (Vec3::select(ray.dir.cmpgt(Vec3::ZERO), Vec3::splat(size), Vec3::ZERO) - ray.origin) * ray.inv;
-    let axis = argmin(far);
-    let t = far[axis].max(0.0);
-    let p = ray.origin + ray.dir * t;
-    let mut voxel = p.floor().as_ivec3();
-    let mut normal = IVec3::ZERO;
-    normal[axis] = if ray.dir[axis] > 0.0 { -1 } else { 1 };
-    voxel[axis] = if ray.dir[axis] > 0.0 { size as i32 } else { -1 };
-    Crossing { hit: Hit { voxel, normal, iterations, ..Hit::default() }, t, found: true }
 }
 
 /// Finite, non-negative, at most [`MAX_SAMPLE_RADIANCE`] per channel.

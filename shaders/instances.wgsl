@@ -1,0 +1,176 @@
+// Two-level tracing: a scene of objects is a tree of boxes over instance
+// records, each placing a model's octree by a signed permutation and an
+// integer offset (src/scene/instances.rs writes both). The twin of
+// src/trace/instanced.rs: change both together. Prefixed with common.wgsl
+// and trace_svo.wgsl.
+
+// An instance: its model's tree, and model cell m[j] = ±s[src[j]] + offset[j]
+// of scene cell s (minus where `negative[j]`).
+struct Instance {
+    tree: Tree,
+    src: vec3<u32>,
+    negative: vec3<bool>,
+    offset: vec3<i32>,
+}
+
+fn load_instance(index: u32) -> Instance {
+    let at = u.instance_nodes * BVH_NODE_WORDS + index * INSTANCE_WORDS;
+    let axes = instances[at + 4u];
+    var inst: Instance;
+    inst.tree = Tree(instances[at], instances[at + 1u], instances[at + 2u], instances[at + 3u], instances[at + 5u]);
+    inst.src = vec3<u32>(axes & 3u, (axes >> 2u) & 3u, (axes >> 4u) & 3u);
+    inst.negative = (vec3<u32>(axes) & vec3<u32>(64u, 128u, 256u)) != vec3<u32>(0u);
+    inst.offset = bitcast<vec3<i32>>(vec3<u32>(instances[at + 6u], instances[at + 7u], instances[at + 8u]));
+    return inst;
+}
+
+// The ray in the model's tree-local frame: the same t reaches the same point.
+fn model_ray(inst: Instance, r: Ray) -> Ray {
+    let s = select(vec3<f32>(1.0), vec3<f32>(-1.0), inst.negative);
+    let o = vec3<f32>(r.o[inst.src.x], r.o[inst.src.y], r.o[inst.src.z]);
+    let d = vec3<f32>(r.d[inst.src.x], r.d[inst.src.y], r.d[inst.src.z]);
+    let inv = vec3<f32>(r.inv[inst.src.x], r.inv[inst.src.y], r.inv[inst.src.z]);
+    return Ray(s * o + vec3<f32>(inst.offset), s * d, s * inv);
+}
+
+// A hit in the model's frame, in the scene's.
+fn scene_hit(inst: Instance, index: u32, h: Hit) -> Hit {
+    var out = h;
+    let d = h.voxel - inst.offset;
+    // Cell m spans m..m + 1: mirrored, its low corner is the image of m + 1.
+    let m = select(d, -d - vec3<i32>(1), inst.negative);
+    out.voxel[inst.src.x] = m.x;
+    out.voxel[inst.src.y] = m.y;
+    out.voxel[inst.src.z] = m.z;
+    if (h.normal_code != 0u) {
+        let axis = (h.normal_code - 1u) / 2u;
+        // Odd codes are the positive normals.
+        let negative_normal = (h.normal_code % 2u == 0u) != inst.negative[axis];
+        out.normal_code = 1u + 2u * inst.src[axis] + select(0u, 1u, negative_normal);
+    }
+    out.instance = index;
+    return out;
+}
+
+// A ray inside glass that leaves the tree's cube crosses into empty space
+// at the cube's face (twin of `root_exit` in src/trace/svo.rs).
+fn root_exit(r: Ray, depth: u32, iterations: u32) -> Hit {
+    let size = f32(1u << depth);
+    let far = (select(vec3<f32>(0.0), vec3<f32>(size), r.d > vec3<f32>(0.0)) - r.o) * r.inv;
+    let axis = argmin3(far);
+    let t = max(far[axis], 0.0);
+    let p = r.o + r.d * t;
+    var hit: Hit;
+    hit.voxel = vec3<i32>(floor(p));
+    hit.voxel[axis] = select(-1, i32(1u << depth), r.d[axis] > 0.0);
+    hit.normal_code = 1u + 2u * axis + select(0u, 1u, r.d[axis] > 0.0);
+    hit.iterations = iterations;
+    hit.t = t;
+    hit.found = true;
+    hit.instance = NO_INSTANCE;
+    return hit;
+}
+
+// The first voxel of `tree` along `r` that is not `medium`; a ray inside
+// glass that finds none leaves the glass at the tree's face (twin of `cross`).
+fn cross_tree(tree: Tree, r: Ray, t_min: f32, medium: u32, lod: vec2<f32>) -> Hit {
+    let hit = trace_svo(tree, r, t_min, medium, lod);
+    if (hit.found || medium == 0u || hit.iterations >= tree.max_iterations) {
+        return hit;
+    }
+    return root_exit(r, tree.depth, hit.iterations);
+}
+
+// Within TIE_T of each other two hits are at one distance.
+fn tie_limit(t: f32) -> f32 {
+    return t + TIE_T * max(t, 1.0);
+}
+
+// The box of tree node i, or none (x > y: nothing drawn below it).
+fn node_box(i: u32) -> array<vec3<f32>, 2> {
+    let at = i * BVH_NODE_WORDS;
+    let lo = bitcast<vec3<i32>>(vec3<u32>(instances[at], instances[at + 1u], instances[at + 2u]));
+    let hi = bitcast<vec3<i32>>(vec3<u32>(instances[at + 3u], instances[at + 4u], instances[at + 5u]));
+    return array<vec3<f32>, 2>(vec3<f32>(lo), vec3<f32>(hi));
+}
+
+// The first voxel along `r` that is not the medium, in a scene of one model
+// or of objects. `medium` is the glass the ray is in (0: none) and `inside`
+// the instance of that glass; every other object is crossed as empty space.
+// The tree of boxes is walked in preorder without a stack: a node the ray
+// misses, or meets beyond the nearest hit so far, is skipped whole. Leaves
+// come in walk order, so a hit at the nearest hit's distance (within
+// TIE_T) is of a later object and wins, as composing gives. Twin of
+// `trace_through` in src/trace/instanced.rs.
+fn trace_scene(r: Ray, t_min: f32, medium: u32, inside: u32, lod: vec2<f32>) -> Hit {
+    if (u.instance_nodes == 0u) {
+        return cross_tree(scene_tree(), r, t_min, medium, lod);
+    }
+    var best: Hit;
+    best.instance = NO_INSTANCE;
+    var iterations = 0u;
+    var gave_up = false;
+    var i = 0u;
+    loop {
+        if (i >= u.instance_nodes) {
+            break;
+        }
+        let at = i * BVH_NODE_WORDS;
+        let leaf = instances[at + LEAF_WORD];
+        var enter = (leaf & EMPTY_BIT) == 0u;
+        if (enter) {
+            let b = node_box(i);
+            let s = slab(r, b[0], b[1]);
+            let reach = select(3.0e38, tie_limit(best.t), best.found);
+            enter = s.t_enter <= s.t_exit && s.t_exit > max(t_min, 0.0) && s.t_enter <= reach;
+        }
+        if (enter && leaf != 0u) {
+            let index = leaf - 1u;
+            let inst = load_instance(index);
+            let h = cross_tree(inst.tree, model_ray(inst, r), t_min, select(0u, medium, index == inside), lod);
+            iterations += h.iterations;
+            gave_up = gave_up || (!h.found && h.iterations >= inst.tree.max_iterations);
+            if (h.found && (!best.found || h.t <= tie_limit(best.t))) {
+                best = scene_hit(inst, index, h);
+            }
+        }
+        i = select(instances[at + 6u], i + 1u, enter && leaf == 0u);
+    }
+    if (gave_up) {
+        var miss: Hit;
+        miss.iterations = u.max_iterations;
+        return miss;
+    }
+    best.iterations = min(iterations, u.max_iterations - 1u);
+    return best;
+}
+
+// The beam prepass of a scene of objects: the distance from the eye to the
+// nearest instance box inside the tile's pyramid (planes n0..n3), or
+// BEAM_NONE. Every ray of the tile that meets a voxel meets it in a box.
+fn beam_instances(n0: vec3<f32>, n1: vec3<f32>, n2: vec3<f32>, n3: vec3<f32>) -> f32 {
+    var best = BEAM_NONE;
+    var i = 0u;
+    loop {
+        if (i >= u.instance_nodes) {
+            break;
+        }
+        let at = i * BVH_NODE_WORDS;
+        let leaf = instances[at + LEAF_WORD];
+        var descend = false;
+        if ((leaf & EMPTY_BIT) == 0u) {
+            let b = node_box(i);
+            // Half a voxel of slack against rounding in the plane tests.
+            let lo = b[0] - vec3<f32>(0.5);
+            let hi = b[1] + vec3<f32>(0.5);
+            let distance = length(max(max(lo - u.eye, u.eye - hi), vec3<f32>(0.0)));
+            let outside = beyond(n0, lo, hi) || beyond(n1, lo, hi) || beyond(n2, lo, hi) || beyond(n3, lo, hi);
+            if (!outside && distance < best) {
+                descend = leaf == 0u;
+                best = select(distance, best, descend);
+            }
+        }
+        i = select(instances[at + 6u], i + 1u, descend);
+    }
+    return best;
+}

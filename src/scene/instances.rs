@@ -1,0 +1,361 @@
+//! The top level of two-level ray tracing: one record per placed object
+//! (its model, and the signed permutation and integer offset that take
+//! scene cells to the model's cells) and a bounding-volume tree over their
+//! boxes. The GPU reads both as words ([`InstanceTable::words`]); the CPU
+//! reference walks the same records (`crate::trace::instanced`).
+//!
+//! The tree is balanced over the objects in walk order: its shape depends
+//! only on how many objects there are, so moving, turning or hiding one
+//! changes its leaf and the boxes above it that change, nothing else. Walk
+//! order follows the file's groups, which MagicaVoxel users build spatially.
+
+use glam::IVec3;
+
+use super::objects::{Model, Objects};
+use crate::gpu_pool::{BRICK_BYTES, NODE_BYTES, PoolTooLarge};
+
+/// Words of one tree node on the GPU: the box's min corner and its max
+/// corner (exclusive, scene-local cells), the index of the node after its
+/// subtree, and [`LEAF_WORD`]'s instance.
+pub const BVH_NODE_WORDS: usize = 8;
+/// Word of a tree node naming its instance (index + 1; 0: an inner node).
+pub const LEAF_WORD: usize = 7;
+/// Bit of [`LEAF_WORD`] marking a subtree with nothing drawn: every object
+/// under it hidden or empty. A traversal skips it without a box test.
+pub const EMPTY_BIT: u32 = 0x8000_0000;
+/// Words of one instance record on the GPU (see [`InstanceTable::words`]).
+pub const INSTANCE_WORDS: usize = 12;
+/// The instance of a hit in a scene of one model.
+pub const NO_INSTANCE: u32 = u32::MAX;
+/// Two hits closer than this (in t, relative to t, at least 1) count as one
+/// distance: the later object in walk order wins there, as composing gives.
+/// Each object's ray is its own rounding of the scene ray, so faces that
+/// coincide in the scene differ by a few ulps in t.
+pub const TIE_T: f32 = 1.0 / 65536.0;
+
+/// One placed object: scene-local cell `s` is model tree-local cell `m` with
+/// `m[j] = sign[j] · s[src[j]] + offset[j]` (continuous points likewise).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Instance {
+    pub model: usize,
+    pub src: [usize; 3],
+    pub sign: [i32; 3],
+    pub offset: IVec3,
+    /// Inclusive scene-local box of its voxels; `None` when hidden or empty.
+    pub bounds: Option<(IVec3, IVec3)>,
+}
+
+impl Instance {
+    /// The scene cell of model tree-local cell `m`.
+    pub fn cell_to_scene(&self, m: IVec3) -> IVec3 {
+        let mut s = IVec3::ZERO;
+        for j in 0..3 {
+            // Cell m spans m..m + 1; mirrored, its low corner is the image of m + 1.
+            let d = m[j] - self.offset[j];
+            s[self.src[j]] = if self.sign[j] < 0 { -d - 1 } else { d };
+        }
+        s
+    }
+
+    /// The scene direction of a model direction (a normal).
+    pub fn dir_to_scene(&self, n: IVec3) -> IVec3 {
+        let mut s = IVec3::ZERO;
+        for j in 0..3 {
+            s[self.src[j]] = self.sign[j] * n[j];
+        }
+        s
+    }
+}
+
+/// A node of the tree over instance boxes, in preorder: an inner node's
+/// first child follows it, and `skip` is the node after its subtree.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BvhNode {
+    /// Inclusive scene-local cell box; `None`: nothing drawn below.
+    pub bounds: Option<(IVec3, IVec3)>,
+    pub skip: u32,
+    pub leaf: Option<u32>,
+}
+
+/// The instances of a scene of objects and the tree over their boxes.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct InstanceTable {
+    pub instances: Vec<Instance>,
+    pub nodes: Vec<BvhNode>,
+}
+
+impl InstanceTable {
+    /// The objects as instances, in a scene whose local cells start at
+    /// world cell `origin`.
+    pub fn build(objects: &Objects, origin: IVec3) -> InstanceTable {
+        let model_bounds: Vec<Option<(IVec3, IVec3)>> = objects.models.iter().map(|m| m.tree.solid_bounds()).collect();
+        let instances: Vec<Instance> = (0..objects.list().len())
+            .map(|i| {
+                let object = &objects.list()[i];
+                let model = object.placement.model;
+                let map = objects.map(i);
+                let tree_origin = objects.models[model].tree.origin();
+                let mut instance = Instance { model, src: [0; 3], sign: [1; 3], offset: IVec3::ZERO, bounds: None };
+                for (row, (axis, sign, offset)) in map.rows().into_iter().enumerate() {
+                    // w = sign · v + offset on cells; on points a mirrored
+                    // axis adds one (cell v spans v..v + 1).
+                    let corner = i32::from(sign < 0);
+                    instance.src[axis] = row;
+                    instance.sign[axis] = sign;
+                    instance.offset[axis] = sign * (origin[row] - offset - corner) - tree_origin[axis];
+                }
+                instance.bounds = model_bounds[model]
+                    .filter(|_| !object.hidden)
+                    .map(|(lo, hi)| map.apply_box(lo, hi))
+                    .map(|(lo, hi)| (lo - origin, hi - origin));
+                instance
+            })
+            .collect();
+        let mut nodes = Vec::with_capacity(2 * instances.len());
+        if !instances.is_empty() {
+            build_range(&instances, 0, instances.len(), &mut nodes);
+        }
+        InstanceTable { instances, nodes }
+    }
+
+    /// The table as the GPU reads it: the tree's nodes, then one record per
+    /// instance, given where each model's pool lies in the pool buffer.
+    /// A record: the model's root word, its depth, its first node slot, the
+    /// word its bricks start at, the axes (`src[j]` in bits 2j, a mirrored
+    /// `j` in bit 6 + j), its iteration bound, the offset, three spare words.
+    pub fn words(&self, models: &[Model], regions: &[ModelRegion], brick_words: u32) -> Vec<u32> {
+        let mut words = Vec::with_capacity(self.nodes.len() * BVH_NODE_WORDS + self.instances.len() * INSTANCE_WORDS);
+        for node in &self.nodes {
+            let (lo, hi) = node.bounds.map_or((IVec3::ZERO, IVec3::ZERO), |(lo, hi)| (lo, hi + IVec3::ONE));
+            words.extend(lo.to_array().map(|c| c as u32));
+            words.extend(hi.to_array().map(|c| c as u32));
+            words.push(node.skip);
+            let empty = if node.bounds.is_none() { EMPTY_BIT } else { 0 };
+            words.push(node.leaf.map_or(0, |i| i + 1) | empty);
+        }
+        for instance in &self.instances {
+            let tree = &models[instance.model].tree;
+            let region = regions[instance.model];
+            let mut axes = 0;
+            for j in 0..3 {
+                axes |= (instance.src[j] as u32) << (2 * j);
+                axes |= u32::from(instance.sign[j] < 0) << (6 + j);
+            }
+            words.extend([
+                tree.root_word(),
+                tree.depth(),
+                region.node_base,
+                brick_words + 2 * region.brick_base,
+                axes,
+                crate::trace::iteration_bound(tree.depth()),
+            ]);
+            words.extend(instance.offset.to_array().map(|c| c as u32));
+            words.extend([0; 3]);
+        }
+        words
+    }
+}
+
+/// Bytes of the instance words of `objects` objects: the tree's nodes and
+/// the records.
+pub fn word_bytes(objects: usize) -> u64 {
+    let nodes = (2 * objects).saturating_sub(1);
+    4 * (nodes * BVH_NODE_WORDS + objects * INSTANCE_WORDS) as u64
+}
+
+/// Appends the subtree over instances `lo..hi` to `nodes`; returns its box.
+fn build_range(instances: &[Instance], lo: usize, hi: usize, nodes: &mut Vec<BvhNode>) -> Option<(IVec3, IVec3)> {
+    let at = nodes.len();
+    nodes.push(BvhNode { bounds: None, skip: 0, leaf: None });
+    let bounds = if hi - lo == 1 {
+        nodes[at].leaf = Some(lo as u32);
+        instances[lo].bounds
+    } else {
+        let mid = lo + (hi - lo) / 2;
+        let a = build_range(instances, lo, mid, nodes);
+        let b = build_range(instances, mid, hi, nodes);
+        match (a, b) {
+            (Some(a), Some(b)) => Some((a.0.min(b.0), a.1.max(b.1))),
+            (a, b) => a.or(b),
+        }
+    };
+    nodes[at].bounds = bounds;
+    nodes[at].skip = nodes.len() as u32;
+    bounds
+}
+
+/// Where one model's pool lies in the GPU pool buffer, in slots: its nodes
+/// from `node_base` in the node region, its bricks from `brick_base` in the
+/// brick region, each with room for `*_slots`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ModelRegion {
+    pub node_base: u32,
+    pub node_slots: u32,
+    pub brick_base: u32,
+    pub brick_slots: u32,
+}
+
+/// What the GPU holds of a scene of objects: where each model's pool lies
+/// and the instance words last sent. [`GpuCopy::take`] sends what differs.
+#[derive(Clone, Debug, Default)]
+pub struct GpuCopy {
+    /// Empty: nothing sent yet (or forgotten); the next take lays out afresh.
+    regions: Vec<ModelRegion>,
+    node_slots: u32,
+    brick_slots: u32,
+    words: Vec<u32>,
+}
+
+/// The writes of one [`GpuCopy::take`], as byte offsets into the two buffers.
+#[derive(Clone, Debug, Default)]
+pub struct ObjectsUpload {
+    /// A new pool buffer of these node and brick region bytes, when the
+    /// models were laid out afresh (then `pool` covers every model).
+    pub pool_size: Option<(u64, u64)>,
+    pub pool: Vec<(u64, Vec<u8>)>,
+    /// A new instance buffer of this many bytes (then `instances` is all of it).
+    pub instances_size: Option<u64>,
+    pub instances: Vec<(u64, Vec<u8>)>,
+    /// Tree nodes at the start of the instance words (0: nothing drawn).
+    pub instance_nodes: u32,
+}
+
+impl ObjectsUpload {
+    pub fn byte_count(&self) -> u64 {
+        self.pool.iter().chain(&self.instances).map(|(_, bytes)| bytes.len() as u64).sum()
+    }
+
+    pub fn range_count(&self) -> usize {
+        self.pool.len() + self.instances.len()
+    }
+}
+
+impl GpuCopy {
+    /// Forgets what the GPU holds: the next take sends everything.
+    pub fn forget(&mut self) {
+        *self = GpuCopy::default();
+    }
+
+    /// Bytes the GPU holds for the scene: the pool regions and the instance words.
+    pub fn bytes(&self) -> u64 {
+        u64::from(self.node_slots) * NODE_BYTES
+            + u64::from(self.brick_slots) * BRICK_BYTES
+            + 4 * self.words.len() as u64
+    }
+
+    /// Takes every model's changed slots and the instance words that differ
+    /// from those sent, for a scene whose local cells start at `origin`. A
+    /// model that outgrew its region lays every model out afresh, each with
+    /// half again its slots as room.
+    ///
+    /// # Errors
+    /// [`PoolTooLarge`] when the models' pools do not fit `max_bytes`; the
+    /// changes are kept for a later take.
+    pub fn take(
+        &mut self,
+        objects: &mut Objects,
+        origin: IVec3,
+        max_bytes: u64,
+    ) -> Result<ObjectsUpload, PoolTooLarge> {
+        let fits = self.regions.len() == objects.models.len()
+            && self.regions.iter().zip(&objects.models).all(|(r, m)| {
+                m.tree.pool().nodes.len() <= r.node_slots as usize
+                    && m.tree.pool().bricks.len() <= r.brick_slots as usize
+            });
+        let mut upload = ObjectsUpload::default();
+        if fits {
+            self.send_changes(objects, &mut upload);
+        } else {
+            self.lay_out(objects, max_bytes)?;
+            upload.pool_size = Some((self.node_region_bytes(), u64::from(self.brick_slots) * BRICK_BYTES));
+            self.send_all(objects, &mut upload);
+        }
+        let table = InstanceTable::build(objects, origin);
+        let words = table.words(&objects.models, &self.regions, (self.node_region_bytes() / 4) as u32);
+        upload.instance_nodes = table.nodes.len() as u32;
+        if words.len() != self.words.len() {
+            upload.instances_size = Some(4 * words.len() as u64);
+            upload.instances.push((0, bytemuck::cast_slice(&words).to_vec()));
+        } else {
+            upload.instances = changed_runs(&self.words, &words);
+        }
+        self.words = words;
+        Ok(upload)
+    }
+
+    fn node_region_bytes(&self) -> u64 {
+        u64::from(self.node_slots) * NODE_BYTES
+    }
+
+    /// Gives each model a region of half again its slots.
+    fn lay_out(&mut self, objects: &Objects, max_bytes: u64) -> Result<(), PoolTooLarge> {
+        let room = |n: usize| (n + n / 2).max(16);
+        let (mut nodes, mut bricks) = (0u64, 0u64);
+        let mut regions = Vec::with_capacity(objects.models.len());
+        for model in &objects.models {
+            let pool = model.tree.pool();
+            let (n, b) = (room(pool.nodes.len()) as u64, room(pool.bricks.len()) as u64);
+            regions.push((nodes, n, bricks, b));
+            (nodes, bricks) = (nodes + n, bricks + b);
+        }
+        let needed = nodes * NODE_BYTES + bricks * BRICK_BYTES;
+        if needed > max_bytes || nodes > u64::from(u32::MAX / 2) || bricks > u64::from(u32::MAX / 4) {
+            return Err(PoolTooLarge { needed, limit: max_bytes });
+        }
+        let slot = |v: u64| v as u32;
+        self.regions = regions
+            .into_iter()
+            .map(|(nb, n, bb, b)| ModelRegion {
+                node_base: slot(nb),
+                node_slots: slot(n),
+                brick_base: slot(bb),
+                brick_slots: slot(b),
+            })
+            .collect();
+        (self.node_slots, self.brick_slots) = (slot(nodes), slot(bricks));
+        Ok(())
+    }
+
+    /// Every model's pool, whole, and its dirty slots taken.
+    fn send_all(&self, objects: &mut Objects, upload: &mut ObjectsUpload) {
+        for (model, region) in objects.models.iter_mut().zip(&self.regions) {
+            let pool = model.tree.pool_mut();
+            pool.flush();
+            upload.pool.push((u64::from(region.node_base) * NODE_BYTES, pool.nodes.bytes().to_vec()));
+            let bricks = self.node_region_bytes() + u64::from(region.brick_base) * BRICK_BYTES;
+            upload.pool.push((bricks, pool.bricks.bytes().to_vec()));
+        }
+    }
+
+    /// Each model's dirty slots, at its region.
+    fn send_changes(&self, objects: &mut Objects, upload: &mut ObjectsUpload) {
+        for (model, region) in objects.models.iter_mut().zip(&self.regions) {
+            let pool = model.tree.pool_mut();
+            let changes = pool.flush();
+            let nodes = u64::from(region.node_base) * NODE_BYTES;
+            let bricks = self.node_region_bytes() + u64::from(region.brick_base) * BRICK_BYTES;
+            let pool = model.tree.pool();
+            upload.pool.extend(changes.nodes.ranges(&pool.nodes).map(|(at, bytes)| (nodes + at, bytes.to_vec())));
+            upload.pool.extend(changes.bricks.ranges(&pool.bricks).map(|(at, bytes)| (bricks + at, bytes.to_vec())));
+        }
+    }
+}
+
+/// The runs of words where `new` differs from `old` (of the same length),
+/// as byte offsets and bytes.
+fn changed_runs(old: &[u32], new: &[u32]) -> Vec<(u64, Vec<u8>)> {
+    let mut runs = Vec::new();
+    let mut i = 0;
+    while i < new.len() {
+        if old[i] == new[i] {
+            i += 1;
+            continue;
+        }
+        let start = i;
+        while i < new.len() && old[i] != new[i] {
+            i += 1;
+        }
+        runs.push((4 * start as u64, bytemuck::cast_slice(&new[start..i]).to_vec()));
+    }
+    runs
+}
