@@ -13,6 +13,7 @@ mod export;
 mod export_scene;
 mod fuzz_corpus;
 mod hostile_input;
+mod instanced;
 mod mesh_import;
 mod octree_props;
 mod ovx;
