@@ -62,8 +62,10 @@ fn load_constants() {
 }
 // Nodes (NODE_WORDS words each) and then bricks (2 words each) of the node pool.
 @group(0) @binding(1) var<storage, read> pool: array<u32>;
-// The instance tree's nodes, then the instance records (src/scene/instances.rs).
-@group(0) @binding(2) var<storage, read> instances: array<u32>;
+// The instance tree's nodes, then the instance records (src/scene/instances.rs),
+// read four words at a time: each load site costs a scalar loop over the
+// lanes on CPU-emulated GPUs.
+@group(0) @binding(2) var<storage, read> instances: array<vec4<u32>>;
 @group(0) @binding(3) var<storage, read> palette: array<u32>;
 @group(0) @binding(4) var<storage, read> grid: array<u32>;
 @group(0) @binding(5) var out_color: texture_storage_2d<rgba8unorm, write>;

@@ -4,6 +4,9 @@
 // src/trace/instanced.rs: change both together. Prefixed with common.wgsl
 // and trace_svo.wgsl.
 
+// A t past every node's entry: the node is not entered.
+const NO_ENTRY: f32 = 3.0e38;
+
 // An instance: its model's tree, and model cell m[j] = ±s[src[j]] + offset[j]
 // of scene cell s (minus where `negative[j]`).
 struct Instance {
@@ -14,14 +17,35 @@ struct Instance {
 }
 
 fn load_instance(index: u32) -> Instance {
-    let at = u.instance_nodes * BVH_NODE_WORDS + index * INSTANCE_WORDS;
-    let axes = instances[at + 4u];
+    let at = (u.instance_nodes * BVH_NODE_WORDS + index * INSTANCE_WORDS) / 4u;
+    let a = instances[at];
+    let b = instances[at + 1u];
+    let axes = a.w >> 8u;
     var inst: Instance;
-    inst.tree = Tree(instances[at], instances[at + 1u], instances[at + 2u], instances[at + 3u], instances[at + 5u]);
+    inst.tree = Tree(a.x, a.w & 0xffu, a.y, a.z, b.x);
     inst.src = vec3<u32>(axes & 3u, (axes >> 2u) & 3u, (axes >> 4u) & 3u);
     inst.negative = (vec3<u32>(axes) & vec3<u32>(64u, 128u, 256u)) != vec3<u32>(0u);
-    inst.offset = bitcast<vec3<i32>>(vec3<u32>(instances[at + 6u], instances[at + 7u], instances[at + 8u]));
+    inst.offset = bitcast<vec3<i32>>(b.yzw);
     return inst;
+}
+
+// A node of the tree of boxes (its words: src/scene/instances.rs).
+struct BoxNode {
+    lo: vec3<f32>,
+    hi: vec3<f32>,
+    // The node after its subtree, and its instance + 1 (0: an inner node)
+    // with EMPTY_BIT where nothing below it is drawn.
+    skip: u32,
+    leaf: u32,
+}
+
+fn load_node(i: u32) -> BoxNode {
+    let at = i * (BVH_NODE_WORDS / 4u);
+    let a = instances[at];
+    let b = instances[at + 1u];
+    let lo = bitcast<vec3<i32>>(a.xyz);
+    let hi = bitcast<vec3<i32>>(vec3<u32>(a.w, b.x, b.y));
+    return BoxNode(vec3<f32>(lo), vec3<f32>(hi), b.z, b.w);
 }
 
 // The ray in the model's tree-local frame: the same t reaches the same point.
@@ -86,22 +110,31 @@ fn tie_limit(t: f32) -> f32 {
     return t + TIE_T * max(t, 1.0);
 }
 
-// The box of tree node i, or none (x > y: nothing drawn below it).
-fn node_box(i: u32) -> array<vec3<f32>, 2> {
-    let at = i * BVH_NODE_WORDS;
-    let lo = bitcast<vec3<i32>>(vec3<u32>(instances[at], instances[at + 1u], instances[at + 2u]));
-    let hi = bitcast<vec3<i32>>(vec3<u32>(instances[at + 3u], instances[at + 4u], instances[at + 5u]));
-    return array<vec3<f32>, 2>(vec3<f32>(lo), vec3<f32>(hi));
+// Whether a hit at t in instance `index` wins over `best`: it is nearer, or
+// at its distance and of a later object (as composing gives).
+fn wins(t: f32, index: u32, best: Hit) -> bool {
+    return !best.found || t < best.t - TIE_T * max(best.t, 1.0) || (t <= tie_limit(best.t) && index > best.instance);
+}
+
+// Farthest t a node may be entered at and still hold a winning hit.
+fn reach(best: Hit) -> f32 {
+    return select(NO_ENTRY, tie_limit(best.t), best.found);
+}
+
+// The t the ray enters a node's box at, or NO_ENTRY: it misses the box,
+// nothing is drawn below it, or it lies past `until`.
+fn entry_t(node: BoxNode, r: Ray, t_min: f32, until: f32) -> f32 {
+    let s = slab(r, node.lo, node.hi);
+    let meets = s.t_enter <= s.t_exit && s.t_exit > max(t_min, 0.0) && s.t_enter <= until;
+    return select(NO_ENTRY, s.t_enter, meets && (node.leaf & EMPTY_BIT) == 0u);
 }
 
 // The first voxel along `r` that is not the medium, in a scene of one model
 // or of objects. `medium` is the glass the ray is in (0: none) and `inside`
 // the instance of that glass; every other object is crossed as empty space.
-// The tree of boxes is walked in preorder without a stack: a node the ray
-// misses, or meets beyond the nearest hit so far, is skipped whole. Leaves
-// come in walk order, so a hit at the nearest hit's distance (within
-// TIE_T) is of a later object and wins, as composing gives. Twin of
-// `trace_through` in src/trace/instanced.rs.
+// The tree of boxes is walked nearer child first, the farther one on a
+// stack, and a node entered past the nearest hit so far is skipped whole.
+// Twin of `Traced::trace_through` in src/trace/instanced.rs.
 fn trace_scene(r: Ray, t_min: f32, medium: u32, inside: u32, lod: vec2<f32>) -> Hit {
     if (u.instance_nodes == 0u) {
         return cross_tree(scene_tree(), r, t_min, medium, lod);
@@ -110,31 +143,64 @@ fn trace_scene(r: Ray, t_min: f32, medium: u32, inside: u32, lod: vec2<f32>) -> 
     best.instance = NO_INSTANCE;
     var iterations = 0u;
     var gave_up = false;
+    var stack_node: array<u32, BVH_STACK>;
+    var stack_t: array<f32, BVH_STACK>;
+    var top = 0u;
     var i = 0u;
+    var node = load_node(0u);
+    var t_i = entry_t(node, r, t_min, NO_ENTRY);
     loop {
-        if (i >= u.instance_nodes) {
-            break;
-        }
-        let at = i * BVH_NODE_WORDS;
-        let leaf = instances[at + LEAF_WORD];
-        var enter = (leaf & EMPTY_BIT) == 0u;
-        if (enter) {
-            let b = node_box(i);
-            let s = slab(r, b[0], b[1]);
-            let reach = select(3.0e38, tie_limit(best.t), best.found);
-            enter = s.t_enter <= s.t_exit && s.t_exit > max(t_min, 0.0) && s.t_enter <= reach;
-        }
-        if (enter && leaf != 0u) {
+        if (t_i < NO_ENTRY) {
+            let leaf = node.leaf;
+            if (leaf == 0u) {
+                // Both children, the nearer first: the left one follows its
+                // parent, the right one follows the left one's subtree.
+                let left = load_node(i + 1u);
+                let right_index = left.skip;
+                let right = load_node(right_index);
+                let until = reach(best);
+                let t_left = entry_t(left, r, t_min, until);
+                let t_right = entry_t(right, r, t_min, until);
+                let left_first = t_left <= t_right;
+                if (max(t_left, t_right) < NO_ENTRY) {
+                    stack_node[top] = select(i + 1u, right_index, left_first);
+                    stack_t[top] = max(t_left, t_right);
+                    top += 1u;
+                }
+                i = select(right_index, i + 1u, left_first);
+                node = right;
+                if (left_first) {
+                    node = left;
+                }
+                t_i = min(t_left, t_right);
+                continue;
+            }
             let index = leaf - 1u;
             let inst = load_instance(index);
             let h = cross_tree(inst.tree, model_ray(inst, r), t_min, select(0u, medium, index == inside), lod);
             iterations += h.iterations;
             gave_up = gave_up || (!h.found && h.iterations >= inst.tree.max_iterations);
-            if (h.found && (!best.found || h.t <= tie_limit(best.t))) {
+            if (h.found && wins(h.t, index, best)) {
                 best = scene_hit(inst, index, h);
             }
         }
-        i = select(instances[at + 6u], i + 1u, enter && leaf == 0u);
+        // The next node on the stack still within reach, if any.
+        t_i = NO_ENTRY;
+        loop {
+            if (top == 0u) {
+                break;
+            }
+            top -= 1u;
+            if (stack_t[top] <= reach(best)) {
+                i = stack_node[top];
+                node = load_node(i);
+                t_i = stack_t[top];
+                break;
+            }
+        }
+        if (t_i >= NO_ENTRY) {
+            break;
+        }
     }
     if (gave_up) {
         var miss: Hit;
@@ -155,22 +221,20 @@ fn beam_instances(n0: vec3<f32>, n1: vec3<f32>, n2: vec3<f32>, n3: vec3<f32>) ->
         if (i >= u.instance_nodes) {
             break;
         }
-        let at = i * BVH_NODE_WORDS;
-        let leaf = instances[at + LEAF_WORD];
+        let node = load_node(i);
         var descend = false;
-        if ((leaf & EMPTY_BIT) == 0u) {
-            let b = node_box(i);
+        if ((node.leaf & EMPTY_BIT) == 0u) {
             // Half a voxel of slack against rounding in the plane tests.
-            let lo = b[0] - vec3<f32>(0.5);
-            let hi = b[1] + vec3<f32>(0.5);
+            let lo = node.lo - vec3<f32>(0.5);
+            let hi = node.hi + vec3<f32>(0.5);
             let distance = length(max(max(lo - u.eye, u.eye - hi), vec3<f32>(0.0)));
             let outside = beyond(n0, lo, hi) || beyond(n1, lo, hi) || beyond(n2, lo, hi) || beyond(n3, lo, hi);
             if (!outside && distance < best) {
-                descend = leaf == 0u;
+                descend = node.leaf == 0u;
                 best = select(distance, best, descend);
             }
         }
-        i = select(instances[at + 6u], i + 1u, descend);
+        i = select(node.skip, i + 1u, descend);
     }
     return best;
 }

@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 
 use super::layout::{FLOOR_ROW, GRID_MIX, HIGHLIGHT_MIX, HIGHLIGHT_TINT, ROW_TILES};
 use crate::gpu_pool::{LOD_WORD, NODE_WORDS, POINTER_BIT};
-use crate::scene::instances::{BVH_NODE_WORDS, EMPTY_BIT, INSTANCE_WORDS, LEAF_WORD, NO_INSTANCE, TIE_T};
+use crate::scene::instances::{BVH_NODE_WORDS, BVH_STACK, EMPTY_BIT, INSTANCE_WORDS, NO_INSTANCE, TIE_T};
 use crate::settings::{SUN_DIR, View};
 use crate::trace::denoise;
 use crate::trace::path::{self, materials};
@@ -28,7 +28,7 @@ pub fn shared_constants() -> String {
     line("NODE_WORDS", "u32", format!("{NODE_WORDS}u"));
     line("LOD_WORD", "u32", format!("{LOD_WORD}u"));
     line("BVH_NODE_WORDS", "u32", format!("{BVH_NODE_WORDS}u"));
-    line("LEAF_WORD", "u32", format!("{LEAF_WORD}u"));
+    line("BVH_STACK", "u32", format!("{BVH_STACK}u"));
     line("EMPTY_BIT", "u32", format!("{EMPTY_BIT:#x}u"));
     line("INSTANCE_WORDS", "u32", format!("{INSTANCE_WORDS}u"));
     line("NO_INSTANCE", "u32", format!("{NO_INSTANCE:#x}u"));

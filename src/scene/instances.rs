@@ -16,17 +16,28 @@ use crate::gpu_pool::{BRICK_BYTES, NODE_BYTES, PoolTooLarge};
 
 /// Words of one tree node on the GPU: the box's min corner and its max
 /// corner (exclusive, scene-local cells), the index of the node after its
-/// subtree, and [`LEAF_WORD`]'s instance.
+/// subtree ([`SKIP_WORD`]), and its instance ([`LEAF_WORD`]).
 pub const BVH_NODE_WORDS: usize = 8;
+/// Word of a tree node holding the index of the node after its subtree: an
+/// inner node's right child is the node after its left child's subtree.
+pub const SKIP_WORD: usize = 6;
+/// Levels of the tree a traversal can keep on its stack: the balanced tree
+/// over `n` objects has `ceil(log2 n)` levels below its root, so this holds
+/// 2^24 objects, far past what a scene's memory allows.
+pub const BVH_STACK: usize = 24;
 /// Word of a tree node naming its instance (index + 1; 0: an inner node).
 pub const LEAF_WORD: usize = 7;
 /// Bit of [`LEAF_WORD`] marking a subtree with nothing drawn: every object
 /// under it hidden or empty. A traversal skips it without a box test.
 pub const EMPTY_BIT: u32 = 0x8000_0000;
 /// Words of one instance record on the GPU (see [`InstanceTable::words`]).
-pub const INSTANCE_WORDS: usize = 12;
+pub const INSTANCE_WORDS: usize = 8;
 /// The instance of a hit in a scene of one model.
 pub const NO_INSTANCE: u32 = u32::MAX;
+// `load_node` and `load_instance` in shaders/instances.wgsl read a node and
+// a record as two four-word loads, by these positions.
+const _: () = assert!(BVH_NODE_WORDS == 8 && SKIP_WORD == 6 && LEAF_WORD == 7 && INSTANCE_WORDS == 8);
+
 /// Two hits closer than this (in t, relative to t, at least 1) count as one
 /// distance: the later object in walk order wins there, as composing gives.
 /// Each object's ray is its own rounding of the scene ray, so faces that
@@ -120,9 +131,10 @@ impl InstanceTable {
 
     /// The table as the GPU reads it: the tree's nodes, then one record per
     /// instance, given where each model's pool lies in the pool buffer.
-    /// A record: the model's root word, its depth, its first node slot, the
-    /// word its bricks start at, the axes (`src[j]` in bits 2j, a mirrored
-    /// `j` in bit 6 + j), its iteration bound, the offset, three spare words.
+    /// A record: the model's root word, its first node slot, the word its
+    /// bricks start at, its depth in the low byte with the axes above
+    /// (`src[j]` in bits 8 + 2j, a mirrored `j` in bit 14 + j), its
+    /// iteration bound, and the offset.
     pub fn words(&self, models: &[Model], regions: &[ModelRegion], brick_words: u32) -> Vec<u32> {
         let mut words = Vec::with_capacity(self.nodes.len() * BVH_NODE_WORDS + self.instances.len() * INSTANCE_WORDS);
         for node in &self.nodes {
@@ -143,14 +155,12 @@ impl InstanceTable {
             }
             words.extend([
                 tree.root_word(),
-                tree.depth(),
                 region.node_base,
                 brick_words + 2 * region.brick_base,
-                axes,
+                tree.depth() | axes << 8,
                 crate::trace::iteration_bound(tree.depth()),
             ]);
             words.extend(instance.offset.to_array().map(|c| c as u32));
-            words.extend([0; 3]);
         }
         words
     }

@@ -9,7 +9,7 @@ use glam::IVec3;
 use super::svo::{self, Crossing};
 use super::{Footprint, Hit, Ray};
 use crate::scene::Scene;
-use crate::scene::instances::{Instance, InstanceTable, TIE_T};
+use crate::scene::instances::{BVH_STACK, Instance, InstanceTable, TIE_T};
 use crate::scene::objects::Model;
 use crate::scene::octree::Octree;
 
@@ -47,7 +47,9 @@ impl<'a> Traced<'a> {
     /// The first voxel along `ray` that is not `medium`, where `inside` is
     /// the instance whose glass the ray is in: every other object is
     /// crossed as empty space. A ray in glass that finds none leaves it at
-    /// its tree's face. Twin of `trace_scene` in `shaders/instances.wgsl`.
+    /// its tree's face. The tree of boxes is walked nearer child first, and
+    /// a node entered past the nearest hit so far is skipped. Twin of
+    /// `trace_scene` in `shaders/instances.wgsl`.
     pub fn trace_through(&self, ray: &Ray, medium: u8, inside: Option<u32>, footprint: Footprint) -> Crossing {
         let (table, models, bound) = match self {
             Traced::Tree(tree) => return svo::cross(tree, ray, medium, footprint),
@@ -55,26 +57,41 @@ impl<'a> Traced<'a> {
         };
         let mut best: Option<Crossing> = None;
         let (mut iterations, mut gave_up) = (0u32, false);
-        let mut i = 0;
-        while i < table.nodes.len() {
+        let mut stack: Vec<(usize, f32)> = Vec::with_capacity(BVH_STACK);
+        let mut next = entry_t(table, 0, ray, f32::MAX).map(|t| (0, t));
+        while let Some((i, _)) = next {
             let node = table.nodes[i];
-            let enter = node.bounds.is_some_and(|(lo, hi)| {
-                let (t_enter, t_exit, _) = ray.slab(lo.as_vec3(), (hi + IVec3::ONE).as_vec3());
-                let reach = best.map_or(f32::MAX, |b| tie_limit(b.t));
-                t_enter <= t_exit && t_exit > 0.0 && t_enter <= reach
-            });
-            if let (true, Some(index)) = (enter, node.leaf) {
+            if let Some(index) = node.leaf {
                 let instance = &table.instances[index as usize];
                 let tree = &models[instance.model].tree;
                 let m = if inside == Some(index) { medium } else { 0 };
                 let c = svo::cross(tree, &model_ray(instance, ray), m, footprint);
                 iterations = iterations.saturating_add(c.hit.iterations);
                 gave_up |= c.hit.gave_up;
-                if c.found && best.is_none_or(|b| c.t <= tie_limit(b.t)) {
+                if c.found && wins(c.t, index, best) {
                     best = Some(scene_crossing(instance, index, c));
                 }
+            } else {
+                // The right child is the node after the left one's subtree.
+                let (left, right) = (i + 1, table.nodes[i + 1].skip as usize);
+                let until = reach(best);
+                let mut children: Vec<(usize, f32)> =
+                    [left, right].into_iter().filter_map(|c| entry_t(table, c, ray, until).map(|t| (c, t))).collect();
+                // Nearer first; the left one first at equal t, as on the GPU.
+                children.sort_by(|a, b| b.1.total_cmp(&a.1).then(b.0.cmp(&a.0)));
+                if let Some(near) = children.pop() {
+                    stack.extend(children);
+                    next = Some(near);
+                    continue;
+                }
             }
-            i = if enter && node.leaf.is_none() { i + 1 } else { node.skip as usize };
+            next = None;
+            while let Some((node, t)) = stack.pop() {
+                if t <= reach(best) {
+                    next = Some((node, t));
+                    break;
+                }
+            }
         }
         if gave_up {
             return Crossing { hit: Hit::miss(bound, bound), ..Crossing::default() };
@@ -88,6 +105,28 @@ impl<'a> Traced<'a> {
 /// Within [`TIE_T`] of each other two hits are at one distance.
 fn tie_limit(t: f32) -> f32 {
     t + TIE_T * t.max(1.0)
+}
+
+/// Whether a hit at `t` in instance `index` wins over `best`: it is nearer,
+/// or at its distance and of a later object (as composing gives).
+fn wins(t: f32, index: u32, best: Option<Crossing>) -> bool {
+    best.is_none_or(|b| {
+        let later = b.instance.is_none_or(|i| index > i);
+        t < b.t - TIE_T * b.t.max(1.0) || (t <= tie_limit(b.t) && later)
+    })
+}
+
+/// Farthest t a node may be entered at and still hold a winning hit.
+fn reach(best: Option<Crossing>) -> f32 {
+    best.map_or(f32::MAX, |b| tie_limit(b.t))
+}
+
+/// The t the ray enters node `i`'s box at, unless it misses the box,
+/// nothing is drawn below it, or it lies past `until`.
+fn entry_t(table: &InstanceTable, i: usize, ray: &Ray, until: f32) -> Option<f32> {
+    let (lo, hi) = table.nodes[i].bounds?;
+    let (t_enter, t_exit, _) = ray.slab(lo.as_vec3(), (hi + IVec3::ONE).as_vec3());
+    (t_enter <= t_exit && t_exit > 0.0 && t_enter <= until).then_some(t_enter)
 }
 
 /// The ray in the model's tree-local frame: the same t reaches the same point.
