@@ -47,8 +47,8 @@ const TOOLS: Option<&str> = Some("Tools");
 const VIEW: Option<&str> = Some("View");
 const OBJECT: Option<&str> = Some("Object");
 
-const fn object(label: &'static str, code: KeyCode, shift: bool, line: ObjectLine) -> Action {
-    Action { label, key: code, ctrl: true, shift, menu: OBJECT, command: Command::Object(line) }
+const fn object(label: &'static str, code: KeyCode, line: ObjectLine) -> Action {
+    Action { label, key: code, ctrl: true, shift: false, menu: OBJECT, command: Command::Object(line) }
 }
 
 /// Every keyboard action, in menu order.
@@ -80,12 +80,19 @@ pub static ACTIONS: [Action; 49] = [
     key("Line mode", KeyCode::KeyL, TOOLS, Command::ToggleLine),
     key("Box select mode", KeyCode::KeyB, TOOLS, Command::ToggleSelect),
     key("Object mode", KeyCode::Tab, OBJECT, Command::ToggleObject),
-    object("Duplicate object", KeyCode::KeyD, false, ObjectLine::Duplicate { reference: false }),
-    object("Duplicate object as a reference", KeyCode::KeyD, true, ObjectLine::Duplicate { reference: true }),
-    object("Make object unique", KeyCode::KeyU, false, ObjectLine::Unique),
-    object("Turn object about y", KeyCode::KeyR, false, ObjectLine::Rotate(1)),
-    object("Hide object", KeyCode::KeyH, false, ObjectLine::Hide(true)),
-    object("Delete object", KeyCode::Delete, false, ObjectLine::Delete),
+    object("Duplicate object", KeyCode::KeyD, ObjectLine::Duplicate { reference: false }),
+    Action {
+        label: "Duplicate object as a reference",
+        key: KeyCode::KeyD,
+        ctrl: false,
+        shift: true,
+        menu: OBJECT,
+        command: Command::Object(ObjectLine::Duplicate { reference: true }),
+    },
+    object("Make object unique", KeyCode::KeyU, ObjectLine::Unique),
+    object("Turn object about y", KeyCode::KeyR, ObjectLine::Rotate(1)),
+    object("Hide object", KeyCode::KeyH, ObjectLine::Hide(true)),
+    object("Delete object", KeyCode::Delete, ObjectLine::Delete),
     key("Frame model", KeyCode::KeyF, VIEW, Command::FrameModel),
     Action {
         label: "Frame selection",

@@ -236,16 +236,27 @@ fn tab_object_mode_picks_moves_drags_turns_and_deletes_objects() {
     save(&display, &mut lines, &file);
     assert_eq!(translation(&file), before, "one Ctrl+Z undoes the whole drag");
 
-    // Y turns the picked object a quarter about y, Delete deletes it.
+    // Shift+D and Ctrl+D duplicate; Y turns the picked object a quarter
+    // about y, Delete deletes it.
     let transforms = |file: &std::path::Path| {
         let data = dot_vox::load_bytes(&std::fs::read(file).unwrap()).unwrap();
         data.scenes.iter().filter(|n| matches!(n, dot_vox::SceneNode::Transform { .. })).count()
     };
     let count = transforms(&file);
+    // Shift+D places the picked object's model again (a reference: no model
+    // added), Ctrl+D copies it (one more model).
+    let models = model_sizes(&file).len();
+    xdotool(&display, &["key", "shift+d"]);
+    lines.wait_for("object:", Duration::from_secs(30));
+    xdotool(&display, &["key", "ctrl+d"]);
+    lines.wait_for("object:", Duration::from_secs(30));
+    save(&display, &mut lines, &file);
+    assert_eq!(transforms(&file), count + 2, "two duplicates");
+    assert_eq!(model_sizes(&file).len(), models + 1, "Shift+D added no model, Ctrl+D one");
     xdotool(&display, &["key", "y"]);
     lines.wait_for("object:", Duration::from_secs(30));
     xdotool(&display, &["key", "Delete"]);
     lines.wait_for("object:", Duration::from_secs(30));
     save(&display, &mut lines, &file);
-    assert_eq!(transforms(&file), count - 1, "Delete deleted the object");
+    assert_eq!(transforms(&file), count + 1, "Delete deleted the object");
 }
