@@ -13,7 +13,7 @@ use crate::edit::{Edit, History};
 use crate::scene::objects::Objects;
 use crate::scene::transform::CellMap;
 use crate::scene::{EditError, Op, Palette, Scene};
-use crate::script::{Command, LayerLine, ObjectLine, ObjectRef, PaletteLine};
+use crate::script::{Command, ObjectLine, ObjectRef, PaletteLine};
 use crate::settings::PathSettings;
 
 /// Why a line could not run. A refused line changes nothing.
@@ -206,14 +206,16 @@ impl Editor {
                 return Ok(checked(ok, format!("effects [{}]", want.join(" ")), format!("[{}]", got.join(" "))));
             }
             Command::Object(line) => self.object_line(line)?,
-            Command::Layer(id, line) => {
-                let objects = self.objects()?;
-                let change = match line {
-                    LayerLine::Hide(hidden) => objects.layer_with(*id, "_hidden", hidden.then_some("1"))?,
-                    LayerLine::Name(name) => objects.layer_with(*id, "_name", Some(name))?,
-                };
-                self.commit(vec![Edit::Graph(Box::new(change))])?
-            }
+            Command::Layer(id, line) => match line.attribute() {
+                None => {
+                    self.scene.set_new_layer(*id)?;
+                    true
+                }
+                Some((key, value)) => {
+                    let change = self.objects()?.layer_with(*id, key, value.as_deref())?;
+                    self.commit(vec![Edit::Graph(Box::new(change))])?
+                }
+            },
             Command::ExpectObjects(want) => {
                 let got = self.scene.objects().map_or(1, |o| o.list().len());
                 return Ok(checked(got == *want, format!("{want} objects"), got));

@@ -197,6 +197,9 @@ pub struct UiState {
     /// The Objects panel's name field: the object it was filled from, and
     /// the text (Enter renames the object to it).
     pub rename: (Option<usize>, String),
+    /// A layer colour being picked: set when the pointer lets go (one
+    /// `layer N color` line, one undo step, per pick).
+    pub layer_color: Option<(u32, [u8; 3])>,
     /// The open scene's edits are not journaled, and why: shown until a
     /// journal starts again.
     pub journal_warning: Option<String>,
@@ -264,6 +267,7 @@ pub fn show(
             ui.separator();
             if let Some(objects) = info.objects {
                 objects_panel(ui, objects, &mut ui_state.rename, &mut out);
+                layers_panel(ui, objects, &mut ui_state.layer_color, &mut out);
                 ui.separator();
             }
             // Sections below the palette collapse; none above it changes height.
@@ -492,10 +496,10 @@ fn palette(ui: &mut egui::Ui, tools: &mut Tools, palette: &Palette, out: &mut Ve
 const MAX_OBJECT_ROWS: usize = 500;
 
 /// The Objects panel: every object in walk order, an eye to hide or show
-/// it, a click to pick the one edits go to; then the layers, each with an
-/// eye. What they do are the `object` and `layer` script lines.
+/// it, a click to pick the one edits go to. What they do are `object`
+/// script lines.
 fn objects_panel(ui: &mut egui::Ui, objects: &Objects, rename: &mut (Option<usize>, String), out: &mut Vec<Command>) {
-    use octovox::script::{Command as Line, LayerLine, ObjectLine, ObjectRef};
+    use octovox::script::{Command as Line, ObjectLine, ObjectRef};
     let list = objects.list();
     egui::CollapsingHeader::new(format!("Objects ({}, {} models)", list.len(), objects.models.len()))
         .default_open(true)
@@ -522,20 +526,49 @@ fn objects_panel(ui: &mut egui::Ui, objects: &Objects, rename: &mut (Option<usiz
                     ui.label(format!("… and {} more (object N picks any)", list.len() - MAX_OBJECT_ROWS));
                 }
             });
-            let layers = objects.layers();
-            if !layers.is_empty() {
-                ui.label("Layers");
-                ui.horizontal_wrapped(|ui| {
-                    for (id, name, hidden) in layers {
-                        let mut shown = !hidden;
-                        let label = if name.is_empty() { id.to_string() } else { name };
-                        if ui.checkbox(&mut shown, label).changed() {
-                            out.push(Command::Lines(vec![Line::Layer(id, LayerLine::Hide(!shown))]));
-                        }
-                    }
-                });
-            }
         });
+}
+
+/// The Layers panel: each layer's eye, name, colour, and whether new
+/// objects go on it. What they do are `layer` script lines.
+fn layers_panel(ui: &mut egui::Ui, objects: &Objects, picking: &mut Option<(u32, [u8; 3])>, out: &mut Vec<Command>) {
+    use octovox::script::{Command as Line, LayerLine};
+    let layers = objects.layer_list();
+    if layers.is_empty() {
+        return;
+    }
+    let active = objects.new_layer.filter(|id| layers.iter().any(|l| l.id == *id)).unwrap_or(layers[0].id);
+    egui::CollapsingHeader::new(format!("Layers ({})", layers.len())).default_open(true).show(ui, |ui| {
+        for layer in layers {
+            ui.horizontal(|ui| {
+                let mut shown = !layer.hidden();
+                if ui.checkbox(&mut shown, "").on_hover_text("show or hide").changed() {
+                    out.push(Command::Lines(vec![Line::Layer(layer.id, LayerLine::Hide(!shown))]));
+                }
+                let mut color = picking.filter(|(id, _)| *id == layer.id).map_or(layer.color(), |(_, c)| c);
+                if ui.color_edit_button_srgb(&mut color).on_hover_text("colour").changed() {
+                    *picking = Some((layer.id, color));
+                }
+                let new_here = ui.radio(active == layer.id, "").on_hover_text("new objects go on this layer");
+                if new_here.clicked() && active != layer.id {
+                    out.push(Command::Lines(vec![Line::Layer(layer.id, LayerLine::Active)]));
+                }
+                let name =
+                    if layer.name().is_empty() { format!("layer {}", layer.id) } else { layer.name().to_owned() };
+                ui.label(name).on_hover_text(format!("layer {}", layer.id));
+            });
+        }
+    });
+    // A pick is set once the pointer lets go, so a drag is one undo step.
+    if let Some((id, color)) = *picking
+        && !ui.input(|i| i.pointer.any_down())
+    {
+        *picking = None;
+        let current = layers.iter().find(|l| l.id == id).map(|l| l.color());
+        if current.is_some_and(|c| c != color) {
+            out.push(Command::Lines(vec![Line::Layer(id, LayerLine::Color(color))]));
+        }
+    }
 }
 
 /// The picked object's name, editable: Enter renames it (`object rename`,

@@ -82,6 +82,18 @@ impl Layer {
     pub fn hidden(&self) -> bool {
         is_set(&self.attributes, "_hidden")
     }
+
+    /// Its colour (`_color`, "R G B"), white where it has none or a bad one.
+    pub fn color(&self) -> [u8; 3] {
+        let parts: Vec<u8> = self
+            .attributes
+            .get("_color")
+            .map_or(Vec::new(), |c| c.split_whitespace().filter_map(|p| p.parse().ok()).collect());
+        match parts[..] {
+            [r, g, b] => [r, g, b],
+            _ => [255; 3],
+        }
+    }
 }
 
 /// Whether a flag attribute (`_hidden`) is set: MagicaVoxel writes "1".

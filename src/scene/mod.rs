@@ -146,6 +146,14 @@ impl Scene {
         self.tree.origin()
     }
 
+    /// Makes layer `id` the one `object new` puts objects on.
+    pub fn set_new_layer(&mut self, id: u32) -> Result<(), EditError> {
+        match &mut self.objects {
+            Some(objects) => objects.set_new_layer(id),
+            None => Err(EditError::Brush("the scene has no layers".to_owned())),
+        }
+    }
+
     /// Picks the object edits go to (no effect on a scene of one model).
     pub fn select_object(&mut self, index: Option<usize>) {
         if let Some(objects) = &mut self.objects {

@@ -70,6 +70,9 @@ pub struct Objects {
     maps: Vec<CellMap>,
     /// The object edits go to, by index in walk order.
     pub selected: Option<usize>,
+    /// The layer `object new` puts objects on (`layer N active`); the
+    /// first layer when unset or gone.
+    pub new_layer: Option<u32>,
 }
 
 /// Why the objects cannot be placed.
@@ -93,7 +96,16 @@ impl Objects {
         frame: usize,
         voxel_limit: usize,
     ) -> Result<Objects, ObjectsError> {
-        let mut objects = Objects { graph, models, kept, frame, objects: Vec::new(), maps: Vec::new(), selected: None };
+        let mut objects = Objects {
+            graph,
+            models,
+            kept,
+            frame,
+            objects: Vec::new(),
+            maps: Vec::new(),
+            selected: None,
+            new_layer: None,
+        };
         objects.walk(voxel_limit)?;
         Ok(objects)
     }
@@ -517,7 +529,8 @@ impl Objects {
         let next = graph.nodes.iter().map(|n| n.id).max().unwrap_or(0);
         let ids = next.checked_add(1).zip(next.checked_add(2));
         let (transform_id, shape_id) = ids.ok_or_else(|| EditError::Brush("no node ids are left".to_owned()))?;
-        let layer = graph.layers.first().map_or(u32::MAX, |l| l.id);
+        let active = self.new_layer.filter(|id| graph.layers.iter().any(|l| l.id == *id));
+        let layer = active.or(graph.layers.first().map(|l| l.id)).unwrap_or(u32::MAX);
         let attributes = [("_name".to_owned(), name.to_owned())].into();
         let transform = Node {
             id: transform_id,
@@ -581,6 +594,20 @@ impl Objects {
     /// Layers by id, and whether each is hidden, for listings.
     pub fn layers(&self) -> Vec<(u32, String, bool)> {
         self.graph.iter().flat_map(|g| &g.layers).map(|l| (l.id, l.name().to_owned(), l.hidden())).collect()
+    }
+
+    /// The layers as the graph holds them.
+    pub fn layer_list(&self) -> &[Layer] {
+        self.graph.as_ref().map_or(&[], |g| &g.layers)
+    }
+
+    /// Makes layer `id` the one new objects go on.
+    pub fn set_new_layer(&mut self, id: u32) -> Result<(), EditError> {
+        if !self.layer_list().iter().any(|l| l.id == id) {
+            return Err(EditError::Brush(format!("the scene has no layer {id}")));
+        }
+        self.new_layer = Some(id);
+        Ok(())
     }
 
     /// Number of group nodes.

@@ -161,6 +161,23 @@ pub enum LayerLine {
     /// `hide` (true) or `show` (false).
     Hide(bool),
     Name(String),
+    /// `color R G B`.
+    Color([u8; 3]),
+    /// `active`: `object new` puts objects on this layer.
+    Active,
+}
+
+impl LayerLine {
+    /// The layer attribute the line sets (`None`: removes it), or `None`
+    /// for `active`, which changes no layer.
+    pub fn attribute(&self) -> Option<(&'static str, Option<String>)> {
+        match self {
+            LayerLine::Hide(hidden) => Some(("_hidden", hidden.then(|| "1".to_owned()))),
+            LayerLine::Name(name) => Some(("_name", Some(name.clone()))),
+            LayerLine::Color([r, g, b]) => Some(("_color", Some(format!("{r} {g} {b}")))),
+            LayerLine::Active => None,
+        }
+    }
 }
 
 /// Which object an `object` line names.

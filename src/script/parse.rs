@@ -405,12 +405,17 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
         "object" => Command::Object(parse_object(c)?),
         "layer" => {
             let id = c.int_in("layer id", 0..=i64::from(u32::MAX - 1))? as u32;
-            let what = c.word("hide, show or a name")?;
+            let what = c.word("hide, show, color, active or a name")?;
             Command::Layer(
                 id,
                 match what.text.as_str() {
                     "hide" => LayerLine::Hide(true),
                     "show" => LayerLine::Hide(false),
+                    "active" => LayerLine::Active,
+                    "color" => {
+                        let mut channel = || c.int_in("a colour channel", 0..=255).map(|v| v as u8);
+                        LayerLine::Color([channel()?, channel()?, channel()?])
+                    }
                     _ => LayerLine::Name(what.text),
                 },
             )
@@ -657,7 +662,7 @@ mod tests {
                     extrude 1 2 3 0 -1 0 -2\nobject 3\nobject \"tree 4/top\"\nobject hide\nobject show\nlayer 2 hide\n\
                     ortho 42.5\nperspective\nground off\nground on\nlayer 0 show\nexpect objects 19\nexpect models 15\nobject new \"a b\"\nobject move 1 -2 3\nobject rotate z\n\
                     object duplicate\nobject duplicate reference\nobject unique\nobject delete\nobject rename top\n\
-                    object layer 3\nlayer 4 \"roof tiles\"\n";
+                    object layer 3\nlayer 4 \"roof tiles\"\nlayer 4 color 10 200 255\nlayer 2 active\n";
         let script = parse_script(Path::new("t.ovr"), text).unwrap();
         let printed: String = script.lines.iter().map(|l| format!("{}\n", l.command)).collect();
         let again = parse_script(Path::new("t.ovr"), &printed).unwrap();
@@ -665,7 +670,7 @@ mod tests {
             script.lines.iter().map(|l| &l.command).collect::<Vec<_>>(),
             again.lines.iter().map(|l| &l.command).collect::<Vec<_>>()
         );
-        assert_eq!(script.lines.len(), 70);
+        assert_eq!(script.lines.len(), 72);
     }
 
     #[test]

@@ -86,6 +86,8 @@ impl fmt::Display for Command {
             Command::Layer(id, LayerLine::Hide(true)) => write!(f, "layer {id} hide"),
             Command::Layer(id, LayerLine::Hide(false)) => write!(f, "layer {id} show"),
             Command::Layer(id, LayerLine::Name(name)) => write!(f, "layer {id} {}", quoted(std::path::Path::new(name))),
+            Command::Layer(id, LayerLine::Color([r, g, b])) => write!(f, "layer {id} color {r} {g} {b}"),
+            Command::Layer(id, LayerLine::Active) => write!(f, "layer {id} active"),
             Command::Palette(PaletteLine::Load(path)) => write!(f, "palette load {}", quoted(path)),
             Command::Palette(PaletteLine::Save(path)) => write!(f, "palette save {}", quoted(path)),
             Command::Palette(PaletteLine::Set { first, colors }) => {

@@ -532,3 +532,32 @@ fn a_cut_model_never_gets_an_empty_piece() {
     }
     assert_eq!(load(&again).solid_voxels(), 256 + 5, "every voxel loads back");
 }
+
+/// A layer's colour is an undo step saved as its `_color`; `layer N active`
+/// puts the objects `object new` makes on that layer (read back by
+/// `dot_vox`).
+#[test]
+fn layer_colours_are_saved_and_new_objects_go_on_the_active_layer() {
+    let mut editor = Editor::default();
+    editor.set_scene(load(&written_scene(3)));
+    let run = |editor: &mut Editor, text: &str| {
+        let script = octovox::script::parse_script(std::path::Path::new("t.ovr"), text).unwrap();
+        script.lines.iter().try_for_each(|l| editor.run(&l.command).map(|_| ()))
+    };
+    run(&mut editor, "layer 1 color 10 200 255\nlayer 0 color 1 2 3\nundo\nlayer 2 active\nobject new fresh").unwrap();
+    assert!(run(&mut editor, "layer 9 active").unwrap_err().to_string().contains("no layer 9"));
+    let data = dot_vox::load_bytes(&saved(&editor.scene)).unwrap();
+    let color = |l: usize| data.layers[l].attributes.get("_color").cloned();
+    assert_eq!((color(0), color(1)), (Some("255 0 128".to_owned()), Some("10 200 255".to_owned())));
+    let fresh = data
+        .scenes
+        .iter()
+        .find_map(|n| match n {
+            dot_vox::SceneNode::Transform { attributes, layer_id, .. } => {
+                (attributes.get("_name").map(String::as_str) == Some("fresh")).then_some(*layer_id)
+            }
+            _ => None,
+        })
+        .expect("the new object is saved");
+    assert_eq!(fresh, 2, "on the active layer");
+}
