@@ -4,6 +4,11 @@
 // src/trace/instanced.rs: change both together. Prefixed with common.wgsl
 // and trace_svo.wgsl.
 
+// Compiled in for a scene of objects only: the kernels of a scene of one
+// model have no instance walk at all (on CPU-emulated GPUs its mere
+// presence made them 2-3x slower).
+override INSTANCES: bool = false;
+
 // A t past every node's entry: the node is not entered.
 const NO_ENTRY: f32 = 3.0e38;
 
@@ -136,7 +141,7 @@ fn entry_t(node: BoxNode, r: Ray, t_min: f32, until: f32) -> f32 {
 // stack, and a node entered past the nearest hit so far is skipped whole.
 // Twin of `Traced::trace_through` in src/trace/instanced.rs.
 fn trace_scene(r: Ray, t_min: f32, medium: u32, inside: u32, lod: vec2<f32>) -> Hit {
-    if (u.instance_nodes == 0u) {
+    if (!INSTANCES || u.instance_nodes == 0u) {
         return cross_tree(scene_tree(), r, t_min, medium, lod);
     }
     var best: Hit;

@@ -248,7 +248,7 @@ fn beam_search(tile: vec2<u32>) -> f32 {
     let n3 = inward(cross(c01, c00), center);
     var best = BEAM_NONE;
     let depth = u.depth;
-    if (u.instance_nodes != 0u) {
+    if (INSTANCES && u.instance_nodes != 0u) {
         // An orthographic view of objects: every ray starts at its origin.
         let anything = (load_node(0u).leaf & EMPTY_BIT) == 0u;
         return select(select(BEAM_NONE, 0.0, anything), beam_instances(n0, n1, n2, n3), u.ortho == 0u);

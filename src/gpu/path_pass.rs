@@ -3,11 +3,12 @@
 //! denoiser's guides from the first sample), the mean written to a display
 //! texture.
 //!
-//! The kernel is compiled per effect set (override constants of
-//! `shaders/path.wgsl`) on worker threads and kept, so a diffuse-only scene
-//! runs a kernel without metal, glass or emitter code, and a scene that
-//! gains an effect runs the kernel with every effect (the same image) until
-//! its own is compiled.
+//! The kernel is compiled per effect set and per scene kind (override
+//! constants of `shaders/path.wgsl` and `shaders/instances.wgsl`) on worker
+//! threads and kept, so a diffuse-only scene runs a kernel without metal,
+//! glass or emitter code, a scene of one model one without the instance
+//! walk, and a scene that gains an effect runs the kernel with everything
+//! (the same image) until its own is compiled.
 
 use std::collections::HashMap;
 use std::sync::mpsc;
@@ -43,14 +44,32 @@ fn thread_gone() -> GpuError {
     GpuError::Shader { name: "path tracer".into(), message: "the compile thread ended without a result".into() }
 }
 
-/// Compiles the path kernel for an effect set (on any thread).
+/// What a path kernel is compiled for: the effects, and whether the scene
+/// is of objects (the instance walk compiled in; it also draws one model).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+struct KernelKey {
+    effects: Effects,
+    instances: bool,
+}
+
+impl KernelKey {
+    /// The stand-in while this kernel compiles: every effect, for the same
+    /// kind of scene.
+    fn stand_in(self) -> KernelKey {
+        KernelKey { effects: Effects::ALL, ..self }
+    }
+}
+
+/// Compiles the path kernel for a key (on any thread).
 fn compile(
     device: &wgpu::Device,
     layout: &wgpu::PipelineLayout,
     module: &wgpu::ShaderModule,
-    effects: Effects,
+    key: KernelKey,
 ) -> Result<wgpu::ComputePipeline, GpuError> {
-    compute_pipeline(device, layout, module, "path", &effects.constants(), "path tracer")
+    let mut constants = key.effects.constants().to_vec();
+    constants.push(("INSTANCES", if key.instances { 1.0 } else { 0.0 }));
+    compute_pipeline(device, layout, module, "path", &constants, "path tracer")
 }
 
 const EMITTER_BYTES: u64 = std::mem::size_of::<Emitter>() as u64;
@@ -77,7 +96,7 @@ pub struct PathPass {
     layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
     module: wgpu::ShaderModule,
-    kernels: HashMap<Effects, Compiled>,
+    kernels: HashMap<KernelKey, Compiled>,
     frame_buf: wgpu::Buffer,
     path_buf: wgpu::Buffer,
     materials_buf: wgpu::Buffer,
@@ -238,24 +257,24 @@ impl PathPass {
         self.bound_generation = buffers.generation;
     }
 
-    /// Starts compiling the kernel of an effect set on a worker thread.
-    fn start(&mut self, device: &wgpu::Device, effects: Effects) {
-        if self.kernels.contains_key(&effects) {
+    /// Starts compiling a kernel on a worker thread.
+    fn start(&mut self, device: &wgpu::Device, key: KernelKey) {
+        if self.kernels.contains_key(&key) {
             return;
         }
         let (tx, rx) = mpsc::channel();
         let (device, layout, module) = (device.clone(), self.pipeline_layout.clone(), self.module.clone());
         std::thread::spawn(move || {
             // The receiver may be gone (the pass was dropped): nothing to do then.
-            let _ = tx.send(compile(&device, &layout, &module, effects));
+            let _ = tx.send(compile(&device, &layout, &module, key));
         });
-        self.kernels.insert(effects, Compiled::Compiling(rx));
+        self.kernels.insert(key, Compiled::Compiling(rx));
     }
 
-    /// Whether the kernel of `effects` is ready, taking a finished compile.
-    fn ready(&mut self, effects: Effects, wait: bool) -> Result<bool, GpuError> {
-        let Some(Compiled::Compiling(rx)) = self.kernels.get(&effects) else {
-            return Ok(self.kernels.contains_key(&effects));
+    /// Whether the kernel of `key` is ready, taking a finished compile.
+    fn ready(&mut self, key: KernelKey, wait: bool) -> Result<bool, GpuError> {
+        let Some(Compiled::Compiling(rx)) = self.kernels.get(&key) else {
+            return Ok(self.kernels.contains_key(&key));
         };
         let result = if wait {
             rx.recv().map_err(|_| thread_gone())?
@@ -268,32 +287,33 @@ impl PathPass {
         };
         match result {
             Ok(pipeline) => {
-                self.kernels.insert(effects, Compiled::Ready(pipeline));
+                self.kernels.insert(key, Compiled::Ready(pipeline));
                 Ok(true)
             }
             Err(err) => {
-                self.kernels.remove(&effects);
+                self.kernels.remove(&key);
                 Err(err)
             }
         }
     }
 
-    /// The effect set whose kernel runs now for `effects`: its own once
-    /// compiled; until then the kernel with every effect, if that one is
-    /// ready (it draws the same image, see `bench effects`), so a new set is
-    /// compiled off the frame path; on first use, its own after a wait.
-    fn kernel_for(&mut self, device: &wgpu::Device, effects: Effects) -> Result<Effects, GpuError> {
-        self.start(device, effects);
-        if self.ready(effects, false)? {
-            self.start(device, Effects::ALL);
-            return Ok(effects);
+    /// The kernel that runs now for `key`: its own once compiled; until
+    /// then the kernel with every effect, if that one is ready (it draws the
+    /// same image, see `bench effects`), so a new one is compiled off the
+    /// frame path; on first use, its own after a wait.
+    fn kernel_for(&mut self, device: &wgpu::Device, key: KernelKey) -> Result<KernelKey, GpuError> {
+        let stand_in = key.stand_in();
+        self.start(device, key);
+        if self.ready(key, false)? {
+            self.start(device, stand_in);
+            return Ok(key);
         }
-        if self.ready(Effects::ALL, false)? {
-            return Ok(Effects::ALL);
+        if self.ready(stand_in, false)? {
+            return Ok(stand_in);
         }
-        self.ready(effects, true)?;
-        self.start(device, Effects::ALL);
-        Ok(effects)
+        self.ready(key, true)?;
+        self.start(device, stand_in);
+        Ok(key)
     }
 
     /// Re-creates the outputs for a new size; returns whether it did (the
@@ -355,33 +375,35 @@ impl PathPass {
         gpu.queue.write_buffer(&self.path_buf, 0, bytemuck::bytes_of(path));
     }
 
-    /// Compiles the kernel of `effects` now if it is not ready (benchmarks
-    /// time the kernel of a set, not its stand-in).
-    pub fn compile_now(&mut self, device: &wgpu::Device, effects: Effects) -> Result<(), GpuError> {
-        self.start(device, effects);
-        self.ready(effects, true).map(|_| ())
+    /// Compiles the kernel of `effects` (for a scene of objects when
+    /// `instances`) now if it is not ready (benchmarks time the kernel of a
+    /// set, not its stand-in).
+    pub fn compile_now(&mut self, device: &wgpu::Device, effects: Effects, instances: bool) -> Result<(), GpuError> {
+        let key = KernelKey { effects, instances };
+        self.start(device, key);
+        self.ready(key, true).map(|_| ())
     }
 
-    /// Records one sample's dispatch for `effects` over `rows` rows (the
-    /// uniforms' band); returns the effect set of the kernel that ran (see
-    /// [`PathPass::kernel_for`]).
+    /// Records one sample's dispatch for `effects` (in a scene of objects
+    /// when `instances`) over `rows` rows (the uniforms' band); returns the
+    /// effect set of the kernel that ran (see [`PathPass::kernel_for`]).
     pub fn encode(
         &mut self,
         gpu: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
-        effects: Effects,
+        (effects, instances): (Effects, bool),
         rows: u32,
         timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) -> Result<Effects, GpuError> {
         let width = self.size().0;
-        let used = self.kernel_for(&gpu.device, effects)?;
+        let used = self.kernel_for(&gpu.device, KernelKey { effects, instances })?;
         let Some(Compiled::Ready(pipeline)) = self.kernels.get(&used) else { return Err(thread_gone()) };
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("path"), timestamp_writes: timestamps });
         pass.set_bind_group(0, &self.bind_group, &[]);
         pass.set_pipeline(pipeline);
         pass.dispatch_workgroups(width.div_ceil(8), rows.div_ceil(8), 1);
-        Ok(used)
+        Ok(used.effects)
     }
 
     /// The mean radiance of every pixel so far, row-major.

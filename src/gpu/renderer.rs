@@ -338,6 +338,13 @@ impl Renderer {
 
     fn encode_trace(&mut self, encoder: &mut wgpu::CommandEncoder, preview: &Preview) -> Result<(), GpuError> {
         let Preview { scene, camera, size, view, lod, highlight, kernel } = *preview;
+        // A scene of objects runs the kernels with the instance walk.
+        let kernel = match kernel {
+            Kernel::Trace { mode, shadows, lod, .. } => {
+                Kernel::Trace { mode, shadows, lod, instances: self.buffers.instance_nodes.is_some() }
+            }
+            Kernel::Floor => Kernel::Floor,
+        };
         let tree = scene.drawn();
         let gpu = &self.gpu;
         self.pass.resize(gpu, &self.buffers, size, self.hit_records)?;
@@ -430,7 +437,9 @@ impl Renderer {
         let frame = FrameUniforms::new(&key.basis, drawn, &self.buffers, View::Shaded, highlight, Footprint::EXACT)
             .with_ground(key.ground, drawn.origin());
         self.path.prepare(gpu, &self.buffers, &frame, &path);
-        let kernel = self.path.encode(gpu, encoder, effects, end_row - first_row, self.timer.pass_writes())?;
+        let instances = self.buffers.instance_nodes.is_some();
+        let rows = end_row - first_row;
+        let kernel = self.path.encode(gpu, encoder, (effects, instances), rows, self.timer.pass_writes())?;
         self.timer.resolve(encoder);
         // Until its first sample has every row, the accumulation is not
         // shown: the trace output is (the window traces the preview first).
@@ -600,7 +609,7 @@ impl Renderer {
     /// A kernel that does not compile.
     pub fn compile_path_kernel(&mut self, scene: &Scene, settings: &PathSettings) -> Result<(), GpuError> {
         let effects = effects_for(scene, settings);
-        self.path.compile_now(&self.gpu.device, effects)
+        self.path.compile_now(&self.gpu.device, effects, scene.instanced().is_some())
     }
 
     /// Whether frame times come from GPU timestamps (else the wall clock:

@@ -83,8 +83,9 @@ impl SceneBuffers {
         scene: &mut Scene,
         max_bytes: u64,
     ) -> Result<UploadStats, PoolTooLarge> {
-        if scene.objects().is_none() && self.instance_nodes.is_some() {
-            // The buffer holds a scene of objects' models: the one model goes up whole.
+        if scene.instanced().is_some() != self.instance_nodes.is_some() {
+            // The buffers hold the other kind of copy (the scene gained or
+            // lost its last reference): everything goes up afresh.
             scene.forget_uploads();
             (self.node_capacity, self.brick_capacity) = (0, 0);
         }

@@ -1,6 +1,8 @@
 //! The ray tracing compute pass: one thread per pixel walks the SVO (or the
 //! dense grid) and writes a colour texture plus a hit record per pixel.
 
+use std::collections::HashMap;
+
 use super::context::compute_pipeline;
 use super::layout::{
     FLOOR_ROW, FrameUniforms, ROW_TILES, buffer_entry, constants_buffer, constants_entry, output_entry, output_texture,
@@ -21,8 +23,9 @@ const FLOOR_WGSL: &str = include_str!("../../shaders/floor.wgsl");
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kernel {
     /// The scene, traced (the SVO with its beam prepass, or the grid);
-    /// `lod`: the SVO kernels with the level-of-detail test compiled in.
-    Trace { mode: TraceMode, shadows: bool, lod: bool },
+    /// `lod`: the SVO kernels with the level-of-detail test compiled in;
+    /// `instances`: with the instance walk (a scene of objects).
+    Trace { mode: TraceMode, shadows: bool, lod: bool, instances: bool },
     /// Everything but the traversal: the floor a frame cannot go below.
     Floor,
 }
@@ -30,7 +33,7 @@ pub enum Kernel {
 impl From<&RenderSettings> for Kernel {
     fn from(settings: &RenderSettings) -> Kernel {
         let lod = settings.mode == TraceMode::Svo && settings.lod > 0.0;
-        Kernel::Trace { mode: settings.mode, shadows: settings.shadows, lod }
+        Kernel::Trace { mode: settings.mode, shadows: settings.shadows, lod, instances: false }
     }
 }
 
@@ -58,8 +61,9 @@ const BEAM_TILE: u32 = 16;
 // The per-pixel kernels cover a tile with 8×8 workgroups.
 const _: () = assert!(BEAM_TILE.is_multiple_of(8));
 
-/// Pipelines are compiled per tracer and per shadow setting (an override
-/// constant), so a scene rendered without shadows pays nothing for them. The
+/// Pipelines are compiled per tracer and per shadow setting, level of
+/// detail and scene kind (override constants), so a scene rendered without
+/// shadows pays nothing for them, nor a scene of one model for instances. The
 /// SVO frame runs in four dispatches: the floor kernel draws every pixel as
 /// sky, the beam prepass (one thread per tile of pixels) lists the tiles with
 /// something in them, a one-thread kernel turns their count into a dispatch
@@ -70,13 +74,13 @@ pub struct TracePass {
     /// Group 1 of `tile_dispatch`: the indirect arguments it writes.
     args_layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
-    /// [svo without shadows, svo with, grid without, grid with].
-    pipelines: [wgpu::ComputePipeline; 4],
-    beam: wgpu::ComputePipeline,
+    /// [grid without shadows, grid with].
+    grid: [wgpu::ComputePipeline; 2],
+    /// The SVO kernels by (level of detail, instances): [without shadows,
+    /// with shadows, beam]. The exact ones of one model are compiled at
+    /// start, the others from `svo` on first use.
+    svo_kernels: HashMap<(bool, bool), [wgpu::ComputePipeline; 3]>,
     tile_dispatch: wgpu::ComputePipeline,
-    /// The SVO kernels with level of detail, compiled on first use from
-    /// `svo`: [without shadows, with shadows, beam].
-    lod_pipelines: Option<[wgpu::ComputePipeline; 3]>,
     svo: wgpu::ShaderModule,
     floor: wgpu::ComputePipeline,
     uniform_buf: wgpu::Buffer,
@@ -124,13 +128,11 @@ impl TracePass {
             compute_pipeline(&gpu.device, &pipeline_layout, module, entry, constants, label)
         };
         let tile = ("BEAM_TILE", f64::from(BEAM_TILE));
-        let pipelines = [
-            pipeline(&svo, "main", &[("SHADOWS", 0.0), tile], "trace svo")?,
-            pipeline(&svo, "main", &[("SHADOWS", 1.0), tile], "trace svo + shadows")?,
+        let grid = [
             pipeline(&grid, "main", &[("SHADOWS", 0.0)], "trace grid")?,
             pipeline(&grid, "main", &[("SHADOWS", 1.0)], "trace grid + shadows")?,
         ];
-        let beam = pipeline(&svo, "beam", &[tile], "beam prepass")?;
+        let exact = svo_kernels(&gpu.device, &pipeline_layout, &svo, (false, false))?;
         let tile_dispatch =
             compute_pipeline(&gpu.device, &args_pipeline_layout, &svo, "tile_dispatch", &[tile], "tile dispatch")?;
         let floor_module = gpu.shader("floor.wgsl", &with_prelude(&[COMMON_WGSL, FLOOR_WGSL]))?;
@@ -144,10 +146,9 @@ impl TracePass {
             layout,
             args_layout,
             pipeline_layout,
-            pipelines,
-            beam,
+            grid,
+            svo_kernels: HashMap::from([((false, false), exact)]),
             tile_dispatch,
-            lod_pipelines: None,
             svo,
             floor,
             uniform_buf,
@@ -158,24 +159,17 @@ impl TracePass {
         })
     }
 
-    /// Compiles the level-of-detail kernels if `kernel` needs them and they
-    /// are not compiled yet (a frame with `--lod` above 0).
+    /// Compiles the SVO kernels `kernel` needs if they are not compiled yet
+    /// (a frame with `--lod` above 0, a scene of objects).
     ///
     /// # Errors
     /// A kernel that does not compile.
     pub fn ensure_kernel(&mut self, gpu: &GpuContext, kernel: Kernel) -> Result<(), GpuError> {
-        if !matches!(kernel, Kernel::Trace { lod: true, .. }) || self.lod_pipelines.is_some() {
-            return Ok(());
+        let Kernel::Trace { mode: TraceMode::Svo, lod, instances, .. } = kernel else { return Ok(()) };
+        if !self.svo_kernels.contains_key(&(lod, instances)) {
+            let kernels = svo_kernels(&gpu.device, &self.pipeline_layout, &self.svo, (lod, instances))?;
+            self.svo_kernels.insert((lod, instances), kernels);
         }
-        let pipeline = |entry, constants: &[(&str, f64)], label| {
-            compute_pipeline(&gpu.device, &self.pipeline_layout, &self.svo, entry, constants, label)
-        };
-        let (tile, lod) = (("BEAM_TILE", f64::from(BEAM_TILE)), ("LOD", 1.0));
-        self.lod_pipelines = Some([
-            pipeline("main", &[("SHADOWS", 0.0), tile, lod], "trace svo, lod")?,
-            pipeline("main", &[("SHADOWS", 1.0), tile, lod], "trace svo + shadows, lod")?,
-            pipeline("beam", &[tile, lod], "beam prepass, lod")?,
-        ]);
         Ok(())
     }
 
@@ -306,33 +300,31 @@ impl TracePass {
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("trace"), timestamp_writes: timestamps });
         pass.set_bind_group(0, &self.bind_group, &[]);
-        let (mode, shadows, lod) = match kernel {
-            Kernel::Trace { mode, shadows, lod } => (mode, shadows, lod),
+        let (mode, shadows, key) = match kernel {
+            Kernel::Trace { mode, shadows, lod, instances } => (mode, shadows, (lod, instances)),
             Kernel::Floor => {
                 self.encode_floor(&mut pass);
                 return;
             }
         };
-        let index = match mode {
-            TraceMode::Svo => 0,
-            TraceMode::Grid => 2,
-        } + usize::from(shadows);
-        // `ensure_kernel` compiled these; without them the exact kernels run.
-        let lod_pipelines = self.lod_pipelines.as_ref().filter(|_| lod);
-        let trace = lod_pipelines.map_or(&self.pipelines[index], |p| &p[usize::from(shadows)]);
         if mode == TraceMode::Grid {
-            pass.set_pipeline(trace);
+            pass.set_pipeline(&self.grid[usize::from(shadows)]);
             pass.dispatch_workgroups(self.target.width.div_ceil(8), self.target.height.div_ceil(8), 1);
             return;
         }
+        // `ensure_kernel` compiled these.
+        let Some(kernels) = self.svo_kernels.get(&key) else {
+            log::error!("the SVO kernels {key:?} were not compiled");
+            return;
+        };
         self.encode_floor(&mut pass);
         let (tiles_x, tiles_y) = (self.target.width.div_ceil(BEAM_TILE), self.target.height.div_ceil(BEAM_TILE));
-        pass.set_pipeline(lod_pipelines.map_or(&self.beam, |p| &p[2]));
+        pass.set_pipeline(&kernels[2]);
         pass.dispatch_workgroups(tiles_x.div_ceil(8), tiles_y.div_ceil(8), 1);
         pass.set_pipeline(&self.tile_dispatch);
         pass.set_bind_group(1, &self.args_bind_group, &[]);
         pass.dispatch_workgroups(1, 1, 1);
-        pass.set_pipeline(trace);
+        pass.set_pipeline(&kernels[usize::from(shadows)]);
         pass.dispatch_workgroups_indirect(&self.target.dispatch_args, 0);
     }
 
@@ -353,4 +345,31 @@ impl TracePass {
     pub fn read_color(&self, gpu: &GpuContext) -> Result<Vec<u8>, GpuError> {
         read_texture_rgba8(gpu, &self.target.texture)
     }
+}
+
+/// The SVO kernels for (level of detail, instances): [trace without
+/// shadows, trace with shadows, beam prepass].
+fn svo_kernels(
+    device: &wgpu::Device,
+    layout: &wgpu::PipelineLayout,
+    svo: &wgpu::ShaderModule,
+    (lod, instances): (bool, bool),
+) -> Result<[wgpu::ComputePipeline; 3], GpuError> {
+    let flag = |on: bool| if on { 1.0 } else { 0.0 };
+    let common = [("BEAM_TILE", f64::from(BEAM_TILE)), ("LOD", flag(lod)), ("INSTANCES", flag(instances))];
+    let label =
+        |what: &str| format!("{what}{}{}", if lod { ", lod" } else { "" }, if instances { ", instances" } else { "" });
+    let main = |shadows: bool| {
+        let mut constants = common.to_vec();
+        constants.push(("SHADOWS", flag(shadows)));
+        compute_pipeline(
+            device,
+            layout,
+            svo,
+            "main",
+            &constants,
+            &label(if shadows { "trace svo + shadows" } else { "trace svo" }),
+        )
+    };
+    Ok([main(false)?, main(true)?, compute_pipeline(device, layout, svo, "beam", &common, &label("beam prepass"))?])
 }

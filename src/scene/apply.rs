@@ -57,7 +57,7 @@ impl Scene {
     /// Bytes the GPU traces that are in use: the one model's pool, or every
     /// model's pool (each once) and the instance words.
     pub fn drawn_pool_bytes(&self) -> u64 {
-        match self.objects.as_deref() {
+        match self.instanced() {
             None => self.tree.pool().live_bytes(),
             Some(objects) => objects.pool_bytes() + super::instances::word_bytes(objects.list().len()),
         }
@@ -72,12 +72,13 @@ impl Scene {
     }
 
     /// The same within `max_bytes` of pool, or the pool's size when larger.
-    /// The drawn tree of one model goes as its dirty slots; a scene of
-    /// objects as its models' dirty slots and the instance words that
-    /// changed (the composed tree stays on the CPU, for reading voxels).
+    /// The drawn tree goes as its dirty slots; a scene drawn as instances
+    /// ([`Scene::instanced`]) as its models' dirty slots and the instance
+    /// words that changed (the composed tree stays on the CPU, for reading
+    /// voxels).
     pub fn take_uploads_within(&mut self, max_bytes: u64) -> Result<SceneUpload, PoolTooLarge> {
         let origin = self.tree.origin();
-        match self.objects.as_deref_mut() {
+        match self.objects.as_deref_mut().filter(|o| o.has_references()) {
             None => Ok(SceneUpload::Tree(self.tree.pool_mut().flush_within(max_bytes)?)),
             Some(objects) => Ok(SceneUpload::Objects(self.gpu.take(objects, origin, max_bytes)?)),
         }

@@ -104,6 +104,17 @@ impl Scene {
         self.objects.as_deref()
     }
 
+    /// The objects when the scene is drawn as instances of its models: a
+    /// scene where some model is placed more than once (a reference). Then
+    /// each model is stored once on the GPU too, and a move writes one
+    /// record. A scene whose every model is placed once (a big model saved
+    /// in 256³ blocks, say) is drawn as its objects composed into one
+    /// octree: no memory to save, and CPU-emulated GPUs trace one octree
+    /// 2.5x faster than instances (docs/bench/scene.md).
+    pub fn instanced(&self) -> Option<&objects::Objects> {
+        self.objects().filter(|o| o.has_references())
+    }
+
     /// Takes the objects out (a loader that keeps only them).
     pub fn into_objects(self) -> Option<objects::Objects> {
         self.objects.map(|o| *o)

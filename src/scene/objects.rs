@@ -293,6 +293,13 @@ impl Objects {
     }
 
     /// How many objects place each model.
+    /// Whether some model is placed more than once (a reference): then the
+    /// scene is drawn as instances, its models stored once on the GPU too.
+    pub fn has_references(&self) -> bool {
+        let mut placed = vec![false; self.models.len()];
+        self.objects.iter().any(|o| std::mem::replace(&mut placed[o.placement.model], true))
+    }
+
     pub fn placements_of(&self, model: usize) -> usize {
         self.objects.iter().filter(|o| o.placement.model == model).count()
     }

@@ -26,10 +26,11 @@ pub enum Traced<'a> {
 }
 
 impl<'a> Traced<'a> {
-    /// The scene's one model, or its objects placed in its local frame
-    /// (cells from `scene.origin()`).
+    /// The scene's drawn octree, or its objects as instances in its local
+    /// frame (cells from `scene.origin()`), as the GPU draws it
+    /// ([`Scene::instanced`]).
     pub fn of(scene: &'a Scene) -> Traced<'a> {
-        match scene.objects() {
+        match scene.instanced() {
             None => Traced::Tree(scene.drawn()),
             Some(objects) => Traced::Objects {
                 table: InstanceTable::build(objects, scene.origin()),
