@@ -201,10 +201,11 @@ fn report(r: &SceneRow) -> String {
     md += &format!(
         "Adapter: **{}**, {}×{}, SVO preview without shadows, median of the frames after one warm-up, the two scenes \
          alternating. One tree model ({} voxels as placed: {} in all) placed {} times with the eight upright rotations, \
-         against the same voxels saved as one scene of 256³ blocks. Both are traced in two levels: a tree of boxes over \
-         the instances, then each instance's model. *Drawn*: what the GPU holds, the models' pools (each model once) \
-         and the instance words (tree nodes and records); *bytes written*: what the upload after the line sends. The \
-         targets are the issue's.\n\n",
+         against the same voxels saved as one scene of 256³ blocks. The forest (whose model is placed 2000 times) is \
+         traced in two levels: a tree of boxes over the instances, then each instance's model; the merged blocks (each \
+         model placed once) are drawn composed into one octree (`Scene::instanced`). *Drawn*: what the GPU holds (the \
+         forest's model pool once and its instance words: tree nodes and records); *bytes written*: what the upload \
+         after the line sends. The targets are the issue's.\n\n",
         r.adapter,
         r.width,
         r.height,
