@@ -358,6 +358,12 @@ impl Editor {
                 let change = objects.made_unique(index, model)?;
                 (vec![Edit::AddModel(Box::new(copy)), Edit::Graph(Box::new(change))], Picks::Same)
             }
+            ObjectLine::Merge(others) => {
+                let others = others.iter().map(|o| self.object_named(o)).collect::<Result<Vec<_>, _>>()?;
+                let (model, change) = objects.merged(index, &others)?;
+                let own = objects.transform_node(index)?.id;
+                (vec![Edit::AddModel(Box::new(model)), Edit::Graph(Box::new(change))], Picks::Transform(own))
+            }
             ObjectLine::Pick(_) | ObjectLine::New(_) => (Vec::new(), Picks::Same),
         })
     }

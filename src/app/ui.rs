@@ -197,6 +197,9 @@ pub struct UiState {
     /// The Objects panel's name field: the object it was filled from, and
     /// the text (Enter renames the object to it).
     pub rename: (Option<usize>, String),
+    /// The objects Ctrl+clicked in the Objects panel, to merge into the
+    /// picked one.
+    pub merge: Vec<usize>,
     /// A layer colour being picked: set when the pointer lets go (one
     /// `layer N color` line, one undo step, per pick).
     pub layer_color: Option<(u32, [u8; 3])>,
@@ -266,7 +269,7 @@ pub fn show(
             material_editor(ui, tools.color, info.palette, &mut out);
             ui.separator();
             if let Some(objects) = info.objects {
-                objects_panel(ui, objects, &mut ui_state.rename, &mut out);
+                objects_panel(ui, objects, (&mut ui_state.rename, &mut ui_state.merge), &mut out);
                 layers_panel(ui, objects, &mut ui_state.layer_color, &mut out);
                 ui.separator();
             }
@@ -496,15 +499,22 @@ fn palette(ui: &mut egui::Ui, tools: &mut Tools, palette: &Palette, out: &mut Ve
 const MAX_OBJECT_ROWS: usize = 500;
 
 /// The Objects panel: every object in walk order, an eye to hide or show
-/// it, a click to pick the one edits go to. What they do are `object`
-/// script lines.
-fn objects_panel(ui: &mut egui::Ui, objects: &Objects, rename: &mut (Option<usize>, String), out: &mut Vec<Command>) {
+/// it, a click to pick the one edits go to, a + to mark it for merging
+/// into the picked one. What they do are `object` script lines.
+fn objects_panel(
+    ui: &mut egui::Ui,
+    objects: &Objects,
+    (rename, merge): (&mut (Option<usize>, String), &mut Vec<usize>),
+    out: &mut Vec<Command>,
+) {
     use octovox::script::{Command as Line, ObjectLine, ObjectRef};
     let list = objects.list();
+    merge.retain(|&i| i < list.len() && objects.selected != Some(i));
     egui::CollapsingHeader::new(format!("Objects ({}, {} models)", list.len(), objects.models.len()))
         .default_open(true)
         .show(ui, |ui| {
             rename_row(ui, objects, rename, out);
+            merge_row(ui, objects, merge, out);
             egui::ScrollArea::vertical().id_salt("objects").max_height(160.0).show(ui, |ui| {
                 for (index, object) in list.iter().enumerate().take(MAX_OBJECT_ROWS) {
                     let pick = Line::Object(ObjectLine::Pick(ObjectRef::Index(index)));
@@ -515,8 +525,15 @@ fn objects_panel(ui: &mut egui::Ui, objects: &Objects, rename: &mut (Option<usiz
                         }
                         let name = if object.path.is_empty() { "(unnamed)" } else { &object.path };
                         let label = format!("{index} {name} · model {}", object.placement.model);
+                        let marked = merge.contains(&index);
+                        let can_mark = objects.selected.is_some_and(|p| p != index);
+                        let mark = ui.add_enabled(can_mark, egui::Button::new(if marked { "−" } else { "+" }).small());
+                        if mark.on_hover_text("mark to merge into the picked object").clicked() {
+                            toggle(merge, index);
+                        }
                         let text =
                             if object.hidden { egui::RichText::new(label).weak() } else { egui::RichText::new(label) };
+                        let text = if marked { text.underline() } else { text };
                         if ui.selectable_label(objects.selected == Some(index), text).clicked() {
                             out.push(Command::Lines(vec![pick]));
                         }
@@ -527,6 +544,37 @@ fn objects_panel(ui: &mut egui::Ui, objects: &Objects, rename: &mut (Option<usiz
                 }
             });
         });
+}
+
+/// Puts `index` in `set`, or takes it out.
+fn toggle(set: &mut Vec<usize>, index: usize) {
+    match set.iter().position(|&i| i == index) {
+        Some(at) => {
+            set.remove(at);
+        }
+        None => set.push(index),
+    }
+}
+
+/// The objects marked for merging, and the button that merges them into
+/// the picked object (`object merge N…`, one undo step).
+fn merge_row(ui: &mut egui::Ui, objects: &Objects, merge: &mut Vec<usize>, out: &mut Vec<Command>) {
+    use octovox::script::{Command as Line, ObjectLine, ObjectRef};
+    if merge.is_empty() {
+        ui.weak("+ marks objects to merge into the picked one");
+        return;
+    }
+    ui.horizontal(|ui| {
+        let ready = objects.selected.is_some();
+        let text = format!("Merge {} into the picked object", merge.len());
+        if ui.add_enabled(ready, egui::Button::new(text)).clicked() {
+            let others = merge.drain(..).map(ObjectRef::Index).collect();
+            out.push(Command::Lines(vec![Line::Object(ObjectLine::Merge(others))]));
+        }
+        if ui.button("Clear").clicked() {
+            merge.clear();
+        }
+    });
 }
 
 /// The Layers panel: each layer's eye, name, colour, and whether new

@@ -25,6 +25,10 @@ const NO_GRAPH: &str = "a file of animation frames has no scene graph to change"
 /// around them all (see `Objects::recompose_model`).
 const MANY_PLACEMENTS: usize = 64;
 
+/// Most voxels a merge gathers into one model: a full 256³ model, the
+/// largest a .vox file stores in one.
+const MERGE_LIMIT: u64 = 1 << 24;
+
 /// Largest box one removal covers while composing (a brush's widest).
 const COMPOSE_BOX: i32 = super::shape::MAX_BRUSH_EXTENT;
 
@@ -522,6 +526,67 @@ impl Objects {
         Ok(GraphChange { nodes: vec![own, shape], ..GraphChange::default() })
     }
 
+    /// Merges objects `others` into object `index`, all shown: a new model
+    /// (the last) holding every voxel of them all in `index`'s model grid
+    /// (the later in walk order wins where two overlap, as drawn), shown by
+    /// `index`, and the change that shows it and deletes the others.
+    pub fn merged(&self, index: usize, others: &[usize]) -> Result<(Model, GraphChange), EditError> {
+        let mut all: Vec<usize> = others.to_vec();
+        all.push(index);
+        all.sort_unstable();
+        all.dedup();
+        if all.len() != others.len() + 1 || all.iter().any(|&i| i >= self.objects.len()) {
+            return Err(EditError::Brush(format!(
+                "merge needs other objects than the picked one, each once, of the {} there are",
+                self.objects.len()
+            )));
+        }
+        if let Some(&hidden) = all.iter().find(|&&k| self.objects[k].hidden) {
+            // Its voxels would show once part of a shown model.
+            return Err(EditError::Brush(format!("object {hidden} is hidden: show it (or its layer) to merge it")));
+        }
+        let voxels: u64 = all.iter().map(|&k| self.models[self.objects[k].placement.model].tree.solid_voxels()).sum();
+        if voxels > MERGE_LIMIT {
+            return Err(EditError::Brush(format!(
+                "the objects hold {voxels} voxels; a merge takes at most {MERGE_LIMIT} (one model of 256³)"
+            )));
+        }
+        let target = self.maps[index];
+        let mut cells = HashMap::new();
+        for &k in &all {
+            let map = self.maps[k];
+            self.models[self.objects[k].placement.model].tree.for_each_solid_cell(|min, size, value| {
+                for offset in cube_cells(size) {
+                    cells.insert(target.invert(map.apply(min + offset)), value);
+                }
+            });
+        }
+        let voxels: Vec<(IVec3, u8)> = cells.into_iter().collect();
+        let tree = Octree::from_voxels(&voxels).map_err(|e| EditError::Brush(e.to_string()))?;
+        let model = Model { size: self.models[self.objects[index].placement.model].size, tree };
+        let mut change = self.made_unique(index, self.models.len())?;
+        let mut groups: Vec<Node> = Vec::new();
+        for &k in others {
+            let own = self.transform_node(k)?.id;
+            let parent = self.parent_group(own)?;
+            let at = groups.iter().position(|g| g.id == parent.id).unwrap_or_else(|| {
+                groups.push(parent.clone());
+                groups.len() - 1
+            });
+            if let NodeKind::Group { children } = &mut groups[at].kind {
+                children.retain(|&c| c != own);
+            }
+            change.remove.push(own);
+            let shape = self.objects[k].shape_node;
+            let kept = self.objects.iter().enumerate().any(|(i, o)| o.shape_node == shape && !others.contains(&i));
+            if !kept && !change.remove.contains(&shape) {
+                change.remove.push(shape);
+            }
+        }
+        change.nodes.extend(groups);
+        Ok((model, change))
+    }
+
     /// The edits that make an empty object named `name` in the top group
     /// (an empty model of one cell, its shape and transform), and the new
     /// transform's id.
@@ -689,6 +754,11 @@ impl GraphChange {
             + self.layers.iter().map(|l| 32 + attributes(&l.attributes)).sum::<usize>()
             + 4 * (self.remove.len() + self.remove_layers.len())
     }
+}
+
+/// The offsets of the cells of a cube `size` cells wide.
+fn cube_cells(size: i32) -> impl Iterator<Item = IVec3> {
+    (0..size).flat_map(move |z| (0..size).flat_map(move |y| (0..size).map(move |x| IVec3::new(x, y, z))))
 }
 
 /// Min corners of the boxes of at most [`COMPOSE_BOX`] a side that tile `lo..=hi`.

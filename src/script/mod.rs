@@ -133,6 +133,9 @@ pub enum ObjectLine {
     },
     /// `object unique`: the picked placement gets a model of its own.
     Unique,
+    /// `object merge N|NAME…`: the objects named become part of the picked
+    /// one, whose new model holds all their voxels; they are deleted.
+    Merge(Vec<ObjectRef>),
     Delete,
     /// `object hide` (true) or `object show` (false).
     Hide(bool),

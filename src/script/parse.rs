@@ -426,11 +426,18 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
 
 /// `object N|NAME`, and what the picked object does: `new NAME`, `move DX
 /// DY DZ`, `rotate x|y|z`, `duplicate [reference]`, `unique`, `delete`,
-/// `hide`, `show`, `rename NAME`, `layer N`. (An object named like one of
-/// these words is picked by its index or its path.)
+/// `hide`, `show`, `rename NAME`, `layer N`, `merge N|NAME…`. (An object
+/// named like one of these words is picked by its index or its path.)
 fn parse_object(c: &mut Cursor) -> Result<ObjectLine, Fail> {
     let word = c.word("an object index or name, or what the picked object does")?;
     Ok(match word.text.as_str() {
+        "merge" => {
+            let mut others = vec![object_ref(c.word("an object to merge")?)?];
+            while let Some(word) = c.optional() {
+                others.push(object_ref(word)?);
+            }
+            ObjectLine::Merge(others)
+        }
         "hide" => ObjectLine::Hide(true),
         "show" => ObjectLine::Hide(false),
         "new" => ObjectLine::New(c.word("a name")?.text),
@@ -441,12 +448,19 @@ fn parse_object(c: &mut Cursor) -> Result<ObjectLine, Fail> {
         "delete" => ObjectLine::Delete,
         "rename" => ObjectLine::Rename(c.word("a name")?.text),
         "layer" => ObjectLine::Layer(c.int_in("layer id", 0..=i64::from(u32::MAX - 1))? as u32),
-        text if !text.is_empty() && text.bytes().all(|b| b.is_ascii_digit()) => ObjectLine::Pick(ObjectRef::Index(
+        _ => ObjectLine::Pick(object_ref(word)?),
+    })
+}
+
+/// An object by index (digits) or by name or `group/name` path.
+fn object_ref(word: Token) -> Result<ObjectRef, Fail> {
+    match word.text.as_str() {
+        text if !text.is_empty() && text.bytes().all(|b| b.is_ascii_digit()) => Ok(ObjectRef::Index(
             text.parse().map_err(|_| (word.column, format!("object index '{text}' is too large")))?,
         )),
-        "" => return Err((word.column, "an empty object name".to_owned())),
-        text => ObjectLine::Pick(ObjectRef::Name(text.to_owned())),
-    })
+        "" => Err((word.column, "an empty object name".to_owned())),
+        text => Ok(ObjectRef::Name(text.to_owned())),
+    }
 }
 
 /// `palette load PATH`, `palette save PATH`, `palette set INDEX RRGGBB…`
@@ -662,7 +676,7 @@ mod tests {
                     extrude 1 2 3 0 -1 0 -2\nobject 3\nobject \"tree 4/top\"\nobject hide\nobject show\nlayer 2 hide\n\
                     ortho 42.5\nperspective\nground off\nground on\nlayer 0 show\nexpect objects 19\nexpect models 15\nobject new \"a b\"\nobject move 1 -2 3\nobject rotate z\n\
                     object duplicate\nobject duplicate reference\nobject unique\nobject delete\nobject rename top\n\
-                    object layer 3\nlayer 4 \"roof tiles\"\nlayer 4 color 10 200 255\nlayer 2 active\n";
+                    object layer 3\nlayer 4 \"roof tiles\"\nlayer 4 color 10 200 255\nlayer 2 active\nobject merge 3 \"tree 4/top\" 7\n";
         let script = parse_script(Path::new("t.ovr"), text).unwrap();
         let printed: String = script.lines.iter().map(|l| format!("{}\n", l.command)).collect();
         let again = parse_script(Path::new("t.ovr"), &printed).unwrap();
@@ -670,7 +684,7 @@ mod tests {
             script.lines.iter().map(|l| &l.command).collect::<Vec<_>>(),
             again.lines.iter().map(|l| &l.command).collect::<Vec<_>>()
         );
-        assert_eq!(script.lines.len(), 72);
+        assert_eq!(script.lines.len(), 73);
     }
 
     #[test]

@@ -78,6 +78,16 @@ impl fmt::Display for Command {
             Command::Object(ObjectLine::Duplicate { reference: false }) => write!(f, "object duplicate"),
             Command::Object(ObjectLine::Duplicate { reference: true }) => write!(f, "object duplicate reference"),
             Command::Object(ObjectLine::Unique) => write!(f, "object unique"),
+            Command::Object(ObjectLine::Merge(others)) => {
+                write!(f, "object merge")?;
+                for other in others {
+                    match other {
+                        ObjectRef::Index(i) => write!(f, " {i}")?,
+                        ObjectRef::Name(name) => write!(f, " {}", quoted(std::path::Path::new(name)))?,
+                    }
+                }
+                Ok(())
+            }
             Command::Object(ObjectLine::Delete) => write!(f, "object delete"),
             Command::Object(ObjectLine::Rename(name)) => {
                 write!(f, "object rename {}", quoted(std::path::Path::new(name)))

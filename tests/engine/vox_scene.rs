@@ -561,3 +561,35 @@ fn layer_colours_are_saved_and_new_objects_go_on_the_active_layer() {
         .expect("the new object is saved");
     assert_eq!(fresh, 2, "on the active layer");
 }
+
+/// `object merge` makes one model of the picked object and the others
+/// (placed where they were, the later winning where they overlap), deletes
+/// the others, and is one undo step; the file keeps what is drawn.
+#[test]
+fn merged_objects_become_one_model_that_draws_the_same() {
+    let mut editor = Editor::default();
+    editor.set_scene(load(&written_scene(6)));
+    let run = |editor: &mut Editor, text: &str| {
+        let script = octovox::script::parse_script(std::path::Path::new("t.ovr"), text).unwrap();
+        script.lines.iter().try_for_each(|l| editor.run(&l.command).map(|_| ()))
+    };
+    let before = editor.scene.voxels();
+    let (objects, models) = (6, editor.scene.objects().unwrap().models.len());
+    // Objects 0, 1, 3 and 4 are shown (2 is on the hidden layer 2, 5 hidden).
+    run(&mut editor, "object 1\nobject merge 0 \"tree 3\" 4").unwrap();
+    let merged = editor.scene.objects().unwrap();
+    assert_eq!((merged.list().len(), merged.models.len()), (objects - 3, models + 1));
+    assert_eq!(merged.list()[merged.selected.unwrap()].path, "tree 1", "the picked object stays picked");
+    assert_eq!(editor.scene.voxels(), before, "the merge draws what was drawn");
+    let saved_bytes = saved(&editor.scene);
+    assert_eq!(load(&saved_bytes).voxels(), before, "and the file keeps it");
+    let data = dot_vox::load_bytes(&saved_bytes).unwrap();
+    assert_eq!(data.models.len(), models + 1, "dot_vox reads the merged model");
+    run(&mut editor, "undo").unwrap();
+    assert_eq!(editor.scene.objects().unwrap().list().len(), objects, "one undo step");
+    assert_eq!(editor.scene.objects().unwrap().models.len(), models);
+    for bad in ["object merge 1", "object merge 3 3", "object merge 99", "object merge 2", "object merge 5"] {
+        assert!(run(&mut editor, &format!("object 1\n{bad}")).is_err(), "{bad}");
+    }
+    assert_eq!(editor.scene.voxels(), before, "refused merges change nothing");
+}
