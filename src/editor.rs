@@ -358,6 +358,11 @@ impl Editor {
                 let change = objects.made_unique(index, model)?;
                 (vec![Edit::AddModel(Box::new(copy)), Edit::Graph(Box::new(change))], Picks::Same)
             }
+            ObjectLine::Regroup(target, after) => {
+                let target = self.object_named(target)?;
+                let own = objects.transform_node(index)?.id;
+                (graph(objects.regrouped(index, target, *after)?), Picks::Transform(own))
+            }
             ObjectLine::Merge(others) => {
                 let others = others.iter().map(|o| self.object_named(o)).collect::<Result<Vec<_>, _>>()?;
                 let (model, change) = objects.merged(index, &others)?;

@@ -507,7 +507,6 @@ fn objects_panel(
     (rename, merge): (&mut (Option<usize>, String), &mut Vec<usize>),
     out: &mut Vec<Command>,
 ) {
-    use octovox::script::{Command as Line, ObjectLine, ObjectRef};
     let list = objects.list();
     merge.retain(|&i| i < list.len() && objects.selected != Some(i));
     egui::CollapsingHeader::new(format!("Objects ({}, {} models)", list.len(), objects.models.len()))
@@ -516,34 +515,39 @@ fn objects_panel(
             rename_row(ui, objects, rename, out);
             merge_row(ui, objects, merge, out);
             egui::ScrollArea::vertical().id_salt("objects").max_height(160.0).show(ui, |ui| {
-                for (index, object) in list.iter().enumerate().take(MAX_OBJECT_ROWS) {
-                    let pick = Line::Object(ObjectLine::Pick(ObjectRef::Index(index)));
-                    ui.horizontal(|ui| {
-                        let mut shown = !object.own_hidden;
-                        if ui.checkbox(&mut shown, "").on_hover_text("show or hide").changed() {
-                            out.push(Command::Lines(vec![pick.clone(), Line::Object(ObjectLine::Hide(!shown))]));
-                        }
-                        let name = if object.path.is_empty() { "(unnamed)" } else { &object.path };
-                        let label = format!("{index} {name} · model {}", object.placement.model);
-                        let marked = merge.contains(&index);
-                        let can_mark = objects.selected.is_some_and(|p| p != index);
-                        let mark = ui.add_enabled(can_mark, egui::Button::new(if marked { "−" } else { "+" }).small());
-                        if mark.on_hover_text("mark to merge into the picked object").clicked() {
-                            toggle(merge, index);
-                        }
-                        let text =
-                            if object.hidden { egui::RichText::new(label).weak() } else { egui::RichText::new(label) };
-                        let text = if marked { text.underline() } else { text };
-                        if ui.selectable_label(objects.selected == Some(index), text).clicked() {
-                            out.push(Command::Lines(vec![pick]));
-                        }
-                    });
+                for index in 0..list.len().min(MAX_OBJECT_ROWS) {
+                    ui.horizontal(|ui| object_row(ui, objects, index, merge, out));
                 }
                 if list.len() > MAX_OBJECT_ROWS {
                     ui.label(format!("… and {} more (object N picks any)", list.len() - MAX_OBJECT_ROWS));
                 }
             });
         });
+}
+
+/// One row of the Objects panel: the eye, the merge mark, and the name
+/// that picks the object.
+fn object_row(ui: &mut egui::Ui, objects: &Objects, index: usize, merge: &mut Vec<usize>, out: &mut Vec<Command>) {
+    use octovox::script::{Command as Line, ObjectLine, ObjectRef};
+    let object = &objects.list()[index];
+    let pick = Line::Object(ObjectLine::Pick(ObjectRef::Index(index)));
+    let mut shown = !object.own_hidden;
+    if ui.checkbox(&mut shown, "").on_hover_text("show or hide").changed() {
+        out.push(Command::Lines(vec![pick.clone(), Line::Object(ObjectLine::Hide(!shown))]));
+    }
+    let name = if object.path.is_empty() { "(unnamed)" } else { &object.path };
+    let label = format!("{index} {name} · model {}", object.placement.model);
+    let marked = merge.contains(&index);
+    let can_mark = objects.selected.is_some_and(|p| p != index);
+    let mark = ui.add_enabled(can_mark, egui::Button::new(if marked { "−" } else { "+" }).small());
+    if mark.on_hover_text("mark to merge into the picked object").clicked() {
+        toggle(merge, index);
+    }
+    let text = if object.hidden { egui::RichText::new(label).weak() } else { egui::RichText::new(label) };
+    let text = if marked { text.underline() } else { text };
+    if ui.selectable_label(objects.selected == Some(index), text).clicked() {
+        out.push(Command::Lines(vec![pick]));
+    }
 }
 
 /// Puts `index` in `set`, or takes it out.

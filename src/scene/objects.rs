@@ -435,6 +435,52 @@ impl Objects {
         Ok(GraphChange { nodes: vec![node], ..GraphChange::default() })
     }
 
+    /// The change that moves object `index` into the group of object
+    /// `target`, right before it (or after), where it is drawn: its own
+    /// transform, every keyframe of it, takes what the two groups' placements
+    /// differ by (exact for groups without keyframes of their own).
+    pub fn regrouped(&self, index: usize, target: usize, after: bool) -> Result<GraphChange, EditError> {
+        if index == target || target >= self.objects.len() {
+            return Err(EditError::Brush("an object goes before or after another object".to_owned()));
+        }
+        let mut node = self.transform_node(index)?.clone();
+        let target_id = self.transform_node(target)?.id;
+        let delta = self.parent_placement(target)?.inverse().compose(self.parent_placement(index)?);
+        if let NodeKind::Transform { frames, .. } = &mut node.kind {
+            for frame in frames.iter_mut() {
+                let own = graph::parse_transform(frame, node.id).map_err(|e| EditError::Brush(e.to_string()))?;
+                graph::write_transform(frame, delta.compose(own));
+            }
+        }
+        let mut old_group = self.parent_group(node.id)?.clone();
+        if let NodeKind::Group { children } = &mut old_group.kind {
+            children.retain(|&c| c != node.id);
+        }
+        let new_id = self.parent_group(target_id)?.id;
+        let mut new_group =
+            if new_id == old_group.id { old_group.clone() } else { self.parent_group(target_id)?.clone() };
+        if let NodeKind::Group { children } = &mut new_group.kind {
+            let at = children.iter().position(|&c| c == target_id).map_or(children.len(), |p| p + usize::from(after));
+            children.insert(at, node.id);
+        }
+        let mut nodes = vec![node];
+        if new_id != old_group.id {
+            nodes.push(old_group);
+        }
+        nodes.push(new_group);
+        Ok(GraphChange { nodes, ..GraphChange::default() })
+    }
+
+    /// Where object `index`'s group places it: its whole transform at the
+    /// shown frame without its own.
+    fn parent_placement(&self, index: usize) -> Result<Transform, EditError> {
+        let mut node = self.transform_node(index)?.clone();
+        let k = self.shown_keyframe(&mut node)?;
+        let NodeKind::Transform { frames, .. } = &node.kind else { unreachable!("checked by shown_keyframe") };
+        let own = graph::parse_transform(&frames[k], node.id).map_err(|e| EditError::Brush(e.to_string()))?;
+        Ok(self.objects[index].placement.transform.compose(own.inverse()))
+    }
+
     /// The change that sets an attribute of object `index`'s transform
     /// (`_name`, `_hidden`); `None` removes it.
     pub fn with_attribute(&self, index: usize, key: &str, value: Option<&str>) -> Result<GraphChange, EditError> {

@@ -82,6 +82,13 @@ pub struct Transform {
 impl Transform {
     pub const IDENTITY: Transform = Transform { rotation: Rotation::IDENTITY, translation: [0, 0, 0] };
 
+    /// The transform that undoes this one.
+    pub fn inverse(self) -> Transform {
+        let rotation = self.rotation.inverse();
+        let back = rotation.apply(self.translation);
+        Transform { rotation, translation: back.map(|c| -c) }
+    }
+
     /// The transform that applies `child` first, then `self`.
     pub fn compose(self, child: Transform) -> Transform {
         let moved = self.rotation.apply(child.translation);

@@ -133,6 +133,10 @@ pub enum ObjectLine {
     },
     /// `object unique`: the picked placement gets a model of its own.
     Unique,
+    /// `object before N|NAME` (false), `object after N|NAME` (true): the
+    /// picked object goes into that object's group, next to it, staying
+    /// where it is drawn.
+    Regroup(ObjectRef, bool),
     /// `object merge N|NAME…`: the objects named become part of the picked
     /// one, whose new model holds all their voxels; they are deleted.
     Merge(Vec<ObjectRef>),

@@ -426,11 +426,14 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
 
 /// `object N|NAME`, and what the picked object does: `new NAME`, `move DX
 /// DY DZ`, `rotate x|y|z`, `duplicate [reference]`, `unique`, `delete`,
-/// `hide`, `show`, `rename NAME`, `layer N`, `merge N|NAME…`. (An object
+/// `hide`, `show`, `rename NAME`, `layer N`, `before N|NAME`, `after
+/// N|NAME`, `merge N|NAME…`. (An object
 /// named like one of these words is picked by its index or its path.)
 fn parse_object(c: &mut Cursor) -> Result<ObjectLine, Fail> {
     let word = c.word("an object index or name, or what the picked object does")?;
     Ok(match word.text.as_str() {
+        "before" => ObjectLine::Regroup(object_ref(c.word("an object")?)?, false),
+        "after" => ObjectLine::Regroup(object_ref(c.word("an object")?)?, true),
         "merge" => {
             let mut others = vec![object_ref(c.word("an object to merge")?)?];
             while let Some(word) = c.optional() {
@@ -676,7 +679,7 @@ mod tests {
                     extrude 1 2 3 0 -1 0 -2\nobject 3\nobject \"tree 4/top\"\nobject hide\nobject show\nlayer 2 hide\n\
                     ortho 42.5\nperspective\nground off\nground on\nlayer 0 show\nexpect objects 19\nexpect models 15\nobject new \"a b\"\nobject move 1 -2 3\nobject rotate z\n\
                     object duplicate\nobject duplicate reference\nobject unique\nobject delete\nobject rename top\n\
-                    object layer 3\nlayer 4 \"roof tiles\"\nlayer 4 color 10 200 255\nlayer 2 active\nobject merge 3 \"tree 4/top\" 7\n";
+                    object layer 3\nlayer 4 \"roof tiles\"\nlayer 4 color 10 200 255\nlayer 2 active\nobject merge 3 \"tree 4/top\" 7\nobject before 2\nobject after \"a b\"\n";
         let script = parse_script(Path::new("t.ovr"), text).unwrap();
         let printed: String = script.lines.iter().map(|l| format!("{}\n", l.command)).collect();
         let again = parse_script(Path::new("t.ovr"), &printed).unwrap();
@@ -684,7 +687,7 @@ mod tests {
             script.lines.iter().map(|l| &l.command).collect::<Vec<_>>(),
             again.lines.iter().map(|l| &l.command).collect::<Vec<_>>()
         );
-        assert_eq!(script.lines.len(), 73);
+        assert_eq!(script.lines.len(), 75);
     }
 
     #[test]

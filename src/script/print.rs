@@ -78,6 +78,13 @@ impl fmt::Display for Command {
             Command::Object(ObjectLine::Duplicate { reference: false }) => write!(f, "object duplicate"),
             Command::Object(ObjectLine::Duplicate { reference: true }) => write!(f, "object duplicate reference"),
             Command::Object(ObjectLine::Unique) => write!(f, "object unique"),
+            Command::Object(ObjectLine::Regroup(target, after)) => {
+                write!(f, "object {} ", if *after { "after" } else { "before" })?;
+                match target {
+                    ObjectRef::Index(i) => write!(f, "{i}"),
+                    ObjectRef::Name(name) => write!(f, "{}", quoted(std::path::Path::new(name))),
+                }
+            }
             Command::Object(ObjectLine::Merge(others)) => {
                 write!(f, "object merge")?;
                 for other in others {

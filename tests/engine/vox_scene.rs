@@ -593,3 +593,58 @@ fn merged_objects_become_one_model_that_draws_the_same() {
     }
     assert_eq!(editor.scene.voxels(), before, "refused merges change nothing");
 }
+
+/// `object before|after N` moves the picked object into object N's group
+/// next to it, where it was drawn (its transform takes the groups'
+/// difference), as one undo step; dot_vox reads the new group lists.
+#[test]
+fn an_object_moved_to_another_group_stays_where_it_is_drawn() {
+    let bytes = std::fs::read(assets().join("format/test_groups.vox")).unwrap();
+    let mut editor = Editor::default();
+    editor.set_scene(load(&bytes));
+    let run = |editor: &mut Editor, text: &str| {
+        let script = octovox::script::parse_script(std::path::Path::new("t.ovr"), text).unwrap();
+        script.lines.iter().try_for_each(|l| editor.run(&l.command).map(|_| ()))
+    };
+    let before = editor.scene.voxels();
+    let paths = |editor: &Editor| -> Vec<String> {
+        editor.scene.objects().unwrap().list().iter().map(|o| o.path.clone()).collect()
+    };
+    let start = paths(&editor);
+    assert!(start[0].starts_with("characters") && start[15].starts_with("text"), "{start:?}");
+    let id = editor.scene.objects().unwrap().list()[0].transform_node.unwrap();
+    let translation = |bytes: &[u8]| {
+        let data = dot_vox::load_bytes(bytes).unwrap();
+        data.scenes.iter().enumerate().find_map(|(i, n)| match n {
+            dot_vox::SceneNode::Transform { frames, .. } if i as u32 == id => frames[0].attributes.get("_t").cloned(),
+            _ => None,
+        })
+    };
+    // A character into the text group, before object 15; then the last
+    // text object to the front of its group.
+    run(&mut editor, "object 0\nobject before 15").unwrap();
+    let moved = paths(&editor);
+    let picked = editor.scene.objects().unwrap().selected.unwrap();
+    assert!(moved[picked].starts_with("text"), "{moved:?}");
+    assert_eq!(moved.iter().filter(|p| p.starts_with("characters")).count(), 3);
+    assert_eq!(editor.scene.voxels(), before, "drawn where it was");
+    let own = translation(&saved(&editor.scene));
+    assert_ne!(own, translation(&bytes), "its own transform took the groups' difference");
+    run(&mut editor, "object 18\nobject before 4").unwrap();
+    assert_eq!(editor.scene.voxels(), before, "reordered, drawn the same");
+    let data = dot_vox::load_bytes(&saved(&editor.scene)).unwrap();
+    let groups: Vec<&Vec<u32>> = data
+        .scenes
+        .iter()
+        .filter_map(|n| match n {
+            dot_vox::SceneNode::Group { children, .. } => Some(children),
+            _ => None,
+        })
+        .collect();
+    let sizes: Vec<usize> = groups.iter().map(|c| c.len()).collect();
+    assert!(sizes.contains(&3) && sizes.contains(&16), "the characters' group lost one, the text's got it: {sizes:?}");
+    assert_eq!(load(&saved(&editor.scene)).voxels(), before, "and the file draws it there");
+    run(&mut editor, "undo\nundo").unwrap();
+    assert_eq!(paths(&editor), start, "two undo steps");
+    assert!(run(&mut editor, "object 3\nobject after 3").is_err(), "not next to itself");
+}
