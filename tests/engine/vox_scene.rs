@@ -69,6 +69,12 @@ fn assert_same_scene(name: &str, before: &[u8], after: &[u8]) {
     assert_eq!(kept_chunks(before), kept_chunks(after), "{name}: kept chunks");
 }
 
+/// Runs script lines on the editor; the first refused one's error.
+fn run(editor: &mut Editor, text: &str) -> Result<(), octovox::editor::EditorError> {
+    let script = octovox::script::parse_script(std::path::Path::new("t.ovr"), text).unwrap();
+    script.lines.iter().try_for_each(|l| editor.run(&l.command).map(|_| ()))
+}
+
 fn load(bytes: &[u8]) -> Scene {
     load_vox_scene(bytes, 0).unwrap().0
 }
@@ -459,10 +465,6 @@ fn an_edit_with_no_object_left_is_refused_and_a_new_object_takes_it() {
     let bytes = written_scene(2);
     let mut editor = Editor::default();
     editor.set_scene(load(&bytes));
-    let run = |editor: &mut Editor, text: &str| {
-        let script = octovox::script::parse_script(std::path::Path::new("t.ovr"), text).unwrap();
-        script.lines.iter().try_for_each(|l| editor.run(&l.command).map(|_| ()))
-    };
     run(&mut editor, "object 0\nobject delete\nobject 0\nobject delete").unwrap();
     assert_eq!(editor.scene.objects().unwrap().list().len(), 0);
     assert_eq!(editor.scene.solid_voxels(), 0);
@@ -540,10 +542,6 @@ fn a_cut_model_never_gets_an_empty_piece() {
 fn layer_colours_are_saved_and_new_objects_go_on_the_active_layer() {
     let mut editor = Editor::default();
     editor.set_scene(load(&written_scene(3)));
-    let run = |editor: &mut Editor, text: &str| {
-        let script = octovox::script::parse_script(std::path::Path::new("t.ovr"), text).unwrap();
-        script.lines.iter().try_for_each(|l| editor.run(&l.command).map(|_| ()))
-    };
     run(&mut editor, "layer 1 color 10 200 255\nlayer 0 color 1 2 3\nundo\nlayer 2 active\nobject new fresh").unwrap();
     assert!(run(&mut editor, "layer 9 active").unwrap_err().to_string().contains("no layer 9"));
     let data = dot_vox::load_bytes(&saved(&editor.scene)).unwrap();
@@ -569,10 +567,6 @@ fn layer_colours_are_saved_and_new_objects_go_on_the_active_layer() {
 fn merged_objects_become_one_model_that_draws_the_same() {
     let mut editor = Editor::default();
     editor.set_scene(load(&written_scene(6)));
-    let run = |editor: &mut Editor, text: &str| {
-        let script = octovox::script::parse_script(std::path::Path::new("t.ovr"), text).unwrap();
-        script.lines.iter().try_for_each(|l| editor.run(&l.command).map(|_| ()))
-    };
     let before = editor.scene.voxels();
     let (objects, models) = (6, editor.scene.objects().unwrap().models.len());
     // Objects 0, 1, 3 and 4 are shown (2 is on the hidden layer 2, 5 hidden).
@@ -602,10 +596,6 @@ fn an_object_moved_to_another_group_stays_where_it_is_drawn() {
     let bytes = std::fs::read(assets().join("format/test_groups.vox")).unwrap();
     let mut editor = Editor::default();
     editor.set_scene(load(&bytes));
-    let run = |editor: &mut Editor, text: &str| {
-        let script = octovox::script::parse_script(std::path::Path::new("t.ovr"), text).unwrap();
-        script.lines.iter().try_for_each(|l| editor.run(&l.command).map(|_| ()))
-    };
     let before = editor.scene.voxels();
     let paths = |editor: &Editor| -> Vec<String> {
         editor.scene.objects().unwrap().list().iter().map(|o| o.path.clone()).collect()
