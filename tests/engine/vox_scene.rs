@@ -401,6 +401,19 @@ fn a_hundred_thousand_objects_load_and_edit() {
         editor.run(&line.command).unwrap();
     }
     assert_eq!(editor.scene.solid_voxels(), before + visible);
+    // Drawn as instances: the upload holds every record and a tree of
+    // boxes 17 levels deep, and rays through it hit what is composed.
+    let upload = editor.scene.take_uploads().byte_count();
+    assert!(upload >= octovox::scene::instances::word_bytes(100_000), "{upload} bytes");
+    let traced = octovox::trace::instanced::Traced::of(&editor.scene);
+    let (lo, hi) = editor.scene.solid_bounds().unwrap();
+    for i in 0..64 {
+        let target = (lo + (hi - lo) * i / 63 - editor.scene.origin()).as_vec3() + glam::Vec3::splat(0.5);
+        let origin = target + glam::Vec3::new(0.3, 40.0, 0.2);
+        let ray = octovox::trace::Ray::new(origin, target - origin);
+        let (a, b) = (traced.trace(&ray, Default::default()), octovox::trace::svo::trace(editor.scene.drawn(), &ray));
+        assert!(!a.gave_up && a.value == b.value && (a.voxel - b.voxel).abs().max_element() <= 1, "{a:?} {b:?}");
+    }
     editor.run(&octovox::script::Command::Undo(1)).unwrap();
     assert_eq!(editor.scene.solid_voxels(), before);
     assert!(started.elapsed().as_secs() < 120, "loaded in {loaded:?}, all in {:?}", started.elapsed());

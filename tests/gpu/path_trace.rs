@@ -543,3 +543,80 @@ fn the_ground_grid_is_hidden_by_the_voxels_in_front_of_it() {
     assert!(lines.len() > 150, "the grid shows in the path tracer: {} pixels", lines.len());
     assert_eq!(over_column, 0, "grid pixels inside the column");
 }
+
+/// The material scene as a model placed three times (a reference each:
+/// turned, mirrored), a scene drawn as instances.
+fn instanced_material_scene() -> Scene {
+    use octovox::scene::graph::{Attributes, Layer, Node, NodeKind, SceneGraph};
+    use octovox::scene::objects::{Model, Objects};
+    let single = material_scene();
+    // MagicaVoxel's axes: z up, world (x, y, z) is model (x, −z, y).
+    let voxels: Vec<(IVec3, u8)> = single.voxels().into_iter().map(|(p, v)| (IVec3::new(p.x, -p.z, p.y), v)).collect();
+    let tree = Octree::from_voxels(&voxels).unwrap();
+    let (lo, hi) = tree.solid_bounds().unwrap();
+    let model = Model { size: (hi - lo + IVec3::ONE).as_uvec3().to_array(), tree };
+    let placements = [("0 0 0", "4"), ("40 0 0", "17"), ("0 44 0", "20")];
+    let mut nodes = vec![
+        Node {
+            id: 0,
+            attributes: Attributes::new(),
+            kind: NodeKind::Transform { child: 1, reserved: u32::MAX, layer: 0, frames: vec![] },
+        },
+        Node { id: 1, attributes: Attributes::new(), kind: NodeKind::Group { children: vec![2, 4, 6] } },
+    ];
+    for (k, (t, r)) in placements.into_iter().enumerate() {
+        let id = 2 + 2 * k as u32;
+        let frame: Attributes = [("_t".to_owned(), t.to_owned()), ("_r".to_owned(), r.to_owned())].into();
+        let transform = NodeKind::Transform { child: id + 1, reserved: u32::MAX, layer: 0, frames: vec![frame] };
+        nodes.push(Node { id, attributes: Attributes::new(), kind: transform });
+        let shape = NodeKind::Shape { models: vec![(0, Attributes::new())] };
+        nodes.push(Node { id: id + 1, attributes: Attributes::new(), kind: shape });
+    }
+    let layers = vec![Layer { id: 0, attributes: Attributes::new(), reserved: u32::MAX }];
+    let objects = Objects::new(Some(SceneGraph { nodes, layers }), vec![model], Vec::new(), 0, usize::MAX).unwrap();
+    let scene = Scene::compose(single.palette.clone(), objects).unwrap();
+    assert!(scene.instanced().is_some());
+    scene
+}
+
+/// Path tracing a scene of references (glass, metal and lamps in each):
+/// the GPU against the CPU reference, and the CPU's instances against the
+/// same voxels composed into one octree, with the same random numbers.
+#[test]
+fn gpu_and_cpu_path_trace_instances_alike_and_as_composed() {
+    let mut scene = instanced_material_scene();
+    let composed = Scene::new(scene.palette.clone(), scene.drawn().clone());
+    // The first placement, as the composed material scene's test sees it.
+    let (lo, hi) = scene.objects().unwrap().world_box(0).unwrap();
+    let centre = (lo + hi).as_dvec3() / 2.0;
+    let camera = look(centre + DVec3::new(18.0, 9.0, 26.0), centre - DVec3::new(0.0, 2.0, 0.0));
+    let settings = PathSettings { bounces: 3, ..PathSettings::default() };
+    let (size, spp) = ((48, 36), 8);
+    let basis = camera.basis(size.0, size.1, scene.origin());
+    let traced = octovox::trace::instanced::Traced::of(&scene);
+    let hits = octovox::trace::render::trace_image(
+        &octovox::trace::render::Tracer::Svo(traced),
+        &basis,
+        octovox::trace::Footprint::EXACT,
+    );
+    let seen = |index: u8| hits.iter().filter(|h| h.value == index).count();
+    let shown = hits.iter().filter(|h| h.is_hit()).count();
+    assert!(
+        shown * 3 > hits.len() && seen(6) > 20 && seen(5) > 20,
+        "{shown} hits, {} glass, {} metal",
+        seen(6),
+        seen(5)
+    );
+    let cpu = render_cpu(&scene, &camera, size, &settings, spp).pixels;
+    let flat = render_cpu(&composed, &camera, size, &settings, spp).pixels;
+    let (gpu, effects) = render_gpu(&mut scene, &camera, size, &settings, spp);
+    assert_eq!(effects.names(), ["sun", "sky", "emit", "metal", "glass"]);
+    assert!(mean(&cpu).min_element() > 0.05, "a picture, not black: {}", mean(&cpu));
+    for (what, other) in [("GPU", &gpu), ("composed", &flat)] {
+        let (mc, mo) = (mean(&cpu), mean(other));
+        assert!((mc - mo).abs().max_element() < 0.01, "{what}: CPU mean {mc}, other {mo}");
+        let differing = cpu.iter().zip(other).filter(|(a, b)| (**a - **b).abs().max_element() > 0.02).count();
+        println!("{what}: {differing} of {} pixels differ by more than 0.02", cpu.len());
+        assert!(differing * 20 <= cpu.len(), "{what}: {differing} of {} pixels differ", cpu.len());
+    }
+}
