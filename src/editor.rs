@@ -282,7 +282,7 @@ impl Editor {
     /// is not the picked one already (what a click runs before its edit).
     pub fn object_line_at(&self, voxel: IVec3) -> Option<Command> {
         let objects = self.scene.objects()?;
-        let owner = objects.owner_at(voxel).filter(|&i| objects.selected != Some(i))?;
+        let owner = objects.owner_at(voxel).filter(|&i| objects.selected != Some(i) && !objects.locked(i))?;
         Some(Command::Object(ObjectLine::Pick(ObjectRef::Index(owner))))
     }
 
@@ -335,6 +335,15 @@ impl Editor {
         let index = self.picked_object()?;
         let objects = self.objects()?;
         let graph = |change| vec![Edit::Graph(Box::new(change))];
+        let reshapes =
+            matches!(line, ObjectLine::Move(_) | ObjectLine::Rotate(_) | ObjectLine::Delete | ObjectLine::Regroup(..));
+        let merges_locked = match line {
+            ObjectLine::Merge(others) => others.iter().any(|o| self.object_named(o).is_ok_and(|k| objects.locked(k))),
+            _ => false,
+        };
+        if ((reshapes || matches!(line, ObjectLine::Merge(_))) && objects.locked(index)) || merges_locked {
+            return Err(EditorError::Object("a locked object stays as it is: `object unlock` first".to_owned()));
+        }
         Ok(match line {
             ObjectLine::Move(by) => (graph(objects.moved(index, *by)?), Picks::Same),
             ObjectLine::Rotate(axis) => (graph(objects.rotated(index, *axis)?), Picks::Same),
@@ -342,6 +351,9 @@ impl Editor {
                 (graph(objects.with_attribute(index, "_hidden", hidden.then_some("1"))?), Picks::Same)
             }
             ObjectLine::Rename(name) => (graph(objects.with_attribute(index, "_name", Some(name))?), Picks::Same),
+            ObjectLine::Lock(locked) => {
+                (graph(objects.with_attribute(index, "_lock", locked.then_some("1"))?), Picks::Same)
+            }
             ObjectLine::Layer(layer) => (graph(objects.on_layer(index, *layer)?), Picks::Same),
             ObjectLine::Delete => (graph(objects.deleted(index)?), Picks::None),
             ObjectLine::Duplicate { reference: true } => {

@@ -525,8 +525,8 @@ fn objects_panel(
         });
 }
 
-/// One row of the Objects panel: the eye, the merge mark, and the name
-/// that picks the object.
+/// One row of the Objects panel: the eye, the lock, the merge mark, and
+/// the name that picks the object.
 fn object_row(ui: &mut egui::Ui, objects: &Objects, index: usize, merge: &mut Vec<usize>, out: &mut Vec<Command>) {
     use octovox::script::{Command as Line, ObjectLine, ObjectRef};
     let object = &objects.list()[index];
@@ -534,6 +534,12 @@ fn object_row(ui: &mut egui::Ui, objects: &Objects, index: usize, merge: &mut Ve
     let mut shown = !object.own_hidden;
     if ui.checkbox(&mut shown, "").on_hover_text("show or hide").changed() {
         out.push(Command::Lines(vec![pick.clone(), Line::Object(ObjectLine::Hide(!shown))]));
+    }
+    let mut locked = objects.locked(index);
+    let icon = if locked { "🔒" } else { "🔓" };
+    let lock = ui.toggle_value(&mut locked, icon);
+    if lock.on_hover_text("lock: no edits, moves or picks by a click").changed() {
+        out.push(Command::Lines(vec![pick.clone(), Line::Object(ObjectLine::Lock(locked))]));
     }
     let name = if object.path.is_empty() { "(unnamed)" } else { &object.path };
     let label = format!("{index} {name} · model {}", object.placement.model);

@@ -221,6 +221,13 @@ impl Objects {
         Ok(())
     }
 
+    /// Whether object `index` is locked (`_lock` on its transform): its
+    /// voxels, place and group are not to be changed, and a click does not
+    /// pick it.
+    pub fn locked(&self, index: usize) -> bool {
+        self.transform_node(index).is_ok_and(|node| graph::is_set(&node.attributes, "_lock"))
+    }
+
     /// The visible object drawn at world cell `at` (the last in walk order
     /// holding a voxel there), if any.
     pub fn owner_at(&self, at: IVec3) -> Option<usize> {
@@ -259,6 +266,9 @@ impl Objects {
             .ok_or_else(|| EditError::Brush(format!("there is no object {index}")))?
             .placement
             .model;
+        if self.locked(index) {
+            return Err(EditError::Brush(format!("object {index} is locked (`object unlock` lets it be edited)")));
+        }
         let local = self.maps[index].invert_shape(shape);
         let patch = self.models[model].tree.apply_brush(&local, op)?;
         self.recompose_model(tree, model, local.bounds())?;

@@ -143,6 +143,8 @@ pub enum ObjectLine {
     Delete,
     /// `object hide` (true) or `object show` (false).
     Hide(bool),
+    /// `object lock` (true) or `object unlock` (false).
+    Lock(bool),
     Rename(String),
     /// `object layer N`.
     Layer(u32),

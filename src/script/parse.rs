@@ -426,7 +426,7 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
 
 /// `object N|NAME`, and what the picked object does: `new NAME`, `move DX
 /// DY DZ`, `rotate x|y|z`, `duplicate [reference]`, `unique`, `delete`,
-/// `hide`, `show`, `rename NAME`, `layer N`, `before N|NAME`, `after
+/// `hide`, `show`, `lock`, `unlock`, `rename NAME`, `layer N`, `before N|NAME`, `after
 /// N|NAME`, `merge N|NAME…`. (An object
 /// named like one of these words is picked by its index or its path.)
 fn parse_object(c: &mut Cursor) -> Result<ObjectLine, Fail> {
@@ -443,6 +443,8 @@ fn parse_object(c: &mut Cursor) -> Result<ObjectLine, Fail> {
         }
         "hide" => ObjectLine::Hide(true),
         "show" => ObjectLine::Hide(false),
+        "lock" => ObjectLine::Lock(true),
+        "unlock" => ObjectLine::Lock(false),
         "new" => ObjectLine::New(c.word("a name")?.text),
         "move" => ObjectLine::Move(c.position()?),
         "rotate" => ObjectLine::Rotate(c.axis()?),
@@ -679,7 +681,7 @@ mod tests {
                     extrude 1 2 3 0 -1 0 -2\nobject 3\nobject \"tree 4/top\"\nobject hide\nobject show\nlayer 2 hide\n\
                     ortho 42.5\nperspective\nground off\nground on\nlayer 0 show\nexpect objects 19\nexpect models 15\nobject new \"a b\"\nobject move 1 -2 3\nobject rotate z\n\
                     object duplicate\nobject duplicate reference\nobject unique\nobject delete\nobject rename top\n\
-                    object layer 3\nlayer 4 \"roof tiles\"\nlayer 4 color 10 200 255\nlayer 2 active\nobject merge 3 \"tree 4/top\" 7\nobject before 2\nobject after \"a b\"\n";
+                    object layer 3\nlayer 4 \"roof tiles\"\nlayer 4 color 10 200 255\nlayer 2 active\nobject merge 3 \"tree 4/top\" 7\nobject before 2\nobject after \"a b\"\nobject lock\nobject unlock\n";
         let script = parse_script(Path::new("t.ovr"), text).unwrap();
         let printed: String = script.lines.iter().map(|l| format!("{}\n", l.command)).collect();
         let again = parse_script(Path::new("t.ovr"), &printed).unwrap();
@@ -687,7 +689,7 @@ mod tests {
             script.lines.iter().map(|l| &l.command).collect::<Vec<_>>(),
             again.lines.iter().map(|l| &l.command).collect::<Vec<_>>()
         );
-        assert_eq!(script.lines.len(), 75);
+        assert_eq!(script.lines.len(), 77);
     }
 
     #[test]

@@ -72,6 +72,8 @@ impl fmt::Display for Command {
             }
             Command::Object(ObjectLine::Hide(true)) => write!(f, "object hide"),
             Command::Object(ObjectLine::Hide(false)) => write!(f, "object show"),
+            Command::Object(ObjectLine::Lock(true)) => write!(f, "object lock"),
+            Command::Object(ObjectLine::Lock(false)) => write!(f, "object unlock"),
             Command::Object(ObjectLine::New(name)) => write!(f, "object new {}", quoted(std::path::Path::new(name))),
             Command::Object(ObjectLine::Move(d)) => write!(f, "object move {}", v(*d)),
             Command::Object(ObjectLine::Rotate(axis)) => write!(f, "object rotate {}", ["x", "y", "z"][*axis]),

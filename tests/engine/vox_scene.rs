@@ -651,3 +651,31 @@ fn an_object_moved_to_another_group_stays_where_it_is_drawn() {
     assert_eq!(paths(&editor), start, "two undo steps");
     assert!(run(&mut editor, "object 3\nobject after 3").is_err(), "not next to itself");
 }
+
+/// A locked object keeps its voxels and place (edits, moves, deletes and
+/// merges are refused with a reason and change nothing) until unlocked;
+/// the file keeps the lock.
+#[test]
+fn a_locked_object_is_kept_as_it_is_until_unlocked() {
+    let mut editor = Editor::default();
+    editor.set_scene(load(&written_scene(6)));
+    run(&mut editor, "object 1\nobject lock").unwrap();
+    let before = editor.scene.voxels();
+    let corner = editor.scene.objects().unwrap().world_box(1).unwrap().0;
+    let place = format!("object 1\nplace {} {} {}", corner.x, corner.y, corner.z);
+    for refused in [
+        "object 1\nobject move 1 0 0",
+        "object 1\nobject delete",
+        "object 1\nobject merge 0",
+        "object 0\nobject merge 1",
+        place.as_str(),
+    ] {
+        let err = run(&mut editor, refused).unwrap_err().to_string();
+        assert!(err.contains("locked"), "{refused}: {err}");
+        assert_eq!(editor.scene.voxels(), before, "{refused} changed nothing");
+    }
+    assert_eq!(editor.object_line_at(corner), None, "a click does not pick it");
+    assert!(load(&saved(&editor.scene)).objects().unwrap().locked(1), "saved locked");
+    run(&mut editor, &format!("object 1\nobject unlock\n{place}")).unwrap();
+    assert_ne!(editor.scene.voxels(), before, "unlocked, it is edited");
+}
