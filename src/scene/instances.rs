@@ -158,7 +158,7 @@ impl InstanceTable {
                 region.node_base,
                 brick_words + 2 * region.brick_base,
                 tree.depth() | axes << 8,
-                crate::trace::iteration_bound(tree.depth()),
+                super::octree::iteration_bound(tree.depth()),
             ]);
             words.extend(instance.offset.to_array().map(|c| c as u32));
         }

@@ -57,6 +57,24 @@ pub const MAX_DEPTH: u32 = 20;
 /// World coordinates must stay within ±2^24 so they are exact in f32.
 pub const WORLD_LIMIT: i32 = 1 << 24;
 
+/// The most loop iterations a ray may take in a tree `2^depth` voxels wide
+/// (SVO and grid alike), chosen so that no valid ray reaches it.
+///
+/// Every iteration of the SVO loop descends a level, steps across a plane
+/// into the next cell, or ends the ray. Inside the root a ray crosses at most
+/// 3·2^depth planes (2^depth per axis), and after each crossing, or at the
+/// start, it descends at most `depth` levels (a pop goes straight to the
+/// common ancestor; the GPU's restart from the root re-descends at most
+/// `depth` levels too). So a ray takes at most (3·2^depth + 1)·(depth + 1)
+/// iterations. The grid DDA inside the same cube takes at most 3·2^depth + 1.
+/// A ray that reaches the bound is a bug; it is reported as a give-up,
+/// never as a miss.
+pub fn iteration_bound(depth: u32) -> u32 {
+    let planes = 3u64 << depth.min(40);
+    let bound = (planes + 1) * (u64::from(depth) + 1);
+    u32::try_from(bound).unwrap_or(u32::MAX)
+}
+
 /// Octant index of child offset bits: `x | y << 1 | z << 2`.
 pub fn octant_offset(octant: usize) -> IVec3 {
     IVec3::new((octant & 1) as i32, ((octant >> 1) & 1) as i32, ((octant >> 2) & 1) as i32)

@@ -11,23 +11,7 @@ pub mod svo;
 
 use glam::{IVec3, Vec3};
 
-/// The most loop iterations a ray may take in a tree `2^depth` voxels wide
-/// (SVO and grid alike), chosen so that no valid ray reaches it.
-///
-/// Every iteration of the SVO loop descends a level, steps across a plane
-/// into the next cell, or ends the ray. Inside the root a ray crosses at most
-/// 3·2^depth planes (2^depth per axis), and after each crossing, or at the
-/// start, it descends at most `depth` levels (a pop goes straight to the
-/// common ancestor; the GPU's restart from the root re-descends at most
-/// `depth` levels too). So a ray takes at most (3·2^depth + 1)·(depth + 1)
-/// iterations. The grid DDA inside the same cube takes at most 3·2^depth + 1.
-/// A ray that reaches the bound is a bug; it is reported as a give-up,
-/// never as a miss.
-pub fn iteration_bound(depth: u32) -> u32 {
-    let planes = 3u64 << depth.min(40);
-    let bound = (planes + 1) * (u64::from(depth) + 1);
-    u32::try_from(bound).unwrap_or(u32::MAX)
-}
+pub use crate::scene::octree::iteration_bound;
 
 /// The width in voxels below which a traversal stops at a node and shades
 /// it by its level-of-detail summary (`crate::scene::lod`): `at_start +
