@@ -16,7 +16,7 @@ use octovox::io::output::{OutputKind, check_output};
 use octovox::replay::{Host, HostError, Ran, Recorder, StepError, StepResult, step};
 use octovox::script::Command as Line;
 use octovox::settings::RenderSettings;
-use octovox::trace::svo;
+use octovox::trace::pick;
 
 use super::App;
 
@@ -143,7 +143,7 @@ impl Host for App {
         }
     }
 
-    fn pick(&mut self, x: u32, y: u32) -> Result<Option<(IVec3, IVec3, u8)>, svo::GaveUp> {
+    fn pick(&mut self, x: u32, y: u32) -> Result<Option<(IVec3, IVec3, u8)>, pick::GaveUp> {
         let pick = self.pick_or_ground(f64::from(x) + 0.5, f64::from(y) + 0.5)?;
         Ok(pick.map(|pick| (pick.voxel, pick.normal, pick.value)))
     }

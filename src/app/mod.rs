@@ -58,7 +58,7 @@ use octovox::gpu::{BlitMode, BlitPass, GpuContext, Renderer};
 use octovox::io::atomic::WriteOptions;
 use octovox::replay::Recorder;
 use octovox::scene::Scene;
-use octovox::trace::svo;
+use octovox::trace::pick;
 
 use crate::cli::WindowArgs;
 use clock::FrameClock;
@@ -469,18 +469,18 @@ impl App {
     /// coordinates. Same ray as the GPU's pixel (window pixels map to trace
     /// pixels by the render scale; the panels sit over the image).
     /// A ray that gave up is an error, never "nothing under the cursor".
-    fn pick_at(&self, x: f64, y: f64) -> Result<Option<Pick>, svo::GaveUp> {
+    fn pick_at(&self, x: f64, y: f64) -> Result<Option<Pick>, pick::GaveUp> {
         self.pick_pixel(x, y, false)
     }
 
     /// [`App::pick_at`], or where there is no voxel and the ground is on,
     /// the ground cell under y = 0 (value 0): what Attach, lines, selections
     /// and pastes start from in an empty scene.
-    fn pick_or_ground(&self, x: f64, y: f64) -> Result<Option<Pick>, svo::GaveUp> {
+    fn pick_or_ground(&self, x: f64, y: f64) -> Result<Option<Pick>, pick::GaveUp> {
         self.pick_pixel(x, y, self.doc.editor.ground)
     }
 
-    fn pick_pixel(&self, x: f64, y: f64, ground: bool) -> Result<Option<Pick>, svo::GaveUp> {
+    fn pick_pixel(&self, x: f64, y: f64, ground: bool) -> Result<Option<Pick>, pick::GaveUp> {
         let (window_w, window_h) = self.window_size();
         let (w, h) = self.trace_size();
         if x < 0.0 || y < 0.0 || x >= f64::from(window_w) || y >= f64::from(window_h) {
@@ -488,7 +488,7 @@ impl App {
         }
         let px = ((x * f64::from(w) / f64::from(window_w)) as u32).min(w - 1);
         let py = ((y * f64::from(h) / f64::from(window_h)) as u32).min(h - 1);
-        let hit = svo::pick_with_ground(&self.doc.editor.scene, &self.state.camera, (w, h), (px, py), ground)?;
+        let hit = pick::pick_with_ground(&self.doc.editor.scene, &self.state.camera, (w, h), (px, py), ground)?;
         Ok(hit.map(|hit| Pick { voxel: hit.voxel, normal: hit.normal, value: hit.value }))
     }
 
@@ -503,7 +503,7 @@ impl App {
         self.say_if_none(self.pick_or_ground(x, y), nothing)
     }
 
-    fn say_if_none(&mut self, picked: Result<Option<Pick>, svo::GaveUp>, nothing: &str) -> Option<Pick> {
+    fn say_if_none(&mut self, picked: Result<Option<Pick>, pick::GaveUp>, nothing: &str) -> Option<Pick> {
         match picked {
             Ok(Some(pick)) => Some(pick),
             Ok(None) => {

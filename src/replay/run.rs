@@ -15,8 +15,8 @@ use crate::io::output::{OutputKind, check_output};
 use crate::io::png::save_png;
 use crate::script::{Line, Script};
 use crate::settings::RenderSettings;
+use crate::trace::pick;
 use crate::trace::render::render_scene_cpu;
-use crate::trace::svo;
 
 /// Where renders and pool flushes go.
 pub enum RunnerMode {
@@ -186,9 +186,9 @@ impl Host for Runner {
         self.viewport = (width, height);
     }
 
-    fn pick(&mut self, x: u32, y: u32) -> Result<Option<(IVec3, IVec3, u8)>, svo::GaveUp> {
+    fn pick(&mut self, x: u32, y: u32) -> Result<Option<(IVec3, IVec3, u8)>, pick::GaveUp> {
         let (scene, ground) = (&self.editor.scene, self.editor.ground);
-        let hit = svo::pick_with_ground(scene, &self.camera, self.viewport, (x, y), ground)?;
+        let hit = pick::pick_with_ground(scene, &self.camera, self.viewport, (x, y), ground)?;
         Ok(hit.map(|hit| (hit.voxel, hit.normal, hit.value)))
     }
 

@@ -16,7 +16,7 @@ use crate::edit::selection::Region;
 use crate::editor::{Editor, EditorError, Outcome};
 use crate::io::png::{differing_fraction, load_png, save_png};
 use crate::script::{Command, PaletteLine, edit_command};
-use crate::trace::svo;
+use crate::trace::pick;
 
 /// The size of renders (and of the pixels `click` names headless) before a
 /// `viewport` line.
@@ -48,7 +48,7 @@ pub trait Host {
     ///
     /// # Errors
     /// The traversal gave up.
-    fn pick(&mut self, x: u32, y: u32) -> Result<Option<(IVec3, IVec3, u8)>, svo::GaveUp>;
+    fn pick(&mut self, x: u32, y: u32) -> Result<Option<(IVec3, IVec3, u8)>, pick::GaveUp>;
 
     /// `save PATH`.
     ///

@@ -6,6 +6,7 @@ pub mod denoise;
 pub mod grid;
 pub mod instanced;
 pub mod path;
+pub mod pick;
 pub mod render;
 pub mod svo;
 

@@ -326,7 +326,7 @@ fn the_comb_ray_reaches_the_wall_in_the_pick() {
     };
     let depth = tree.depth();
     let scene = octovox::scene::Scene::new(Default::default(), tree);
-    let hit = octovox::trace::svo::pick(&scene, &camera, (1, 1), 0, 0).unwrap().expect("the wall");
+    let hit = octovox::trace::pick::pick(&scene, &camera, (1, 1), 0, 0).unwrap().expect("the wall");
     assert_eq!(hit.voxel.x, 4010);
     println!("the comb ray took {} iterations", hit.iterations);
     assert!(hit.iterations > 4096, "{} iterations", hit.iterations);

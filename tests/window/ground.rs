@@ -10,7 +10,7 @@ use std::time::Duration;
 use common::window::*;
 use glam::IVec3;
 use octovox::camera::Camera;
-use octovox::trace::svo;
+use octovox::trace::pick;
 
 /// The working volume of a new scene (`DEFAULT_VOLUME` in src/app/state.rs).
 const VOLUME: i32 = 32;
@@ -27,7 +27,7 @@ fn new_scene_camera() -> Camera {
 fn stable_ground_pixel(camera: &Camera) -> (u32, u32, IVec3) {
     let empty = octovox::scene::Scene::default();
     let cell = |x: u32, y: u32| {
-        svo::pick_with_ground(&empty, camera, (WIDTH, HEIGHT), (x, y), true).unwrap().map(|hit| hit.voxel)
+        pick::pick_with_ground(&empty, camera, (WIDTH, HEIGHT), (x, y), true).unwrap().map(|hit| hit.voxel)
     };
     for y in (HEIGHT / 2..HEIGHT - 40).step_by(7) {
         for x in (FREE_X + 60..WIDTH - 60).step_by(7) {

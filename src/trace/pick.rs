@@ -1,0 +1,62 @@
+//! What lies under a pixel: the one CPU pick that the window's mouse and
+//! replay's `click` share, walking the scene as the GPU draws it.
+
+use super::instanced::Traced;
+use super::{Footprint, Hit, Ray};
+use crate::camera::Camera;
+use crate::scene::Scene;
+
+/// The voxel and face under pixel (x, y) of a `size` view, with the voxel in
+/// world coordinates: the one CPU pick that the window's mouse and replay's
+/// `click` share.
+pub fn pick(scene: &Scene, camera: &Camera, size: (u32, u32), x: u32, y: u32) -> Result<Option<Hit>, GaveUp> {
+    let basis = camera.basis(size.0, size.1, scene.origin());
+    let (origin, dir) = basis.ray(x, y);
+    let hit = Traced::of(scene).trace(&Ray::new(origin, dir), Footprint::EXACT);
+    if hit.gave_up() {
+        return Err(GaveUp { iterations: hit.iterations });
+    }
+    Ok(hit.is_hit().then(|| Hit { voxel: hit.voxel + scene.origin(), ..hit }))
+}
+
+/// [`pick`], and where it finds no voxel and `ground` is on, the ground:
+/// the cell under the plane y = 0 where the pixel's ray, coming down from
+/// above it, crosses it (value 0, normal +y: Attach places on (x, 0, z)).
+/// The ground of an empty scene is what a first click builds on.
+pub fn pick_with_ground(
+    scene: &Scene,
+    camera: &Camera,
+    size: (u32, u32),
+    (x, y): (u32, u32),
+    ground: bool,
+) -> Result<Option<Hit>, GaveUp> {
+    match pick(scene, camera, size, x, y)? {
+        Some(hit) => Ok(Some(hit)),
+        None if ground => Ok(ground_pick(camera, size, x, y)),
+        None => Ok(None),
+    }
+}
+
+/// The ground cell under pixel (x, y), if its ray comes down through y = 0.
+fn ground_pick(camera: &Camera, size: (u32, u32), x: u32, y: u32) -> Option<Hit> {
+    let (origin, dir) = camera.basis(size.0, size.1, glam::IVec3::ZERO).ray(x, y);
+    let (origin, dir) = (origin.as_dvec3(), dir.as_dvec3());
+    if origin.y <= 0.0 || dir.y >= 0.0 {
+        return None;
+    }
+    let at = origin + dir * (-origin.y / dir.y);
+    let limit = f64::from(crate::scene::octree::WORLD_LIMIT - 1);
+    if !(at.x.abs() < limit && at.z.abs() < limit) {
+        return None;
+    }
+    let voxel = glam::IVec3::new(at.x.floor() as i32, -1, at.z.floor() as i32);
+    Some(Hit { value: 0, voxel, normal: glam::IVec3::Y, ..Hit::default() })
+}
+
+/// A pick whose ray ran out of iterations: what lies under the pixel is
+/// unknown, which is not the same as nothing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("the ray under the cursor gave up after {iterations} steps without reaching a voxel or leaving the scene")]
+pub struct GaveUp {
+    pub iterations: u32,
+}
