@@ -312,8 +312,8 @@ impl Editor {
                 return Ok(false);
             }
             ObjectLine::New(name) => {
-                let (edits, id) = self.objects()?.created(name)?;
-                (edits, Picks::Transform(id))
+                let (model, change, id) = self.objects()?.created(name)?;
+                (vec![Edit::AddModel(Box::new(model)), Edit::Graph(Box::new(change))], Picks::Transform(id))
             }
             line => self.picked_object_edits(line)?,
         };

@@ -643,10 +643,10 @@ impl Objects {
         Ok((model, change))
     }
 
-    /// The edits that make an empty object named `name` in the top group
-    /// (an empty model of one cell, its shape and transform), and the new
-    /// transform's id.
-    pub fn created(&self, name: &str) -> Result<(Vec<crate::edit::Edit>, u32), EditError> {
+    /// An empty object named `name` in the top group: the empty model of
+    /// one cell to store, the change that adds its shape and transform, and
+    /// the new transform's id.
+    pub fn created(&self, name: &str) -> Result<(Model, GraphChange, u32), EditError> {
         let graph = self.graph.as_ref().ok_or_else(|| EditError::Brush(NO_GRAPH.to_owned()))?;
         let mut group = graph
             .nodes
@@ -681,10 +681,7 @@ impl Objects {
         }
         let empty = Model { size: [1, 1, 1], tree: Octree::default() };
         let change = GraphChange { nodes: vec![group, transform, shape], ..GraphChange::default() };
-        Ok((
-            vec![crate::edit::Edit::AddModel(Box::new(empty)), crate::edit::Edit::Graph(Box::new(change))],
-            transform_id,
-        ))
+        Ok((empty, change, transform_id))
     }
 
     /// The change that takes object `index` out of its group (its nodes go
