@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use egui_file::{FileDialog, State};
 
-use super::ui::DialogKind;
+use super::dialog_kind::DialogKind;
 
 /// Recent folders shown.
 const FOLDERS: usize = 6;

@@ -11,7 +11,7 @@ use winit::event_loop::ActiveEventLoop;
 
 use super::App;
 use super::browser::Browser;
-use super::ui::DialogKind;
+use super::dialog_kind::DialogKind;
 
 /// A dialog that answers faster than this never showed itself: nobody
 /// picks or cancels a file that fast.

@@ -15,10 +15,10 @@ use octovox::scene::Scene;
 use octovox::journal::{Checks, FileStamp};
 use octovox::script::Command::Load;
 
+use super::dialog_kind::DialogKind;
 use super::document::Loading;
 use super::gesture::Gesture;
 use super::journal::{Found, JournalStart, classify};
-use super::ui::DialogKind;
 use super::{App, Choice, Pending, camera_control, first_used_color};
 
 impl App {

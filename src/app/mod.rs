@@ -20,6 +20,7 @@ mod camera_control;
 mod capture;
 mod clock;
 mod command;
+mod dialog_kind;
 mod document;
 mod egui_layers;
 mod file_dialog;
@@ -63,13 +64,14 @@ use octovox::trace::pick;
 use crate::cli::WindowArgs;
 use clock::FrameClock;
 pub use command::{Choice, Command, Nudge, Pending, StrokePhase};
+use dialog_kind::DialogKind;
 use document::Document;
 use egui_layers::EguiLayers;
 use gesture::{Gesture, Stroke};
 use input::Input;
 use preview::Hover;
 use state::{EditorState, Mode, Pick, Tool};
-use ui::{DialogKind, Readouts, UiState};
+use ui::{Readouts, UiState};
 
 /// Where screenshots and the journal of an untitled scene go, relative to
 /// the working directory.
