@@ -1,16 +1,13 @@
-//! `octovox bench build|edit|render` (and `effects`, in `bench_effects`): the numbers the issues ask for,
-//! printed and written to `--out` (target/bench/ unless told; the committed
-//! tables are docs/bench/) as markdown and JSON.
+//! `octovox bench build|edit|render`, and what every bench shares: the
+//! models, the report header, the median.
 
 use std::path::{Path, PathBuf};
-use std::process::ExitCode;
 use std::time::Instant;
 
 use anyhow::Context;
 use glam::IVec3;
 use serde::Serialize;
 
-use crate::cli::{BenchArgs, BenchKind};
 use octovox::camera::Camera;
 use octovox::gpu::Renderer;
 use octovox::io::mesh::{DenseVoxels, MESH_COLOR, UpAxis, load_obj_triangles, voxelize_dense};
@@ -85,33 +82,6 @@ pub(super) fn median(mut samples: Vec<f64>) -> f64 {
     samples[samples.len() / 2]
 }
 
-pub fn run(args: &BenchArgs) -> anyhow::Result<ExitCode> {
-    if args.lod > 0.0 && args.what != BenchKind::Render {
-        anyhow::bail!("--lod is for `bench render`; `bench quality` measures several levels of detail itself");
-    }
-    let (markdown, json) = match args.what {
-        BenchKind::Build => bench_build(args.quick)?,
-        BenchKind::Edit => bench_edit(args.quick)?,
-        BenchKind::Render => bench_render(args.quick, args.lod)?,
-        BenchKind::Effects => super::bench_effects::bench_effects(args.quick)?,
-        BenchKind::Quality => super::bench_quality::bench_quality(args.quick, &args.out)?,
-        BenchKind::Scale => super::bench_scale::bench_scale(args.quick)?,
-        BenchKind::Scene => super::bench_scene::bench_scene(args.quick)?,
-    };
-    say!("{markdown}")?;
-    let mut name = format!("{:?}", args.what).to_lowercase();
-    if args.lod > 0.0 {
-        // Beside the exact table, not over it.
-        name += &format!("-lod{}", args.lod);
-    }
-    std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
-    for (ext, text) in [("md", markdown), ("json", json)] {
-        let path = args.out.join(format!("{name}.{ext}"));
-        std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
-    }
-    Ok(ExitCode::SUCCESS)
-}
-
 pub(super) fn header(title: &str) -> String {
     format!(
         "# {title}\n\nMeasured by `octovox bench` on {} ({} cores), {}.\n\n",
@@ -135,7 +105,7 @@ struct BuildRow {
     report_build_ms: f64,
 }
 
-fn bench_build(quick: bool) -> anyhow::Result<(String, String)> {
+pub(super) fn bench_build(quick: bool) -> anyhow::Result<(String, String)> {
     let mut rows = Vec::new();
     for model in &MODELS {
         let source = source(model)?;
@@ -194,7 +164,7 @@ struct EditRow {
     cells_recorded: usize,
 }
 
-fn bench_edit(quick: bool) -> anyhow::Result<(String, String)> {
+pub(super) fn bench_edit(quick: bool) -> anyhow::Result<(String, String)> {
     let model = octovox::io::vox::load_vox_file(&assets().join("vox/seed/teapot256.vox"), 0)?;
     let mut tree = Octree::from_voxels(&model.voxels)?;
     tree.pool_mut().flush();
@@ -271,7 +241,7 @@ struct RenderRow {
     report_grid_over_svo: f64,
 }
 
-fn bench_render(quick: bool, lod: f32) -> anyhow::Result<(String, String)> {
+pub(super) fn bench_render(quick: bool, lod: f32) -> anyhow::Result<(String, String)> {
     let (width, height) = if quick { (425, 225) } else { (1700, 900) };
     let mut renderer = Renderer::headless().context("bench render needs a GPU (lavapipe works)")?;
     let mut rows = Vec::new();

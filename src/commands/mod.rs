@@ -14,6 +14,7 @@ mod bench_effects;
 mod bench_quality;
 mod bench_scale;
 mod bench_scene;
+mod benches;
 mod convert;
 mod export;
 mod import;
@@ -43,7 +44,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Some(Command::Recover { file, output, force }) => recover::run(&file, &output, force),
         Some(Command::Export { file, output, scale, frame, force }) => export::run(&file, &output, scale, frame, force),
         Some(Command::Render(args)) => render::run(&args),
-        Some(Command::Bench(args)) => bench::run(&args),
+        Some(Command::Bench(args)) => benches::run(&args),
         Some(Command::Replay { scripts, cpu, force }) => replay::run(&scripts, cpu, force, update_images()),
     }
 }
