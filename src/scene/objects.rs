@@ -610,36 +610,18 @@ impl Objects {
         let target = self.maps[index];
         let mut cells = HashMap::new();
         for &k in &all {
-            let map = self.maps[k];
-            self.models[self.objects[k].placement.model].tree.for_each_solid_cell(|min, size, value| {
-                for offset in cube_cells(size) {
-                    cells.insert(target.invert(map.apply(min + offset)), value);
-                }
-            });
+            let Some(world) = self.world_box(k) else { continue };
+            for (at, value) in self.placed(k, world) {
+                cells.insert(target.invert(at), value);
+            }
         }
         let voxels: Vec<(IVec3, u8)> = cells.into_iter().collect();
         let tree = Octree::from_voxels(&voxels).map_err(|e| EditError::Brush(e.to_string()))?;
         let model = Model { size: self.models[self.objects[index].placement.model].size, tree };
         let mut change = self.made_unique(index, self.models.len())?;
-        let mut groups: Vec<Node> = Vec::new();
-        for &k in others {
-            let own = self.transform_node(k)?.id;
-            let parent = self.parent_group(own)?;
-            let at = groups.iter().position(|g| g.id == parent.id).unwrap_or_else(|| {
-                groups.push(parent.clone());
-                groups.len() - 1
-            });
-            if let NodeKind::Group { children } = &mut groups[at].kind {
-                children.retain(|&c| c != own);
-            }
-            change.remove.push(own);
-            let shape = self.objects[k].shape_node;
-            let kept = self.objects.iter().enumerate().any(|(i, o)| o.shape_node == shape && !others.contains(&i));
-            if !kept && !change.remove.contains(&shape) {
-                change.remove.push(shape);
-            }
-        }
-        change.nodes.extend(groups);
+        let gone = self.deleted_all(others)?;
+        change.nodes.extend(gone.nodes);
+        change.remove.extend(gone.remove);
         Ok((model, change))
     }
 
@@ -687,18 +669,32 @@ impl Objects {
     /// The change that takes object `index` out of its group (its nodes go
     /// too; its model stays stored).
     pub fn deleted(&self, index: usize) -> Result<GraphChange, EditError> {
-        let own = self.transform_node(index)?;
-        let mut group = self.parent_group(own.id)?.clone();
-        if let NodeKind::Group { children } = &mut group.kind {
-            children.retain(|&c| c != own.id);
+        self.deleted_all(&[index])
+    }
+
+    /// The change that takes objects `indices` out of their groups, with
+    /// their shapes where no other object shows them.
+    fn deleted_all(&self, indices: &[usize]) -> Result<GraphChange, EditError> {
+        let mut change = GraphChange::default();
+        for &k in indices {
+            let own = self.transform_node(k)?.id;
+            let parent = self.parent_group(own)?;
+            let at = change.nodes.iter().position(|g| g.id == parent.id).unwrap_or_else(|| {
+                change.nodes.push(parent.clone());
+                change.nodes.len() - 1
+            });
+            if let NodeKind::Group { children } = &mut change.nodes[at].kind {
+                children.retain(|&c| c != own);
+            }
+            change.remove.push(own);
+            let shape = self.objects[k].shape_node;
+            let shown_elsewhere =
+                self.objects.iter().enumerate().any(|(i, o)| o.shape_node == shape && !indices.contains(&i));
+            if !shown_elsewhere && !change.remove.contains(&shape) {
+                change.remove.push(shape);
+            }
         }
-        let shape = self.objects[index].shape_node;
-        let shared = self.objects.iter().filter(|o| o.shape_node == shape).count() > 1;
-        let mut remove = vec![own.id];
-        if !shared {
-            remove.push(shape);
-        }
-        Ok(GraphChange { nodes: vec![group], remove, ..GraphChange::default() })
+        Ok(change)
     }
 
     /// The group that holds transform `id`.
@@ -807,11 +803,6 @@ impl GraphChange {
             + self.layers.iter().map(|l| 32 + attributes(&l.attributes)).sum::<usize>()
             + 4 * (self.remove.len() + self.remove_layers.len())
     }
-}
-
-/// The offsets of the cells of a cube `size` cells wide.
-fn cube_cells(size: i32) -> impl Iterator<Item = IVec3> {
-    (0..size).flat_map(move |z| (0..size).flat_map(move |y| (0..size).map(move |x| IVec3::new(x, y, z))))
 }
 
 /// Min corners of the boxes of at most [`COMPOSE_BOX`] a side that tile `lo..=hi`.
