@@ -338,17 +338,12 @@ impl Renderer {
 
     fn encode_trace(&mut self, encoder: &mut wgpu::CommandEncoder, preview: &Preview) -> Result<(), GpuError> {
         let Preview { scene, camera, size, view, lod, highlight, kernel } = *preview;
-        // A scene of objects runs the kernels with the instance walk.
-        let kernel = match kernel {
-            Kernel::Trace { mode, shadows, lod, .. } => {
-                Kernel::Trace { mode, shadows, lod, instances: self.buffers.instance_nodes.is_some() }
-            }
-            Kernel::Floor => Kernel::Floor,
-        };
+        // A scene drawn as instances runs the kernels with the instance walk.
+        let instances = self.buffers.instance_nodes.is_some();
         let tree = scene.drawn();
         let gpu = &self.gpu;
         self.pass.resize(gpu, &self.buffers, size, self.hit_records)?;
-        self.pass.ensure_kernel(gpu, kernel)?;
+        self.pass.ensure_kernel(gpu, kernel, instances)?;
         let basis = camera.basis(size.0.max(1), size.1.max(1), tree.origin());
         let uniforms = FrameUniforms {
             hit_records: u32::from(self.hit_records),
@@ -358,7 +353,7 @@ impl Renderer {
         self.records_written = self.hit_records;
         self.shown = Shown::Trace;
         self.pass.prepare(&gpu.device, &gpu.queue, &self.buffers, &uniforms);
-        self.pass.encode(encoder, kernel, self.timer.pass_writes());
+        self.pass.encode(encoder, (kernel, instances), self.timer.pass_writes());
         self.timer.resolve(encoder);
         Ok(())
     }

@@ -68,10 +68,12 @@ impl SceneBuffers {
         }
     }
 
-    /// Flushes the pool's dirty ranges to the GPU: only changed slots are
-    /// written; a pool that outgrew its buffer gets a bigger one, filled by a
-    /// GPU-side copy of the old contents, its headroom cut to what one
-    /// binding of `max_bytes` allows.
+    /// Sends what changed to the GPU (see [`Scene::take_uploads_within`]):
+    /// for one drawn octree only its changed slots, a pool that outgrew its
+    /// buffer getting a bigger one, filled by a GPU-side copy of the old
+    /// contents, its headroom cut to what one binding of `max_bytes` allows;
+    /// for a scene drawn as instances its models' changed slots and the
+    /// instance words that changed, in new buffers when the layout changed.
     ///
     /// # Errors
     /// [`PoolTooLarge`] when the pool does not fit one buffer binding of

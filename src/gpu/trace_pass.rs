@@ -23,9 +23,8 @@ const FLOOR_WGSL: &str = include_str!("../../shaders/floor.wgsl");
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kernel {
     /// The scene, traced (the SVO with its beam prepass, or the grid);
-    /// `lod`: the SVO kernels with the level-of-detail test compiled in;
-    /// `instances`: with the instance walk (a scene of objects).
-    Trace { mode: TraceMode, shadows: bool, lod: bool, instances: bool },
+    /// `lod`: the SVO kernels with the level-of-detail test compiled in.
+    Trace { mode: TraceMode, shadows: bool, lod: bool },
     /// Everything but the traversal: the floor a frame cannot go below.
     Floor,
 }
@@ -33,7 +32,7 @@ pub enum Kernel {
 impl From<&RenderSettings> for Kernel {
     fn from(settings: &RenderSettings) -> Kernel {
         let lod = settings.mode == TraceMode::Svo && settings.lod > 0.0;
-        Kernel::Trace { mode: settings.mode, shadows: settings.shadows, lod, instances: false }
+        Kernel::Trace { mode: settings.mode, shadows: settings.shadows, lod }
     }
 }
 
@@ -160,12 +159,13 @@ impl TracePass {
     }
 
     /// Compiles the SVO kernels `kernel` needs if they are not compiled yet
-    /// (a frame with `--lod` above 0, a scene of objects).
+    /// (a frame with `--lod` above 0; `instances`: a scene drawn as
+    /// instances, whose kernels have the instance walk).
     ///
     /// # Errors
     /// A kernel that does not compile.
-    pub fn ensure_kernel(&mut self, gpu: &GpuContext, kernel: Kernel) -> Result<(), GpuError> {
-        let Kernel::Trace { mode: TraceMode::Svo, lod, instances, .. } = kernel else { return Ok(()) };
+    pub fn ensure_kernel(&mut self, gpu: &GpuContext, kernel: Kernel, instances: bool) -> Result<(), GpuError> {
+        let Kernel::Trace { mode: TraceMode::Svo, lod, .. } = kernel else { return Ok(()) };
         if !self.svo_kernels.contains_key(&(lod, instances)) {
             let kernels = svo_kernels(&gpu.device, &self.pipeline_layout, &self.svo, (lod, instances))?;
             self.svo_kernels.insert((lod, instances), kernels);
@@ -286,11 +286,12 @@ impl TracePass {
 
     /// Records the dispatches: for the SVO the sky (the floor kernel), the
     /// beam prepass, the trace's size and the trace of the listed tiles; for
-    /// the grid its per-pixel kernel; or the floor alone.
+    /// the grid its per-pixel kernel; or the floor alone. `instances`: the
+    /// scene is drawn as instances (as for [`TracePass::ensure_kernel`]).
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        kernel: Kernel,
+        (kernel, instances): (Kernel, bool),
         timestamps: Option<wgpu::ComputePassTimestampWrites<'_>>,
     ) {
         if matches!(kernel, Kernel::Trace { mode: TraceMode::Svo, .. }) {
@@ -301,7 +302,7 @@ impl TracePass {
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("trace"), timestamp_writes: timestamps });
         pass.set_bind_group(0, &self.bind_group, &[]);
         let (mode, shadows, key) = match kernel {
-            Kernel::Trace { mode, shadows, lod, instances } => (mode, shadows, (lod, instances)),
+            Kernel::Trace { mode, shadows, lod } => (mode, shadows, (lod, instances)),
             Kernel::Floor => {
                 self.encode_floor(&mut pass);
                 return;

@@ -246,13 +246,6 @@ impl GpuCopy {
         *self = GpuCopy::default();
     }
 
-    /// Bytes the GPU holds for the scene: the pool regions and the instance words.
-    pub fn bytes(&self) -> u64 {
-        u64::from(self.node_slots) * NODE_BYTES
-            + u64::from(self.brick_slots) * BRICK_BYTES
-            + 4 * self.words.len() as u64
-    }
-
     /// Takes every model's changed slots and the instance words that differ
     /// from those sent, for a scene whose local cells start at `origin`. A
     /// model that outgrew its region lays every model out afresh, each with
@@ -297,6 +290,12 @@ impl GpuCopy {
         u64::from(self.node_slots) * NODE_BYTES
     }
 
+    /// Where a model's nodes and bricks start in the pool buffer, in bytes.
+    fn offsets(&self, region: &ModelRegion) -> (u64, u64) {
+        let nodes = u64::from(region.node_base) * NODE_BYTES;
+        (nodes, self.node_region_bytes() + u64::from(region.brick_base) * BRICK_BYTES)
+    }
+
     /// Gives each model a region of half again its slots.
     fn lay_out(&mut self, objects: &Objects, max_bytes: u64) -> Result<(), PoolTooLarge> {
         let room = |n: usize| (n + n / 2).max(16);
@@ -331,8 +330,8 @@ impl GpuCopy {
         for (model, region) in objects.models.iter_mut().zip(&self.regions) {
             let pool = model.tree.pool_mut();
             pool.flush();
-            upload.pool.push((u64::from(region.node_base) * NODE_BYTES, pool.nodes.bytes().to_vec()));
-            let bricks = self.node_region_bytes() + u64::from(region.brick_base) * BRICK_BYTES;
+            let (nodes, bricks) = self.offsets(region);
+            upload.pool.push((nodes, pool.nodes.bytes().to_vec()));
             upload.pool.push((bricks, pool.bricks.bytes().to_vec()));
         }
     }
@@ -342,8 +341,7 @@ impl GpuCopy {
         for (model, region) in objects.models.iter_mut().zip(&self.regions) {
             let pool = model.tree.pool_mut();
             let changes = pool.flush();
-            let nodes = u64::from(region.node_base) * NODE_BYTES;
-            let bricks = self.node_region_bytes() + u64::from(region.brick_base) * BRICK_BYTES;
+            let (nodes, bricks) = self.offsets(region);
             let pool = model.tree.pool();
             upload.pool.extend(changes.nodes.ranges(&pool.nodes).map(|(at, bytes)| (nodes + at, bytes.to_vec())));
             upload.pool.extend(changes.bricks.ranges(&pool.bricks).map(|(at, bytes)| (bricks + at, bytes.to_vec())));

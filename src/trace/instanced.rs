@@ -58,7 +58,9 @@ impl<'a> Traced<'a> {
         };
         let mut best: Option<Crossing> = None;
         let (mut iterations, mut gave_up) = (0u32, false);
-        let mut stack: Vec<(usize, f32)> = Vec::with_capacity(BVH_STACK);
+        // The farther children still to visit, with their entry t.
+        let mut stack = [(0usize, 0f32); BVH_STACK];
+        let mut top = 0;
         let mut next = entry_t(table, 0, ray, f32::MAX).map(|t| (0, t));
         while let Some((i, _)) = next {
             let node = table.nodes[i];
@@ -73,23 +75,29 @@ impl<'a> Traced<'a> {
                     best = Some(scene_crossing(instance, index, c));
                 }
             } else {
-                // The right child is the node after the left one's subtree.
+                // The right child is the node after the left one's subtree;
+                // the nearer goes first, the left one at equal t, as on the GPU.
                 let (left, right) = (i + 1, table.nodes[i + 1].skip as usize);
                 let until = reach(best);
-                let mut children: Vec<(usize, f32)> =
-                    [left, right].into_iter().filter_map(|c| entry_t(table, c, ray, until).map(|t| (c, t))).collect();
-                // Nearer first; the left one first at equal t, as on the GPU.
-                children.sort_by(|a, b| b.1.total_cmp(&a.1).then(b.0.cmp(&a.0)));
-                if let Some(near) = children.pop() {
-                    stack.extend(children);
-                    next = Some(near);
+                let (t_left, t_right) = (entry_t(table, left, ray, until), entry_t(table, right, ray, until));
+                let left_first = t_left.unwrap_or(f32::MAX) <= t_right.unwrap_or(f32::MAX);
+                let (near, far) =
+                    if left_first { ((left, t_left), (right, t_right)) } else { ((right, t_right), (left, t_left)) };
+                // A farther child that is entered means a nearer one is too.
+                if let Some(t_far) = far.1 {
+                    stack[top] = (far.0, t_far);
+                    top += 1;
+                }
+                if let Some(t_near) = near.1 {
+                    next = Some((near.0, t_near));
                     continue;
                 }
             }
             next = None;
-            while let Some((node, t)) = stack.pop() {
-                if t <= reach(best) {
-                    next = Some((node, t));
+            while top > 0 {
+                top -= 1;
+                if stack[top].1 <= reach(best) {
+                    next = Some(stack[top]);
                     break;
                 }
             }
