@@ -335,15 +335,6 @@ impl Editor {
         let index = self.picked_object()?;
         let objects = self.objects()?;
         let graph = |change| vec![Edit::Graph(Box::new(change))];
-        let reshapes =
-            matches!(line, ObjectLine::Move(_) | ObjectLine::Rotate(_) | ObjectLine::Delete | ObjectLine::Regroup(..));
-        let merges_locked = match line {
-            ObjectLine::Merge(others) => others.iter().any(|o| self.object_named(o).is_ok_and(|k| objects.locked(k))),
-            _ => false,
-        };
-        if ((reshapes || matches!(line, ObjectLine::Merge(_))) && objects.locked(index)) || merges_locked {
-            return Err(EditorError::Object("a locked object stays as it is: `object unlock` first".to_owned()));
-        }
         Ok(match line {
             ObjectLine::Move(by) => (graph(objects.moved(index, *by)?), Picks::Same),
             ObjectLine::Rotate(axis) => (graph(objects.rotated(index, *axis)?), Picks::Same),

@@ -228,6 +228,14 @@ impl Objects {
         self.transform_node(index).is_ok_and(|node| graph::is_set(&node.attributes, "_lock"))
     }
 
+    /// Refuses a change to any of objects `indices` that is locked.
+    fn unlocked(&self, indices: &[usize]) -> Result<(), EditError> {
+        match indices.iter().find(|&&k| self.locked(k)) {
+            Some(k) => Err(EditError::Brush(format!("object {k} is locked and stays as it is: `object unlock` first"))),
+            None => Ok(()),
+        }
+    }
+
     /// The visible object drawn at world cell `at` (the last in walk order
     /// holding a voxel there), if any.
     pub fn owner_at(&self, at: IVec3) -> Option<usize> {
@@ -266,9 +274,7 @@ impl Objects {
             .ok_or_else(|| EditError::Brush(format!("there is no object {index}")))?
             .placement
             .model;
-        if self.locked(index) {
-            return Err(EditError::Brush(format!("object {index} is locked (`object unlock` lets it be edited)")));
-        }
+        self.unlocked(&[index])?;
         let local = self.maps[index].invert_shape(shape);
         let patch = self.models[model].tree.apply_brush(&local, op)?;
         self.recompose_model(tree, model, local.bounds())?;
@@ -435,6 +441,7 @@ impl Objects {
         index: usize,
         f: impl Fn(Transform, Rotation) -> Transform,
     ) -> Result<GraphChange, EditError> {
+        self.unlocked(&[index])?;
         let mut node = self.transform_node(index)?.clone();
         let k = self.shown_keyframe(&mut node)?;
         let NodeKind::Transform { frames, .. } = &mut node.kind else { unreachable!("checked by shown_keyframe") };
@@ -453,6 +460,7 @@ impl Objects {
         if index == target || target >= self.objects.len() {
             return Err(EditError::Brush("an object goes before or after another object".to_owned()));
         }
+        self.unlocked(&[index])?;
         let mut node = self.transform_node(index)?.clone();
         let target_id = self.transform_node(target)?.id;
         let delta = self.parent_placement(target)?.inverse().compose(self.parent_placement(index)?);
@@ -597,6 +605,7 @@ impl Objects {
                 self.objects.len()
             )));
         }
+        self.unlocked(&all)?;
         if let Some(&hidden) = all.iter().find(|&&k| self.objects[k].hidden) {
             // Its voxels would show once part of a shown model.
             return Err(EditError::Brush(format!("object {hidden} is hidden: show it (or its layer) to merge it")));
@@ -675,6 +684,7 @@ impl Objects {
     /// The change that takes objects `indices` out of their groups, with
     /// their shapes where no other object shows them.
     fn deleted_all(&self, indices: &[usize]) -> Result<GraphChange, EditError> {
+        self.unlocked(indices)?;
         let mut change = GraphChange::default();
         for &k in indices {
             let own = self.transform_node(k)?.id;
