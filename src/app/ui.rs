@@ -544,10 +544,7 @@ fn merge_row(ui: &mut egui::Ui, objects: &Objects, merge: &mut Vec<usize>, out: 
 fn layers_panel(ui: &mut egui::Ui, objects: &Objects, picking: &mut Option<(u32, [u8; 3])>, out: &mut Vec<Command>) {
     use octovox::script::{Command as Line, LayerLine};
     let layers = objects.layer_list();
-    if layers.is_empty() {
-        return;
-    }
-    let active = objects.new_layer.filter(|id| layers.iter().any(|l| l.id == *id)).unwrap_or(layers[0].id);
+    let Some(active) = objects.layer_for_new() else { return };
     egui::CollapsingHeader::new(format!("Layers ({})", layers.len())).default_open(true).show(ui, |ui| {
         for layer in layers {
             ui.horizontal(|ui| {

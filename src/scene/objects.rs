@@ -648,8 +648,7 @@ impl Objects {
         let next = graph.nodes.iter().map(|n| n.id).max().unwrap_or(0);
         let ids = next.checked_add(1).zip(next.checked_add(2));
         let (transform_id, shape_id) = ids.ok_or_else(|| EditError::Brush("no node ids are left".to_owned()))?;
-        let active = self.new_layer.filter(|id| graph.layers.iter().any(|l| l.id == *id));
-        let layer = active.or(graph.layers.first().map(|l| l.id)).unwrap_or(u32::MAX);
+        let layer = self.layer_for_new().unwrap_or(u32::MAX);
         let attributes = [("_name".to_owned(), name.to_owned())].into();
         let transform = Node {
             id: transform_id,
@@ -730,6 +729,13 @@ impl Objects {
     /// The layers as the graph holds them.
     pub fn layer_list(&self) -> &[Layer] {
         self.graph.as_ref().map_or(&[], |g| &g.layers)
+    }
+
+    /// The layer `object new` puts objects on: the one made active, while it
+    /// exists, else the first; `None` without layers.
+    pub fn layer_for_new(&self) -> Option<u32> {
+        let layers = self.layer_list();
+        self.new_layer.filter(|id| layers.iter().any(|l| l.id == *id)).or(layers.first().map(|l| l.id))
     }
 
     /// Makes layer `id` the one new objects go on.
