@@ -26,7 +26,6 @@ pub const ROW_TILES: u64 = 64;
 /// docs/traversal.md).
 pub const FLOOR_ROW: u32 = 64;
 
-/// Twin of `FrameUniforms` in `shaders/common.wgsl`.
 /// The colour highlighted voxels (the brush's reach, the selection) are
 /// mixed toward, and by how much.
 pub const HIGHLIGHT_TINT: [f32; 3] = [1.0, 0.85, 0.2];
@@ -46,6 +45,7 @@ pub struct GroundGrid {
     pub step: u32,
 }
 
+/// Twin of `FrameUniforms` in `shaders/common.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct FrameUniforms {
@@ -100,8 +100,8 @@ impl FrameUniforms {
     ) -> FrameUniforms {
         let local = highlight.map(|(lo, hi)| (lo - tree.origin(), hi - tree.origin()));
         let (lo, hi) = local.unwrap_or((IVec3::ZERO, IVec3::NEG_ONE));
-        // A scene of objects is traced from its instance tree; the composed
-        // tree is not on the GPU.
+        // A scene drawn as instances is traced from its instance tree; the
+        // composed tree is not on the GPU.
         let instanced = buffers.instance_nodes.is_some();
         FrameUniforms {
             eye: basis.eye.into(),
