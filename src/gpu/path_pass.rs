@@ -6,9 +6,9 @@
 //! The kernel is compiled per effect set and per scene kind (override
 //! constants of `shaders/path.wgsl` and `shaders/instances.wgsl`) on worker
 //! threads and kept, so a diffuse-only scene runs a kernel without metal,
-//! glass or emitter code, a scene of one model one without the instance
-//! walk, and a scene that gains an effect runs the kernel with everything
-//! (the same image) until its own is compiled.
+//! glass or emitter code, a scene not drawn as instances one without the
+//! instance walk, and a scene that gains an effect runs the kernel with
+//! every effect (the same image) until its own is compiled.
 
 use std::collections::HashMap;
 use std::sync::mpsc;
@@ -45,7 +45,7 @@ fn thread_gone() -> GpuError {
 }
 
 /// What a path kernel is compiled for: the effects, and whether the scene
-/// is of objects (the instance walk compiled in; it also draws one model).
+/// is drawn as instances (the instance walk compiled in).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 struct KernelKey {
     effects: Effects,
