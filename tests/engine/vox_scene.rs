@@ -259,11 +259,7 @@ fn an_edit_goes_into_the_model_of_the_object_and_every_reference_shows_it() {
     // at scene (−2, −2, 0) = world (−2, 0, 2). Put a voxel on top of it.
     // (`dot_vox` counts colour indices from 0: its 11 is the file's 12.)
     assert_eq!(editor.scene.voxel(IVec3::new(-2, 0, 2)), 12);
-    let script =
-        octovox::script::parse_script(std::path::Path::new("t.ovr"), "object a\ncolor 7\nplace -2 1 2").unwrap();
-    for line in &script.lines {
-        editor.run(&line.command).unwrap();
-    }
+    run(&mut editor, "object a\ncolor 7\nplace -2 1 2").unwrap();
     assert_eq!(editor.scene.solid_voxels(), before + 2, "both placements show the new voxel");
     let saved_once = saved(&editor.scene);
     let parsed = dot_vox::load_bytes(&saved_once).unwrap();
@@ -285,10 +281,7 @@ fn a_model_that_grows_on_one_side_keeps_its_voxels_where_they_were() {
     editor.set_scene(load(&bytes));
     let lo = editor.scene.objects().unwrap().world_box(1).unwrap().0;
     let place = format!("place {} {} {}", lo.x - 1, lo.y - 1, lo.z - 1);
-    for line in ["object 1", "brush box 3 3 3", place.as_str()] {
-        let script = octovox::script::parse_script(std::path::Path::new("t.ovr"), line).unwrap();
-        editor.run(&script.lines[0].command).unwrap();
-    }
+    run(&mut editor, &format!("object 1\nbrush box 3 3 3\n{place}")).unwrap();
     let drawn = editor.scene.voxels();
     let again = saved(&editor.scene);
     let grown = &dot_vox::load_bytes(&again).unwrap().models[1];
@@ -342,10 +335,7 @@ fn a_model_grown_past_256_is_saved_in_pieces_that_load_back_as_drawn() {
     data.write_vox(&mut bytes).unwrap();
     let mut editor = Editor::default();
     editor.set_scene(load(&bytes));
-    let script = "object a\ncolor 7\nplace 300 0 2\nplace -250 6 -270\nplace 1 1 1";
-    for line in &octovox::script::parse_script(std::path::Path::new("t.ovr"), script).unwrap().lines {
-        editor.run(&line.command).unwrap();
-    }
+    run(&mut editor, "object a\ncolor 7\nplace 300 0 2\nplace -250 6 -270\nplace 1 1 1").unwrap();
     let drawn = editor.scene.voxels();
     let again = saved(&editor.scene);
     let parsed = dot_vox::load_bytes(&again).unwrap();
@@ -392,14 +382,7 @@ fn a_hundred_thousand_objects_load_and_edit() {
     // Object 0 shows model 0; the cell beside its marked corner is empty in every placement.
     let visible = (0..100_000).filter(|k| k % 3 == 0 && k % 11 != 5).count() as u64;
     let corner = objects.world_box(0).unwrap().1 + IVec3::ONE;
-    let script = octovox::script::parse_script(
-        std::path::Path::new("t.ovr"),
-        &format!("object 0\nplace {} {} {}", corner.x, corner.y, corner.z),
-    )
-    .unwrap();
-    for line in &script.lines {
-        editor.run(&line.command).unwrap();
-    }
+    run(&mut editor, &format!("object 0\nplace {} {} {}", corner.x, corner.y, corner.z)).unwrap();
     assert_eq!(editor.scene.solid_voxels(), before + visible);
     // Drawn as instances: the upload holds every record and a tree of
     // boxes 17 levels deep, and rays through it hit what is composed.
@@ -454,14 +437,7 @@ fn an_ovx_file_keeps_the_objects() {
     let bytes = std::fs::read(assets().join("format/test_groups.vox")).unwrap();
     let mut editor = Editor::default();
     editor.set_scene(load(&bytes));
-    let script = octovox::script::parse_script(
-        std::path::Path::new("t.ovr"),
-        "object 3\nobject hide\nobject 0\nobject move 0 0 9",
-    )
-    .unwrap();
-    for line in &script.lines {
-        editor.run(&line.command).unwrap();
-    }
+    run(&mut editor, "object 3\nobject hide\nobject 0\nobject move 0 0 9").unwrap();
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("groups.ovx");
     octovox::io::save_scene(&path, &editor.scene, Default::default()).unwrap();
@@ -528,12 +504,7 @@ fn a_cut_model_never_gets_an_empty_piece() {
     let mut editor = Editor::default();
     editor.set_scene(load(&bytes));
     // Model cell x = −1 (the pivot is x = 128): the grid grows to 257.
-    for line in &octovox::script::parse_script(std::path::Path::new("t.ovr"), "object a\ncolor 7\nplace -129 0 0")
-        .unwrap()
-        .lines
-    {
-        editor.run(&line.command).unwrap();
-    }
+    run(&mut editor, "object a\ncolor 7\nplace -129 0 0").unwrap();
     let again = saved(&editor.scene);
     let parsed = dot_vox::load_bytes(&again).unwrap();
     // Cut at x = 255, where the model holds nothing: one piece, under a group.
