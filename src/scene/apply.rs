@@ -42,6 +42,10 @@ pub enum EditError {
     Shape(#[from] crate::scene::shape::ShapeError),
     #[error("invalid brush: {0}")]
     Brush(String),
+    /// A change to a scene of objects that cannot be made (no such object
+    /// or layer, a locked object, a file without a scene graph, …).
+    #[error("{0}")]
+    Objects(String),
     #[error("palette index 0 means empty; use remove, or a colour in 1..=255")]
     ZeroColor,
     #[error(transparent)]
@@ -94,7 +98,7 @@ impl Scene {
     /// A scene of objects refuses it: a brush goes into an object's model.
     pub fn apply_brush(&mut self, shape: &Shape, op: Op) -> Result<Patch, EditError> {
         if self.objects.is_some() {
-            return Err(EditError::Brush("the scene has no object to edit: `object new NAME` makes one".to_owned()));
+            return Err(EditError::Objects("the scene has no object to edit: `object new NAME` makes one".to_owned()));
         }
         self.tree.apply_brush(shape, op)
     }
@@ -137,7 +141,8 @@ impl Scene {
     /// composes what it changes; an error when the scene has none.
     fn objects_and_drawn_mut(&mut self) -> Result<(&mut Objects, &mut Octree), EditError> {
         let Scene { tree, objects, .. } = self;
-        let objects = objects.as_deref_mut().ok_or_else(|| EditError::Brush("the scene has no objects".to_owned()))?;
+        let objects =
+            objects.as_deref_mut().ok_or_else(|| EditError::Objects("the scene has no objects".to_owned()))?;
         Ok((objects, tree))
     }
 }

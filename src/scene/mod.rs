@@ -161,7 +161,7 @@ impl Scene {
     pub fn set_new_layer(&mut self, id: u32) -> Result<(), EditError> {
         match &mut self.objects {
             Some(objects) => objects.set_new_layer(id),
-            None => Err(EditError::Brush("the scene has no layers".to_owned())),
+            None => Err(EditError::Objects("the scene has no layers".to_owned())),
         }
     }
 

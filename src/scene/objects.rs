@@ -176,7 +176,7 @@ impl Objects {
         let Some(bounds) = boxes.iter().copied().reduce(|a, b| (a.0.min(b.0), a.1.max(b.1))) else {
             return Ok(Octree::default());
         };
-        let mut tree = Octree::empty_for(bounds.0, bounds.1).map_err(|e| EditError::Brush(e.to_string()))?;
+        let mut tree = Octree::empty_for(bounds.0, bounds.1).map_err(|e| EditError::Objects(e.to_string()))?;
         for index in self.visible() {
             tree.insert_voxels(&self.placed(index, bounds));
         }
@@ -231,7 +231,9 @@ impl Objects {
     /// Refuses a change to any of objects `indices` that is locked.
     fn unlocked(&self, indices: &[usize]) -> Result<(), EditError> {
         match indices.iter().find(|&&k| self.locked(k)) {
-            Some(k) => Err(EditError::Brush(format!("object {k} is locked and stays as it is: `object unlock` first"))),
+            Some(k) => {
+                Err(EditError::Objects(format!("object {k} is locked and stays as it is: `object unlock` first")))
+            }
             None => Ok(()),
         }
     }
@@ -271,7 +273,7 @@ impl Objects {
         let model = self
             .objects
             .get(index)
-            .ok_or_else(|| EditError::Brush(format!("there is no object {index}")))?
+            .ok_or_else(|| EditError::Objects(format!("there is no object {index}")))?
             .placement
             .model;
         self.unlocked(&[index])?;
@@ -287,7 +289,7 @@ impl Objects {
         let inverse = self
             .models
             .get_mut(model)
-            .ok_or_else(|| EditError::Brush(format!("there is no model {model}")))?
+            .ok_or_else(|| EditError::Objects(format!("there is no model {model}")))?
             .tree
             .apply_patch(patch)?;
         if let Some(bounds) = patch.bounds() {
@@ -329,14 +331,14 @@ impl Objects {
     /// Returns the change that undoes it; a change the walk refuses (a
     /// cycle) changes nothing.
     pub fn apply_change(&mut self, tree: &mut Octree, change: &GraphChange) -> Result<GraphChange, EditError> {
-        let graph = self.graph.as_mut().ok_or_else(|| EditError::Brush(NO_GRAPH.to_owned()))?;
+        let graph = self.graph.as_mut().ok_or_else(|| EditError::Objects(NO_GRAPH.to_owned()))?;
         let saved = graph.clone();
         let inverse = change.apply(graph);
         let before = self.drawn();
         if let Err(err) = self.walk(usize::MAX) {
             self.graph = Some(saved);
-            self.walk(usize::MAX).map_err(|e| EditError::Brush(e.to_string()))?;
-            return Err(EditError::Brush(err.to_string()));
+            self.walk(usize::MAX).map_err(|e| EditError::Objects(e.to_string()))?;
+            return Err(EditError::Objects(err.to_string()));
         }
         let after = self.drawn();
         let mut counts: HashMap<(usize, CellMap), i64> = HashMap::new();
@@ -372,9 +374,9 @@ impl Objects {
     /// unless an object still places it.
     pub fn pop_model(&mut self) -> Result<Model, EditError> {
         let last =
-            self.models.len().checked_sub(1).ok_or_else(|| EditError::Brush("there are no models".to_owned()))?;
+            self.models.len().checked_sub(1).ok_or_else(|| EditError::Objects("there are no models".to_owned()))?;
         if self.placements_of(last) > 0 {
-            return Err(EditError::Brush(format!("model {last} is still placed")));
+            return Err(EditError::Objects(format!("model {last} is still placed")));
         }
         Ok(self.models.pop().expect("checked above"))
     }
@@ -382,25 +384,26 @@ impl Objects {
     /// The transform node of object `index` (what moves, turns, hides and
     /// names it).
     pub fn transform_node(&self, index: usize) -> Result<&Node, EditError> {
-        let graph = self.graph.as_ref().ok_or_else(|| EditError::Brush(NO_GRAPH.to_owned()))?;
-        let object = self.objects.get(index).ok_or_else(|| EditError::Brush(format!("there is no object {index}")))?;
+        let graph = self.graph.as_ref().ok_or_else(|| EditError::Objects(NO_GRAPH.to_owned()))?;
+        let object =
+            self.objects.get(index).ok_or_else(|| EditError::Objects(format!("there is no object {index}")))?;
         object
             .transform_node
             .and_then(|id| graph.node(id))
-            .ok_or_else(|| EditError::Brush(format!("object {index} has no transform node")))
+            .ok_or_else(|| EditError::Objects(format!("object {index} has no transform node")))
     }
 
     /// The index of the keyframe of `node` shown now (the one a move or a
     /// turn changes), adding one to a node without any.
     fn shown_keyframe(&self, node: &mut Node) -> Result<usize, EditError> {
         let NodeKind::Transform { frames, .. } = &mut node.kind else {
-            return Err(EditError::Brush(format!("node {} is not a transform", node.id)));
+            return Err(EditError::Objects(format!("node {} is not a transform", node.id)));
         };
         if frames.is_empty() {
             frames.push(graph::Attributes::new());
         }
         let shown =
-            graph::pick_keyframe(frames.iter(), self.frame, node.id).map_err(|e| EditError::Brush(e.to_string()))?;
+            graph::pick_keyframe(frames.iter(), self.frame, node.id).map_err(|e| EditError::Objects(e.to_string()))?;
         Ok(shown.unwrap_or(0))
     }
 
@@ -445,7 +448,7 @@ impl Objects {
         let mut node = self.transform_node(index)?.clone();
         let k = self.shown_keyframe(&mut node)?;
         let NodeKind::Transform { frames, .. } = &mut node.kind else { unreachable!("checked by shown_keyframe") };
-        let own = graph::parse_transform(&frames[k], node.id).map_err(|e| EditError::Brush(e.to_string()))?;
+        let own = graph::parse_transform(&frames[k], node.id).map_err(|e| EditError::Objects(e.to_string()))?;
         // The whole transform is parent · own, so the parent's rotation is whole · own⁻¹.
         let parent = self.objects[index].placement.transform.rotation.times(own.rotation.inverse());
         graph::write_transform(&mut frames[k], f(own, parent));
@@ -458,7 +461,7 @@ impl Objects {
     /// differ by (exact for groups without keyframes of their own).
     pub fn regrouped(&self, index: usize, target: usize, after: bool) -> Result<GraphChange, EditError> {
         if index == target || target >= self.objects.len() {
-            return Err(EditError::Brush("an object goes before or after another object".to_owned()));
+            return Err(EditError::Objects("an object goes before or after another object".to_owned()));
         }
         self.unlocked(&[index])?;
         let mut node = self.transform_node(index)?.clone();
@@ -466,7 +469,7 @@ impl Objects {
         let delta = self.parent_placement(target)?.inverse().compose(self.parent_placement(index)?);
         if let NodeKind::Transform { frames, .. } = &mut node.kind {
             for frame in frames.iter_mut() {
-                let own = graph::parse_transform(frame, node.id).map_err(|e| EditError::Brush(e.to_string()))?;
+                let own = graph::parse_transform(frame, node.id).map_err(|e| EditError::Objects(e.to_string()))?;
                 graph::write_transform(frame, delta.compose(own));
             }
         }
@@ -495,7 +498,7 @@ impl Objects {
         let mut node = self.transform_node(index)?.clone();
         let k = self.shown_keyframe(&mut node)?;
         let NodeKind::Transform { frames, .. } = &node.kind else { unreachable!("checked by shown_keyframe") };
-        let own = graph::parse_transform(&frames[k], node.id).map_err(|e| EditError::Brush(e.to_string()))?;
+        let own = graph::parse_transform(&frames[k], node.id).map_err(|e| EditError::Objects(e.to_string()))?;
         Ok(self.objects[index].placement.transform.compose(own.inverse()))
     }
 
@@ -513,7 +516,7 @@ impl Objects {
     /// The change that puts object `index` on layer `layer`.
     pub fn on_layer(&self, index: usize, layer: u32) -> Result<GraphChange, EditError> {
         if !self.graph.as_ref().is_some_and(|g| g.layers.iter().any(|l| l.id == layer)) {
-            return Err(EditError::Brush(format!("there is no layer {layer}")));
+            return Err(EditError::Objects(format!("there is no layer {layer}")));
         }
         let mut node = self.transform_node(index)?.clone();
         if let NodeKind::Transform { layer: own, .. } = &mut node.kind {
@@ -525,7 +528,7 @@ impl Objects {
     /// The change that sets layer `id`'s attribute `key` (adding the layer
     /// when there is none of that id).
     pub fn layer_with(&self, id: u32, key: &str, value: Option<&str>) -> Result<GraphChange, EditError> {
-        let graph = self.graph.as_ref().ok_or_else(|| EditError::Brush(NO_GRAPH.to_owned()))?;
+        let graph = self.graph.as_ref().ok_or_else(|| EditError::Objects(NO_GRAPH.to_owned()))?;
         let mut layer = graph.layers.iter().find(|l| l.id == id).cloned().unwrap_or(Layer {
             id,
             attributes: graph::Attributes::new(),
@@ -542,16 +545,16 @@ impl Objects {
     /// group: showing the same model (a reference), or `model`. Returns it
     /// and the new transform node's id.
     pub fn duplicated(&self, index: usize, model: Option<usize>) -> Result<(GraphChange, u32), EditError> {
-        let graph = self.graph.as_ref().ok_or_else(|| EditError::Brush(NO_GRAPH.to_owned()))?;
+        let graph = self.graph.as_ref().ok_or_else(|| EditError::Objects(NO_GRAPH.to_owned()))?;
         let own = self.transform_node(index)?;
         let mut group = self.parent_group(own.id)?.clone();
         let shape = graph
             .node(self.objects[index].shape_node)
-            .ok_or_else(|| EditError::Brush("its shape is missing".to_owned()))?;
+            .ok_or_else(|| EditError::Objects("its shape is missing".to_owned()))?;
         let next = graph.nodes.iter().map(|n| n.id).max().unwrap_or(0);
         let (transform_id, shape_id) = (next.checked_add(1), next.checked_add(2));
         let (Some(transform_id), Some(shape_id)) = (transform_id, shape_id) else {
-            return Err(EditError::Brush("no node ids are left".to_owned()));
+            return Err(EditError::Objects("no node ids are left".to_owned()));
         };
         let mut transform = own.clone();
         transform.id = transform_id;
@@ -582,7 +585,7 @@ impl Objects {
     pub fn made_unique(&self, index: usize, model: usize) -> Result<GraphChange, EditError> {
         let (mut change, _) = self.duplicated(index, Some(model))?;
         // Of the duplicate keep the shape; the object's own transform takes it.
-        let shape = change.nodes.pop().ok_or_else(|| EditError::Brush("no shape".to_owned()))?;
+        let shape = change.nodes.pop().ok_or_else(|| EditError::Objects("no shape".to_owned()))?;
         let mut own = self.transform_node(index)?.clone();
         if let NodeKind::Transform { child, .. } = &mut own.kind {
             *child = shape.id;
@@ -600,7 +603,7 @@ impl Objects {
         all.sort_unstable();
         all.dedup();
         if all.len() != others.len() + 1 || all.iter().any(|&i| i >= self.objects.len()) {
-            return Err(EditError::Brush(format!(
+            return Err(EditError::Objects(format!(
                 "merge needs other objects than the picked one, each once, of the {} there are",
                 self.objects.len()
             )));
@@ -608,11 +611,11 @@ impl Objects {
         self.unlocked(&all)?;
         if let Some(&hidden) = all.iter().find(|&&k| self.objects[k].hidden) {
             // Its voxels would show once part of a shown model.
-            return Err(EditError::Brush(format!("object {hidden} is hidden: show it (or its layer) to merge it")));
+            return Err(EditError::Objects(format!("object {hidden} is hidden: show it (or its layer) to merge it")));
         }
         let voxels: u64 = all.iter().map(|&k| self.models[self.objects[k].placement.model].tree.solid_voxels()).sum();
         if voxels > MERGE_LIMIT {
-            return Err(EditError::Brush(format!(
+            return Err(EditError::Objects(format!(
                 "the objects hold {voxels} voxels; a merge takes at most {MERGE_LIMIT} (one model of 256³)"
             )));
         }
@@ -625,7 +628,7 @@ impl Objects {
             }
         }
         let voxels: Vec<(IVec3, u8)> = cells.into_iter().collect();
-        let tree = Octree::from_voxels(&voxels).map_err(|e| EditError::Brush(e.to_string()))?;
+        let tree = Octree::from_voxels(&voxels).map_err(|e| EditError::Objects(e.to_string()))?;
         let model = Model { size: self.models[self.objects[index].placement.model].size, tree };
         let mut change = self.made_unique(index, self.models.len())?;
         let gone = self.deleted_all(others)?;
@@ -638,16 +641,16 @@ impl Objects {
     /// one cell to store, the change that adds its shape and transform, and
     /// the new transform's id.
     pub fn created(&self, name: &str) -> Result<(Model, GraphChange, u32), EditError> {
-        let graph = self.graph.as_ref().ok_or_else(|| EditError::Brush(NO_GRAPH.to_owned()))?;
+        let graph = self.graph.as_ref().ok_or_else(|| EditError::Objects(NO_GRAPH.to_owned()))?;
         let mut group = graph
             .nodes
             .iter()
             .find(|n| matches!(n.kind, NodeKind::Group { .. }))
             .cloned()
-            .ok_or_else(|| EditError::Brush("the scene graph has no group to put an object in".to_owned()))?;
+            .ok_or_else(|| EditError::Objects("the scene graph has no group to put an object in".to_owned()))?;
         let next = graph.nodes.iter().map(|n| n.id).max().unwrap_or(0);
         let ids = next.checked_add(1).zip(next.checked_add(2));
-        let (transform_id, shape_id) = ids.ok_or_else(|| EditError::Brush("no node ids are left".to_owned()))?;
+        let (transform_id, shape_id) = ids.ok_or_else(|| EditError::Objects("no node ids are left".to_owned()))?;
         let layer = self.layer_for_new().unwrap_or(u32::MAX);
         let attributes = [("_name".to_owned(), name.to_owned())].into();
         let transform = Node {
@@ -708,12 +711,12 @@ impl Objects {
 
     /// The group that holds transform `id`.
     fn parent_group(&self, id: u32) -> Result<&Node, EditError> {
-        let graph = self.graph.as_ref().ok_or_else(|| EditError::Brush(NO_GRAPH.to_owned()))?;
+        let graph = self.graph.as_ref().ok_or_else(|| EditError::Objects(NO_GRAPH.to_owned()))?;
         graph
             .nodes
             .iter()
             .find(|n| matches!(&n.kind, NodeKind::Group { children } if children.contains(&id)))
-            .ok_or_else(|| EditError::Brush("the object is not in a group (it is the whole scene)".to_owned()))
+            .ok_or_else(|| EditError::Objects("the object is not in a group (it is the whole scene)".to_owned()))
     }
 
     /// The index of the object placed by transform node `id`.
@@ -741,7 +744,7 @@ impl Objects {
     /// Makes layer `id` the one new objects go on.
     pub fn set_new_layer(&mut self, id: u32) -> Result<(), EditError> {
         if !self.layer_list().iter().any(|l| l.id == id) {
-            return Err(EditError::Brush(format!("the scene has no layer {id}")));
+            return Err(EditError::Objects(format!("the scene has no layer {id}")));
         }
         self.new_layer = Some(id);
         Ok(())
