@@ -35,45 +35,44 @@ fn projected(camera: &Camera) -> [(Vec2, f64); 6] {
     })
 }
 
-/// Draws the gizmo; a click on an axis end asks for the view from it.
-pub fn show(ctx: &egui::Context, camera: &Camera, out: &mut Vec<Command>) {
-    egui::Area::new(egui::Id::unique("axis gizmo")).anchor(egui::Align2::RIGHT_TOP, Vec2::new(-8.0, 32.0)).show(
-        ctx,
-        |ui| {
-            let (rect, response) = ui.allocate_exact_size(Vec2::splat(SIZE), Sense::click());
-            let painter = ui.painter_at(rect);
-            let center = rect.center();
-            painter.circle_filled(center, SIZE * 0.5, Color32::from_black_alpha(90));
-            let ends = projected(camera);
-            // Far ends first, so the near ones are drawn over them.
-            let mut order: Vec<usize> = (0..6).collect();
-            order.sort_by(|&a, &b| ends[a].1.total_cmp(&ends[b].1));
-            for i in order {
-                let (axis, label, color) = ENDS[i];
-                let tip = center + ends[i].0;
-                if axis.max_element() > 0 {
-                    painter.line_segment([center, tip], Stroke::new(2.0, color));
-                }
-                painter.circle_filled(tip, if label.is_empty() { 4.0 } else { 7.0 }, color);
-                painter.text(tip, egui::Align2::CENTER_CENTER, label, egui::FontId::proportional(10.0), Color32::WHITE);
+/// Draws the gizmo at the top right of the view, left of a panel `right`
+/// points wide; a click on an axis end asks for the view from it.
+pub fn show(ctx: &egui::Context, camera: &Camera, right: f32, out: &mut Vec<Command>) {
+    let at = Vec2::new(-8.0 - right, 32.0);
+    egui::Area::new(egui::Id::unique("axis gizmo")).anchor(egui::Align2::RIGHT_TOP, at).show(ctx, |ui| {
+        let (rect, response) = ui.allocate_exact_size(Vec2::splat(SIZE), Sense::click());
+        let painter = ui.painter_at(rect);
+        let center = rect.center();
+        painter.circle_filled(center, SIZE * 0.5, Color32::from_black_alpha(90));
+        let ends = projected(camera);
+        // Far ends first, so the near ones are drawn over them.
+        let mut order: Vec<usize> = (0..6).collect();
+        order.sort_by(|&a, &b| ends[a].1.total_cmp(&ends[b].1));
+        for i in order {
+            let (axis, label, color) = ENDS[i];
+            let tip = center + ends[i].0;
+            if axis.max_element() > 0 {
+                painter.line_segment([center, tip], Stroke::new(2.0, color));
             }
-            let projection = if camera.ortho.is_some() { "ortho" } else { "persp" };
-            let bottom = center + Vec2::new(0.0, SIZE * 0.5 - 3.0);
-            let font = egui::FontId::proportional(10.0);
-            painter.text(bottom, egui::Align2::CENTER_BOTTOM, projection, font, Color32::from_gray(220));
-            let nearest = |pos: Pos2| {
-                (0..6)
-                    .filter(|&i| (center + ends[i].0).distance(pos) <= HIT_RADIUS)
-                    .max_by(|&a, &b| ends[a].1.total_cmp(&ends[b].1))
-            };
-            if response.clicked()
-                && let Some(i) = response.interact_pointer_pos().and_then(nearest)
-            {
-                out.push(Command::ViewFrom(ENDS[i].0));
-            }
-            response.on_hover_text("click an axis end to look from that side · O: orthographic or perspective");
-        },
-    );
+            painter.circle_filled(tip, if label.is_empty() { 4.0 } else { 7.0 }, color);
+            painter.text(tip, egui::Align2::CENTER_CENTER, label, egui::FontId::proportional(10.0), Color32::WHITE);
+        }
+        let projection = if camera.ortho.is_some() { "ortho" } else { "persp" };
+        let bottom = center + Vec2::new(0.0, SIZE * 0.5 - 3.0);
+        let font = egui::FontId::proportional(10.0);
+        painter.text(bottom, egui::Align2::CENTER_BOTTOM, projection, font, Color32::from_gray(220));
+        let nearest = |pos: Pos2| {
+            (0..6)
+                .filter(|&i| (center + ends[i].0).distance(pos) <= HIT_RADIUS)
+                .max_by(|&a, &b| ends[a].1.total_cmp(&ends[b].1))
+        };
+        if response.clicked()
+            && let Some(i) = response.interact_pointer_pos().and_then(nearest)
+        {
+            out.push(Command::ViewFrom(ENDS[i].0));
+        }
+        response.on_hover_text("click an axis end to look from that side · O: orthographic or perspective");
+    });
 }
 
 #[cfg(test)]

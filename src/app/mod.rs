@@ -32,6 +32,7 @@ mod host;
 mod input;
 mod journal;
 mod motion;
+mod outliner;
 mod presets;
 mod preview;
 mod recent;
@@ -444,7 +445,14 @@ impl App {
         camera_control::frame_model(&mut self.state.camera, bounds);
         let (scale, height) =
             self.gfx.as_ref().map_or((1.0, self.args.size.1), |g| (g.window.scale_factor(), g.config.height));
-        camera_control::pan(&mut self.state.camera, f64::from(ui::PANEL_WIDTH) * scale * 0.5, 0.0, height);
+        let (left, right) = self.side_panels();
+        camera_control::pan(&mut self.state.camera, f64::from(left - right) * scale * 0.5, 0.0, height);
+    }
+
+    /// Widths in points of the panels at the window's left and right sides.
+    fn side_panels(&self) -> (f32, f32) {
+        let outliner = self.doc.editor.scene.objects().is_some();
+        (ui::PANEL_WIDTH, if outliner { outliner::OUTLINER_WIDTH } else { 0.0 })
     }
 
     // ----- picking and mouse edits ---------------------------------------------------
@@ -802,6 +810,7 @@ impl ApplicationHandler for App {
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        let (left, right) = self.side_panels();
         let Some(gfx) = &mut self.gfx else { return };
         if !matches!(event, WindowEvent::RedrawRequested) {
             log::trace!("window event {event:?}");
@@ -850,12 +859,10 @@ impl ApplicationHandler for App {
         // The prompt is modal: while it is open the scene gets no input. A
         // wheel over the side panel is the panel's even where egui lets it
         // go (at the end of its scroll range), never a zoom of the view.
+        let (scale, width) = (gfx.window.scale_factor(), f64::from(gfx.config.width));
+        let on_panel = |x: f64| x < f64::from(left) * scale || x > width - f64::from(right) * scale;
         let wheel_on_panel = matches!(event, WindowEvent::MouseWheel { .. })
-            && (self.hover.pointer_over_ui
-                || self
-                    .input
-                    .cursor()
-                    .is_some_and(|(x, _)| x < f64::from(ui::PANEL_WIDTH) * gfx.window.scale_factor()));
+            && (self.hover.pointer_over_ui || self.input.cursor().is_some_and(|(x, _)| on_panel(x)));
         let consumed = response.consumed || self.ui.prompt_open || wheel_on_panel;
         let extruding = matches!(self.gesture, Gesture::Extrude { .. });
         for command in self.input.on_event(&event, consumed, self.state.tool, extruding) {

@@ -2,9 +2,10 @@
 //! brush, colour, render settings) directly, and return [`Command`]s for
 //! everything that acts (edits, files, camera moves).
 //!
-//! Layout: a menu bar on top and a tool panel on the left, both drawn *over*
-//! the traced image, which always fills the whole window. So window pixel
-//! (x, y) is trace pixel (x, y) at render scale 1, whatever the panels do.
+//! Layout: a menu bar on top, a tool panel on the left and, for a scene of
+//! objects, the Outliner on the right, all drawn *over* the traced image,
+//! which always fills the whole window. So window pixel (x, y) is trace
+//! pixel (x, y) at render scale 1, whatever the panels do.
 
 use std::path::{Path, PathBuf};
 
@@ -146,15 +147,8 @@ pub struct UiState {
     /// A crash-recovery journal found beside the document just opened, and
     /// why applying it needs a second thought (its document changed since).
     pub recover: Option<(PathBuf, Option<String>)>,
-    /// The Objects panel's name field: the object it was filled from, and
-    /// the text (Enter renames the object to it).
-    pub rename: (Option<usize>, String),
-    /// The objects Ctrl+clicked in the Objects panel, to merge into the
-    /// picked one.
-    pub merge: Vec<usize>,
-    /// A layer colour being picked: set when the pointer lets go (one
-    /// `layer N color` line, one undo step, per pick).
-    pub layer_color: Option<(u32, [u8; 3])>,
+    /// The Outliner's and Layers panel's own state.
+    pub outliner: super::outliner::OutlinerState,
     /// The open scene's edits are not journaled, and why: shown until a
     /// journal starts again.
     pub journal_warning: Option<String>,
@@ -211,6 +205,9 @@ pub fn show(
 ) -> Vec<Command> {
     let mut out = Vec::new();
     egui::Panel::top("menu").show(ui, |ui| menu_bar(ui, info, ui_state, &mut out));
+    if let Some(objects) = info.objects {
+        super::outliner::show(ui, objects, &mut ui_state.outliner, &mut out);
+    }
     egui::Panel::left("tools").resizable(false).exact_size(PANEL_WIDTH).show(ui, |ui| {
         egui::ScrollArea::vertical().show(ui, |ui| {
             tool_panel(ui, state, tools, &mut out);
@@ -220,11 +217,6 @@ pub fn show(
             palette(ui, tools, info.palette, &mut out);
             material_editor(ui, tools.color, info.palette, &mut out);
             ui.separator();
-            if let Some(objects) = info.objects {
-                objects_panel(ui, objects, (&mut ui_state.rename, &mut ui_state.merge), &mut out);
-                layers_panel(ui, objects, &mut ui_state.layer_color, &mut out);
-                ui.separator();
-            }
             // Sections below the palette collapse; none above it changes height.
             egui::CollapsingHeader::new("Render").default_open(true).show(ui, |ui| {
                 render(ui, state, info.stats);
@@ -233,7 +225,8 @@ pub fn show(
             egui::CollapsingHeader::new("Stats").default_open(true).show(ui, |ui| stats(ui, info));
         });
     });
-    super::gizmo::show(ui.ctx(), &state.camera, &mut out);
+    let right = if info.objects.is_some() { super::outliner::OUTLINER_WIDTH } else { 0.0 };
+    super::gizmo::show(ui.ctx(), &state.camera, right, &mut out);
     dialog(ui.ctx(), ui_state, &mut out);
     prompt(ui.ctx(), ui_state, &mut out);
     read_only_prompt(ui.ctx(), ui_state, &mut out);
@@ -445,163 +438,6 @@ fn palette(ui: &mut egui::Ui, tools: &mut Tools, palette: &Palette, out: &mut Ve
         tools.color,
         material.kind.vox_name().trim_start_matches('_')
     ));
-}
-
-/// Most rows the Objects panel lists (a scene may place 10⁵ objects).
-const MAX_OBJECT_ROWS: usize = 500;
-
-/// The Objects panel: every object in walk order, an eye to hide or show
-/// it, a click to pick the one edits go to, a + to mark it for merging
-/// into the picked one. What they do are `object` script lines.
-fn objects_panel(
-    ui: &mut egui::Ui,
-    objects: &Objects,
-    (rename, merge): (&mut (Option<usize>, String), &mut Vec<usize>),
-    out: &mut Vec<Command>,
-) {
-    let list = objects.list();
-    merge.retain(|&i| i < list.len() && objects.selected != Some(i));
-    egui::CollapsingHeader::new(format!("Objects ({}, {} models)", list.len(), objects.models.len()))
-        .default_open(true)
-        .show(ui, |ui| {
-            rename_row(ui, objects, rename, out);
-            merge_row(ui, objects, merge, out);
-            egui::ScrollArea::vertical().id_salt("objects").max_height(160.0).show(ui, |ui| {
-                for index in 0..list.len().min(MAX_OBJECT_ROWS) {
-                    ui.horizontal(|ui| object_row(ui, objects, index, merge, out));
-                }
-                if list.len() > MAX_OBJECT_ROWS {
-                    ui.label(format!("… and {} more (object N picks any)", list.len() - MAX_OBJECT_ROWS));
-                }
-            });
-        });
-}
-
-/// One row of the Objects panel: the eye, the lock, the merge mark, and
-/// the name that picks the object.
-fn object_row(ui: &mut egui::Ui, objects: &Objects, index: usize, merge: &mut Vec<usize>, out: &mut Vec<Command>) {
-    use octovox::script::{Command as Line, ObjectLine, ObjectRef};
-    let object = &objects.list()[index];
-    let pick = Line::Object(ObjectLine::Pick(ObjectRef::Index(index)));
-    let mut shown = !object.own_hidden;
-    if ui.checkbox(&mut shown, "").on_hover_text("show or hide").changed() {
-        out.push(Command::Lines(vec![pick.clone(), Line::Object(ObjectLine::Hide(!shown))]));
-    }
-    let mut locked = objects.locked(index);
-    let icon = if locked { "🔒" } else { "🔓" };
-    let lock = ui.toggle_value(&mut locked, icon);
-    if lock.on_hover_text("lock: no edits, moves or picks by a click").changed() {
-        out.push(Command::Lines(vec![pick.clone(), Line::Object(ObjectLine::Lock(locked))]));
-    }
-    let name = if object.path.is_empty() { "(unnamed)" } else { &object.path };
-    let label = format!("{index} {name} · model {}", object.placement.model);
-    let marked = merge.contains(&index);
-    let can_mark = objects.selected.is_some_and(|p| p != index);
-    let mark = ui.add_enabled(can_mark, egui::Button::new(if marked { "−" } else { "+" }).small());
-    if mark.on_hover_text("mark to merge into the picked object").clicked() {
-        toggle(merge, index);
-    }
-    let text = if object.hidden { egui::RichText::new(label).weak() } else { egui::RichText::new(label) };
-    let text = if marked { text.underline() } else { text };
-    if ui.selectable_label(objects.selected == Some(index), text).clicked() {
-        out.push(Command::Lines(vec![pick]));
-    }
-}
-
-/// Puts `index` in `set`, or takes it out.
-fn toggle(set: &mut Vec<usize>, index: usize) {
-    match set.iter().position(|&i| i == index) {
-        Some(at) => {
-            set.remove(at);
-        }
-        None => set.push(index),
-    }
-}
-
-/// The objects marked for merging, and the button that merges them into
-/// the picked object (`object merge N…`, one undo step).
-fn merge_row(ui: &mut egui::Ui, objects: &Objects, merge: &mut Vec<usize>, out: &mut Vec<Command>) {
-    use octovox::script::{Command as Line, ObjectLine, ObjectRef};
-    if merge.is_empty() {
-        ui.weak("+ marks objects to merge into the picked one");
-        return;
-    }
-    ui.horizontal(|ui| {
-        let ready = objects.selected.is_some();
-        let text = format!("Merge {} into the picked object", merge.len());
-        if ui.add_enabled(ready, egui::Button::new(text)).clicked() {
-            let others = merge.drain(..).map(ObjectRef::Index).collect();
-            out.push(Command::Lines(vec![Line::Object(ObjectLine::Merge(others))]));
-        }
-        if ui.button("Clear").clicked() {
-            merge.clear();
-        }
-    });
-}
-
-/// The Layers panel: each layer's eye, name, colour, and whether new
-/// objects go on it. What they do are `layer` script lines.
-fn layers_panel(ui: &mut egui::Ui, objects: &Objects, picking: &mut Option<(u32, [u8; 3])>, out: &mut Vec<Command>) {
-    use octovox::script::{Command as Line, LayerLine};
-    let layers = objects.layer_list();
-    let Some(active) = objects.layer_for_new() else { return };
-    egui::CollapsingHeader::new(format!("Layers ({})", layers.len())).default_open(true).show(ui, |ui| {
-        for layer in layers {
-            ui.horizontal(|ui| {
-                let mut shown = !layer.hidden();
-                if ui.checkbox(&mut shown, "").on_hover_text("show or hide").changed() {
-                    out.push(Command::Lines(vec![Line::Layer(layer.id, LayerLine::Hide(!shown))]));
-                }
-                let mut color = picking.filter(|(id, _)| *id == layer.id).map_or(layer.color(), |(_, c)| c);
-                if ui.color_edit_button_srgb(&mut color).on_hover_text("colour").changed() {
-                    *picking = Some((layer.id, color));
-                }
-                let new_here = ui.radio(active == layer.id, "").on_hover_text("new objects go on this layer");
-                if new_here.clicked() && active != layer.id {
-                    out.push(Command::Lines(vec![Line::Layer(layer.id, LayerLine::Active)]));
-                }
-                let name =
-                    if layer.name().is_empty() { format!("layer {}", layer.id) } else { layer.name().to_owned() };
-                ui.label(name).on_hover_text(format!("layer {}", layer.id));
-            });
-        }
-    });
-    // A pick is set once the pointer lets go, so a drag is one undo step.
-    if let Some((id, color)) = *picking
-        && !ui.input(|i| i.pointer.any_down())
-    {
-        *picking = None;
-        let current = layers.iter().find(|l| l.id == id).map(|l| l.color());
-        if current.is_some_and(|c| c != color) {
-            out.push(Command::Lines(vec![Line::Layer(id, LayerLine::Color(color))]));
-        }
-    }
-}
-
-/// The picked object's name, editable: Enter renames it (`object rename`,
-/// an undo step). Always there, disabled with no object picked, so that
-/// the rows below stay put.
-fn rename_row(ui: &mut egui::Ui, objects: &Objects, rename: &mut (Option<usize>, String), out: &mut Vec<Command>) {
-    use octovox::script::{Command as Line, ObjectLine, ObjectRef};
-    let picked = objects.selected;
-    if rename.0 != picked {
-        let own = picked.and_then(|i| objects.transform_node(i).ok()).and_then(octovox::scene::graph::Node::name);
-        *rename = (picked, own.unwrap_or_default().to_owned());
-    }
-    ui.horizontal(|ui| {
-        ui.label("Name");
-        ui.add_enabled_ui(picked.is_some(), |ui| {
-            let field = ui.add(egui::TextEdit::singleline(&mut rename.1).desired_width(140.0));
-            let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
-            if let (true, Some(index)) = (entered && !rename.1.trim().is_empty(), picked) {
-                out.push(Command::Lines(vec![
-                    Line::Object(ObjectLine::Pick(ObjectRef::Index(index))),
-                    Line::Object(ObjectLine::Rename(rename.1.trim().to_owned())),
-                ]));
-            }
-            field.on_hover_text("object rename NAME (Enter)");
-        });
-    });
 }
 
 /// The selected entry's colour, material kind and the parameters the path

@@ -152,6 +152,12 @@ impl SceneGraph {
     /// children in file order). `model_voxels[m]` is the voxel count of model
     /// `m`; the placed models may hold at most `voxel_limit` voxels together.
     pub fn objects(&self, model_voxels: &[usize], frame: usize, voxel_limit: usize) -> Result<Vec<Object>, GraphError> {
+        Ok(self.walk(model_voxels, frame, voxel_limit)?.objects)
+    }
+
+    /// The objects as [`SceneGraph::objects`] finds them, and the outline
+    /// of groups and objects that shows them.
+    pub fn walk(&self, model_voxels: &[usize], frame: usize, voxel_limit: usize) -> Result<Walked, GraphError> {
         let walk = Walk {
             graph: self,
             index_of: index_nodes(&self.nodes)?,
@@ -164,18 +170,23 @@ impl SceneGraph {
             stack: vec![Step::Enter { id: 0, parent: None, context: Context::ROOT }],
             visits: 0,
             voxels: 0,
-            out: Vec::new(),
+            out: Walked::default(),
         };
         walk.run()
     }
 
-    /// The node with id `id`.
+    /// The node with id `id`: found at once where ids are file positions
+    /// (as MagicaVoxel writes them), else searched for.
     pub fn node(&self, id: u32) -> Option<&Node> {
-        self.nodes.iter().find(|n| n.id == id)
+        self.nodes.get(id as usize).filter(|n| n.id == id).or_else(|| self.nodes.iter().find(|n| n.id == id))
     }
 
     pub fn node_mut(&mut self, id: u32) -> Option<&mut Node> {
-        self.nodes.iter_mut().find(|n| n.id == id)
+        let at = match self.nodes.get(id as usize) {
+            Some(n) if n.id == id => Some(id as usize),
+            _ => self.nodes.iter().position(|n| n.id == id),
+        };
+        at.map(|i| &mut self.nodes[i])
     }
 
     /// Number of group nodes.
@@ -195,6 +206,8 @@ struct Context {
     layer: Option<u32>,
     /// Last named transform on the path, as an index into `Walk::names`.
     name: Option<usize>,
+    /// Groups above, not counting the root's.
+    depth: u32,
 }
 
 impl Context {
@@ -205,6 +218,7 @@ impl Context {
         transform_node: None,
         layer: None,
         name: None,
+        depth: 0,
     };
 }
 
@@ -233,11 +247,27 @@ struct Walk<'a> {
     visits: usize,
     /// Voxels of all placements so far.
     voxels: usize,
-    out: Vec<Object>,
+    out: Walked,
+}
+
+/// What a walk finds: the objects, and the rows of the outline.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Walked {
+    pub objects: Vec<Object>,
+    pub outline: Vec<OutlineRow>,
+}
+
+/// One row of the outline, in walk order: a group (the transform above an
+/// nGRP other than the root's) or an object; `depth` counts the groups
+/// above it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum OutlineRow {
+    Group { transform: u32, name: String, depth: u32, hidden: bool },
+    Object { index: usize, depth: u32 },
 }
 
 impl<'a> Walk<'a> {
-    fn run(mut self) -> Result<Vec<Object>, GraphError> {
+    fn run(mut self) -> Result<Walked, GraphError> {
         while let Some(step) = self.stack.pop() {
             match step {
                 Step::Leave { index } => self.on_path[index] = false,
@@ -268,7 +298,13 @@ impl<'a> Walk<'a> {
         let node: &'a Node = &self.graph.nodes[index];
         match &node.kind {
             NodeKind::Transform { frames, child, layer, .. } => {
-                let context = self.transformed(node, frames, *layer, context)?;
+                let mut context = self.transformed(node, frames, *layer, context)?;
+                if parent.is_some() && self.leads_to_group(*child) {
+                    let name = node.name().unwrap_or_default().to_owned();
+                    let (depth, hidden) = (context.depth, context.hidden);
+                    self.out.outline.push(OutlineRow::Group { transform: id, name, depth, hidden });
+                    context.depth += 1;
+                }
                 self.stack.push(Step::Enter { id: *child, parent: Some(id), context });
             }
             NodeKind::Group { children } => {
@@ -280,6 +316,11 @@ impl<'a> Walk<'a> {
             NodeKind::Shape { models } => self.place_shape(id, models, context)?,
         }
         Ok(())
+    }
+
+    /// Whether node `id` is a group (a missing one is reported when entered).
+    fn leads_to_group(&self, id: u32) -> bool {
+        self.index_of.get(&id).is_some_and(|&i| matches!(self.graph.nodes[i].kind, NodeKind::Group { .. }))
     }
 
     /// The context below transform `node`.
@@ -310,6 +351,7 @@ impl<'a> Walk<'a> {
             transform_node: Some(node.id),
             layer,
             name,
+            depth: context.depth,
         })
     }
 
@@ -326,10 +368,12 @@ impl<'a> Walk<'a> {
         if self.voxels > self.voxel_limit {
             return Err(GraphError::TooManyVoxels { limit: self.voxel_limit, found: self.voxels });
         }
-        if self.out.len() >= MAX_INSTANCES {
+        if self.out.objects.len() >= MAX_INSTANCES {
             return Err(GraphError::Bad(format!("more than {MAX_INSTANCES} model placements")));
         }
-        self.out.push(Object {
+        let index = self.out.objects.len();
+        self.out.outline.push(OutlineRow::Object { index, depth: context.depth });
+        self.out.objects.push(Object {
             placement: Placement { model, transform: context.transform, centred: true },
             shape_node: id,
             transform_node: context.transform_node,
@@ -450,7 +494,8 @@ mod tests {
         Node { id, attributes: Attributes::new(), kind: NodeKind::Shape { models: vec![(model, Attributes::new())] } }
     }
 
-    /// Paths name the named transforms on the way; a hidden layer hides what is on it.
+    /// Paths name the named transforms on the way; a hidden layer hides what
+    /// is on it; the outline puts a group's objects below it.
     #[test]
     fn objects_carry_paths_layers_and_hidden_flags() {
         let hidden_layer = Layer { id: 1, attributes: [("_hidden".into(), "1".into())].into(), reserved: u32::MAX };
@@ -470,6 +515,9 @@ mod tests {
         let seen: Vec<(&str, bool, Option<u32>)> =
             objects.iter().map(|o| (o.path.as_str(), o.hidden, o.layer)).collect();
         assert_eq!(seen, [("house/door", true, Some(1)), ("", false, Some(0))]);
+        let house = OutlineRow::Group { transform: 2, name: "house".into(), depth: 0, hidden: false };
+        let rows = [house, OutlineRow::Object { index: 0, depth: 1 }, OutlineRow::Object { index: 1, depth: 0 }];
+        assert_eq!(graph.walk(&[10], 0, 100).unwrap().outline, rows, "the outline nests the door in the house");
         assert_eq!(graph.objects(&[10], 0, 15).unwrap_err(), GraphError::TooManyVoxels { limit: 15, found: 20 });
     }
 

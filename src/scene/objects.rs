@@ -13,7 +13,7 @@ use std::collections::HashMap;
 
 use glam::IVec3;
 
-use super::graph::{self, GraphError, Layer, Node, NodeKind, Object, SceneGraph};
+use super::graph::{self, GraphError, Layer, Node, NodeKind, Object, OutlineRow, SceneGraph, Walked};
 use super::octree::{Octree, WORLD_LIMIT};
 use super::transform::{CellMap, Rotation, Transform};
 use super::{EditError, Op, Patch, Shape};
@@ -71,6 +71,7 @@ pub struct Objects {
     pub frame: usize,
     /// The walk at `frame`, and each object's cell map.
     objects: Vec<Object>,
+    outline: Vec<OutlineRow>,
     maps: Vec<CellMap>,
     /// The object edits go to, by index in walk order.
     pub selected: Option<usize>,
@@ -106,6 +107,7 @@ impl Objects {
             kept,
             frame,
             objects: Vec::new(),
+            outline: Vec::new(),
             maps: Vec::new(),
             selected: None,
             new_layer: None,
@@ -118,8 +120,8 @@ impl Objects {
     fn walk(&mut self, voxel_limit: usize) -> Result<(), ObjectsError> {
         let voxels: Vec<usize> =
             self.models.iter().map(|m| usize::try_from(m.tree.solid_voxels()).unwrap_or(usize::MAX)).collect();
-        self.objects = match &self.graph {
-            Some(graph) => graph.objects(&voxels, self.frame, voxel_limit)?,
+        Walked { objects: self.objects, outline: self.outline } = match &self.graph {
+            Some(graph) => graph.walk(&voxels, self.frame, voxel_limit)?,
             None => self.frame_object()?,
         };
         self.maps = Vec::with_capacity(self.objects.len());
@@ -143,7 +145,7 @@ impl Objects {
     }
 
     /// Without a graph: model `frame` as stored.
-    fn frame_object(&self) -> Result<Vec<Object>, GraphError> {
+    fn frame_object(&self) -> Result<Walked, GraphError> {
         if self.frame >= self.models.len() {
             return Err(GraphError::Bad(format!(
                 "frame {} requested but there are {} models",
@@ -151,12 +153,18 @@ impl Objects {
                 self.models.len()
             )));
         }
-        Ok(vec![Object::frame(self.frame)])
+        let outline = vec![OutlineRow::Object { index: 0, depth: 0 }];
+        Ok(Walked { objects: vec![Object::frame(self.frame)], outline })
     }
 
     /// The objects in walk order.
     pub fn list(&self) -> &[Object] {
         &self.objects
+    }
+
+    /// The groups and objects in walk order, as the Outliner shows them.
+    pub fn outline(&self) -> &[OutlineRow] {
+        &self.outline
     }
 
     /// The map from object `index`'s model cells to world cells.

@@ -19,6 +19,9 @@ pub const HEIGHT: u32 = 600;
 /// stay clear of both.
 pub const FREE_X: u32 = 300;
 pub const FREE_Y: u32 = 60;
+/// A scene of objects has the Outliner over the window's right 250 points
+/// (`src/app/outliner.rs`).
+pub const OUTLINER_X: u32 = WIDTH - 250;
 
 /// Kills a child process when dropped (also when the test panics).
 pub struct KillOnDrop(pub Child, pub &'static str);
@@ -169,15 +172,25 @@ impl Lines {
 /// A pixel clear of the panels whose 5×5 neighbourhood hits the same voxel
 /// through the same face, so a click there cannot land on a neighbour.
 pub fn stable_pixel(tree: &Octree, camera: &Camera, accept: impl Fn(IVec3, IVec3) -> bool) -> (u32, u32, IVec3, IVec3) {
+    stable_pixel_left_of(WIDTH, tree, camera, accept)
+}
+
+/// [`stable_pixel`] left of window column `right` (a panel there).
+pub fn stable_pixel_left_of(
+    right: u32,
+    tree: &Octree,
+    camera: &Camera,
+    accept: impl Fn(IVec3, IVec3) -> bool,
+) -> (u32, u32, IVec3, IVec3) {
     let basis = camera.basis(WIDTH, HEIGHT, tree.origin());
     let hit_at = |x: u32, y: u32| {
         let (o, d) = basis.ray(x, y);
         svo::trace(tree, &Ray::new(o, d))
     };
-    let (cx, cy) = ((FREE_X + WIDTH) / 2, (FREE_Y + HEIGHT) / 2);
+    let (cx, cy) = ((FREE_X + right) / 2, (FREE_Y + HEIGHT) / 2);
     let mut candidates: Vec<(u32, u32)> = (FREE_Y + 4..HEIGHT - 4)
         .step_by(3)
-        .flat_map(|y| (FREE_X + 4..WIDTH - 4).step_by(3).map(move |x| (x, y)))
+        .flat_map(|y| (FREE_X + 4..right - 4).step_by(3).map(move |x| (x, y)))
         .collect();
     candidates.sort_by_key(|&(x, y)| (x as i64 - cx as i64).pow(2) + (y as i64 - cy as i64).pow(2));
     for (x, y) in candidates {

@@ -26,6 +26,23 @@ fn groups_document() -> (tempfile::TempDir, std::path::PathBuf, octovox::scene::
     (dir, file, scene)
 }
 
+/// The pixels clear of the panels that show object `owner`, by the CPU
+/// tracer (every other one each way).
+fn pixels_of(scene: &octovox::scene::Scene, camera: &Camera, owner: usize) -> Vec<(u32, u32)> {
+    use octovox::trace::{Ray, svo};
+    let objects = scene.objects().unwrap();
+    let basis = camera.basis(WIDTH, HEIGHT, scene.origin());
+    (FREE_Y..HEIGHT)
+        .step_by(2)
+        .flat_map(|py| (FREE_X..OUTLINER_X).step_by(2).map(move |px| (px, py)))
+        .filter(|&(px, py)| {
+            let (o, d) = basis.ray(px, py);
+            let hit = svo::trace(scene.drawn(), &Ray::new(o, d));
+            hit.is_hit() && objects.owner_at(hit.voxel + scene.origin()) == Some(owner)
+        })
+        .collect()
+}
+
 #[test]
 fn a_click_picks_the_object_it_hits_and_edits_its_model() {
     let (dir, file, scene) = groups_document();
@@ -35,7 +52,8 @@ fn a_click_picks_the_object_it_hits_and_edits_its_model() {
     // A pixel on a face of an object that is not the last one (so that
     // the pick is not the default target by chance).
     let last = objects.list().len() - 1;
-    let (x, y, voxel, _) = stable_pixel(scene.drawn(), &camera, |v, _| objects.owner_at(v).is_some_and(|o| o != last));
+    let (x, y, voxel, _) =
+        stable_pixel_left_of(OUTLINER_X, scene.drawn(), &camera, |v, _| objects.owner_at(v).is_some_and(|o| o != last));
     let owner = objects.owner_at(voxel).unwrap();
     let model = objects.list()[owner].placement.model;
     let before = model_sizes(&file);
@@ -63,24 +81,14 @@ fn a_click_picks_the_object_it_hits_and_edits_its_model() {
 /// saved file keeps it (hidden, its model whole); Ctrl+Z shows it again.
 #[test]
 fn ctrl_h_hides_the_picked_object_and_the_file_keeps_it() {
-    use octovox::trace::{Ray, svo};
     let (dir, file, scene) = groups_document();
     let objects = scene.objects().unwrap();
     let (lo, hi) = scene.solid_bounds().unwrap();
     let camera = Camera::framing(lo, hi, 50.0);
-    let (x, y, voxel, _) = stable_pixel(scene.drawn(), &camera, |v, _| objects.owner_at(v).is_some());
+    let (x, y, voxel, _) =
+        stable_pixel_left_of(OUTLINER_X, scene.drawn(), &camera, |v, _| objects.owner_at(v).is_some());
     let owner = objects.owner_at(voxel).unwrap();
-    // The pixels that show the object, by the CPU tracer.
-    let basis = camera.basis(WIDTH, HEIGHT, scene.origin());
-    let shows: Vec<(u32, u32)> = (FREE_Y..HEIGHT)
-        .step_by(2)
-        .flat_map(|py| (FREE_X..WIDTH).step_by(2).map(move |px| (px, py)))
-        .filter(|&(px, py)| {
-            let (o, d) = basis.ray(px, py);
-            let hit = svo::trace(scene.drawn(), &Ray::new(o, d));
-            hit.is_hit() && objects.owner_at(hit.voxel + scene.origin()) == Some(owner)
-        })
-        .collect();
+    let shows = pixels_of(&scene, &camera, owner);
     assert!(shows.len() > 20, "object {owner} covers {} pixels", shows.len());
 
     let (_xvfb, display) = start_xvfb(22);
@@ -102,8 +110,7 @@ fn ctrl_h_hides_the_picked_object_and_the_file_keeps_it() {
         before.save(format!("{keep}/hide-before.png")).unwrap();
         after.save(format!("{keep}/hide-after.png")).unwrap();
     }
-    let changed = shows.iter().filter(|&&(px, py)| before.get_pixel(px, py) != after.get_pixel(px, py)).count();
-    assert!(changed * 10 >= shows.len() * 9, "{changed} of the object's {} pixels changed", shows.len());
+    assert_gone(&shows, &before, &after);
 
     save(&display, &mut lines, &file);
     let data = dot_vox::load_bytes(&std::fs::read(&file).unwrap()).unwrap();
@@ -131,7 +138,8 @@ fn object_edits_survive_a_kill() {
     let objects = scene.objects().unwrap();
     let (lo, hi) = scene.solid_bounds().unwrap();
     let camera = Camera::framing(lo, hi, 50.0);
-    let (x, y, voxel, _) = stable_pixel(scene.drawn(), &camera, |v, _| objects.owner_at(v).is_some());
+    let (x, y, voxel, _) =
+        stable_pixel_left_of(OUTLINER_X, scene.drawn(), &camera, |v, _| objects.owner_at(v).is_some());
     let owner = objects.owner_at(voxel).unwrap();
     let model = objects.list()[owner].placement.model;
     let before = model_sizes(&file);
@@ -175,7 +183,8 @@ fn tab_object_mode_picks_moves_drags_turns_and_deletes_objects() {
     let (lo, hi) = scene.solid_bounds().unwrap();
     let camera = Camera::framing(lo, hi, 50.0);
     let last = objects.list().len() - 1;
-    let (x, y, voxel, _) = stable_pixel(scene.drawn(), &camera, |v, _| objects.owner_at(v).is_some_and(|o| o != last));
+    let (x, y, voxel, _) =
+        stable_pixel_left_of(OUTLINER_X, scene.drawn(), &camera, |v, _| objects.owner_at(v).is_some_and(|o| o != last));
     let owner = objects.owner_at(voxel).unwrap();
     let node = objects.list()[owner].transform_node.expect("a transform above the object") as usize;
     let translation = |file: &std::path::Path| -> [i32; 3] {
@@ -259,4 +268,140 @@ fn tab_object_mode_picks_moves_drags_turns_and_deletes_objects() {
     lines.wait_for("object:", Duration::from_secs(30));
     save(&display, &mut lines, &file);
     assert_eq!(transforms(&file), count + 1, "Delete deleted the object");
+}
+
+/// Asserts that nine in ten of the pixels `shows` changed from `before` to
+/// `after`, not counting those under the picked object's box (orange, drawn
+/// hidden or not).
+fn assert_gone(shows: &[(u32, u32)], before: &image::RgbImage, after: &image::RgbImage) {
+    let boxed = |p: &image::Rgb<u8>| p[0] >= 200 && p[2] <= 130 && p[0] - p[2] >= 100;
+    let seen: Vec<_> = shows.iter().filter(|&&(x, y)| !boxed(after.get_pixel(x, y))).collect();
+    let changed = seen.iter().filter(|&&&(x, y)| before.get_pixel(x, y) != after.get_pixel(x, y)).count();
+    assert!(seen.len() * 4 >= shows.len() * 3, "the box covers most of the object");
+    assert!(changed * 10 >= seen.len() * 9, "{changed} of the object's {} pixels changed", seen.len());
+}
+
+/// Where the Outliner draws its rows in an 800×600 window at scale 1: the
+/// first row's middle, the rows' pitch, a row's eye at depth 0, one level
+/// of groups' indent, and how far right of the eye the name is. A click
+/// that lands elsewhere fails on the `ran: object N` line it prints.
+const FIRST_ROW_Y: u32 = 110;
+const ROW_PITCH: u32 = 23;
+const EYE_X: u32 = OUTLINER_X + 16;
+const INDENT: u32 = 12;
+const NAME_FROM_EYE: u32 = 110;
+/// Rows shown without scrolling the Outliner.
+const ROWS_SHOWN: usize = 14;
+
+/// Object `index`'s row in the Outliner (from the top), and its depth.
+fn outline_row(objects: &octovox::scene::objects::Objects, index: usize) -> (u32, u32) {
+    use octovox::scene::graph::OutlineRow;
+    let at = objects.outline().iter().position(|r| matches!(r, OutlineRow::Object { index: i, .. } if *i == index));
+    let at = at.unwrap();
+    let OutlineRow::Object { depth, .. } = objects.outline()[at] else { unreachable!() };
+    (at as u32, depth)
+}
+
+/// The nGRP whose children hold transform `node`, and those children, as
+/// `dot_vox` reads `file`.
+fn group_of(file: &std::path::Path, node: u32) -> (usize, Vec<u32>) {
+    let data = dot_vox::load_bytes(&std::fs::read(file).unwrap()).unwrap();
+    data.scenes
+        .iter()
+        .enumerate()
+        .find_map(|(i, n)| match n {
+            dot_vox::SceneNode::Group { children, .. } if children.contains(&node) => Some((i, children.clone())),
+            _ => None,
+        })
+        .unwrap()
+}
+
+/// The Outliner with the real mouse: an object's eye hides it (its pixels
+/// change on screen, the saved file keeps it with `_hidden`), and its name
+/// dragged onto another group's row puts it there, after that row (read
+/// back with `dot_vox`); one Ctrl+Z undoes each.
+#[test]
+fn the_outliner_eye_hides_an_object_and_a_drag_regroups_it() {
+    let (dir, file, scene) = groups_document();
+    let objects = scene.objects().unwrap();
+    let (lo, hi) = scene.solid_bounds().unwrap();
+    let camera = Camera::framing(lo, hi, 50.0);
+    let count = objects.list().len();
+    let visible: Vec<usize> = (0..count).filter(|&i| (outline_row(objects, i).0 as usize) < ROWS_SHOWN).collect();
+    let (owner, shows) =
+        visible.iter().map(|&i| (i, pixels_of(&scene, &camera, i))).max_by_key(|(_, p)| p.len()).unwrap();
+    assert!(shows.len() > 20, "object {owner} covers {} pixels", shows.len());
+    let node = objects.list()[owner].transform_node.unwrap();
+    let hidden_flag = |file: &std::path::Path| {
+        let data = dot_vox::load_bytes(&std::fs::read(file).unwrap()).unwrap();
+        let dot_vox::SceneNode::Transform { attributes, .. } = &data.scenes[node as usize] else { panic!() };
+        attributes.get("_hidden").cloned()
+    };
+
+    let (_xvfb, display) = start_xvfb(24);
+    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &document_args(&file, &camera, &[]));
+    let window = find_window(&display, &mut app, &stderr_path);
+    lines.wait_for("octovox: ready", Duration::from_secs(90));
+    xdotool(&display, &["windowfocus", "--sync", &window]);
+    xdotool(&display, &["mousemove", "--window", &window, "790", "590"]);
+    std::thread::sleep(Duration::from_millis(800));
+    let before = screenshot_x(&display, &dir.path().join("before.png"));
+    let (row, depth) = outline_row(objects, owner);
+    let (eye_x, y) = (EYE_X + INDENT * depth, FIRST_ROW_Y + ROW_PITCH * row);
+    xdotool(&display, &["mousemove", "--window", &window, &eye_x.to_string(), &y.to_string()]);
+    std::thread::sleep(Duration::from_millis(300));
+    xdotool(&display, &["click", "1"]);
+    assert_eq!(lines.wait_for("ran: object", Duration::from_secs(30)), format!("ran: object {owner}"));
+    lines.wait_for("object:", Duration::from_secs(30));
+    xdotool(&display, &["mousemove", "--window", &window, "790", "590"]);
+    std::thread::sleep(Duration::from_millis(800));
+    let after = screenshot_x(&display, &dir.path().join("after.png"));
+    if let Ok(keep) = std::env::var("OCTOVOX_KEEP_SHOTS") {
+        before.save(format!("{keep}/eye-before.png")).unwrap();
+        after.save(format!("{keep}/eye-after.png")).unwrap();
+    }
+    assert_gone(&shows, &before, &after);
+    save(&display, &mut lines, &file);
+    assert_eq!(hidden_flag(&file).as_deref(), Some("1"), "saved hidden");
+    assert_eq!(model_sizes(&file).len(), objects.models.len(), "every model is kept");
+    xdotool(&display, &["key", "ctrl+z"]);
+    lines.wait_for("undo:", Duration::from_secs(30));
+    save(&display, &mut lines, &file);
+    assert_eq!(hidden_flag(&file), None, "one Ctrl+Z shows it again");
+
+    // A drag of the first shown object's name onto the lower half of the
+    // last shown row of another group.
+    let transform = |i: usize| objects.list()[i].transform_node.unwrap();
+    let from = visible[0];
+    let (group, children) = group_of(&file, transform(from));
+    let onto = *visible.iter().rev().find(|&&i| group_of(&file, transform(i)).0 != group).unwrap();
+    let (target_group, target_children) = group_of(&file, transform(onto));
+    let (from_row, from_depth) = outline_row(objects, from);
+    let (onto_row, _) = outline_row(objects, onto);
+    let x = EYE_X + INDENT * from_depth + NAME_FROM_EYE;
+    let (y0, y1) = (FIRST_ROW_Y + ROW_PITCH * from_row, FIRST_ROW_Y + ROW_PITCH * onto_row + 6);
+    xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y0.to_string()]);
+    std::thread::sleep(Duration::from_millis(300));
+    xdotool(&display, &["mousedown", "1"]);
+    std::thread::sleep(Duration::from_millis(300));
+    for step in 1..=8 {
+        let y = y0 + (y1 - y0) * step / 8;
+        xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y.to_string()]);
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    std::thread::sleep(Duration::from_millis(300));
+    xdotool(&display, &["mouseup", "1"]);
+    assert_eq!(lines.wait_for("ran: object", Duration::from_secs(30)), format!("ran: object {from}"));
+    lines.wait_for("object:", Duration::from_secs(30));
+    save(&display, &mut lines, &file);
+    let (now_group, now_children) = group_of(&file, transform(from));
+    assert_eq!(now_group, target_group, "object {from} went into object {onto}'s group");
+    let at = now_children.iter().position(|&c| c == transform(from)).unwrap();
+    assert_eq!(now_children[at - 1], transform(onto), "right after object {onto}: {now_children:?}");
+    assert_eq!(now_children.len(), target_children.len() + 1);
+    assert_eq!(model_sizes(&file), model_sizes(&common::assets().join("vox/format/test_groups.vox")));
+    xdotool(&display, &["key", "ctrl+z"]);
+    lines.wait_for("undo:", Duration::from_secs(30));
+    save(&display, &mut lines, &file);
+    assert_eq!(group_of(&file, transform(from)), (group, children), "one Ctrl+Z puts it back");
 }
