@@ -16,6 +16,9 @@ use super::command::Command;
 /// Width of the right panel in points.
 pub const OUTLINER_WIDTH: f32 = 250.0;
 
+/// The picked object's colour: its box in the view, the Outliner's drop line.
+pub const PICKED: Color32 = Color32::from_rgb(255, 190, 60);
+
 /// Most rows the Outliner lists (a scene may place 10⁵ objects).
 const MAX_ROWS: usize = 500;
 
@@ -169,7 +172,7 @@ fn drop_target(ui: &mut egui::Ui, targets: &[(usize, egui::Rect)], state: &mut O
     let place = over.filter(|&(i, ..)| i != dragged).map(|(i, r, p)| (i, r, p.y > r.center().y));
     if let Some((_, rect, after)) = place {
         let y = if after { rect.bottom() } else { rect.top() };
-        let stroke = Stroke::new(2.0, Color32::from_rgb(255, 160, 40));
+        let stroke = Stroke::new(2.0, PICKED);
         ui.painter().hline(rect.x_range(), y, stroke);
     }
     if down {

@@ -964,11 +964,10 @@ pub fn draw_ground(ui: &egui::Ui, state: &EditorState, info: &Info) {
 /// Outlines the selected box (or the one being dragged); in select mode
 /// with a dot on each face, the handle that resizes it.
 pub fn draw_selection(ui: &egui::Ui, state: &EditorState, info: &Info) {
-    // The picked object's box, in the Objects panel's highlight colour.
     if let Some(objects) = info.objects
         && let Some(bounds) = objects.selected.and_then(|i| objects.world_box(i))
     {
-        outline_box(ui, state, info, bounds, egui::Color32::from_rgb(255, 190, 60), false);
+        outline_box(ui, state, info, bounds, super::outliner::PICKED, false);
     }
     if let Some(region) = info.selection {
         outline_box(
