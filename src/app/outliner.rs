@@ -38,6 +38,8 @@ pub struct OutlinerState {
     /// A layer colour being picked: set when the pointer lets go (one
     /// `layer N color` line, one undo step, per pick).
     pub layer_color: Option<(u32, [u8; 3])>,
+    /// A layer being renamed (a double click on its name) and the text.
+    pub layer_name: Option<(u32, String)>,
     /// Groups folded shut, by their transform node.
     pub collapsed: HashSet<u32>,
     /// The object whose row is being dragged.
@@ -57,7 +59,7 @@ pub fn show(ui: &mut egui::Ui, objects: &Objects, state: &mut OutlinerState, out
                 tree(ui, objects, state, out);
             });
             ui.separator();
-            layers(ui, objects, &mut state.layer_color, out);
+            layers(ui, objects, state, out);
         });
     });
 }
@@ -216,7 +218,8 @@ fn merge_row(ui: &mut egui::Ui, objects: &Objects, merge: &mut Vec<usize>, out: 
 
 /// The Layers panel: each layer's eye, colour, whether new objects go on
 /// it, and its name.
-fn layers(ui: &mut egui::Ui, objects: &Objects, picking: &mut Option<(u32, [u8; 3])>, out: &mut Vec<Command>) {
+fn layers(ui: &mut egui::Ui, objects: &Objects, state: &mut OutlinerState, out: &mut Vec<Command>) {
+    let picking = &mut state.layer_color;
     let layers = objects.layer_list();
     let Some(active) = objects.layer_for_new() else { return };
     ui.strong(format!("Layers ({})", layers.len()));
@@ -234,8 +237,7 @@ fn layers(ui: &mut egui::Ui, objects: &Objects, picking: &mut Option<(u32, [u8; 
             if new_here.clicked() && active != layer.id {
                 out.push(Command::Lines(vec![Line::Layer(layer.id, LayerLine::Active)]));
             }
-            let name = if layer.name().is_empty() { format!("layer {}", layer.id) } else { layer.name().to_owned() };
-            ui.label(name).on_hover_text(format!("layer {}", layer.id));
+            layer_name(ui, layer, &mut state.layer_name, out);
         });
     }
     // A pick is set once the pointer lets go, so a drag is one undo step.
@@ -247,6 +249,35 @@ fn layers(ui: &mut egui::Ui, objects: &Objects, picking: &mut Option<(u32, [u8; 
         if current.is_some_and(|c| c != color) {
             out.push(Command::Lines(vec![Line::Layer(id, LayerLine::Color(color))]));
         }
+    }
+}
+
+/// A layer's name; a double click edits it, Enter renames the layer
+/// (`layer N NAME`, one undo step), Escape or a click elsewhere keeps it.
+fn layer_name(
+    ui: &mut egui::Ui,
+    layer: &octovox::scene::graph::Layer,
+    editing: &mut Option<(u32, String)>,
+    out: &mut Vec<Command>,
+) {
+    if let Some((_, text)) = editing.as_mut().filter(|(id, _)| *id == layer.id) {
+        let field = ui.add(egui::TextEdit::singleline(text).desired_width(110.0));
+        if !field.has_focus() && !field.lost_focus() {
+            field.request_focus();
+        }
+        if field.lost_focus() {
+            let name = text.trim().to_owned();
+            if ui.input(|i| i.key_pressed(egui::Key::Enter)) && !name.is_empty() && name != layer.name() {
+                out.push(Command::Lines(vec![Line::Layer(layer.id, LayerLine::Name(name))]));
+            }
+            *editing = None;
+        }
+        return;
+    }
+    let name = if layer.name().is_empty() { format!("layer {}", layer.id) } else { layer.name().to_owned() };
+    let label = ui.add(egui::Label::new(name).sense(Sense::click()));
+    if label.on_hover_text(format!("layer {} · double click to rename", layer.id)).double_clicked() {
+        *editing = Some((layer.id, layer.name().to_owned()));
     }
 }
 

@@ -290,6 +290,9 @@ const ROW_PITCH: u32 = 23;
 const EYE_X: u32 = OUTLINER_X + 16;
 const INDENT: u32 = 12;
 const NAME_FROM_EYE: u32 = 110;
+/// The first layer's row in the Layers panel below the rows, and its name.
+const FIRST_LAYER_Y: u32 = 500;
+const LAYER_NAME_X: u32 = OUTLINER_X + 112;
 /// Rows shown without scrolling the Outliner.
 const ROWS_SHOWN: usize = 14;
 
@@ -319,7 +322,8 @@ fn group_of(file: &std::path::Path, node: u32) -> (usize, Vec<u32>) {
 /// The Outliner with the real mouse: an object's eye hides it (its pixels
 /// change on screen, the saved file keeps it with `_hidden`), and its name
 /// dragged onto another group's row puts it there, after that row (read
-/// back with `dot_vox`); one Ctrl+Z undoes each.
+/// back with `dot_vox`); one Ctrl+Z undoes each. A double click on a
+/// layer's name renames it.
 #[test]
 fn the_outliner_eye_hides_an_object_and_a_drag_regroups_it() {
     let (dir, file, scene) = groups_document();
@@ -404,4 +408,22 @@ fn the_outliner_eye_hides_an_object_and_a_drag_regroups_it() {
     lines.wait_for("undo:", Duration::from_secs(30));
     save(&display, &mut lines, &file);
     assert_eq!(group_of(&file, transform(from)), (group, children), "one Ctrl+Z puts it back");
+
+    // A double click on the first layer's name, a new name and Enter.
+    let layer_name = |file: &std::path::Path| {
+        let data = dot_vox::load_bytes(&std::fs::read(file).unwrap()).unwrap();
+        data.layers[0].attributes.get("_name").cloned()
+    };
+    assert_ne!(layer_name(&file).as_deref(), Some("forest"));
+    let (x, y) = (LAYER_NAME_X.to_string(), FIRST_LAYER_Y.to_string());
+    xdotool(&display, &["mousemove", "--window", &window, &x, &y]);
+    std::thread::sleep(Duration::from_millis(300));
+    xdotool(&display, &["click", "--repeat", "2", "--delay", "80", "1"]);
+    std::thread::sleep(Duration::from_millis(500));
+    xdotool(&display, &["key", "ctrl+a"]);
+    xdotool(&display, &["type", "forest"]);
+    xdotool(&display, &["key", "Return"]);
+    lines.wait_for("layer:", Duration::from_secs(30));
+    save(&display, &mut lines, &file);
+    assert_eq!(layer_name(&file).as_deref(), Some("forest"), "the layer is renamed in the file");
 }
