@@ -274,6 +274,19 @@ pub fn screenshot_x(display: &str, out: &Path) -> image::RgbImage {
     image::open(out).expect("the X screenshot is a PNG").to_rgb8()
 }
 
+/// A screenshot of the resting window: the pointer moved to the window's
+/// bottom-right corner (no hover highlight), a few frames let past, the picture taken into
+/// `dir`, and kept as `{OCTOVOX_KEEP_SHOTS}/{name}.png` when that is set.
+pub fn resting_shot(display: &str, window: &str, dir: &Path, name: &str) -> image::RgbImage {
+    xdotool(display, &["mousemove", "--window", window, "790", "590"]);
+    std::thread::sleep(Duration::from_millis(800));
+    let image = screenshot_x(display, &dir.join(format!("{name}.png")));
+    if let Ok(keep) = std::env::var("OCTOVOX_KEEP_SHOTS") {
+        image.save(format!("{keep}/{name}.png")).unwrap();
+    }
+    image
+}
+
 /// Clicks window pixel (x, y) with the left button and waits for the edit.
 pub fn click(display: &str, window: &str, lines: &mut Lines, x: u32, y: u32) -> u64 {
     xdotool(display, &["mousemove", "--window", window, &x.to_string(), &y.to_string()]);

@@ -59,12 +59,7 @@ fn new_then_a_click_on_the_ground_places_a_voxel_at_y_0() {
     let before = screenshot_x(&display, &dir.path().join("demo.png"));
     xdotool(&display, &["key", "ctrl+n"]);
     lines.wait_for("new: an empty scene on the ground", Duration::from_secs(30));
-    xdotool(&display, &["mousemove", "--window", &window, "790", "590"]);
-    std::thread::sleep(Duration::from_millis(800));
-    let empty = screenshot_x(&display, &dir.path().join("empty.png"));
-    if let Ok(keep) = std::env::var("OCTOVOX_KEEP_SHOTS") {
-        empty.save(format!("{keep}/new-scene.png")).unwrap();
-    }
+    let empty = resting_shot(&display, &window, dir.path(), "new-scene");
     // The grid's lines: lighter than the sky around them, along the ground.
     let (mean, variance) = grey_stats(&empty, FREE_X, HEIGHT / 2, WIDTH - 20, HEIGHT - 20);
     assert!(variance > 4.0, "the ground grid shows (grey mean {mean:.1}, variance {variance:.1})");

@@ -99,17 +99,10 @@ fn ctrl_h_hides_the_picked_object_and_the_file_keeps_it() {
     // Paint picks the object without changing its shape.
     xdotool(&display, &["key", "g"]);
     click(&display, &window, &mut lines, x, y);
-    xdotool(&display, &["mousemove", "--window", &window, "790", "590"]);
-    std::thread::sleep(Duration::from_millis(800));
-    let before = screenshot_x(&display, &dir.path().join("before.png"));
+    let before = resting_shot(&display, &window, dir.path(), "hide-before");
     xdotool(&display, &["key", "ctrl+h"]);
     lines.wait_for("object:", Duration::from_secs(30));
-    std::thread::sleep(Duration::from_millis(800));
-    let after = screenshot_x(&display, &dir.path().join("after.png"));
-    if let Ok(keep) = std::env::var("OCTOVOX_KEEP_SHOTS") {
-        before.save(format!("{keep}/hide-before.png")).unwrap();
-        after.save(format!("{keep}/hide-after.png")).unwrap();
-    }
+    let after = resting_shot(&display, &window, dir.path(), "hide-after");
     assert_gone(&shows, &before, &after);
 
     save(&display, &mut lines, &file);
@@ -347,9 +340,7 @@ fn the_outliner_eye_hides_an_object_and_a_drag_regroups_it() {
     let window = find_window(&display, &mut app, &stderr_path);
     lines.wait_for("octovox: ready", Duration::from_secs(90));
     xdotool(&display, &["windowfocus", "--sync", &window]);
-    xdotool(&display, &["mousemove", "--window", &window, "790", "590"]);
-    std::thread::sleep(Duration::from_millis(800));
-    let before = screenshot_x(&display, &dir.path().join("before.png"));
+    let before = resting_shot(&display, &window, dir.path(), "eye-before");
     let (row, depth) = outline_row(objects, owner);
     let (eye_x, y) = (EYE_X + INDENT * depth, FIRST_ROW_Y + ROW_PITCH * row);
     xdotool(&display, &["mousemove", "--window", &window, &eye_x.to_string(), &y.to_string()]);
@@ -357,13 +348,7 @@ fn the_outliner_eye_hides_an_object_and_a_drag_regroups_it() {
     xdotool(&display, &["click", "1"]);
     assert_eq!(lines.wait_for("ran: object", Duration::from_secs(30)), format!("ran: object {owner}"));
     lines.wait_for("object:", Duration::from_secs(30));
-    xdotool(&display, &["mousemove", "--window", &window, "790", "590"]);
-    std::thread::sleep(Duration::from_millis(800));
-    let after = screenshot_x(&display, &dir.path().join("after.png"));
-    if let Ok(keep) = std::env::var("OCTOVOX_KEEP_SHOTS") {
-        before.save(format!("{keep}/eye-before.png")).unwrap();
-        after.save(format!("{keep}/eye-after.png")).unwrap();
-    }
+    let after = resting_shot(&display, &window, dir.path(), "eye-after");
     assert_gone(&shows, &before, &after);
     save(&display, &mut lines, &file);
     assert_eq!(hidden_flag(&file).as_deref(), Some("1"), "saved hidden");

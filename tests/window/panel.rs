@@ -37,15 +37,7 @@ fn choosing_a_brush_moves_no_palette_swatch() {
     // compile the denoiser's kernels on lavapipe).
     lines.wait_for("noise: ", Duration::from_secs(90));
     xdotool(&display, &["windowfocus", "--sync", &window]);
-    let shot = |name: &str| {
-        xdotool(&display, &["mousemove", "--window", &window, "790", "590"]);
-        std::thread::sleep(Duration::from_millis(700));
-        let image = screenshot_x(&display, &dir.path().join(format!("{name}.png")));
-        if let Ok(keep) = std::env::var("OCTOVOX_KEEP_SHOTS") {
-            image.save(format!("{keep}/panel-{name}.png")).unwrap();
-        }
-        image
-    };
+    let shot = |name: &str| resting_shot(&display, &window, dir.path(), &format!("panel-{name}"));
     let voxel = shot("voxel");
     let swatches = palette_pixels(&voxel);
     let distinct: std::collections::HashSet<[u8; 3]> = swatches.iter().copied().collect();
