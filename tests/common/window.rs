@@ -275,8 +275,9 @@ pub fn screenshot_x(display: &str, out: &Path) -> image::RgbImage {
 }
 
 /// A screenshot of the resting window: the pointer moved to the window's
-/// bottom-right corner (no hover highlight), a few frames let past, the picture taken into
-/// `dir`, and kept as `{OCTOVOX_KEEP_SHOTS}/{name}.png` when that is set.
+/// bottom-right corner (no hover highlight), a few frames let past, the
+/// picture taken into `dir`, and kept as `{OCTOVOX_KEEP_SHOTS}/{name}.png`
+/// when that is set.
 pub fn resting_shot(display: &str, window: &str, dir: &Path, name: &str) -> image::RgbImage {
     xdotool(display, &["mousemove", "--window", window, "790", "590"]);
     std::thread::sleep(Duration::from_millis(800));
