@@ -243,6 +243,10 @@ pub struct PathArgs {
     /// Denoise the path-traced image (the edge-avoiding à-trous filter).
     #[arg(long)]
     pub denoise: bool,
+    /// Denoise with Intel Open Image Denoise instead, on the CPU after the
+    /// last sample (only in a build with the `oidn` feature).
+    #[arg(long, conflicts_with = "denoise")]
+    pub oidn: bool,
     /// Scattering events per path (passing through glass does not count).
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(0..=i64::from(octovox::settings::MAX_BOUNCES)))]
     pub bounces: u32,

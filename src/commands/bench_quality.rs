@@ -6,6 +6,7 @@
 //! time, log scale, the Pareto front of each scene joined).
 
 use std::path::Path;
+use std::time::Instant;
 
 use glam::DVec3;
 use serde::Serialize;
@@ -17,6 +18,7 @@ use octovox::quality::{Setting, accumulate, flip, pareto_front, psnr, render_set
 use octovox::scene::Scene;
 use octovox::scene::demo::BuiltIn;
 use octovox::settings::{RenderSettings, TraceMode};
+use octovox::trace::oidn;
 
 use super::bench::header;
 
@@ -30,8 +32,8 @@ struct QualityRow {
     flip: f32,
     /// dB; `None` when identical to the reference.
     psnr: Option<f64>,
-    /// The row's samples were denoised.
-    denoised: bool,
+    /// The filter the row's samples went through.
+    filter: Filter,
     /// Rows that differ from the base in their samples alone (raw or
     /// denoised): FLIP and RMS error (0..1 of full scale) against the base
     /// setting converged (the reference's samples, the base's bounces), so
@@ -41,8 +43,29 @@ struct QualityRow {
     noise_rms: Option<f64>,
     /// Raw ones of those: the noise estimate at the last sample.
     noise_estimate: Option<f32>,
-    /// On the Pareto front of its scene's raw rows or of its denoised rows.
+    /// On the Pareto front of its scene's rows of the same filter.
     pareto: bool,
+}
+
+/// What a row's samples went through before the image was measured.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+enum Filter {
+    Raw,
+    /// `--denoise`, the à-trous filter on the GPU.
+    Atrous,
+    /// `--oidn`, Open Image Denoise on the CPU (builds with the feature).
+    Oidn,
+}
+
+impl Filter {
+    fn label(self) -> &'static str {
+        match self {
+            Filter::Raw => "raw",
+            Filter::Atrous => "denoised",
+            Filter::Oidn => "OIDN",
+        }
+    }
 }
 
 struct Sizes {
@@ -63,9 +86,13 @@ fn spp_values(sizes: &Sizes) -> Vec<u32> {
     values
 }
 
+/// A row to measure: the knob's CLI flag and value, the setting, the filter.
+type Knob = (&'static str, String, Setting, Filter);
+
 /// The base setting and the knobs turned from it, by CLI flag; then every
-/// spp of [`spp_values`] denoised.
-fn knobs(sizes: &Sizes) -> Vec<(&'static str, String, Setting)> {
+/// spp of [`spp_values`] denoised (and through Open Image Denoise, in a
+/// build that has it).
+fn knobs(sizes: &Sizes) -> Vec<Knob> {
     let base = |spp, bounces, shadow_samples, render_scale| Setting::Path {
         spp,
         bounces,
@@ -74,28 +101,59 @@ fn knobs(sizes: &Sizes) -> Vec<(&'static str, String, Setting)> {
         denoise: false,
     };
     let spp = sizes.base_spp;
-    let mut out = vec![("base", format!("--spp {spp} --bounces 3"), base(spp, 3, 1, 1.0))];
+    let raw = |knob, value, setting| (knob, value, setting, Filter::Raw);
+    let mut out = vec![raw("base", format!("--spp {spp} --bounces 3"), base(spp, 3, 1, 1.0))];
     for s in spp_values(sizes).into_iter().filter(|&s| s != spp) {
-        out.push(("--spp", s.to_string(), base(s, 3, 1, 1.0)));
+        out.push(raw("--spp", s.to_string(), base(s, 3, 1, 1.0)));
     }
     for b in [0, 1, 6] {
-        out.push(("--bounces", b.to_string(), base(spp, b, 1, 1.0)));
+        out.push(raw("--bounces", b.to_string(), base(spp, b, 1, 1.0)));
     }
-    out.push(("--shadow-samples", "4".into(), base(spp, 3, 4, 1.0)));
+    out.push(raw("--shadow-samples", "4".into(), base(spp, 3, 4, 1.0)));
     for r in [0.25, 0.5] {
-        out.push(("--render-scale", r.to_string(), base(spp, 3, 1, r)));
+        out.push(raw("--render-scale", r.to_string(), base(spp, 3, 1, r)));
     }
     let preview = |mode, lod| Setting::Preview { mode, render_scale: 1.0, lod };
-    out.push(("--mode", "svo (preview)".into(), preview(TraceMode::Svo, 0.0)));
-    out.push(("--mode", "grid (preview)".into(), preview(TraceMode::Grid, 0.0)));
+    out.push(raw("--mode", "svo (preview)".into(), preview(TraceMode::Svo, 0.0)));
+    out.push(raw("--mode", "grid (preview)".into(), preview(TraceMode::Grid, 0.0)));
     for lod in LOD_PIXELS {
-        out.push(("--lod", format!("{lod} (preview)"), preview(TraceMode::Svo, lod)));
+        out.push(raw("--lod", format!("{lod} (preview)"), preview(TraceMode::Svo, lod)));
     }
     for s in spp_values(sizes) {
         let denoised = Setting::Path { spp: s, bounces: 3, shadow_samples: 1, render_scale: 1.0, denoise: true };
-        out.push(("--denoise", format!("--spp {s}"), denoised));
+        out.push(("--denoise", format!("--spp {s}"), denoised, Filter::Atrous));
+    }
+    if oidn::AVAILABLE {
+        for s in spp_values(sizes) {
+            out.push(("--oidn", format!("--spp {s}"), base(s, 3, 1, 1.0), Filter::Oidn));
+        }
     }
     out
+}
+
+/// Draws one row's frame ([`render_setting`]); through Open Image Denoise
+/// for [`Filter::Oidn`], whose readback and filter count in its time.
+fn measure(
+    renderer: &mut Renderer,
+    scene: &Scene,
+    camera: &Camera,
+    size: (u32, u32),
+    setting: Setting,
+    filter: Filter,
+) -> anyhow::Result<(f64, image::RgbaImage)> {
+    let (ms, image) = render_setting(renderer, scene, camera, size, setting)?;
+    if filter != Filter::Oidn {
+        return Ok((ms, image));
+    }
+    let start = Instant::now();
+    let image = oidn_image(renderer, size)?;
+    Ok((ms + start.elapsed().as_secs_f64() * 1e3, image))
+}
+
+/// The accumulation read back and filtered by Open Image Denoise.
+fn oidn_image(renderer: &Renderer, size: (u32, u32)) -> anyhow::Result<image::RgbaImage> {
+    let (sums, guides) = renderer.read_samples()?;
+    Ok(oidn::denoised_image(&sums, &guides, size.0, size.1)?)
 }
 
 /// The small model, framed.
@@ -136,6 +194,7 @@ pub fn bench_quality(quick: bool, out: &Path) -> anyhow::Result<(String, String)
         };
         let (_, reference_image) = render_setting(&mut renderer, &scene, &camera, sizes.size, reference)?;
         let reference_noise = renderer.noise_estimate()?;
+        let oidn_reference = if oidn::AVAILABLE { Some(oidn_image(&renderer, sizes.size)?) } else { None };
         renderer.denoise_now()?;
         let denoised_reference = renderer.read_image()?;
         let converged_base = Setting::Path {
@@ -146,11 +205,15 @@ pub fn bench_quality(quick: bool, out: &Path) -> anyhow::Result<(String, String)
             denoise: false,
         };
         let (_, converged) = render_setting(&mut renderer, &scene, &camera, sizes.size, converged_base)?;
-        unbiased.push(UnbiasedRow { scene: name, flip: flip(&reference_image, &denoised_reference), reference_noise });
+        unbiased.push(UnbiasedRow {
+            scene: name,
+            flip: flip(&reference_image, &denoised_reference),
+            oidn_flip: oidn_reference.map(|image| flip(&reference_image, &image)),
+            reference_noise,
+        });
         let mut scene_rows = Vec::new();
-        for (knob, value, setting) in knobs(&sizes) {
-            let (ms, image) = render_setting(&mut renderer, &scene, &camera, sizes.size, setting)?;
-            let denoised = matches!(setting, Setting::Path { denoise: true, .. });
+        for (knob, value, setting, filter) in knobs(&sizes) {
+            let (ms, image) = measure(&mut renderer, &scene, &camera, sizes.size, setting, filter)?;
             let spp_only = matches!(setting, Setting::Path { bounces: 3, shadow_samples: 1, render_scale, .. } if render_scale == 1.0);
             scene_rows.push(QualityRow {
                 scene: name,
@@ -159,15 +222,15 @@ pub fn bench_quality(quick: bool, out: &Path) -> anyhow::Result<(String, String)
                 ms_per_frame: ms,
                 flip: flip(&reference_image, &image),
                 psnr: psnr(&reference_image, &image),
-                denoised,
+                filter,
                 noise_flip: spp_only.then(|| flip(&converged, &image)),
                 noise_rms: spp_only.then(|| rms_error(&converged, &image)),
-                noise_estimate: if spp_only && !denoised { renderer.noise_estimate()? } else { None },
+                noise_estimate: if spp_only && filter == Filter::Raw { renderer.noise_estimate()? } else { None },
                 pareto: false,
             });
         }
-        for denoised in [false, true] {
-            let group: Vec<usize> = (0..scene_rows.len()).filter(|&i| scene_rows[i].denoised == denoised).collect();
+        for filter in [Filter::Raw, Filter::Atrous, Filter::Oidn] {
+            let group: Vec<usize> = (0..scene_rows.len()).filter(|&i| scene_rows[i].filter == filter).collect();
             let points: Vec<(f64, f64)> =
                 group.iter().map(|&i| (scene_rows[i].ms_per_frame, f64::from(scene_rows[i].flip))).collect();
             for (&i, on_front) in group.iter().zip(pareto_front(&points)) {
@@ -198,6 +261,8 @@ pub fn bench_quality(quick: bool, out: &Path) -> anyhow::Result<(String, String)
 struct UnbiasedRow {
     scene: &'static str,
     flip: f32,
+    /// The same through Open Image Denoise, in a build that has it.
+    oidn_flip: Option<f32>,
     reference_noise: Option<f32>,
 }
 
@@ -255,7 +320,7 @@ fn rms_error(reference: &image::RgbaImage, test: &image::RgbaImage) -> f64 {
 fn raw_flip_at(rows: &[QualityRow], scene: &str, ms: f64) -> Option<f64> {
     let mut curve: Vec<(f64, f64)> = rows
         .iter()
-        .filter(|r| r.scene == scene && !r.denoised)
+        .filter(|r| r.scene == scene && r.filter == Filter::Raw)
         .filter_map(|r| r.noise_flip.map(|f| (r.ms_per_frame.ln(), f64::from(f))))
         .collect();
     curve.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -267,10 +332,10 @@ fn raw_flip_at(rows: &[QualityRow], scene: &str, ms: f64) -> Option<f64> {
 }
 
 /// The time and FLIP against the converged base of a spp row.
-fn flip_of(rows: &[QualityRow], scene: &str, denoised: bool, spp: u32) -> Option<(f64, f32)> {
+fn flip_of(rows: &[QualityRow], scene: &str, filter: Filter, spp: u32) -> Option<(f64, f32)> {
     rows.iter()
         .find(|r| {
-            r.scene == scene && r.denoised == denoised && {
+            r.scene == scene && r.filter == filter && {
                 let value = r.value.trim_start_matches("--spp ");
                 value.split(' ').next() == Some(spp.to_string().as_str())
             }
@@ -280,16 +345,17 @@ fn flip_of(rows: &[QualityRow], scene: &str, denoised: bool, spp: u32) -> Option
 
 fn denoise_markdown(rows: &[QualityRow], unbiased: &[UnbiasedRow]) -> String {
     let mut md = String::from(
-        "\n## Denoised against raw\n\nThe rows that differ from the base in their samples alone, raw and denoised, against the base setting converged (the reference's samples at the base's 3 bounces and 1 shadow sample): the error left is noise and what the filter did to it, not the bias of fewer bounces (which is in the table above). Each denoised row against the raw path tracer at the same wall time: the raw FLIP interpolated between its rows on a log time axis, blank where the denoised frame is faster than raw 1 spp or slower than the last raw row. Target: ratio ≤ 0.6 at 4–16 spp.\n\n| scene | spp | denoised ms | denoised FLIP | raw FLIP at that time | ratio | denoised RMS |\n|---|---|---|---|---|---|---|\n",
+        "\n## Denoised against raw\n\nThe rows that differ from the base in their samples alone, raw and denoised, against the base setting converged (the reference's samples at the base's 3 bounces and 1 shadow sample): the error left is noise and what the filter did to it, not the bias of fewer bounces (which is in the table above). Each denoised row against the raw path tracer at the same wall time: the raw FLIP interpolated between its rows on a log time axis, blank where the denoised frame is faster than raw 1 spp or slower than the last raw row. Target: ratio ≤ 0.6 at 4–16 spp.\n\n| scene | filter | spp | ms | FLIP | raw FLIP at that time | ratio | RMS |\n|---|---|---|---|---|---|---|---|\n",
     );
     let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene).collect();
     scenes.dedup();
     for scene in &scenes {
-        for r in rows.iter().filter(|r| r.scene == *scene && r.denoised) {
+        for r in rows.iter().filter(|r| r.scene == *scene && r.filter != Filter::Raw) {
             let (Some(flip), Some(rms)) = (r.noise_flip, r.noise_rms) else { continue };
             let raw = raw_flip_at(rows, scene, r.ms_per_frame);
             md += &format!(
-                "| {scene} | {} | {:.1} | {flip:.4} | {} | {} | {rms:.4} |\n",
+                "| {scene} | {} | {} | {:.1} | {flip:.4} | {} | {} | {rms:.4} |\n",
+                r.filter.label(),
                 r.value.trim_start_matches("--spp "),
                 r.ms_per_frame,
                 raw.map_or(String::new(), |f| format!("{f:.4}")),
@@ -297,26 +363,25 @@ fn denoise_markdown(rows: &[QualityRow], unbiased: &[UnbiasedRow]) -> String {
             );
         }
     }
-    md += "\nDenoised 8 spp against raw 32 spp (FLIP against the converged base):\n\n| scene | denoised 8 spp: ms, FLIP | raw 32 spp: ms, FLIP |\n|---|---|---|\n";
+    md += "\nDenoised 8 spp against raw 32 spp (FLIP against the converged base; OIDN only in a build with it):\n\n| scene | denoised 8 spp: ms, FLIP | OIDN 8 spp: ms, FLIP | raw 32 spp: ms, FLIP |\n|---|---|---|---|\n";
     for scene in &scenes {
-        let cell = |v: Option<(f64, f32)>| v.map_or("–".into(), |(ms, f)| format!("{ms:.1} ms, {f:.4}"));
+        let cell = |filter, spp| {
+            flip_of(rows, scene, filter, spp).map_or("–".into(), |(ms, f)| format!("{ms:.1} ms, {f:.4}"))
+        };
         md += &format!(
-            "| {scene} | {} | {} |\n",
-            cell(flip_of(rows, scene, true, 8)),
-            cell(flip_of(rows, scene, false, 32))
+            "| {scene} | {} | {} | {} |\n",
+            cell(Filter::Atrous, 8),
+            cell(Filter::Oidn, 8),
+            cell(Filter::Raw, 32)
         );
     }
-    md += "\nNo bias: the reference's own samples denoised, against the raw reference (target FLIP ≤ 0.01).\n\n| scene | FLIP | the reference's noise estimate |\n|---|---|---|\n";
+    md += "\nNo bias: the reference's own samples denoised, against the raw reference (target FLIP ≤ 0.01).\n\n| scene | FLIP | OIDN FLIP | the reference's noise estimate |\n|---|---|---|---|\n";
+    let cell = |v: Option<f32>| v.map_or("–".into(), |n| format!("{n:.4}"));
     for u in unbiased {
-        md += &format!(
-            "| {} | {:.4} | {} |\n",
-            u.scene,
-            u.flip,
-            u.reference_noise.map_or("–".into(), |n| format!("{n:.4}"))
-        );
+        md += &format!("| {} | {:.4} | {} | {} |\n", u.scene, u.flip, cell(u.oidn_flip), cell(u.reference_noise));
     }
     md += "\nThe noise estimate against the measured error, raw rows: the estimate is the RMS standard error of the displayed pixels from each pixel's own samples; the measured error is the RMS difference from the converged base, which has noise of its own (about the estimate of the reference above) and 8-bit rounding.\n\n| scene | spp | estimate | measured RMS | measured / estimate |\n|---|---|---|---|---|\n";
-    for r in rows.iter().filter(|r| !r.denoised) {
+    for r in rows.iter().filter(|r| r.filter == Filter::Raw) {
         let (Some(estimate), Some(measured)) = (r.noise_estimate, r.noise_rms) else { continue };
         let estimate = f64::from(estimate);
         md += &format!(
@@ -467,7 +532,10 @@ fn far_camera(scene: &Scene) -> Camera {
 fn rows_for_plot(rows: &[QualityRow]) -> Vec<super::quality_plot::Point> {
     rows.iter()
         .map(|r| super::quality_plot::Point {
-            series: if r.denoised { format!("{}, denoised", r.scene) } else { r.scene.to_string() },
+            series: match r.filter {
+                Filter::Raw => r.scene.to_string(),
+                filter => format!("{}, {}", r.scene, filter.label()),
+            },
             label: if r.knob == "base" { "base".to_string() } else { format!("{} {}", r.knob, r.value) },
             ms: r.ms_per_frame,
             error: f64::from(r.flip),

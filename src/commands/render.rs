@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use anyhow::Context;
 
-use crate::cli::{RenderArgs, camera_or_framing};
+use crate::cli::{PathArgs, RenderArgs, camera_or_framing};
 use octovox::camera::Camera;
 use octovox::gpu::{PathView, Renderer};
 use octovox::io::atomic::WriteOptions;
@@ -50,8 +50,11 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<ExitCode> {
     if args.lod > 0.0 && (traced_path || args.mode != TraceMode::Svo) {
         anyhow::bail!("--lod applies to the SVO preview: the path tracer (--spp) and --mode grid trace exactly");
     }
-    if args.path.denoise && !traced_path {
-        anyhow::bail!("--denoise filters the path tracer's samples: give --spp N or --target-error E");
+    if (args.path.denoise || args.path.oidn) && !traced_path {
+        anyhow::bail!("--denoise and --oidn filter the path tracer's samples: give --spp N or --target-error E");
+    }
+    if args.path.oidn && !octovox::trace::oidn::AVAILABLE {
+        return Err(octovox::trace::oidn::OidnError::NotBuilt.into());
     }
     if args.cpu && args.path.target_error.is_some() {
         anyhow::bail!("--target-error samples on the GPU; the CPU reference renders a fixed --spp");
@@ -144,7 +147,7 @@ fn path_traced(
 ) -> anyhow::Result<(image::RgbaImage, Stats)> {
     let settings = args.path.settings();
     if args.cpu {
-        return Ok(path_traced_cpu(scene, camera, args, size));
+        return path_traced_cpu(scene, camera, args, size);
     }
     let mut renderer = Renderer::headless().context("no GPU for rendering (try --cpu)")?;
     log::info!("path tracing on {}", renderer.gpu.adapter_name);
@@ -155,7 +158,7 @@ fn path_traced(
     let Accumulated { last: frame, ms: total_ms } = accumulate(&mut renderer, &view, cap, target, |_| bar.inc(1))?;
     bar.finish_and_clear();
     let noise = renderer.noise_estimate()?;
-    let denoise_ms = if args.path.denoise { Some(renderer.denoise_now()?) } else { None };
+    let (image, denoise_ms) = finished_image(&mut renderer, &args.path, size)?;
     let stats = Stats {
         effects: frame.effects.names(),
         spp: frame.samples,
@@ -171,24 +174,50 @@ fn path_traced(
         log::warn!("stopped at the {cap}-sample cap above the target error {target} (estimate {noise:?})");
     }
     log::info!("{} samples, {:.2} ms each", stats.spp, stats.ms_per_sample);
-    Ok((renderer.read_image()?, stats))
+    Ok((image, stats))
+}
+
+/// The image of the accumulated samples: raw, or denoised by `--denoise`
+/// (on the GPU) or `--oidn` (read back and filtered on the CPU), with the
+/// filter's milliseconds.
+fn finished_image(
+    renderer: &mut Renderer,
+    path: &PathArgs,
+    size: (u32, u32),
+) -> anyhow::Result<(image::RgbaImage, Option<f64>)> {
+    if path.oidn {
+        let start = Instant::now();
+        let (sums, guides) = renderer.read_samples()?;
+        let image = octovox::trace::oidn::denoised_image(&sums, &guides, size.0, size.1)?;
+        return Ok((image, Some(start.elapsed().as_secs_f64() * 1e3)));
+    }
+    let denoise_ms = if path.denoise { Some(renderer.denoise_now()?) } else { None };
+    Ok((renderer.read_image()?, denoise_ms))
 }
 
 /// `--spp` samples of the CPU reference, denoised by the filter's CPU twin
-/// with `--denoise`.
-fn path_traced_cpu(scene: &Scene, camera: &Camera, args: &RenderArgs, size: (u32, u32)) -> (image::RgbaImage, Stats) {
+/// with `--denoise`, or by Open Image Denoise with `--oidn`.
+fn path_traced_cpu(
+    scene: &Scene,
+    camera: &Camera,
+    args: &RenderArgs,
+    size: (u32, u32),
+) -> anyhow::Result<(image::RgbaImage, Stats)> {
     let spp = args.path.samples();
     let start = Instant::now();
     let frame = render_cpu(scene, camera, size, &args.path.settings(), spp);
     let ms = start.elapsed().as_secs_f64() * 1e3 / f64::from(spp);
-    let (pixels, denoise_ms) = if args.path.denoise {
-        let start = Instant::now();
+    let filter_start = Instant::now();
+    let pixels = if args.path.oidn {
+        octovox::trace::oidn::denoise(&frame.sums, &frame.guides, size.0, size.1)?
+    } else if args.path.denoise {
         let basis = camera.basis(size.0, size.1, scene.origin());
-        let pixels = denoise(&Frame::of(&basis), &frame.sums, &frame.guides);
-        (pixels, Some(start.elapsed().as_secs_f64() * 1e3))
+        denoise(&Frame::of(&basis), &frame.sums, &frame.guides)
     } else {
-        (frame.pixels, None)
+        frame.pixels
     };
+    let filtered = args.path.denoise || args.path.oidn;
+    let denoise_ms = filtered.then(|| filter_start.elapsed().as_secs_f64() * 1e3);
     let stats = Stats {
         effects: frame.effects.names(),
         spp,
@@ -198,5 +227,5 @@ fn path_traced_cpu(scene: &Scene, camera: &Camera, args: &RenderArgs, size: (u32
         adapter: "cpu".into(),
         lights: frame.lights,
     };
-    (to_image(&pixels, size.0, size.1), stats)
+    Ok((to_image(&pixels, size.0, size.1), stats))
 }

@@ -16,7 +16,7 @@ use super::{
 use crate::camera::Camera;
 use crate::scene::Scene;
 use crate::settings::{PathSettings, RenderSettings, View};
-use crate::trace::denoise::Frame;
+use crate::trace::denoise::{Frame, Guide, Sums};
 use crate::trace::grid::DenseGrid;
 use crate::trace::path::materials::{Effects, material_table};
 use crate::trace::path::{effects_for, lights};
@@ -616,6 +616,12 @@ impl Renderer {
     /// The mean radiance per pixel of the path tracer's accumulation.
     pub fn read_radiance(&self) -> Result<Vec<glam::Vec3>, GpuError> {
         self.path.read_radiance(&self.gpu)
+    }
+
+    /// The accumulation's sums and the denoiser's guides of every pixel,
+    /// row-major, for a filter on the CPU (`crate::trace::oidn`).
+    pub fn read_samples(&self) -> Result<(Vec<Sums>, Vec<Guide>), GpuError> {
+        Ok((self.path.read_sums(&self.gpu)?, self.path.read_guides(&self.gpu)?))
     }
 
     /// The output of the last frame, for the window's blit.

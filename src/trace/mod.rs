@@ -5,6 +5,7 @@
 pub mod denoise;
 pub mod grid;
 pub mod instanced;
+pub mod oidn;
 pub mod path;
 pub mod pick;
 pub mod render;

@@ -626,3 +626,22 @@ fn meshes_too_small_or_too_far_to_voxelize_say_so() {
         }
     }
 }
+
+/// `--oidn` needs samples, cannot be mixed with `--denoise`, and a build
+/// without Open Image Denoise says how to get one; none writes an image.
+#[test]
+fn open_image_denoise_is_refused_clearly_where_it_cannot_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("o.png");
+    let render = |extra: &[&str]| {
+        let mut args = vec!["render", "--cpu", "--size", "8x8", "-o", s(&png)];
+        args.extend_from_slice(extra);
+        octovox(&args)
+    };
+    assert_refused(&render(&["--oidn"]), "give --spp N");
+    assert_refused(&render(&["--spp", "1", "--oidn", "--denoise"]), "cannot be used with");
+    if !octovox::trace::oidn::AVAILABLE {
+        assert_refused(&render(&["--spp", "1", "--oidn"]), "--features oidn");
+    }
+    assert!(!png.exists(), "a refused render wrote {}", png.display());
+}

@@ -239,3 +239,30 @@ fn a_render_to_a_target_error_stops_near_it() {
         assert!(taken[1] > taken[0], "{name}: a tighter target took {taken:?} samples");
     }
 }
+
+/// Open Image Denoise (a build with `--features oidn`) on the GPU's
+/// samples of the lamp-lit interior: nearer the converged image than the
+/// raw samples are, and not blank.
+#[cfg(feature = "oidn")]
+#[test]
+fn open_image_denoise_brings_few_samples_nearer_the_converged_image() {
+    let mut scene = octovox::scene::demo::BuiltIn::Interior.scene();
+    let camera = octovox::scene::showroom::interior_camera();
+    let settings = PathSettings { bounces: 3, ..PathSettings::default() };
+    let size = (80, 45);
+    let mut renderer = renderer_for(&mut scene);
+    let view = PathView { scene: &scene, camera: &camera, size, settings: &settings };
+    sample(&mut renderer, &view, 256);
+    let converged = renderer.read_image().unwrap();
+    sample(&mut renderer, &view, 4);
+    let raw = renderer.read_image().unwrap();
+    let (sums, guides) = renderer.read_samples().unwrap();
+    let filtered = octovox::trace::oidn::denoised_image(&sums, &guides, size.0, size.1).unwrap();
+    let rms = |image: &image::RgbaImage| psnr(&converged, image).map_or(0.0, |db| 10f64.powf(-db / 20.0));
+    let (raw_rms, oidn_rms) = (rms(&raw), rms(&filtered));
+    let (raw_flip, oidn_flip) = (flip(&converged, &raw), flip(&converged, &filtered));
+    println!("4 spp against 256: raw RMS {raw_rms:.4} FLIP {raw_flip:.4}, OIDN RMS {oidn_rms:.4} FLIP {oidn_flip:.4}");
+    assert!(grey_variance(&filtered) > 100.0, "a flat or blank image");
+    assert!(oidn_rms < 0.7 * raw_rms, "4 spp: RMS error {raw_rms} raw, {oidn_rms} through OIDN");
+    assert!(oidn_flip < 0.7 * raw_flip, "4 spp: FLIP {raw_flip} raw, {oidn_flip} through OIDN");
+}
