@@ -26,19 +26,25 @@ pub fn flip(reference: &RgbaImage, test: &RgbaImage) -> f32 {
     nv_flip::FlipPool::from_image(&error).mean()
 }
 
-/// Peak signal-to-noise ratio over the RGB bytes in dB; `None` for
-/// identical images (infinite).
-pub fn psnr(reference: &RgbaImage, test: &RgbaImage) -> Option<f64> {
+/// The RMS difference of the RGB bytes, as a fraction of full scale
+/// (0 for identical images).
+pub fn rms_error(reference: &RgbaImage, test: &RgbaImage) -> f64 {
     let (mut sum, mut count) = (0.0f64, 0u64);
     for (a, b) in reference.pixels().zip(test.pixels()) {
         for c in 0..3 {
-            let d = f64::from(a[c]) - f64::from(b[c]);
+            let d = (f64::from(a[c]) - f64::from(b[c])) / 255.0;
             sum += d * d;
             count += 1;
         }
     }
-    let mse = sum / count.max(1) as f64;
-    (mse > 0.0).then(|| 10.0 * (255.0 * 255.0 / mse).log10())
+    (sum / count.max(1) as f64).sqrt()
+}
+
+/// Peak signal-to-noise ratio over the RGB bytes in dB; `None` for
+/// identical images (infinite).
+pub fn psnr(reference: &RgbaImage, test: &RgbaImage) -> Option<f64> {
+    let rms = rms_error(reference, test);
+    (rms > 0.0).then(|| -20.0 * rms.log10())
 }
 
 /// One way to draw a frame: the path tracer with its knobs, or the preview.

@@ -14,13 +14,14 @@ use serde::Serialize;
 use octovox::camera::Camera;
 use octovox::gpu::PathView;
 use octovox::gpu::Renderer;
-use octovox::quality::{Setting, accumulate, flip, pareto_front, psnr, render_setting};
+use octovox::quality::{Setting, accumulate, flip, pareto_front, psnr, render_setting, rms_error};
 use octovox::scene::Scene;
 use octovox::scene::demo::BuiltIn;
 use octovox::settings::{RenderSettings, TraceMode};
 use octovox::trace::oidn;
 
 use super::bench::header;
+use super::render::oidn_image;
 
 #[derive(Serialize)]
 struct QualityRow {
@@ -148,12 +149,6 @@ fn measure(
     let start = Instant::now();
     let image = oidn_image(renderer, size)?;
     Ok((ms + start.elapsed().as_secs_f64() * 1e3, image))
-}
-
-/// The accumulation read back and filtered by Open Image Denoise.
-fn oidn_image(renderer: &Renderer, size: (u32, u32)) -> anyhow::Result<image::RgbaImage> {
-    let (sums, guides) = renderer.read_samples()?;
-    Ok(oidn::denoised_image(&sums, &guides, size.0, size.1)?)
 }
 
 /// The small model, framed.
@@ -308,11 +303,6 @@ fn target_rows(
         });
     }
     Ok(rows)
-}
-
-/// The RMS difference of the RGB bytes, as a fraction of full scale.
-fn rms_error(reference: &image::RgbaImage, test: &image::RgbaImage) -> f64 {
-    psnr(reference, test).map_or(0.0, |db| 10f64.powf(-db / 20.0))
 }
 
 /// The raw FLIP against the converged base of `scene` at `ms`,

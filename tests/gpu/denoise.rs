@@ -6,7 +6,7 @@
 use glam::{DVec3, IVec3};
 use octovox::camera::Camera;
 use octovox::gpu::{PathView, Renderer};
-use octovox::quality::{accumulate, flip, psnr};
+use octovox::quality::{accumulate, flip, rms_error};
 use octovox::scene::{Octree, Op, Scene, Shape};
 use octovox::settings::PathSettings;
 use octovox::trace::denoise::{Frame, LUMINANCE, denoise, noise_estimate};
@@ -187,7 +187,7 @@ fn a_one_voxel_checker_keeps_its_contrast_and_the_filter_adds_no_bias() {
     // denoised image is closer to the converged one than the raw is, and
     // no further by FLIP (which, in the dark squares, sees the 8-bit
     // rounding of an image 0.4 % off: 0.014).
-    let rms = |image: &image::RgbaImage| psnr(&converged, image).map_or(0.0, |db| 10f64.powf(-db / 20.0));
+    let rms = |image: &image::RgbaImage| rms_error(&converged, image);
     let (raw_rms, denoised_rms) = (rms(&reference), rms(&denoised_reference));
     let (raw_off, denoised_off) = (flip(&converged, &reference), flip(&converged, &denoised_reference));
     println!(
@@ -227,7 +227,7 @@ fn a_render_to_a_target_error_stops_near_it() {
             let noise = renderer.noise_estimate().unwrap().unwrap();
             assert!(noise < target, "{name}: stopped at {noise} above {target}");
             let image = renderer.read_image().unwrap();
-            let measured = psnr(&reference, &image).map_or(0.0, |db| 10f64.powf(-db / 20.0));
+            let measured = rms_error(&reference, &image);
             let factor = measured / f64::from(target);
             println!(
                 "{name}: target {target}: {} samples, estimate {noise:.4}, measured {measured:.4}",
@@ -258,7 +258,7 @@ fn open_image_denoise_brings_few_samples_nearer_the_converged_image() {
     let raw = renderer.read_image().unwrap();
     let (sums, guides) = renderer.read_samples().unwrap();
     let filtered = octovox::trace::oidn::denoised_image(&sums, &guides, size.0, size.1).unwrap();
-    let rms = |image: &image::RgbaImage| psnr(&converged, image).map_or(0.0, |db| 10f64.powf(-db / 20.0));
+    let rms = |image: &image::RgbaImage| rms_error(&converged, image);
     let (raw_rms, oidn_rms) = (rms(&raw), rms(&filtered));
     let (raw_flip, oidn_flip) = (flip(&converged, &raw), flip(&converged, &filtered));
     println!("4 spp against 256: raw RMS {raw_rms:.4} FLIP {raw_flip:.4}, OIDN RMS {oidn_rms:.4} FLIP {oidn_flip:.4}");
