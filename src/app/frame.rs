@@ -13,7 +13,7 @@ use octovox::trace::grid::DenseGrid;
 
 use super::gesture::Gesture;
 use super::state::Mode;
-use super::{App, Gfx, camera_control, capture, motion, ui};
+use super::{App, Gfx, camera_control, capture, motion, slow_clicks, ui};
 
 /// Most bands a path-traced sample is split into.
 pub(super) const MAX_PATH_BANDS: u32 = 16;
@@ -111,6 +111,7 @@ impl App {
         let gfx = self.gfx.as_mut()?;
         let raw_input = gfx.egui_state.take_egui_input(&gfx.window);
         let ctx = gfx.egui_state.egui_ctx().clone();
+        slow_clicks::allow_for_frame_length(&ctx, &raw_input);
         let loading = self
             .doc
             .loading

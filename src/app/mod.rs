@@ -38,6 +38,7 @@ mod preview;
 mod recent;
 mod script;
 mod selection;
+mod slow_clicks;
 mod state;
 mod ui;
 
