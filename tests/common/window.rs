@@ -381,6 +381,27 @@ pub fn spawn_app_with(
     (KillOnDrop(child, "octovox"), lines, stderr_path)
 }
 
+/// [`spawn_app`], then waits for the window to be ready and gives it the
+/// keyboard focus (without a window manager nothing does): the app, its
+/// stdout lines and its window id.
+pub fn open_ready(display: &str, dir: &Path, args: &[String]) -> (KillOnDrop, Lines, String) {
+    open_ready_with(display, dir, args, &[("OCTOVOX_NO_NATIVE_DIALOGS", "1")])
+}
+
+/// [`open_ready`] with these environment variables ([`spawn_app_with`]).
+pub fn open_ready_with(
+    display: &str,
+    dir: &Path,
+    args: &[String],
+    env: &[(&str, &str)],
+) -> (KillOnDrop, Lines, String) {
+    let (mut app, mut lines, stderr_path) = spawn_app_with(display, dir, args, env);
+    let window = find_window(display, &mut app, &stderr_path);
+    lines.wait_for("octovox: ready", Duration::from_secs(90));
+    xdotool(display, &["windowfocus", "--sync", &window]);
+    (app, lines, window)
+}
+
 /// The window's arguments for `file` seen through `camera` at the tests'
 /// size, then `extra`.
 pub fn document_args(file: &Path, camera: &Camera, extra: &[&str]) -> Vec<String> {

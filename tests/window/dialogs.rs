@@ -55,10 +55,7 @@ fn open_and_save_as_go_through_the_native_dialog_or_the_browser() {
 
     let (_xvfb, display) = start_xvfb(10);
     let args = [a.display().to_string(), "--size".into(), "640x480".into()];
-    let (mut app, mut lines, stderr_path) = spawn_app_with(&display, &root, &args, &[("PATH", &path)]);
-    let window = find_window(&display, &mut app, &stderr_path);
-    lines.wait_for("octovox: ready", Duration::from_secs(90));
-    xdotool(&display, &["windowfocus", "--sync", &window]);
+    let (_app, mut lines, window) = open_ready_with(&display, &root, &args, &[("PATH", &path)]);
 
     xdotool(&display, &["key", "ctrl+o"]);
     lines.wait_for("file dialog: native", Duration::from_secs(30));

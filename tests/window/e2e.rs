@@ -177,10 +177,7 @@ fn slow_load_keeps_the_window_live() {
 
     let (_xvfb, display) = start_xvfb(1);
     let args = ["--size", "640x480", "--render-scale", "0.5", "--no-shadows"].map(String::from);
-    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
-    let window = find_window(&display, &mut app, &stderr_path);
-    lines.wait_for("octovox: ready", Duration::from_secs(90));
-    xdotool(&display, &["windowfocus", "--sync", &window]);
+    let (mut app, mut lines, window) = open_ready(&display, dir.path(), &args);
 
     // Open the FIFO through the Open dialog: the reader blocks until we write.
     xdotool(&display, &["key", "ctrl+o"]);
@@ -313,10 +310,7 @@ fn alt_click_picks_a_colour_and_shift_click_paint_fills_with_it() {
     let (x, y, voxel, normal) = stable_pixel(scene.drawn(), &camera, |v, n| scene.voxel(v) == 77 && n == IVec3::Z);
     let args = document_args(&file, &camera, &["--shading", "preview"]);
     let (_xvfb, display) = start_xvfb(4);
-    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
-    let window = find_window(&display, &mut app, &stderr_path);
-    lines.wait_for("octovox: ready", Duration::from_secs(90));
-    xdotool(&display, &["windowfocus", "--sync", &window]);
+    let (_app, mut lines, window) = open_ready(&display, dir.path(), &args);
     xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y.to_string()]);
     xdotool(&display, &["keydown", "alt", "click", "1", "keyup", "alt"]);
     assert_eq!(lines.wait_for("picked colour", Duration::from_secs(30)), "picked colour 77");
@@ -399,10 +393,7 @@ fn a_dragged_line_in_line_mode() {
     let (a, b) = (va + na, vb + nb);
     let args = document_args(&file, &camera, &["--shading", "preview"]);
     let (_xvfb, display) = start_xvfb(6);
-    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
-    let window = find_window(&display, &mut app, &stderr_path);
-    lines.wait_for("octovox: ready", Duration::from_secs(90));
-    xdotool(&display, &["windowfocus", "--sync", &window]);
+    let (_app, mut lines, window) = open_ready(&display, dir.path(), &args);
     xdotool(&display, &["key", "l"]);
     xdotool(&display, &["mousemove", "--window", &window, &xa.to_string(), &ya.to_string()]);
     xdotool(&display, &["mousedown", "1"]);

@@ -53,10 +53,7 @@ fn ctrl_drag_extrudes_a_face_in_a_real_window() {
 
     let (_xvfb, display) = start_xvfb(8);
     let args = document_args(&file, &camera, &[]);
-    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
-    let window = find_window(&display, &mut app, &stderr_path);
-    lines.wait_for("octovox: ready", Duration::from_secs(90));
-    xdotool(&display, &["windowfocus", "--sync", &window]);
+    let (_app, mut lines, window) = open_ready(&display, dir.path(), &args);
     xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y.to_string()]);
     xdotool(&display, &["keydown", "ctrl"]);
     xdotool(&display, &["mousedown", "1"]);

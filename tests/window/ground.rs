@@ -52,10 +52,7 @@ fn new_then_a_click_on_the_ground_places_a_voxel_at_y_0() {
 
     let (_xvfb, display) = start_xvfb(24);
     let args = ["--size".to_owned(), format!("{WIDTH}x{HEIGHT}")];
-    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
-    let window = find_window(&display, &mut app, &stderr_path);
-    lines.wait_for("octovox: ready", Duration::from_secs(90));
-    xdotool(&display, &["windowfocus", "--sync", &window]);
+    let (_app, mut lines, window) = open_ready(&display, dir.path(), &args);
     let before = screenshot_x(&display, &dir.path().join("demo.png"));
     xdotool(&display, &["key", "ctrl+n"]);
     lines.wait_for("new: an empty scene on the ground", Duration::from_secs(30));

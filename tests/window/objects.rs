@@ -59,10 +59,7 @@ fn a_click_picks_the_object_it_hits_and_edits_its_model() {
     let before = model_sizes(&file);
 
     let (_xvfb, display) = start_xvfb(21);
-    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &document_args(&file, &camera, &[]));
-    let window = find_window(&display, &mut app, &stderr_path);
-    lines.wait_for("octovox: ready", Duration::from_secs(90));
-    xdotool(&display, &["windowfocus", "--sync", &window]);
+    let (_app, mut lines, window) = open_ready(&display, dir.path(), &document_args(&file, &camera, &[]));
     click(&display, &window, &mut lines, x, y);
     assert!(lines.seen.iter().any(|l| *l == format!("ran: object {owner}")), "{:?}", lines.seen);
     save(&display, &mut lines, &file);
@@ -92,10 +89,7 @@ fn ctrl_h_hides_the_picked_object_and_the_file_keeps_it() {
     assert!(shows.len() > 20, "object {owner} covers {} pixels", shows.len());
 
     let (_xvfb, display) = start_xvfb(22);
-    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &document_args(&file, &camera, &[]));
-    let window = find_window(&display, &mut app, &stderr_path);
-    lines.wait_for("octovox: ready", Duration::from_secs(90));
-    xdotool(&display, &["windowfocus", "--sync", &window]);
+    let (_app, mut lines, window) = open_ready(&display, dir.path(), &document_args(&file, &camera, &[]));
     // Paint picks the object without changing its shape.
     xdotool(&display, &["key", "g"]);
     click(&display, &window, &mut lines, x, y);
@@ -138,10 +132,7 @@ fn object_edits_survive_a_kill() {
     let before = model_sizes(&file);
 
     let (_xvfb, display) = start_xvfb(23);
-    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &document_args(&file, &camera, &[]));
-    let window = find_window(&display, &mut app, &stderr_path);
-    lines.wait_for("octovox: ready", Duration::from_secs(90));
-    xdotool(&display, &["windowfocus", "--sync", &window]);
+    let (mut app, mut lines, window) = open_ready(&display, dir.path(), &document_args(&file, &camera, &[]));
     click(&display, &window, &mut lines, x, y);
     // Before object lines were journaled, this hide was lost at recovery.
     xdotool(&display, &["key", "ctrl+h"]);
@@ -190,10 +181,7 @@ fn tab_object_mode_picks_moves_drags_turns_and_deletes_objects() {
     let (before, sizes) = (translation(&file), model_sizes(&file));
 
     let (_xvfb, display) = start_xvfb(23);
-    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &document_args(&file, &camera, &[]));
-    let window = find_window(&display, &mut app, &stderr_path);
-    lines.wait_for("octovox: ready", Duration::from_secs(90));
-    xdotool(&display, &["windowfocus", "--sync", &window]);
+    let (_app, mut lines, window) = open_ready(&display, dir.path(), &document_args(&file, &camera, &[]));
     xdotool(&display, &["key", "Tab"]);
     xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y.to_string()]);
     std::thread::sleep(Duration::from_millis(300));
@@ -336,10 +324,7 @@ fn the_outliner_eye_hides_an_object_and_a_drag_regroups_it() {
     };
 
     let (_xvfb, display) = start_xvfb(24);
-    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &document_args(&file, &camera, &[]));
-    let window = find_window(&display, &mut app, &stderr_path);
-    lines.wait_for("octovox: ready", Duration::from_secs(90));
-    xdotool(&display, &["windowfocus", "--sync", &window]);
+    let (_app, mut lines, window) = open_ready(&display, dir.path(), &document_args(&file, &camera, &[]));
     let before = resting_shot(&display, &window, dir.path(), "eye-before");
     let (row, depth) = outline_row(objects, owner);
     let (eye_x, y) = (EYE_X + INDENT * depth, FIRST_ROW_Y + ROW_PITCH * row);

@@ -23,10 +23,7 @@ fn recorded_window_session_replays_to_the_same_voxels() {
     let (_xvfb, display) = start_xvfb(17);
     let script = dir.path().join("session.ovr");
     let args = document_args(&file, &camera, &["--record", &script.display().to_string()]);
-    let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
-    let window = find_window(&display, &mut app, &stderr_path);
-    lines.wait_for("octovox: ready", Duration::from_secs(90));
-    xdotool(&display, &["windowfocus", "--sync", &window]);
+    let (mut app, mut lines, window) = open_ready(&display, dir.path(), &args);
 
     // Attach twice on the same spot (the second lands on the first), paint,
     // undo the paint, then save and quit.
