@@ -104,6 +104,16 @@ fn rng_next() -> f32 {
     return f32(rng_state >> 8u) * (1.0 / 16777216.0);
 }
 
+// Where a sample falls in its pixel: the R2 sequence shifted per pixel
+// (twin of `pixel_offset` in src/trace/path/rng.rs, which says why).
+fn pixel_offset(pixel: u32, sample: u32) -> vec2<f32> {
+    let shift_x = pcg(pixel ^ R2_SHIFT_SEED);
+    let shift_y = pcg(shift_x);
+    let x = shift_x + sample * R2_STEP_X;
+    let y = shift_y + sample * R2_STEP_Y;
+    return vec2<f32>(f32(x >> 8u), f32(y >> 8u)) * (1.0 / 16777216.0);
+}
+
 // ---- directions ----
 
 // An orthonormal basis around a unit vector (Duff et al., 2017).
@@ -512,9 +522,7 @@ fn path(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let pixel = px.y * u.width + px.x;
     rng_init(pixel, pu.sample_index);
-    let jx = rng_next();
-    let jy = rng_next();
-    let r = image_ray(vec2<f32>(px) + vec2<f32>(jx, jy));
+    let r = image_ray(vec2<f32>(px) + pixel_offset(pixel, pu.sample_index));
     first_albedo = vec3<f32>(1.0);
     first_tint = 0.0;
     first_t = NO_VOXEL_T;

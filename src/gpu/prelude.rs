@@ -44,6 +44,9 @@ pub fn shared_constants() -> String {
     line("SUN_IRRADIANCE", "f32", format!("{:?}", path::SUN_IRRADIANCE));
     line("SUN_RADIANCE", "f32", format!("{:?}", path::sun_radiance()));
     line("MAX_SAMPLE_RADIANCE", "f32", format!("{:?}", path::MAX_SAMPLE_RADIANCE));
+    line("R2_STEP_X", "u32", format!("{}u", path::rng::R2_STEP[0]));
+    line("R2_STEP_Y", "u32", format!("{}u", path::rng::R2_STEP[1]));
+    line("R2_SHIFT_SEED", "u32", format!("{:#x}u", path::rng::R2_SHIFT_SEED));
     line("MAX_TRANSMISSIONS", "u32", format!("{}u", path::MAX_TRANSMISSIONS));
     line("MIN_SAMPLED_ALPHA", "f32", format!("{:?}", path::MIN_SAMPLED_ALPHA));
     line("MATERIAL_DIFFUSE", "u32", format!("{}u", materials::MATERIAL_DIFFUSE));

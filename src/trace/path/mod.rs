@@ -96,8 +96,9 @@ impl PathScene<'_> {
     /// One sample of pixel (x, y) and the colour the denoiser divides its
     /// light by: the first hit's albedo ([`PathScene::demodulation_albedo`]).
     pub fn sample_with_albedo(&self, basis: &RayBasis, x: u32, y: u32, sample: u32) -> (Vec3, Vec3) {
-        let mut rng = Rng::new(y * basis.width + x, sample);
-        let (jx, jy) = (rng.uniform(), rng.uniform());
+        let pixel = y * basis.width + x;
+        let mut rng = Rng::new(pixel, sample);
+        let (jx, jy) = rng::pixel_offset(pixel, sample);
         let (origin, dir) = basis.ray_through(x as f32 + jx, y as f32 + jy);
         let mut albedo = Vec3::ONE;
         let radiance = clamp_sample(self.radiance(Ray::new(origin, dir), &mut rng, &mut albedo));
