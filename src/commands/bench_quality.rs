@@ -6,7 +6,6 @@
 //! time, log scale, the Pareto front of each scene joined).
 
 use std::path::Path;
-use std::time::Instant;
 
 use glam::DVec3;
 use serde::Serialize;
@@ -146,9 +145,8 @@ fn measure(
     if filter != Filter::Oidn {
         return Ok((ms, image));
     }
-    let start = Instant::now();
-    let image = oidn_image(renderer, size)?;
-    Ok((ms + start.elapsed().as_secs_f64() * 1e3, image))
+    let (image, oidn_ms) = oidn_image(renderer, size)?;
+    Ok((ms + oidn_ms, image))
 }
 
 /// The small model, framed.
@@ -189,7 +187,7 @@ pub fn bench_quality(quick: bool, out: &Path) -> anyhow::Result<(String, String)
         };
         let (_, reference_image) = render_setting(&mut renderer, &scene, &camera, sizes.size, reference)?;
         let reference_noise = renderer.noise_estimate()?;
-        let oidn_reference = if oidn::AVAILABLE { Some(oidn_image(&renderer, sizes.size)?) } else { None };
+        let oidn_reference = if oidn::AVAILABLE { Some(oidn_image(&renderer, sizes.size)?.0) } else { None };
         renderer.denoise_now()?;
         let denoised_reference = renderer.read_image()?;
         let converged_base = Setting::Path {

@@ -186,18 +186,20 @@ fn finished_image(
     size: (u32, u32),
 ) -> anyhow::Result<(image::RgbaImage, Option<f64>)> {
     if path.oidn {
-        let start = Instant::now();
-        let image = oidn_image(renderer, size)?;
-        return Ok((image, Some(start.elapsed().as_secs_f64() * 1e3)));
+        let (image, ms) = oidn_image(renderer, size)?;
+        return Ok((image, Some(ms)));
     }
     let denoise_ms = if path.denoise { Some(renderer.denoise_now()?) } else { None };
     Ok((renderer.read_image()?, denoise_ms))
 }
 
-/// The GPU's accumulation read back and filtered by Open Image Denoise.
-pub(crate) fn oidn_image(renderer: &Renderer, size: (u32, u32)) -> anyhow::Result<image::RgbaImage> {
+/// The GPU's accumulation read back and filtered by Open Image Denoise,
+/// and the milliseconds both took (OIDN's cost includes the read-back).
+pub(crate) fn oidn_image(renderer: &Renderer, size: (u32, u32)) -> anyhow::Result<(image::RgbaImage, f64)> {
+    let start = Instant::now();
     let (sums, guides) = renderer.read_samples()?;
-    Ok(octovox::trace::oidn::denoised_image(&sums, &guides, size.0, size.1)?)
+    let image = octovox::trace::oidn::denoised_image(&sums, &guides, size.0, size.1)?;
+    Ok((image, start.elapsed().as_secs_f64() * 1e3))
 }
 
 /// `--spp` samples of the CPU reference, denoised by the filter's CPU twin
