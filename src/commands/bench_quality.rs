@@ -17,6 +17,7 @@ use octovox::quality::{Setting, accumulate, flip, pareto_front, psnr, render_set
 use octovox::scene::Scene;
 use octovox::scene::demo::BuiltIn;
 use octovox::settings::{RenderSettings, TraceMode};
+use octovox::trace::denoise::{Change, Frame, change_in_standard_errors, denoise};
 use octovox::trace::oidn;
 
 use super::bench::header;
@@ -187,6 +188,7 @@ pub fn bench_quality(quick: bool, out: &Path) -> anyhow::Result<(String, String)
         };
         let (_, reference_image) = render_setting(&mut renderer, &scene, &camera, sizes.size, reference)?;
         let reference_noise = renderer.noise_estimate()?;
+        let change = filter_change(&renderer, &scene, &camera, sizes.size)?;
         let oidn_reference = if oidn::AVAILABLE { Some(oidn_image(&renderer, sizes.size)?.0) } else { None };
         renderer.denoise_now()?;
         let denoised_reference = renderer.read_image()?;
@@ -203,6 +205,7 @@ pub fn bench_quality(quick: bool, out: &Path) -> anyhow::Result<(String, String)
             flip: flip(&reference_image, &denoised_reference),
             oidn_flip: oidn_reference.map(|image| flip(&reference_image, &image)),
             reference_noise,
+            change,
         });
         let mut scene_rows = Vec::new();
         for (knob, value, setting, filter) in knobs(&sizes) {
@@ -257,6 +260,25 @@ struct UnbiasedRow {
     /// The same through Open Image Denoise, in a build that has it.
     oidn_flip: Option<f32>,
     reference_noise: Option<f32>,
+    /// The filter's change to the reference in standard errors of its raw
+    /// pixels (the CPU twin on the reference's sums).
+    change: Option<Change>,
+}
+
+/// How far the filter moves the pixels of the renderer's accumulation, in
+/// their standard errors ([`change_in_standard_errors`]). The CPU twin
+/// filters: the GPU's image is rounded to 8 bits, more than a standard
+/// error of a converged pixel.
+fn filter_change(
+    renderer: &Renderer,
+    scene: &Scene,
+    camera: &Camera,
+    size: (u32, u32),
+) -> anyhow::Result<Option<Change>> {
+    let sums = renderer.path.read_sums(&renderer.gpu)?;
+    let guides = renderer.path.read_guides(&renderer.gpu)?;
+    let frame = Frame::of(&camera.basis(size.0, size.1, scene.origin()));
+    Ok(change_in_standard_errors(&sums, &guides, &denoise(&frame, &sums, &guides)))
 }
 
 /// One `--target-error` render.
@@ -363,10 +385,18 @@ fn denoise_markdown(rows: &[QualityRow], unbiased: &[UnbiasedRow]) -> String {
             cell(Filter::Raw, 32)
         );
     }
-    md += "\nNo bias: the reference's own samples denoised, against the raw reference (target FLIP ≤ 0.01).\n\n| scene | FLIP | OIDN FLIP | the reference's noise estimate |\n|---|---|---|---|\n";
+    md += "\nNo bias: the reference's own samples denoised, against the raw reference (target FLIP ≤ 0.01). FLIP also sees the noise the filter took away, which the raw reference still has; the last columns tell the two apart: each filtered channel's change divided by the standard error of its raw mean, RMS and the share beyond 4. Removing noise alone moves a pixel by about its noise: RMS near 1 (a normal distribution puts 0.006 % beyond 4; path-traced noise has longer tails); bias moves it further.\n\n| scene | FLIP | OIDN FLIP | the reference's noise estimate | change, standard errors RMS | share beyond 4 |\n|---|---|---|---|---|---|\n";
     let cell = |v: Option<f32>| v.map_or("–".into(), |n| format!("{n:.4}"));
     for u in unbiased {
-        md += &format!("| {} | {:.4} | {} | {} |\n", u.scene, u.flip, cell(u.oidn_flip), cell(u.reference_noise));
+        md += &format!(
+            "| {} | {:.4} | {} | {} | {} | {} |\n",
+            u.scene,
+            u.flip,
+            cell(u.oidn_flip),
+            cell(u.reference_noise),
+            u.change.map_or("–".into(), |c| format!("{:.2}", c.rms)),
+            cell(u.change.map(|c| c.beyond_four))
+        );
     }
     md += "\nThe noise estimate against the measured error, raw rows: the estimate is the RMS standard error of the displayed pixels from each pixel's own samples; the measured error is the RMS difference from the converged base, which has noise of its own (about the estimate of the reference above) and 8-bit rounding.\n\n| scene | spp | estimate | measured RMS | measured / estimate |\n|---|---|---|---|---|\n";
     for r in rows.iter().filter(|r| r.filter == Filter::Raw) {

@@ -278,6 +278,39 @@ pub fn noise_estimate(sums: &[Sums]) -> Option<f32> {
     Some((total / (3 * sums.len()) as f64).sqrt() as f32)
 }
 
+/// How far a filter moved the pixels it filtered, measured in the standard
+/// errors of their raw means.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Change {
+    /// Root mean square over filtered channels of the change divided by the
+    /// channel's standard error.
+    pub rms: f32,
+    /// The share of those channels moved by more than 4 standard errors
+    /// (a normal distribution puts 0.006 % there).
+    pub beyond_four: f32,
+}
+
+/// The filter's change to each filtered pixel, in standard errors of its
+/// raw mean: the no-bias check that needs no cleaner reference. A filter
+/// that takes away only noise moves a pixel by about the noise it had (RMS
+/// near 1, no pattern); one that also moves the light moves it further, by
+/// more the more samples there are. Channels displayed white before and
+/// after, and channels without variance, are left out; `None` when none
+/// is left.
+pub fn change_in_standard_errors(sums: &[Sums], guides: &[Guide], denoised: &[Vec3]) -> Option<Change> {
+    let (mut squares, mut beyond, mut n) = (0.0f64, 0usize, 0usize);
+    for ((s, _), after) in sums.iter().zip(guides).zip(denoised).filter(|((_, g), _)| g.is_filtered()) {
+        let (before, variance) = (s.mean(), s.variance_of_mean());
+        for c in (0..3).filter(|&c| variance[c] > 0.0 && (before[c] < 1.0 || after[c] < 1.0)) {
+            let z = (after[c] - before[c]) / variance[c].sqrt();
+            squares += f64::from(z * z);
+            beyond += usize::from(z.abs() > 4.0);
+            n += 1;
+        }
+    }
+    (n > 0).then(|| Change { rms: (squares / n as f64).sqrt() as f32, beyond_four: beyond as f32 / n as f32 })
+}
+
 /// The variance of a pixel's displayed channels, summed. Twin of the
 /// estimate in `shaders/denoise.wgsl`.
 pub fn displayed_variance(s: &Sums) -> f32 {
@@ -404,6 +437,26 @@ mod tests {
         assert!((few / expected(4.0) - 1.0).abs() < 0.2, "{few} against {}", expected(4.0));
         assert!((many / expected(64.0) - 1.0).abs() < 0.1, "{many} against {}", expected(64.0));
         assert_eq!(noise_estimate(&noisy(&albedo, 1, light)), None);
+    }
+
+    #[test]
+    fn the_change_in_standard_errors_tells_noise_from_bias() {
+        let (guides, albedo) = floor(|_, _| [200; 3]);
+        let light = |x: u32, _| if x < W / 2 { 0.25 } else { 0.5 };
+        let sums = noisy(&albedo, 256, light);
+        let change = |image: &[Vec3]| change_in_standard_errors(&sums, &guides, image).unwrap();
+        // Moved to the truth: by exactly the noise.
+        let truth: Vec<Vec3> = (0..W * H).map(|i| albedo[i as usize] * light(i % W, i / W)).collect();
+        let exact = change(&truth);
+        assert!((0.9..1.1).contains(&exact.rms) && exact.beyond_four < 0.001, "{exact:?}");
+        let filtered = change(&denoise(&frame(), &sums, &guides));
+        assert!(filtered.rms < 1.1 && filtered.beyond_four < 0.001, "{filtered:?}");
+        // Blurred across the step in the light: biased everywhere.
+        let blurred: Vec<Vec3> = albedo.iter().map(|a| *a * 0.375).collect();
+        let biased = change(&blurred);
+        assert!(biased.rms > 4.0 && biased.beyond_four > 0.5, "{biased:?}");
+        let none_filtered = vec![Guide::LEFT; guides.len()];
+        assert_eq!(change_in_standard_errors(&sums, &none_filtered, &truth), None);
     }
 
     #[test]
