@@ -275,8 +275,7 @@ fn filter_change(
     camera: &Camera,
     size: (u32, u32),
 ) -> anyhow::Result<Option<Change>> {
-    let sums = renderer.path.read_sums(&renderer.gpu)?;
-    let guides = renderer.path.read_guides(&renderer.gpu)?;
+    let (sums, guides) = renderer.read_samples()?;
     let frame = Frame::of(&camera.basis(size.0, size.1, scene.origin()));
     Ok(change_in_standard_errors(&sums, &guides, &denoise(&frame, &sums, &guides)))
 }

@@ -222,8 +222,7 @@ fn the_filter_moves_a_converging_image_by_little_more_than_its_noise() {
     let mut renderer = renderer_for(&mut scene);
     let view = PathView { scene: &scene, camera: &camera, size, settings: &settings };
     sample(&mut renderer, &view, 256);
-    let sums = renderer.path.read_sums(&renderer.gpu).unwrap();
-    let guides = renderer.path.read_guides(&renderer.gpu).unwrap();
+    let (sums, guides) = renderer.read_samples().unwrap();
     let frame = Frame::of(&camera.basis(size.0, size.1, scene.origin()));
     let change = change_in_standard_errors(&sums, &guides, &denoise(&frame, &sums, &guides)).unwrap();
     println!("256 spp: the filter's change in standard errors {change:?}");
