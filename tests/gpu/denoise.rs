@@ -9,7 +9,7 @@ use octovox::gpu::{PathView, Renderer};
 use octovox::quality::{accumulate, flip, rms_error};
 use octovox::scene::{Octree, Op, Scene, Shape};
 use octovox::settings::PathSettings;
-use octovox::trace::denoise::{Frame, LUMINANCE, change_in_standard_errors, denoise, noise_estimate};
+use octovox::trace::denoise::{Frame, Guide, LUMINANCE, Sums, change_in_standard_errors, denoise, noise_estimate};
 use octovox::trace::path::{render_cpu, to_image};
 
 use crate::path_trace::{build, look, material_scene, palette};
@@ -43,14 +43,22 @@ fn grey_variance(image: &image::RgbaImage) -> f64 {
     values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / values.len() as f64
 }
 
+/// The scene of every effect, its view and settings: 48×32, 3 bounces.
+fn every_effect() -> (Scene, Camera, PathSettings, (u32, u32)) {
+    let camera = look(DVec3::new(18.0, 14.0, 26.0), DVec3::new(0.0, 3.0, 0.0));
+    (material_scene(), camera, PathSettings { bounces: 3, ..PathSettings::default() }, (48, 32))
+}
+
+/// The CPU twin of the filter over samples of `scene` seen by `camera`.
+fn cpu_filter(scene: &Scene, camera: &Camera, size: (u32, u32), sums: &[Sums], guides: &[Guide]) -> Vec<glam::Vec3> {
+    denoise(&Frame::of(&camera.basis(size.0, size.1, scene.origin())), sums, guides)
+}
+
 #[test]
 fn the_gpu_filter_matches_its_cpu_twin() {
     // Every effect in view, so some pixels are left to their samples; 3
     // samples take the variance from the neighbours, 6 from the pixel's own.
-    let mut scene = material_scene();
-    let camera = look(DVec3::new(18.0, 14.0, 26.0), DVec3::new(0.0, 3.0, 0.0));
-    let settings = PathSettings { bounces: 3, ..PathSettings::default() };
-    let size = (48, 32);
+    let (mut scene, camera, settings, size) = every_effect();
     let mut renderer = renderer_for(&mut scene);
     let view = PathView { scene: &scene, camera: &camera, size, settings: &settings };
     for spp in [3, 6] {
@@ -58,10 +66,8 @@ fn the_gpu_filter_matches_its_cpu_twin() {
         let raw = renderer.read_image().unwrap();
         renderer.denoise_now().unwrap();
         let gpu = renderer.read_image().unwrap();
-        let sums = renderer.path.read_sums(&renderer.gpu).unwrap();
-        let guides = renderer.path.read_guides(&renderer.gpu).unwrap();
-        let frame = Frame::of(&camera.basis(size.0, size.1, scene.origin()));
-        let cpu = to_image(&denoise(&frame, &sums, &guides), size.0, size.1);
+        let (sums, guides) = renderer.read_samples().unwrap();
+        let cpu = to_image(&cpu_filter(&scene, &camera, size, &sums, &guides), size.0, size.1);
         // exp and sqrt differ in their last bits; one byte of rounding.
         let off = share_differing(&gpu, &cpu, 1);
         println!("{spp} spp: {:.3} % of channels differ by more than 1", 100.0 * off);
@@ -215,16 +221,12 @@ fn the_filter_moves_a_converging_image_by_little_more_than_its_noise() {
     // a smooth gradient in the light is bent a little: 1.75 RMS here, 4 %
     // of channels beyond 4; SVGF's σ_l = 4 gives 2.55 and 9 %, σ_l = 1 1.15
     // and 0.8 %.
-    let mut scene = material_scene();
-    let camera = look(DVec3::new(18.0, 14.0, 26.0), DVec3::new(0.0, 3.0, 0.0));
-    let settings = PathSettings { bounces: 3, ..PathSettings::default() };
-    let size = (48, 32);
+    let (mut scene, camera, settings, size) = every_effect();
     let mut renderer = renderer_for(&mut scene);
     let view = PathView { scene: &scene, camera: &camera, size, settings: &settings };
     sample(&mut renderer, &view, 256);
     let (sums, guides) = renderer.read_samples().unwrap();
-    let frame = Frame::of(&camera.basis(size.0, size.1, scene.origin()));
-    let change = change_in_standard_errors(&sums, &guides, &denoise(&frame, &sums, &guides)).unwrap();
+    let change = change_in_standard_errors(&sums, &guides, &cpu_filter(&scene, &camera, size, &sums, &guides)).unwrap();
     println!("256 spp: the filter's change in standard errors {change:?}");
     assert!(change.rms < 2.0 && change.beyond_four < 0.06, "{change:?}");
 }
