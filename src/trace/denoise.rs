@@ -101,6 +101,12 @@ impl Sums {
         (self.albedo / self.count.max(1) as f32).max(Vec3::splat(MIN_ALBEDO))
     }
 
+    /// The mean divided by [`Sums::albedo`]: the light the filters smooth
+    /// (this one and Open Image Denoise), the colour multiplied back after.
+    pub fn light(&self) -> Vec3 {
+        self.mean() / self.albedo()
+    }
+
     /// The variance of the mean, per channel; zero below two samples.
     pub fn variance_of_mean(&self) -> Vec3 {
         if self.count < 2 {
@@ -186,7 +192,6 @@ fn same_surface(p: &Guide, q: &Guide) -> bool {
 /// [`SPATIAL_VARIANCE_BELOW`] samples the variance of the 3×3 neighbours'
 /// light on the same surface.
 fn prepare(frame: &Frame, sums: &[Sums], guides: &[Guide]) -> Vec<Light> {
-    let demodulated = |i: usize| sums[i].mean() / sums[i].albedo();
     let mut out = Vec::with_capacity(sums.len());
     for y in 0..frame.height {
         for x in 0..frame.width {
@@ -199,7 +204,7 @@ fn prepare(frame: &Frame, sums: &[Sums], guides: &[Guide]) -> Vec<Light> {
             let variance = if s.count < SPATIAL_VARIANCE_BELOW {
                 let (mut m1, mut m2, mut n) = (0.0f32, 0.0f32, 0.0f32);
                 for (q, _, _) in taps(frame, x, y, 1, 1).filter(|&(q, _, _)| same_surface(g, &guides[q])) {
-                    let l = demodulated(q).dot(LUMINANCE);
+                    let l = sums[q].light().dot(LUMINANCE);
                     (m1, m2, n) = (m1 + l, m2 + l * l, n + 1.0);
                 }
                 (m2 / n - (m1 / n) * (m1 / n)).max(0.0)
@@ -207,7 +212,7 @@ fn prepare(frame: &Frame, sums: &[Sums], guides: &[Guide]) -> Vec<Light> {
                 let albedo = s.albedo();
                 (s.variance_of_mean() * (LUMINANCE / albedo) * (LUMINANCE / albedo)).element_sum()
             };
-            out.push(Light { rgb: demodulated(i), variance });
+            out.push(Light { rgb: s.light(), variance });
         }
     }
     out

@@ -1,6 +1,9 @@
 //! Intel Open Image Denoise (OIDN) for final renders: its "RT" filter, a
-//! neural network, over the accumulation's mean, guided by the mean albedo
-//! of the first hits and the centre ray's face normal. On the CPU, after
+//! neural network, over the accumulation's light (the mean divided by the
+//! mean albedo of the first hits, as the à-trous filter takes it), guided
+//! by the centre ray's face normal, the albedo multiplied back after: given
+//! the colour and the albedo instead, it blurred voxel-sharp colour edges
+//! (a one-voxel checker lost a sixth of its contrast). On the CPU, after
 //! the samples are read back; the window keeps the à-trous filter
 //! (`crate::trace::denoise`). Built only with the cargo feature `oidn`
 //! (docs/rendering.md says how to get the library); without it,
@@ -46,7 +49,7 @@ pub fn denoise(sums: &[Sums], guides: &[Guide], width: u32, height: u32) -> Resu
         return Err(OidnError::Size { pixels: sums.len().min(guides.len()), width, height });
     }
     let out = library::filter(sums, guides, width as usize, height as usize)?;
-    Ok(out.chunks_exact(3).map(Vec3::from_slice).collect())
+    Ok(out.chunks_exact(3).zip(sums).map(|(light, s)| Vec3::from_slice(light) * s.albedo()).collect())
 }
 
 #[cfg(feature = "oidn")]
@@ -56,10 +59,11 @@ mod library {
     use super::OidnError;
     use crate::trace::denoise::{Guide, Sums};
 
-    /// The three images OIDN reads, three floats a pixel: the mean radiance,
-    /// the mean first-hit albedo (at most 1, as OIDN asks) and the centre
-    /// ray's face normal (zero where the guide has none: sky, lamps, glass,
-    /// metal).
+    /// The three images OIDN reads, three floats a pixel: the light
+    /// ([`Sums::light`]), white for the albedo (OIDN takes a normal only
+    /// beside an albedo; the real one, beside the light, left the noise in)
+    /// and the centre ray's face normal (zero where the guide has none: sky,
+    /// lamps, glass, metal).
     struct Inputs {
         color: Vec<f32>,
         albedo: Vec<f32>,
@@ -67,8 +71,8 @@ mod library {
     }
 
     fn inputs(sums: &[Sums], guides: &[Guide]) -> Inputs {
-        let color = sums.iter().flat_map(|s| s.mean().to_array()).collect();
-        let albedo = sums.iter().flat_map(|s| s.albedo().min(Vec3::ONE).to_array()).collect();
+        let color = sums.iter().flat_map(|s| s.light().to_array()).collect();
+        let albedo = vec![1.0; 3 * sums.len()];
         let normal = guides
             .iter()
             .flat_map(|g| {
