@@ -30,6 +30,8 @@ struct PathUniforms {
     // adapters).
     first_row: u32,
     end_row: u32,
+    // Added to sample_index in the random sequences: the seed's first sample.
+    first_sample: u32,
 }
 
 // Twin of `GpuMaterial` in src/trace/path/materials.rs.
@@ -521,8 +523,9 @@ fn path(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let pixel = px.y * u.width + px.x;
-    rng_init(pixel, pu.sample_index);
-    let r = image_ray(vec2<f32>(px) + pixel_offset(pixel, pu.sample_index));
+    let sequence_index = pu.first_sample + pu.sample_index;
+    rng_init(pixel, sequence_index);
+    let r = image_ray(vec2<f32>(px) + pixel_offset(pixel, sequence_index));
     first_albedo = vec3<f32>(1.0);
     first_tint = 0.0;
     first_t = NO_VOXEL_T;

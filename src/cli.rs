@@ -262,6 +262,10 @@ pub struct PathArgs {
     /// No sunlight.
     #[arg(long)]
     pub no_sun: bool,
+    /// Which sequence of samples (0 by default): renders of different
+    /// seeds are independent, so one can be the reference of another.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u32,
 }
 
 /// Samples `--target-error` takes at most when `--spp` does not say.
@@ -285,6 +289,7 @@ impl PathArgs {
             effects: self.effects,
             sun: !self.no_sun,
             sky: self.sky,
+            seed: self.seed,
         }
     }
 }

@@ -57,9 +57,29 @@ pub enum Setting {
         render_scale: f32,
         /// Denoised after the last sample (its time counted in the frame's).
         denoise: bool,
+        /// `PathSettings::seed`: [`REFERENCE_SEED`] for a reference.
+        seed: u32,
     },
     /// The preview; `lod` is the level-of-detail footprint in pixels (0 exact).
     Preview { mode: TraceMode, render_scale: f32, lod: f32 },
+}
+
+/// The seed of the reference images the path tracer's settings are
+/// measured against: their samples are independent of the measured ones
+/// (seed 0), which would otherwise be the reference's first samples.
+pub const REFERENCE_SEED: u32 = 1;
+
+impl Setting {
+    /// The same setting drawn from the samples of `seed` (the preview has
+    /// none).
+    pub fn with_seed(self, seed: u32) -> Setting {
+        match self {
+            Setting::Path { spp, bounces, shadow_samples, render_scale, denoise, .. } => {
+                Setting::Path { spp, bounces, shadow_samples, render_scale, denoise, seed }
+            }
+            preview => preview,
+        }
+    }
 }
 
 /// Draws one frame with `setting`; returns its wall-clock milliseconds
@@ -75,8 +95,8 @@ pub fn render_setting(
     setting: Setting,
 ) -> Result<(f64, RgbaImage), crate::gpu::GpuError> {
     match setting {
-        Setting::Path { spp, bounces, shadow_samples, render_scale, denoise } => {
-            let settings = PathSettings { bounces, shadow_samples, ..PathSettings::default() };
+        Setting::Path { spp, bounces, shadow_samples, render_scale, denoise, seed } => {
+            let settings = PathSettings { bounces, shadow_samples, seed, ..PathSettings::default() };
             let traced = scaled_size(size, render_scale);
             renderer.compile_path_kernel(scene, &settings)?;
             let start = std::time::Instant::now();

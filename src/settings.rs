@@ -128,11 +128,35 @@ pub struct PathSettings {
     pub effects: EffectsChoice,
     pub sun: bool,
     pub sky: Sky,
+    /// Which sequence of samples: renders of different seeds are
+    /// independent of each other, so one can be the reference of another
+    /// (a reference that shares the first samples of the image it measures
+    /// flatters it: 64 of 256 shared take a quarter off its RMS error).
+    pub seed: u32,
 }
 
 impl Default for PathSettings {
     fn default() -> PathSettings {
-        PathSettings { bounces: 4, shadow_samples: 1, effects: EffectsChoice::Auto, sun: true, sky: Sky::Gradient }
+        PathSettings {
+            bounces: 4,
+            shadow_samples: 1,
+            effects: EffectsChoice::Auto,
+            sun: true,
+            sky: Sky::Gradient,
+            seed: 0,
+        }
+    }
+}
+
+/// Sample indices between the sequences of two seeds: an accumulation of
+/// fewer samples never reaches the next seed's first.
+pub const SEED_STRIDE: u32 = 1 << 20;
+
+impl PathSettings {
+    /// The index, in the random sequences of the path tracer (CPU and GPU),
+    /// of this accumulation's first sample.
+    pub fn first_sample(&self) -> u32 {
+        self.seed.wrapping_mul(SEED_STRIDE)
     }
 }
 

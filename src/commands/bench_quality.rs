@@ -13,7 +13,7 @@ use serde::Serialize;
 use octovox::camera::Camera;
 use octovox::gpu::PathView;
 use octovox::gpu::Renderer;
-use octovox::quality::{Setting, accumulate, flip, pareto_front, psnr, render_setting, rms_error};
+use octovox::quality::{REFERENCE_SEED, Setting, accumulate, flip, pareto_front, psnr, render_setting, rms_error};
 use octovox::scene::Scene;
 use octovox::scene::demo::BuiltIn;
 use octovox::settings::{RenderSettings, TraceMode};
@@ -100,6 +100,7 @@ fn knobs(sizes: &Sizes) -> Vec<Knob> {
         shadow_samples,
         render_scale,
         denoise: false,
+        seed: 0,
     };
     let spp = sizes.base_spp;
     let raw = |knob, value, setting| (knob, value, setting, Filter::Raw);
@@ -121,7 +122,8 @@ fn knobs(sizes: &Sizes) -> Vec<Knob> {
         out.push(raw("--lod", format!("{lod} (preview)"), preview(TraceMode::Svo, lod)));
     }
     for s in spp_values(sizes) {
-        let denoised = Setting::Path { spp: s, bounces: 3, shadow_samples: 1, render_scale: 1.0, denoise: true };
+        let denoised =
+            Setting::Path { spp: s, bounces: 3, shadow_samples: 1, render_scale: 1.0, denoise: true, seed: 0 };
         out.push(("--denoise", format!("--spp {s}"), denoised, Filter::Atrous));
     }
     if oidn::AVAILABLE {
@@ -185,6 +187,7 @@ pub fn bench_quality(quick: bool, out: &Path) -> anyhow::Result<(String, String)
             shadow_samples: 4,
             render_scale: 1.0,
             denoise: false,
+            seed: REFERENCE_SEED,
         };
         let (_, reference_image) = render_setting(&mut renderer, &scene, &camera, sizes.size, reference)?;
         let reference_noise = renderer.noise_estimate()?;
@@ -198,6 +201,7 @@ pub fn bench_quality(quick: bool, out: &Path) -> anyhow::Result<(String, String)
             shadow_samples: 1,
             render_scale: 1.0,
             denoise: false,
+            seed: REFERENCE_SEED,
         };
         let (_, converged) = render_setting(&mut renderer, &scene, &camera, sizes.size, converged_base)?;
         unbiased.push(UnbiasedRow {
@@ -354,7 +358,7 @@ fn flip_of(rows: &[QualityRow], scene: &str, filter: Filter, spp: u32) -> Option
 
 fn denoise_markdown(rows: &[QualityRow], unbiased: &[UnbiasedRow]) -> String {
     let mut md = String::from(
-        "\n## Denoised against raw\n\nThe rows that differ from the base in their samples alone, raw and denoised, against the base setting converged (the reference's samples at the base's 3 bounces and 1 shadow sample): the error left is noise and what the filter did to it, not the bias of fewer bounces (which is in the table above). Each denoised row against the raw path tracer at the same wall time: the raw FLIP interpolated between its rows on a log time axis, blank where the denoised frame is faster than raw 1 spp or slower than the last raw row. Target: ratio ≤ 0.6 at 4–16 spp.\n\n| scene | filter | spp | ms | FLIP | raw FLIP at that time | ratio | RMS |\n|---|---|---|---|---|---|---|---|\n",
+        "\n## Denoised against raw\n\nThe rows that differ from the base in their samples alone, raw and denoised, against the base setting converged (the reference's samples and seed at the base's 3 bounces and 1 shadow sample): the error left is noise and what the filter did to it, not the bias of fewer bounces (which is in the table above). Each denoised row against the raw path tracer at the same wall time: the raw FLIP interpolated between its rows on a log time axis, blank where the denoised frame is faster than raw 1 spp or slower than the last raw row. Target: ratio ≤ 0.6 at 4–16 spp.\n\n| scene | filter | spp | ms | FLIP | raw FLIP at that time | ratio | RMS |\n|---|---|---|---|---|---|---|---|\n",
     );
     let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene).collect();
     scenes.dedup();
@@ -564,7 +568,7 @@ fn rows_for_plot(rows: &[QualityRow]) -> Vec<super::quality_plot::Point> {
 fn markdown(rows: &[QualityRow], sizes: &Sizes, adapter: &str) -> String {
     let mut md = header("What accuracy costs in time");
     md += &format!(
-        "On {adapter}, {}×{} pixels. The reference per scene: the path tracer at {} samples, 8 bounces, 4 shadow samples, full scale. \
+        "On {adapter}, {}×{} pixels. The reference per scene: the path tracer at {} samples, 8 bounces, 4 shadow samples, full scale, from another seed than the rows' (`--seed 1`: none of its samples is one of theirs). \
          The base: {} samples, 3 bounces, 1 shadow sample, full scale; each other row turns one knob from the base (by its CLI flag). \
          `ms/frame` is the wall time from submitting the frame's first sample to the end of its last (the renderer waits for each); FLIP is the mean of NVIDIA's FLIP error map (0 = identical; lower is better); \
          PSNR over the 8-bit RGB. ★ marks the Pareto front: no other setting of that scene is both faster and closer. \

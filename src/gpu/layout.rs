@@ -159,6 +159,11 @@ pub struct PathUniforms {
     /// The band of rows this dispatch traces (`end_row` at most the height).
     pub first_row: u32,
     pub end_row: u32,
+    /// Added to `sample_index` in the random sequences: the seed's first
+    /// sample (`PathSettings::first_sample`).
+    pub first_sample: u32,
+    /// WGSL rounds the struct's size up to its `vec3`s' 16-byte alignment.
+    pub padding: [u32; 3],
 }
 
 /// Twin of `DenoiseUniforms` in `shaders/denoise.wgsl`.

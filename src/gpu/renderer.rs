@@ -427,6 +427,8 @@ impl Renderer {
             emitter_count: acc.lights as u32,
             first_row,
             end_row,
+            first_sample: settings.first_sample(),
+            padding: [0; 3],
         };
         let (drawn, highlight) = (scene.drawn(), key.highlight);
         let frame = FrameUniforms::new(&key.basis, drawn, &self.buffers, View::Shaded, highlight, Footprint::EXACT)

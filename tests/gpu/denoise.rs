@@ -6,7 +6,7 @@
 use glam::{DVec3, IVec3};
 use octovox::camera::Camera;
 use octovox::gpu::{PathView, Renderer};
-use octovox::quality::{accumulate, flip, rms_error};
+use octovox::quality::{REFERENCE_SEED, accumulate, flip, rms_error};
 use octovox::scene::{Octree, Op, Scene, Shape};
 use octovox::settings::PathSettings;
 use octovox::trace::denoise::{Frame, Guide, LUMINANCE, Sums, change_in_standard_errors, denoise, noise_estimate};
@@ -24,6 +24,14 @@ fn renderer_for(scene: &mut Scene) -> Renderer {
 /// `spp` samples of `view` on the GPU, from a fresh accumulation.
 fn sample(renderer: &mut Renderer, view: &PathView, spp: u32) {
     accumulate(renderer, view, spp, None, |_| ()).unwrap();
+}
+
+/// `spp` samples of `view` from the reference seed, which the samples
+/// measured against them (seed 0) do not share.
+fn reference_image(renderer: &mut Renderer, view: &PathView, spp: u32) -> image::RgbaImage {
+    let settings = PathSettings { seed: REFERENCE_SEED, ..*view.settings };
+    sample(renderer, &PathView { settings: &settings, ..*view }, spp);
+    renderer.read_image().unwrap()
 }
 
 /// Channels that differ by more than `tolerance`, over all channels.
@@ -175,8 +183,7 @@ fn a_one_voxel_checker_keeps_its_contrast_and_the_filter_adds_no_bias() {
     let view = PathView { scene: &scene, camera: &camera, size, settings: &settings };
     // The converged image, and the one the filter is asked not to bias: 8
     // times fewer samples, raw and denoised.
-    sample(&mut renderer, &view, 1024);
-    let converged = renderer.read_image().unwrap();
+    let converged = reference_image(&mut renderer, &view, 1024);
     sample(&mut renderer, &view, 128);
     let reference = renderer.read_image().unwrap();
     renderer.denoise_now().unwrap();
@@ -245,8 +252,7 @@ fn a_render_to_a_target_error_stops_near_it() {
     for (name, mut scene, camera) in scenes {
         let mut renderer = renderer_for(&mut scene);
         let view = PathView { scene: &scene, camera: &camera, size, settings: &settings };
-        sample(&mut renderer, &view, 256);
-        let reference = renderer.read_image().unwrap();
+        let reference = reference_image(&mut renderer, &view, 256);
         let mut taken = Vec::new();
         for target in [0.04, 0.02] {
             let done = accumulate(&mut renderer, &view, 4096, Some(target), |_| ()).unwrap();
@@ -278,8 +284,7 @@ fn open_image_denoise_brings_few_samples_nearer_the_converged_image() {
     let size = (80, 45);
     let mut renderer = renderer_for(&mut scene);
     let view = PathView { scene: &scene, camera: &camera, size, settings: &settings };
-    sample(&mut renderer, &view, 256);
-    let converged = renderer.read_image().unwrap();
+    let converged = reference_image(&mut renderer, &view, 256);
     sample(&mut renderer, &view, 4);
     let raw = renderer.read_image().unwrap();
     let (sums, guides) = renderer.read_samples().unwrap();
@@ -306,8 +311,7 @@ fn open_image_denoise_keeps_a_one_voxel_checker() {
     let size = (96, 96);
     let mut renderer = renderer_for(&mut scene);
     let view = PathView { scene: &scene, camera: &camera, size, settings: &settings };
-    sample(&mut renderer, &view, 1024);
-    let converged = renderer.read_image().unwrap();
+    let converged = reference_image(&mut renderer, &view, 1024);
     sample(&mut renderer, &view, 2);
     let raw = renderer.read_image().unwrap();
     let (sums, guides) = renderer.read_samples().unwrap();

@@ -258,9 +258,11 @@ fn gpu_and_cpu_path_tracers_agree() {
     // The same random numbers feed both; rounding differences (sin and cos
     // are not bit-identical) can send a path another way, so compare the
     // means and the share of pixels that differ by more than the noise.
+    // A seed other than 0, so both must start its sequence at the same
+    // place (with seed 0 on one side only, few pixels would agree).
     let mut scene = material_scene();
     let camera = look(DVec3::new(18.0, 14.0, 26.0), DVec3::new(0.0, 3.0, 0.0));
-    let settings = PathSettings { bounces: 3, ..PathSettings::default() };
+    let settings = PathSettings { bounces: 3, seed: 3, ..PathSettings::default() };
     let size = (40, 30);
     let spp = 8;
     let CpuRender { pixels: cpu, effects: cpu_effects, .. } = render_cpu(&scene, &camera, size, &settings, spp);
@@ -272,6 +274,36 @@ fn gpu_and_cpu_path_tracers_agree() {
     let differing = cpu.iter().zip(&gpu).filter(|(a, b)| (**a - **b).abs().max_element() > 0.02).count();
     println!("CPU mean {mc}, GPU mean {mg}, {differing} of {} pixels differ by more than 0.02", cpu.len());
     assert!(differing * 20 <= cpu.len(), "{differing} of {} pixels differ by more than 0.02", cpu.len());
+}
+
+#[test]
+fn renders_of_two_seeds_are_independent_and_one_seed_repeats() {
+    // Each pixel's mean under seeds 0 and 1, in standard errors of their
+    // difference: about 1 RMS for independent samples, 0 for the same ones.
+    let mut scene = material_scene();
+    let camera = look(DVec3::new(18.0, 14.0, 26.0), DVec3::new(0.0, 3.0, 0.0));
+    let size = (40, 30);
+    let mut renderer = Renderer::headless().expect("a GPU adapter (lavapipe on CI)");
+    renderer.sync(&mut scene);
+    let mut sums = |seed| {
+        let settings = PathSettings { bounces: 3, seed, ..PathSettings::default() };
+        let view = PathView { scene: &scene, camera: &camera, size, settings: &settings };
+        octovox::quality::accumulate(&mut renderer, &view, 16, None, |_| ()).unwrap();
+        renderer.read_samples().unwrap().0
+    };
+    let (first, again, other) = (sums(0), sums(0), sums(1));
+    assert_eq!(first, again, "seed 0 drew other samples the second time");
+    let z: Vec<f32> = first
+        .iter()
+        .zip(&other)
+        .flat_map(|(a, b)| {
+            let (d, v) = (a.mean() - b.mean(), a.variance_of_mean() + b.variance_of_mean());
+            (0..3).filter(move |&c| v[c] > 0.0).map(move |c| d[c] / v[c].sqrt())
+        })
+        .collect();
+    let rms = (z.iter().map(|z| z * z).sum::<f32>() / z.len() as f32).sqrt();
+    println!("seeds 0 and 1: RMS {rms:.3} standard errors over {} channels", z.len());
+    assert!(z.len() > 1000 && (0.8..1.3).contains(&rms), "seeds 0 and 1: RMS {rms} standard errors");
 }
 
 fn all_finite(pixels: &[Vec3]) -> bool {
@@ -412,6 +444,24 @@ fn a_path_traced_render_shows_progress_on_a_terminal_only() {
     let tty = std::process::Command::new("script").args(["-qec", &command, "/dev/null"]).output().unwrap();
     assert!(tty.status.success(), "{}", String::from_utf8_lossy(&tty.stdout));
     assert!(String::from_utf8_lossy(&tty.stdout).contains("path tracing ["), "a bar on a terminal");
+}
+
+/// `render --seed N` draws another sequence of samples: the same seed
+/// gives the same image, another seed another one.
+#[test]
+fn render_seed_picks_the_sequence_of_samples() {
+    let dir = tempfile::tempdir().unwrap();
+    let render = |seed: &str, name: &str| {
+        let out = dir.path().join(name);
+        let args = ["render", "--demo", "showroom", "--spp", "4", "--size", "64x36", "--seed", seed, "-o"];
+        let run = std::process::Command::new(env!("CARGO_BIN_EXE_octovox")).args(args).arg(&out).output().unwrap();
+        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        image::open(&out).unwrap().to_rgba8()
+    };
+    let (one, again, zero) = (render("1", "a.png"), render("1", "b.png"), render("0", "c.png"));
+    assert_eq!(one, again, "seed 1 twice");
+    let differing = one.pixels().zip(zero.pixels()).filter(|(a, b)| a != b).count();
+    assert!(differing * 2 > one.pixels().len(), "only {differing} pixels differ between seeds 1 and 0");
 }
 
 /// Issue 27, bug 7: the selection's tint showed in the preview only. In a

@@ -97,6 +97,7 @@ impl PathScene<'_> {
     /// light by: the first hit's albedo ([`PathScene::demodulation_albedo`]).
     pub fn sample_with_albedo(&self, basis: &RayBasis, x: u32, y: u32, sample: u32) -> (Vec3, Vec3) {
         let pixel = y * basis.width + x;
+        let sample = self.settings.first_sample().wrapping_add(sample);
         let mut rng = Rng::new(pixel, sample);
         let (jx, jy) = rng::pixel_offset(pixel, sample);
         let (origin, dir) = basis.ray_through(x as f32 + jx, y as f32 + jy);
