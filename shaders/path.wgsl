@@ -16,7 +16,7 @@ override GLASS: bool = true;
 
 const PI: f32 = 3.14159265358979;
 
-// Twin of `PathUniforms` in src/gpu/path_pass.rs.
+// Twin of `PathUniforms` in src/gpu/layout.rs.
 struct PathUniforms {
     sky_horizon: vec3<f32>,
     // Index of this frame's sample: 0 restarts the accumulation.

@@ -233,7 +233,7 @@ pub struct RenderArgs {
 pub struct PathArgs {
     /// Path trace with N samples per pixel (without it: the preview shading;
     /// with --target-error: at most N).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1 << 20))]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(octovox::settings::SEED_STRIDE)))]
     pub spp: Option<u32>,
     /// Path trace until the estimated noise (the RMS standard error of the
     /// displayed pixels, 0..1 or a percentage such as 1%) is below E; at
@@ -262,9 +262,10 @@ pub struct PathArgs {
     /// No sunlight.
     #[arg(long)]
     pub no_sun: bool,
-    /// Which sequence of samples (0 by default): renders of different
-    /// seeds are independent, so one can be the reference of another.
-    #[arg(long, default_value_t = 0)]
+    /// Which sequence of samples (0 by default, below 4096): renders of
+    /// different seeds are independent, so one can be the reference of
+    /// another.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..i64::from(octovox::settings::SEEDS)))]
     pub seed: u32,
 }
 

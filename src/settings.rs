@@ -149,8 +149,12 @@ impl Default for PathSettings {
 }
 
 /// Sample indices between the sequences of two seeds: an accumulation of
-/// fewer samples never reaches the next seed's first.
+/// at most this many samples (`render --spp`'s limit) never reaches the
+/// next seed's first.
 pub const SEED_STRIDE: u32 = 1 << 20;
+/// Seeds whose sequences differ: seed `SEEDS` would start where seed 0
+/// does, the index wrapping at 2³².
+pub const SEEDS: u32 = u32::MAX / SEED_STRIDE + 1;
 
 impl PathSettings {
     /// The index, in the random sequences of the path tracer (CPU and GPU),

@@ -148,8 +148,9 @@ fn measure_all(
     let ratio = f64::from(window.0) * f64::from(window.1) / f64::from(MEASURE_SIZE.0 * MEASURE_SIZE.1);
     // The last preset is the reference: the others' error is measured
     // against its image, and its own is 0 by definition (it once was a
-    // separate 64-sample render, and "reference" scored worse than "good"),
-    // drawn from other samples than theirs.
+    // separate 64-sample render, and "reference" scored worse than "good").
+    // Its image is drawn from another seed, so it shares no sample with
+    // theirs.
     let Some((reference_preset, others)) = PRESETS.split_last() else { return Ok(Vec::new()) };
     let setting = reference_preset.setting().with_seed(REFERENCE_SEED);
     let (reference_ms, reference) = render_setting(renderer, scene, camera, MEASURE_SIZE, setting)?;

@@ -568,7 +568,7 @@ fn rows_for_plot(rows: &[QualityRow]) -> Vec<super::quality_plot::Point> {
 fn markdown(rows: &[QualityRow], sizes: &Sizes, adapter: &str) -> String {
     let mut md = header("What accuracy costs in time");
     md += &format!(
-        "On {adapter}, {}×{} pixels. The reference per scene: the path tracer at {} samples, 8 bounces, 4 shadow samples, full scale, from another seed than the rows' (`--seed 1`: none of its samples is one of theirs). \
+        "On {adapter}, {}×{} pixels. The reference per scene: the path tracer at {} samples, 8 bounces, 4 shadow samples, full scale, from another seed than the rows' (`--seed {REFERENCE_SEED}`: none of its samples is one of theirs). \
          The base: {} samples, 3 bounces, 1 shadow sample, full scale; each other row turns one knob from the base (by its CLI flag). \
          `ms/frame` is the wall time from submitting the frame's first sample to the end of its last (the renderer waits for each); FLIP is the mean of NVIDIA's FLIP error map (0 = identical; lower is better); \
          PSNR over the 8-bit RGB. ★ marks the Pareto front: no other setting of that scene is both faster and closer. \

@@ -53,6 +53,9 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<ExitCode> {
     if (args.path.denoise || args.path.oidn) && !traced_path {
         anyhow::bail!("--denoise and --oidn filter the path tracer's samples: give --spp N or --target-error E");
     }
+    if args.path.seed != 0 && !traced_path {
+        anyhow::bail!("--seed picks the path tracer's samples: give --spp N or --target-error E");
+    }
     if args.path.oidn && !octovox::trace::oidn::AVAILABLE {
         return Err(octovox::trace::oidn::OidnError::NotBuilt.into());
     }

@@ -166,6 +166,9 @@ pub struct PathUniforms {
     pub padding: [u32; 3],
 }
 
+// The size WGSL gives its twin: a field added here must fit it or grow both.
+const _: () = assert!(std::mem::size_of::<PathUniforms>() == 64);
+
 /// Twin of `DenoiseUniforms` in `shaders/denoise.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]

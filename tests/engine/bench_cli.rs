@@ -78,6 +78,12 @@ fn the_quality_bench_measures_every_knob_and_plots_them() {
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.path().join("quality.json")).unwrap()).unwrap();
     let rows = json["knobs"].as_array().unwrap();
+    // The filter's change to each reference in standard errors: positive,
+    // and not far above noise (the scenes' figures are in docs/bench).
+    for row in json["denoised_reference"].as_array().unwrap() {
+        let rms = row["change"]["rms"].as_f64().unwrap_or(-1.0);
+        assert!(rms > 0.0 && rms < 3.0, "{row}");
+    }
     // The level of detail alone: exact at 0, and it changes the picture no
     // more as the footprint shrinks.
     let lod = json["level_of_detail"].as_array().unwrap();

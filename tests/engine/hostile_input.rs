@@ -645,3 +645,19 @@ fn open_image_denoise_is_refused_clearly_where_it_cannot_run() {
     }
     assert!(!png.exists(), "a refused render wrote {}", png.display());
 }
+
+/// `--seed` needs samples, and a seed whose sequence would wrap onto seed
+/// 0's is refused; neither writes an image.
+#[test]
+fn a_seed_without_samples_or_past_the_last_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("s.png");
+    let render = |extra: &[&str]| {
+        let mut args = vec!["render", "--cpu", "--size", "8x8", "-o", s(&png)];
+        args.extend_from_slice(extra);
+        octovox(&args)
+    };
+    assert_refused(&render(&["--seed", "2"]), "give --spp N");
+    assert_refused(&render(&["--spp", "1", "--seed", "4096"]), "4096");
+    assert!(!png.exists(), "a refused render wrote {}", png.display());
+}

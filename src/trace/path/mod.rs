@@ -97,9 +97,10 @@ impl PathScene<'_> {
     /// light by: the first hit's albedo ([`PathScene::demodulation_albedo`]).
     pub fn sample_with_albedo(&self, basis: &RayBasis, x: u32, y: u32, sample: u32) -> (Vec3, Vec3) {
         let pixel = y * basis.width + x;
-        let sample = self.settings.first_sample().wrapping_add(sample);
-        let mut rng = Rng::new(pixel, sample);
-        let (jx, jy) = rng::pixel_offset(pixel, sample);
+        // Where this sample is in the seed's random sequences.
+        let sequence_index = self.settings.first_sample().wrapping_add(sample);
+        let mut rng = Rng::new(pixel, sequence_index);
+        let (jx, jy) = rng::pixel_offset(pixel, sequence_index);
         let (origin, dir) = basis.ray_through(x as f32 + jx, y as f32 + jy);
         let mut albedo = Vec3::ONE;
         let radiance = clamp_sample(self.radiance(Ray::new(origin, dir), &mut rng, &mut albedo));
