@@ -151,6 +151,12 @@ fn checker() -> (Scene, Camera) {
     (Scene::new(palette, build(&edits)), camera)
 }
 
+/// The checker, its view and settings: 96×96, 2 bounces.
+fn checker_view() -> (Scene, Camera, PathSettings, (u32, u32)) {
+    let (scene, camera) = checker();
+    (scene, camera, PathSettings { bounces: 2, ..PathSettings::default() }, (96, 96))
+}
+
 /// (light − dark) / (light + dark) of the mean luminance of the squares.
 fn contrast(image: &image::RgbaImage, tree: &Octree, camera: &Camera) -> f64 {
     let basis = camera.basis(image.width(), image.height(), tree.origin());
@@ -176,9 +182,7 @@ fn contrast(image: &image::RgbaImage, tree: &Octree, camera: &Camera) -> f64 {
 
 #[test]
 fn a_one_voxel_checker_keeps_its_contrast_and_the_filter_adds_no_bias() {
-    let (mut scene, camera) = checker();
-    let settings = PathSettings { bounces: 2, ..PathSettings::default() };
-    let size = (96, 96);
+    let (mut scene, camera, settings, size) = checker_view();
     let mut renderer = renderer_for(&mut scene);
     let view = PathView { scene: &scene, camera: &camera, size, settings: &settings };
     // The converged image, and the one the filter is asked not to bias: 8
@@ -306,9 +310,7 @@ fn open_image_denoise_brings_few_samples_nearer_the_converged_image() {
 #[cfg(feature = "oidn")]
 #[test]
 fn open_image_denoise_keeps_a_one_voxel_checker() {
-    let (mut scene, camera) = checker();
-    let settings = PathSettings { bounces: 2, ..PathSettings::default() };
-    let size = (96, 96);
+    let (mut scene, camera, settings, size) = checker_view();
     let mut renderer = renderer_for(&mut scene);
     let view = PathView { scene: &scene, camera: &camera, size, settings: &settings };
     let converged = reference_image(&mut renderer, &view, 1024);
