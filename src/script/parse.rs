@@ -28,7 +28,34 @@ pub struct ScriptError {
 struct Token {
     text: String,
     column: usize,
+    /// Whether any of it was in quotes: a quoted word is a name or a path,
+    /// never a keyword.
+    quoted: bool,
 }
+
+/// The words that mean something where an object's or a layer's name may
+/// also stand (`object hide`, `layer 0 color`): a name spelled like one is
+/// written in quotes (`super::print::quoted_name`).
+pub(super) const NAME_KEYWORDS: &[&str] = &[
+    "before",
+    "after",
+    "merge",
+    "hide",
+    "show",
+    "lock",
+    "unlock",
+    "new",
+    "move",
+    "rotate",
+    "duplicate",
+    "reference",
+    "unique",
+    "delete",
+    "rename",
+    "layer",
+    "color",
+    "active",
+];
 
 /// Reads the tokens of one line, left to right, with errors that point at
 /// the token (or at the end of the line when one is missing).
@@ -97,6 +124,12 @@ fn unescape(chars: &mut std::iter::Peekable<impl Iterator<Item = (char, usize)>>
     })
 }
 
+impl Token {
+    fn new(column: usize) -> Token {
+        Token { text: String::new(), column, quoted: false }
+    }
+}
+
 impl Cursor {
     /// Splits a line into words: whitespace separates them, `"…"` quotes a
     /// word that holds spaces or `#` (with `\"` and `\\` inside), and `#`
@@ -118,7 +151,7 @@ impl Cursor {
                             token.text.push(escaped);
                         }
                     }
-                    _ => current.get_or_insert_with(|| Token { text: String::new(), column }).text.push(c),
+                    _ => current.get_or_insert_with(|| Token::new(column)).text.push(c),
                 }
                 end_column = column + 1;
                 continue;
@@ -128,9 +161,9 @@ impl Cursor {
                 c if c.is_whitespace() => tokens.extend(current.take()),
                 '"' => {
                     quote_column = Some(column);
-                    current.get_or_insert_with(|| Token { text: String::new(), column });
+                    current.get_or_insert_with(|| Token::new(column)).quoted = true;
                 }
-                c => current.get_or_insert_with(|| Token { text: String::new(), column }).text.push(c),
+                c => current.get_or_insert_with(|| Token::new(column)).text.push(c),
             }
             if !c.is_whitespace() {
                 end_column = column + 1;
@@ -409,6 +442,7 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
             Command::Layer(
                 id,
                 match what.text.as_str() {
+                    _ if what.quoted => LayerLine::Name(what.text),
                     "hide" => LayerLine::Hide(true),
                     "show" => LayerLine::Hide(false),
                     "active" => LayerLine::Active,
@@ -432,6 +466,7 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
 fn parse_object(c: &mut Cursor) -> Result<ObjectLine, Fail> {
     let word = c.word("an object index or name, or what the picked object does")?;
     Ok(match word.text.as_str() {
+        _ if word.quoted => ObjectLine::Pick(object_ref(word)?),
         "before" => ObjectLine::Regroup(object_ref(c.word("an object")?)?, false),
         "after" => ObjectLine::Regroup(object_ref(c.word("an object")?)?, true),
         "merge" => {
@@ -460,10 +495,11 @@ fn parse_object(c: &mut Cursor) -> Result<ObjectLine, Fail> {
 /// An object by index (digits) or by name or `group/name` path.
 fn object_ref(word: Token) -> Result<ObjectRef, Fail> {
     match word.text.as_str() {
-        text if !text.is_empty() && text.bytes().all(|b| b.is_ascii_digit()) => Ok(ObjectRef::Index(
+        "" => Err((word.column, "an empty object name".to_owned())),
+        text if word.quoted => Ok(ObjectRef::Name(text.to_owned())),
+        text if text.bytes().all(|b| b.is_ascii_digit()) => Ok(ObjectRef::Index(
             text.parse().map_err(|_| (word.column, format!("object index '{text}' is too large")))?,
         )),
-        "" => Err((word.column, "an empty object name".to_owned())),
         text => Ok(ObjectRef::Name(text.to_owned())),
     }
 }
@@ -731,6 +767,41 @@ mod tests {
             errors("load \"a\\u{zz}.vox\""),
             vec!["expected \\u{HEX} (a character's code in hexadecimal) at build.ovr:1:8"]
         );
+    }
+
+    /// A layer renamed `color` was journaled as `layer 0 color`, which does
+    /// not parse, and one renamed `hide` came back as a hidden layer (issue
+    /// 48, item 4): every keyword, number and odd character round-trips as
+    /// a name wherever a name stands.
+    #[test]
+    fn every_keyword_and_odd_character_round_trips_as_a_name() {
+        let mut names: Vec<String> = NAME_KEYWORDS.iter().map(|k| (*k).to_owned()).collect();
+        names.extend(
+            ["12", "0", "a b", "#x", "\"q\"", "back\\slash", "two\nlines", "tab\t", "\u{7}", "ünï", "a/b", "-3", "x,y"]
+                .map(str::to_owned),
+        );
+        names.extend(["brush", "object", "layer", "on", "off", "x", "reference"].map(str::to_owned));
+        for name in &names {
+            let r = || ObjectRef::Name(name.clone());
+            let commands = [
+                Command::Layer(0, LayerLine::Name(name.clone())),
+                Command::Object(ObjectLine::Pick(r())),
+                Command::Object(ObjectLine::New(name.clone())),
+                Command::Object(ObjectLine::Rename(name.clone())),
+                Command::Object(ObjectLine::Regroup(r(), true)),
+                Command::Object(ObjectLine::Merge(vec![r(), ObjectRef::Index(3), r()])),
+            ];
+            for command in commands {
+                let printed = command.to_string();
+                let again = parse_script(Path::new("n.ovr"), &printed).unwrap_or_else(|e| panic!("{printed:?}: {e:?}"));
+                assert_eq!(again.lines.len(), 1, "{printed:?}");
+                assert_eq!(again.lines[0].command, command, "{printed:?}");
+            }
+        }
+        // Plain names stay unquoted, so older journals read as they did.
+        assert_eq!(Command::Layer(2, LayerLine::Name("roof".to_owned())).to_string(), "layer 2 roof");
+        assert_eq!(Command::Layer(2, LayerLine::Name("hide".to_owned())).to_string(), "layer 2 \"hide\"");
+        assert_eq!(errors("object \"\""), vec!["an empty object name at build.ovr:1:8"]);
     }
 
     /// A 2 MB line took 31 s to reject when columns were counted from the

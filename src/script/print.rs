@@ -68,13 +68,13 @@ impl fmt::Display for Command {
             Command::ExpectEffects(names) => write!(f, "expect effects {}", names.join(" ")),
             Command::Object(ObjectLine::Pick(ObjectRef::Index(n))) => write!(f, "object {n}"),
             Command::Object(ObjectLine::Pick(ObjectRef::Name(name))) => {
-                write!(f, "object {}", quoted(std::path::Path::new(name)))
+                write!(f, "object {}", quoted_name(name))
             }
             Command::Object(ObjectLine::Hide(true)) => write!(f, "object hide"),
             Command::Object(ObjectLine::Hide(false)) => write!(f, "object show"),
             Command::Object(ObjectLine::Lock(true)) => write!(f, "object lock"),
             Command::Object(ObjectLine::Lock(false)) => write!(f, "object unlock"),
-            Command::Object(ObjectLine::New(name)) => write!(f, "object new {}", quoted(std::path::Path::new(name))),
+            Command::Object(ObjectLine::New(name)) => write!(f, "object new {}", quoted_name(name)),
             Command::Object(ObjectLine::Move(d)) => write!(f, "object move {}", v(*d)),
             Command::Object(ObjectLine::Rotate(axis)) => write!(f, "object rotate {}", ["x", "y", "z"][*axis]),
             Command::Object(ObjectLine::Duplicate { reference: false }) => write!(f, "object duplicate"),
@@ -84,7 +84,7 @@ impl fmt::Display for Command {
                 write!(f, "object {} ", if *after { "after" } else { "before" })?;
                 match target {
                     ObjectRef::Index(i) => write!(f, "{i}"),
-                    ObjectRef::Name(name) => write!(f, "{}", quoted(std::path::Path::new(name))),
+                    ObjectRef::Name(name) => write!(f, "{}", quoted_name(name)),
                 }
             }
             Command::Object(ObjectLine::Merge(others)) => {
@@ -92,19 +92,19 @@ impl fmt::Display for Command {
                 for other in others {
                     match other {
                         ObjectRef::Index(i) => write!(f, " {i}")?,
-                        ObjectRef::Name(name) => write!(f, " {}", quoted(std::path::Path::new(name)))?,
+                        ObjectRef::Name(name) => write!(f, " {}", quoted_name(name))?,
                     }
                 }
                 Ok(())
             }
             Command::Object(ObjectLine::Delete) => write!(f, "object delete"),
             Command::Object(ObjectLine::Rename(name)) => {
-                write!(f, "object rename {}", quoted(std::path::Path::new(name)))
+                write!(f, "object rename {}", quoted_name(name))
             }
             Command::Object(ObjectLine::Layer(id)) => write!(f, "object layer {id}"),
             Command::Layer(id, LayerLine::Hide(true)) => write!(f, "layer {id} hide"),
             Command::Layer(id, LayerLine::Hide(false)) => write!(f, "layer {id} show"),
-            Command::Layer(id, LayerLine::Name(name)) => write!(f, "layer {id} {}", quoted(std::path::Path::new(name))),
+            Command::Layer(id, LayerLine::Name(name)) => write!(f, "layer {id} {}", quoted_name(name)),
             Command::Layer(id, LayerLine::Color([r, g, b])) => write!(f, "layer {id} color {r} {g} {b}"),
             Command::Layer(id, LayerLine::Active) => write!(f, "layer {id} active"),
             Command::Palette(PaletteLine::Load(path)) => write!(f, "palette load {}", quoted(path)),
@@ -131,6 +131,23 @@ pub fn quoted(path: &std::path::Path) -> String {
     if !text.is_empty() && !text.chars().any(special) {
         return text.into_owned();
     }
+    in_quotes(&text)
+}
+
+/// A name (of an object, a group path or a layer) as a script word: as it
+/// is when it is a plain word (letters, digits, `_ - . /`, not all digits
+/// and not a word the parser reads as a keyword where a name may stand),
+/// else in quotes, which the parser always reads as a name.
+pub fn quoted_name(name: &str) -> String {
+    let plain_char = |c: char| c.is_alphanumeric() || matches!(c, '_' | '-' | '.' | '/');
+    let plain = name.chars().all(plain_char)
+        && !name.bytes().all(|b| b.is_ascii_digit())
+        && !super::parse::NAME_KEYWORDS.contains(&name);
+    if plain { name.to_owned() } else { in_quotes(name) }
+}
+
+/// `text` in quotes, with quotes, backslashes and control characters escaped.
+fn in_quotes(text: &str) -> String {
     let mut out = String::with_capacity(text.len() + 2);
     out.push('"');
     for c in text.chars() {
