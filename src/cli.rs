@@ -146,8 +146,8 @@ pub enum Command {
         /// Run without a GPU: flushes are counted, renders use the CPU tracer.
         #[arg(long)]
         cpu: bool,
-        /// Let `save` and `render` lines replace existing .vox/.obj/.ovr
-        /// files and the run's inputs.
+        /// Let `save`, `render` and `palette save` lines replace existing
+        /// .vox/.obj/.ovr and palette files and the run's inputs.
         #[arg(long)]
         force: bool,
     },

@@ -1,6 +1,7 @@
 //! Which outputs a command may write: never one of its inputs, never over an
-//! existing document (.vox, .obj, .ovr, .ply, .glb, .mtl) unless the user said
-//! `--force`, and only in the format the file's extension names.
+//! existing document (.vox, .obj, .ovr, .ply, .glb, .mtl, or any palette
+//! file) unless the user said `--force`, and only in the format the file's
+//! extension names.
 
 use std::path::{Path, PathBuf};
 
@@ -79,7 +80,9 @@ pub fn check_output(output: &Path, kind: OutputKind, inputs: &[&Path], force: bo
     if inputs.iter().any(|input| same_file(input, output)) {
         return Err(OutputError::IsInput { path: output.to_path_buf() });
     }
-    if output.exists() && DOCUMENT_EXTENSIONS.contains(&extension.as_str()) {
+    // A palette file is a document whatever its extension: a `.png` render
+    // may be replaced, a `.png` palette someone made may not.
+    if output.exists() && (DOCUMENT_EXTENSIONS.contains(&extension.as_str()) || kind == OutputKind::Palette) {
         return Err(OutputError::Exists { path: output.to_path_buf() });
     }
     Ok(())
@@ -122,6 +125,15 @@ mod tests {
         // The format comes from the extension, in any case.
         assert_eq!(check_output(&dir.path().join("X.PNG"), OutputKind::Image, &[], false), Ok(()));
         assert!(check_output(&dir.path().join("x.jpg"), OutputKind::Image, &[], true).is_err());
+        // Issue 48, item 6: `palette save` replaced an existing palette
+        // (the one the run loaded, too) without --force.
+        for name in ["p.gpl", "p.hex", "p.png"] {
+            let palette = dir.path().join(name);
+            assert_eq!(check_output(&palette, OutputKind::Palette, &[], false), Ok(()));
+            std::fs::write(&palette, b"x").unwrap();
+            assert!(matches!(check_output(&palette, OutputKind::Palette, &[], false), Err(OutputError::Exists { .. })));
+            assert_eq!(check_output(&palette, OutputKind::Palette, &[], true), Ok(()));
+        }
         // A folder (or any name without an extension) is named as such.
         let err = check_output(dir.path(), OutputKind::Mesh, &[], false).unwrap_err();
         assert!(err.to_string().contains("has no file extension (a folder?), but this command writes"), "{err}");

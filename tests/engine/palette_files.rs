@@ -137,3 +137,34 @@ fn a_recording_of_a_load_needs_no_file() {
     let (ok, text) = replay(dir.path(), &format!("new\n{recorded}expect palette 2 64 80 96\n"));
     assert!(ok, "{text}");
 }
+
+/// `palette save` replaced the palette the run had loaded, and any existing
+/// .gpl/.hex/.png, without `--force` (issue 48, item 6): now it refuses and
+/// the file keeps its bytes; `replay --force` replaces it.
+#[test]
+fn palette_save_replaces_an_existing_file_only_with_force() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["mine.hex", "mine.gpl", "mine.png"] {
+        let path = dir.path().join(name);
+        let before = match name {
+            "mine.png" => {
+                image::RgbImage::from_pixel(256, 1, image::Rgb([9, 8, 7])).save(&path).unwrap();
+                std::fs::read(&path).unwrap()
+            }
+            "mine.gpl" => b"GIMP Palette\n1 2 3\n".to_vec(),
+            _ => b"010203\n".to_vec(),
+        };
+        std::fs::write(&path, &before).unwrap();
+        let script = format!("new\npalette load {name}\nrgb 5 200 100 50\npalette save {name}\n");
+        let (ok, text) = replay(dir.path(), &script);
+        assert!(!ok && text.contains("already exists; refusing to replace it (--force replaces it)"), "{text}");
+        assert_eq!(std::fs::read(&path).unwrap(), before, "{name} changed");
+        let script_path = dir.path().join("palette.ovr");
+        let out = Command::new(env!("CARGO_BIN_EXE_octovox"))
+            .args(["replay", "--cpu", "--force", script_path.to_str().unwrap()])
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert_ne!(std::fs::read(&path).unwrap(), before, "{name} with --force");
+    }
+}
