@@ -29,6 +29,10 @@ const MANY_PLACEMENTS: usize = 64;
 /// largest a .vox file stores in one.
 const MERGE_LIMIT: u64 = 1 << 24;
 
+/// Voxels composing gathers before writing them into the drawn tree (cells
+/// a composed box cuts, or single voxels): 16 bytes each, 1 MiB a batch.
+const PLACED_BATCH: usize = 1 << 16;
+
 /// Largest box one removal covers while composing (a brush's widest).
 const COMPOSE_BOX: i32 = super::shape::MAX_BRUSH_EXTENT;
 
@@ -186,7 +190,7 @@ impl Objects {
         };
         let mut tree = Octree::empty_for(bounds.0, bounds.1).map_err(|e| EditError::Objects(e.to_string()))?;
         for index in self.visible() {
-            tree.insert_voxels(&self.placed(index, bounds));
+            self.insert_placed(&mut tree, index, bounds);
         }
         Ok(tree)
     }
@@ -195,22 +199,12 @@ impl Objects {
         (0..self.objects.len()).filter(|&i| !self.objects[i].hidden)
     }
 
-    /// Object `index`'s voxels inside the world box `lo..=hi`, in world cells.
-    fn placed(&self, index: usize, (lo, hi): (IVec3, IVec3)) -> Vec<(IVec3, u8)> {
+    /// Writes object `index`'s voxels inside the world box `lo..=hi` into
+    /// `tree` (which holds that box), over what is there.
+    fn insert_placed(&self, tree: &mut Octree, index: usize, (lo, hi): (IVec3, IVec3)) {
         let map = self.maps[index];
-        let (mlo, mhi) = map.invert_box(lo, hi);
-        let mut out = Vec::new();
-        self.models[self.objects[index].placement.model].tree.for_each_solid_cell_in(mlo, mhi, |min, size, value| {
-            let (clo, chi) = (min.max(mlo), (min + IVec3::splat(size - 1)).min(mhi));
-            for z in clo.z..=chi.z {
-                for y in clo.y..=chi.y {
-                    for x in clo.x..=chi.x {
-                        out.push((map.apply(IVec3::new(x, y, z)), value));
-                    }
-                }
-            }
-        });
-        out
+        let model = &self.models[self.objects[index].placement.model].tree;
+        copy_cells(model, map.invert_box(lo, hi), tree, |p| map.apply(p));
     }
 
     /// Composes the world cells `lo..=hi` of `tree` again from the objects.
@@ -223,7 +217,7 @@ impl Objects {
         for index in self.visible() {
             let reaches = self.world_box(index).is_some_and(|(a, b)| a.cmple(hi).all() && b.cmpge(lo).all());
             if reaches {
-                tree.insert_voxels(&self.placed(index, (lo, hi)));
+                self.insert_placed(tree, index, (lo, hi));
             }
         }
         Ok(())
@@ -356,11 +350,24 @@ impl Objects {
         for key in &after {
             *counts.entry(*key).or_default() -= 1;
         }
-        for ((model, map), count) in counts {
-            if count != 0
-                && let Some((lo, hi)) = self.models[model].tree.solid_bounds()
-            {
-                self.recompose(tree, map.apply_box(lo, hi))?;
+        let regions: Vec<(IVec3, IVec3)> = counts
+            .into_iter()
+            .filter(|&(_, count)| count != 0)
+            .filter_map(|((model, map), _)| {
+                self.models[model].tree.solid_bounds().map(|(lo, hi)| map.apply_box(lo, hi))
+            })
+            .collect();
+        for (done, &region) in regions.iter().enumerate() {
+            if let Err(err) = self.recompose(tree, region) {
+                // A region the tree cannot hold (a move past the world's
+                // width): the graph goes back, and so do the cells already
+                // composed from it. A refused change leaves the scene as it was.
+                self.graph = Some(saved);
+                self.walk(usize::MAX).map_err(|e| EditError::Objects(e.to_string()))?;
+                for &region in &regions[..done] {
+                    self.recompose(tree, region)?;
+                }
+                return Err(err);
             }
         }
         Ok(inverse)
@@ -628,15 +635,19 @@ impl Objects {
             )));
         }
         let target = self.maps[index];
-        let mut cells = HashMap::new();
+        let boxes: Vec<(IVec3, IVec3)> =
+            all.iter().filter_map(|&k| self.world_box(k)).map(|(lo, hi)| target.invert_box(lo, hi)).collect();
+        let mut tree = match boxes.into_iter().reduce(|a, b| (a.0.min(b.0), a.1.max(b.1))) {
+            Some((lo, hi)) => Octree::empty_for(lo, hi).map_err(|e| EditError::Objects(e.to_string()))?,
+            None => Octree::default(),
+        };
+        // In walk order, so the later wins where two overlap, as drawn.
         for &k in &all {
-            let Some(world) = self.world_box(k) else { continue };
-            for (at, value) in self.placed(k, world) {
-                cells.insert(target.invert(at), value);
+            let (map, model) = (self.maps[k], &self.models[self.objects[k].placement.model].tree);
+            if let Some(bounds) = model.solid_bounds() {
+                copy_cells(model, bounds, &mut tree, |p| target.invert(map.apply(p)));
             }
         }
-        let voxels: Vec<(IVec3, u8)> = cells.into_iter().collect();
-        let tree = Octree::from_voxels(&voxels).map_err(|e| EditError::Objects(e.to_string()))?;
         let model = Model { size: self.models[self.objects[index].placement.model].size, tree };
         let mut change = self.made_unique(index, self.models.len())?;
         let gone = self.deleted_all(others)?;
@@ -650,12 +661,17 @@ impl Objects {
     /// the new transform's id.
     pub fn created(&self, name: &str) -> Result<(Model, GraphChange, u32), EditError> {
         let graph = self.graph.as_ref().ok_or_else(|| EditError::Objects(NO_GRAPH.to_owned()))?;
-        let mut group = graph
-            .nodes
-            .iter()
-            .find(|n| matches!(n.kind, NodeKind::Group { .. }))
+        // The top group: the one under the root transform (node 0), where
+        // the walk starts. The first group in file order may be one no walk
+        // reaches (issue 48, item 12), and an object there is in no scene.
+        let top = match graph.node(0).map(|root| &root.kind) {
+            Some(NodeKind::Transform { child, .. }) => graph.node(*child),
+            _ => None,
+        };
+        let mut group = top
+            .filter(|n| matches!(n.kind, NodeKind::Group { .. }))
             .cloned()
-            .ok_or_else(|| EditError::Objects("the scene graph has no group to put an object in".to_owned()))?;
+            .ok_or_else(|| EditError::Objects("the scene graph has no top group to put an object in".to_owned()))?;
         let next = graph.nodes.iter().map(|n| n.id).max().unwrap_or(0);
         let ids = next.checked_add(1).zip(next.checked_add(2));
         let (transform_id, shape_id) = ids.ok_or_else(|| EditError::Objects("no node ids are left".to_owned()))?;
@@ -833,6 +849,37 @@ impl GraphChange {
 }
 
 /// Min corners of the boxes of at most [`COMPOSE_BOX`] a side that tile `lo..=hi`.
+/// Writes the solid cells of `from` inside its box `lo..=hi` into `to`
+/// (which holds where they go), each cell `p` at `map(p)`, over what is
+/// there; `map` is a signed permutation and a shift (a cell map or a chain
+/// of them). A uniform cell wholly inside the box goes in as one cube (a
+/// signed permutation maps a cube onto a cube), so a solid region costs its
+/// surface; single voxels and cells the box cuts go in batches of at most
+/// [`PLACED_BATCH`], so memory stays small whatever the model.
+fn copy_cells(from: &Octree, (lo, hi): (IVec3, IVec3), to: &mut Octree, map: impl Fn(IVec3) -> IVec3) {
+    let mut batch: Vec<(IVec3, u8)> = Vec::new();
+    from.for_each_solid_cell_in(lo, hi, |min, size, value| {
+        let max = min + IVec3::splat(size - 1);
+        if size > 1 && min.cmpge(lo).all() && max.cmple(hi).all() {
+            to.fill_cube(map(min).min(map(max)), size, value);
+            return;
+        }
+        let (clo, chi) = (min.max(lo), max.min(hi));
+        for z in clo.z..=chi.z {
+            for y in clo.y..=chi.y {
+                for x in clo.x..=chi.x {
+                    batch.push((map(IVec3::new(x, y, z)), value));
+                }
+            }
+        }
+        if batch.len() >= PLACED_BATCH {
+            to.insert_voxels(&batch);
+            batch.clear();
+        }
+    });
+    to.insert_voxels(&batch);
+}
+
 fn boxes_of(lo: IVec3, hi: IVec3) -> Vec<IVec3> {
     let steps = |a: i32, b: i32| (a..=b).step_by(COMPOSE_BOX as usize);
     let mut out = Vec::new();

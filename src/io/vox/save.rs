@@ -10,7 +10,7 @@ use super::stored;
 use super::validate::MAX_MODEL_EDGE;
 use super::{MAX_FILE_BYTES, MAX_VOXELS, VoxError};
 use crate::io::atomic::{WriteOptions, write_atomically};
-use crate::scene::graph::{Attributes, Node, NodeKind};
+use crate::scene::graph::{Attributes, Node, NodeKind, SceneGraph};
 use crate::scene::objects::Objects;
 use crate::scene::{Material, Octree, Palette, Voxel};
 
@@ -343,11 +343,14 @@ pub fn save_objects(path: &Path, palette: &Palette, objects: &Objects, options: 
 pub fn encode_objects(palette: &Palette, objects: &Objects) -> Result<Vec<u8>, VoxError> {
     let (stored, cuts) = stored::layout(&objects.models);
     let mut children = Vec::new();
+    let mut stored_voxels = Vec::with_capacity(stored.len());
     for entry in &stored {
-        write_stored(&mut children, entry, &objects.models[entry.model].tree);
+        stored_voxels.push(write_stored(&mut children, entry, &objects.models[entry.model].tree));
     }
     if let Some(graph) = &objects.graph {
-        for node in &stored::written_graph(graph, &objects.models, &stored, &cuts)?.nodes {
+        let written = stored::written_graph(graph, &objects.models, &stored, &cuts)?;
+        check_loadable(&written, &stored_voxels, objects.frame)?;
+        for node in &written.nodes {
             let (id, content) = node_chunk(node);
             push_chunk(&mut children, id, &content, 0);
         }
@@ -385,9 +388,25 @@ pub fn encode_objects(palette: &Palette, objects: &Objects) -> Result<Vec<u8>, V
     Ok(out)
 }
 
+/// A scene whose placements octovox would refuse to load is not written:
+/// the loader's own walk, at frame 0 (what a plain load shows) and at the
+/// frame shown now, over the models as written.
+fn check_loadable(graph: &SceneGraph, stored_voxels: &[usize], frame: usize) -> Result<(), VoxError> {
+    for frame in [0, frame] {
+        graph.objects(stored_voxels, frame, MAX_VOXELS).map_err(|e| match VoxError::from(e) {
+            VoxError::TooManyVoxels { found, .. } => VoxError::Unsavable(format!(
+                "the scene places at least {found} voxels (every reference counted); a .vox file octovox can \
+                 read back places at most {MAX_VOXELS} (docs/limits.md): place fewer references"
+            )),
+            other => VoxError::Unsavable(format!("octovox could not read the file back: {other}")),
+        })?;
+    }
+    Ok(())
+}
+
 /// The SIZE and XYZI chunks of one model as written: the cells of `tree` in
-/// `entry`'s box, shifted to its grid.
-fn write_stored(out: &mut Vec<u8>, entry: &stored::Stored, tree: &Octree) {
+/// `entry`'s box, shifted to its grid. Returns how many voxels it holds.
+fn write_stored(out: &mut Vec<u8>, entry: &stored::Stored, tree: &Octree) -> usize {
     let size: Vec<u8> = entry.size.iter().flat_map(|s| s.to_le_bytes()).collect();
     push_chunk(out, b"SIZE", &size, 0);
     let hi = entry.lo + IVec3::from_array(entry.size.map(|s| s as i32)) - IVec3::ONE;
@@ -407,6 +426,7 @@ fn write_stored(out: &mut Vec<u8>, entry: &stored::Stored, tree: &Octree) {
     let mut content = u32::try_from(voxels.len()).unwrap_or(u32::MAX).to_le_bytes().to_vec();
     content.extend_from_slice(voxels.as_flattened());
     push_chunk(out, b"XYZI", &content, 0);
+    voxels.len()
 }
 
 /// An nTRN, nGRP or nSHP chunk's id and content.
