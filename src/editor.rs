@@ -280,8 +280,9 @@ impl Editor {
 
     /// The `object N` line that picks the object drawn at `voxel`, when that
     /// is not the picked one already (what a click runs before its edit).
+    /// A scene of one object has none to pick: its edits go to it.
     pub fn object_line_at(&self, voxel: IVec3) -> Option<Command> {
-        let objects = self.scene.objects()?;
+        let objects = self.scene.objects().filter(|o| o.list().len() > 1)?;
         let owner = objects.owner_at(voxel).filter(|&i| objects.selected != Some(i) && !objects.locked(i))?;
         Some(Command::Object(ObjectLine::Pick(ObjectRef::Index(owner))))
     }

@@ -19,7 +19,7 @@ pub(crate) fn assets() -> PathBuf {
 /// The `.vox` files of the shared assets, but the one that is not one.
 fn asset_files() -> Vec<PathBuf> {
     let mut files = Vec::new();
-    for dir in ["seed", "magicavoxel", "format"] {
+    for dir in ["seed", "magicavoxel", "format", "anim", "scenes"] {
         for entry in std::fs::read_dir(assets().join(dir)).unwrap() {
             let path = entry.unwrap().path();
             if path.extension().is_some_and(|e| e == "vox") && !path.ends_with("not_a.vox") {
@@ -103,6 +103,76 @@ fn every_scene_file_of_the_assets_round_trips_without_loss() {
         assert_eq!(reloaded.voxels(), scene.voxels(), "{name}: drawn voxels");
     }
     assert!(scenes >= 4, "only {scenes} scene files among the assets");
+}
+
+/// Runs `octovox convert IN OUT`; panics with its output when it fails.
+fn convert(input: &std::path::Path, output: &std::path::Path) {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_octovox"))
+        .args(["convert", input.to_str().unwrap(), output.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "convert {}: {}", input.display(), String::from_utf8_lossy(&out.stderr));
+}
+
+/// Issue 48, item 1: a file of one visible model lost its scene graph,
+/// keys, `_loop`, all but one layer and every chunk octovox does not read
+/// (animation.vox came back with one layer and the bare model). Every
+/// asset now survives `convert` to .vox, and .vox → .ovx → .vox, as
+/// `dot_vox` and the raw chunk reader here see both files.
+#[test]
+fn every_asset_survives_convert_and_a_trip_through_ovx() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut one_object = 0;
+    for (k, path) in asset_files().iter().enumerate() {
+        let name = path.display().to_string();
+        let before = std::fs::read(path).unwrap();
+        let parsed = dot_vox::load_bytes(&before).unwrap();
+        let (vox, ovx, back) = (
+            dir.path().join(format!("{k}.vox")),
+            dir.path().join(format!("{k}.ovx")),
+            dir.path().join(format!("{k}b.vox")),
+        );
+        convert(path, &vox);
+        convert(&vox, &ovx);
+        convert(&ovx, &back);
+        let bare = parsed.scenes.is_empty() && kept_chunks(&before).is_empty() && parsed.models.len() <= 1;
+        if bare {
+            continue;
+        }
+        one_object += usize::from(parsed.models.len() == 1);
+        assert_same_scene(&name, &before, &std::fs::read(&vox).unwrap());
+        assert_same_scene(&format!("{name} through .ovx"), &before, &std::fs::read(&back).unwrap());
+    }
+    // animation.vox and MagicaVoxel's one-model files among them.
+    assert!(one_object >= 3, "only {one_object} one-model files among the assets");
+}
+
+/// animation.vox, written by MagicaVoxel 0.99.7.1: its three keys, `_loop`,
+/// 16 layers, 10 cameras, render settings and note come back after
+/// `convert`, read here from the raw chunks (not by octovox).
+#[test]
+fn the_animation_keeps_its_keys_layers_cameras_and_settings() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = assets().join("anim/animation.vox");
+    let output = dir.path().join("animation.vox");
+    convert(&input, &output);
+    let after = std::fs::read(&output).unwrap();
+    let count = |id: &[u8; 4]| raw_chunks(&after).iter().filter(|(i, _)| i == id).count();
+    assert_eq!((count(b"LAYR"), count(b"rCAM"), count(b"NOTE")), (16, 10, 1));
+    assert!(count(b"rOBJ") >= 15, "{} rOBJ", count(b"rOBJ"));
+    let data = dot_vox::load_bytes(&after).unwrap();
+    let keyed = data.scenes.iter().find_map(|node| match node {
+        SceneNode::Transform { frames, .. } if frames.len() == 3 => Some(frames.clone()),
+        _ => None,
+    });
+    let frames = keyed.expect("a transform with three keys");
+    let keys: Vec<Option<&String>> = frames.iter().map(|f| f.attributes.get("_f")).collect();
+    assert_eq!(keys, [Some(&"0".to_owned()), Some(&"9".to_owned()), Some(&"30".to_owned())]);
+    let looped = data.scenes.iter().any(|node| match node {
+        SceneNode::Transform { attributes, .. } => attributes.get("_loop").is_some_and(|v| v == "1"),
+        _ => false,
+    });
+    assert!(looped, "_loop 1 kept");
 }
 
 /// A cube-ish model with a marked corner, so that rotations show.
@@ -649,4 +719,90 @@ fn a_locked_object_is_kept_as_it_is_until_unlocked() {
     assert!(load(&saved(&editor.scene)).objects().unwrap().locked(1), "saved locked");
     run(&mut editor, &format!("object 1\nobject unlock\n{place}")).unwrap();
     assert_ne!(editor.scene.voxels(), before, "unlocked, it is edited");
+}
+
+/// Issue 48, item 2: `object move 2000000 0 0` was refused ("wider than
+/// 2^20 voxels") but the scene graph kept the move, and the next save wrote
+/// a file octovox refused to open. A refused change now leaves the scene,
+/// and what is saved, exactly as it was.
+#[test]
+fn a_refused_object_move_leaves_the_scene_as_it_was() {
+    let bytes = std::fs::read(assets().join("format/test_groups.vox")).unwrap();
+    let mut editor = Editor::default();
+    editor.set_scene(load(&bytes));
+    let (voxels, file) = (editor.scene.voxels(), saved(&editor.scene));
+    let err = run(&mut editor, "object 0\nobject move 2000000 0 0").unwrap_err();
+    assert!(err.to_string().contains("wider than 2^20"), "{err}");
+    assert_eq!(editor.scene.voxels(), voxels, "drawn as before");
+    assert_eq!(saved(&editor.scene), file, "saved as before");
+    assert_eq!(load(&saved(&editor.scene)).voxels(), voxels, "and it loads back");
+    assert!(!editor.history.can_undo(), "no undo step for a refused change");
+}
+
+/// Issue 48, item 3: five references to a 256³ model (84 M placed voxels)
+/// were saved as a file that loading refuses (more than 2^26 voxels). The
+/// save is now refused before anything is written, saying why, as .vox and
+/// as .ovx; four references (67 M, just past the limit too) and three are
+/// told apart by the same count the loader makes.
+#[test]
+fn a_scene_octovox_could_not_load_back_is_not_saved() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut editor = Editor::default();
+    editor.set_scene(load(&written_scene(1)));
+    run(&mut editor, "object new big\nbrush box 256 256 256\nplace 500 128 0").unwrap();
+    let big = editor.scene.objects().unwrap().list().len() - 1;
+    assert_eq!(editor.scene.objects().unwrap().models.last().unwrap().tree.solid_voxels(), 1 << 24);
+    run(&mut editor, &format!("object {big}\nobject duplicate reference\nobject duplicate reference")).unwrap();
+    let loadable = dir.path().join("three.vox");
+    octovox::io::save_scene(&loadable, &editor.scene, Default::default()).unwrap();
+    assert!(octovox::io::load_scene(&loadable, 0).is_ok(), "three references load back");
+    run(&mut editor, "object duplicate reference\nobject duplicate reference").unwrap();
+    for name in ["five.vox", "five.ovx"] {
+        let path = dir.path().join(name);
+        let err = octovox::io::save_scene(&path, &editor.scene, Default::default()).unwrap_err().to_string();
+        assert!(err.contains("places at most 67108864"), "{name}: {err}");
+        assert!(!path.exists(), "{name}: nothing written");
+    }
+}
+
+/// Issue 48, item 12: `object new` went into the first group in file
+/// order; with a group no walk reaches listed first, the new object was in
+/// no scene and the next `place` landed in object 0. It goes into the top
+/// group, under the root transform.
+#[test]
+fn a_new_object_goes_into_the_top_group() {
+    let transform = |child: u32| SceneNode::Transform {
+        attributes: dict(&[("_name", format!("t{child}"))]),
+        frames: vec![Frame::new(dict(&[]))],
+        child,
+        layer_id: 0,
+    };
+    let scenes = vec![
+        transform(2),
+        SceneNode::Group { attributes: dict(&[]), children: Vec::new() },
+        SceneNode::Group { attributes: dict(&[]), children: vec![3] },
+        transform(4),
+        SceneNode::Shape { attributes: dict(&[]), models: vec![ShapeModel { model_id: 0, attributes: dict(&[]) }] },
+    ];
+    let data = DotVoxData {
+        version: 200,
+        index_map: Vec::new(),
+        models: vec![model(4, 10)],
+        palette: dot_vox::DEFAULT_PALETTE.to_vec(),
+        materials: Vec::new(),
+        scenes,
+        layers: vec![Layer { attributes: dict(&[("_name", "0".into())]) }],
+    };
+    let mut bytes = Vec::new();
+    data.write_vox(&mut bytes).unwrap();
+    let mut editor = Editor::default();
+    editor.set_scene(load(&bytes));
+    let model0 = editor.scene.objects().unwrap().models[0].clone();
+    run(&mut editor, "object new fresh\ncolor 9\nplace 40 40 40").unwrap();
+    let objects = editor.scene.objects().unwrap();
+    assert_eq!(objects.list().len(), 2, "the new object is in the scene");
+    assert!(objects.list()[1].path.ends_with("fresh"), "{}", objects.list()[1].path);
+    assert_eq!(objects.models[0], model0, "object 0 is untouched");
+    assert_eq!(objects.models[1].tree.solid_voxels(), 1, "the voxel went into the new object");
+    assert_eq!(editor.scene.voxel(glam::IVec3::new(40, 40, 40)), 9);
 }

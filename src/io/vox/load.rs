@@ -78,10 +78,11 @@ pub struct VoxMeta {
 /// model at a time: the same voxels as [`load_vox`] then
 /// `Scene::from_model`, without ever holding the list of every voxel.
 ///
-/// A file of several models or objects, or with a hidden one, becomes a
-/// scene of objects (`Scene::objects`): its models, scene graph, layers and
-/// the chunks octovox does not read are kept, and saving writes them back.
-/// A file of one visible model loads as one model, as it always has.
+/// A file of several models or objects, with a hidden one, a scene graph
+/// that says more than where its model is, or chunks octovox does not read
+/// becomes a scene of objects (`Scene::objects`): its models, scene graph,
+/// layers and those chunks are kept, and saving writes them back. Only a
+/// bare model (as octovox writes one) loads as one model.
 ///
 /// # Errors
 /// As [`load_vox`].
@@ -174,9 +175,18 @@ impl Parsed {
         (palette, meta)
     }
 
-    /// Whether the file is more than one visible model: then its objects are kept.
+    /// Whether the file is more than one bare model: several models or
+    /// objects, a hidden one, a scene graph that says more than where the
+    /// model is (keys, turns, layers, names, `_loop`: see [`is_plain`]) or
+    /// chunks octovox does not read (cameras, render settings, notes).
+    /// Then its objects are kept, and saving writes all of it back; a file
+    /// of one visible object is still drawn as one octree.
     fn keeps_objects(&self) -> bool {
-        self.data.models.len() > 1 || self.objects.len() > 1 || self.objects.iter().any(|o| o.hidden)
+        self.data.models.len() > 1
+            || self.objects.len() > 1
+            || self.objects.iter().any(|o| o.hidden)
+            || !self.layout.kept.is_empty()
+            || !is_plain(&self.layout.graph)
     }
 
     /// The models as octrees in their own grids, the graph and the kept chunks.
@@ -199,6 +209,29 @@ impl Parsed {
             other => VoxError::BadSceneGraph(other.to_string()),
         })
     }
+}
+
+/// Whether a scene graph says nothing but where its models are: no node
+/// attributes (names, `_loop`, hidden), no keys or turns (a single frame
+/// holding at most `_t`), one model a shape, and at most one layer, unnamed
+/// or named `0`. That is the graph octovox writes for a model (and none at
+/// all is plain too): saving the model rewrites it without loss, so such a
+/// file loads as one model. Any other graph is kept as the file's.
+fn is_plain(graph: &crate::scene::graph::SceneGraph) -> bool {
+    use crate::scene::graph::NodeKind;
+    let plain_node = |node: &crate::scene::graph::Node| {
+        node.attributes.is_empty()
+            && match &node.kind {
+                NodeKind::Transform { frames, .. } => {
+                    frames.len() <= 1 && frames.iter().all(|f| f.keys().all(|k| k == "_t"))
+                }
+                NodeKind::Group { .. } => true,
+                NodeKind::Shape { models } => models.len() == 1 && models[0].1.is_empty(),
+            }
+    };
+    let plain_layer =
+        |layer: &crate::scene::graph::Layer| layer.attributes.iter().all(|(key, value)| key == "_name" && value == "0");
+    graph.layers.len() <= 1 && graph.layers.iter().all(plain_layer) && graph.nodes.iter().all(plain_node)
 }
 
 /// Runs `dot_vox::load_bytes`, turning a panic into [`VoxError::ParserPanic`].
