@@ -10,6 +10,7 @@ use winit::event_loop::ActiveEventLoop;
 
 use octovox::camera::Camera;
 use octovox::io::atomic::WriteOptions;
+use octovox::io::output::same_file;
 use octovox::scene::Scene;
 
 use octovox::journal::{Checks, FileStamp};
@@ -19,7 +20,7 @@ use super::dialog_kind::DialogKind;
 use super::document::Loading;
 use super::gesture::Gesture;
 use super::journal::{Found, JournalStart, classify};
-use super::{App, Choice, Pending, camera_control, first_used_color};
+use super::{App, Choice, Pending, camera_control, first_used_color, ui};
 
 impl App {
     /// Puts a new scene in place (load, New, a built-in scene) and uploads
@@ -85,8 +86,8 @@ impl App {
                 Some(path) => {
                     if self.save_document(&path, WriteOptions::default()) {
                         self.perform(pending, event_loop);
-                    } else if self.ui.read_only.is_some() {
-                        // Overwriting from the read-only prompt carries on with it.
+                    } else if self.ui.replace.is_some() {
+                        // Replacing from the prompt carries on with it.
                         self.ui.pending = Some(pending);
                     }
                 }
@@ -201,7 +202,15 @@ impl App {
     pub(super) fn save_document(&mut self, path: &Path, options: WriteOptions) -> bool {
         if !options.overwrite_read_only && octovox::io::atomic::is_read_only(path) {
             report!("asking: {} is read-only", path.display());
-            self.ui.read_only = Some(path.to_path_buf());
+            self.ui.replace = Some(ui::Replace { path: path.to_path_buf(), read_only: true });
+            return false;
+        }
+        // Nothing replaces a file but the document's own unless the user
+        // says so (issue 48, item 5: Save As onto an existing file replaced it).
+        let own = self.state.path.as_deref().is_some_and(|own| own == path || same_file(own, path));
+        if !options.overwrite_read_only && path.exists() && !own {
+            report!("asking: {} exists", path.display());
+            self.ui.replace = Some(ui::Replace { path: path.to_path_buf(), read_only: false });
             return false;
         }
         // Just before the rename, the journal notes which file will hold its

@@ -119,6 +119,7 @@ impl App {
             .map(|l| (l.path.clone(), l.started.elapsed().as_secs_f64(), l.progress.fraction()));
         let mut commands = Vec::new();
         let mut overlays = Vec::new();
+        let mut view = None;
         let mut full = {
             let info = ui::Info {
                 palette: &self.doc.editor.scene.palette,
@@ -142,13 +143,14 @@ impl App {
                 fill: self.hover.fill_preview.as_ref().map(|p| p.region),
                 paste,
                 eyedropper,
-                objects: self.doc.editor.scene.objects(),
+                objects: super::outliner::outlined(&self.doc.editor.scene),
                 ground: self.doc.editor.ground,
             };
             let (state, ui_state, tools) = (&mut self.state, &mut self.ui, &mut self.doc.editor.tools);
             let pick = self.hover.pick;
             ctx.run_ui(raw_input, |ui| {
                 commands = ui::show(ui, state, tools, ui_state, &info);
+                view = Some(ui.available_rect_before_wrap());
                 ui::draw_ground(ui, state, &info);
                 ui::draw_selection(ui, state, &info);
                 if let Some((voxels, normal, layers)) = info.extrude {
@@ -161,6 +163,7 @@ impl App {
             })
         };
         self.hover.pointer_over_ui = ctx.is_pointer_over_egui();
+        self.hover.view = view;
         gfx.egui_state.handle_platform_output(&gfx.window, std::mem::take(&mut full.platform_output));
         if !commands.is_empty() {
             log::debug!("panel commands {commands:?}");

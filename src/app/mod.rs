@@ -383,7 +383,14 @@ impl App {
                     report!("picked colour {}", self.doc.editor.tools.color);
                 }
             }
-            Command::SetTool(tool) => self.state.tool = tool,
+            Command::SetTool(tool) => {
+                // A tool is what a press applies: select and object mode,
+                // where a press picks, give way to the brush.
+                if !self.state.mode.uses_brush() {
+                    self.toggle_mode(self.state.mode);
+                }
+                self.state.tool = tool;
+            }
             Command::Orbit { dx, dy } => camera_control::orbit(&mut self.state.camera, dx, dy),
             Command::Pan { dx, dy } => {
                 let height = self.gfx.as_ref().map_or(1, |g| g.config.height);
@@ -452,7 +459,7 @@ impl App {
 
     /// Widths in points of the panels at the window's left and right sides.
     fn side_panels(&self) -> (f32, f32) {
-        let outliner = self.doc.editor.scene.objects().is_some();
+        let outliner = outliner::outlined(&self.doc.editor.scene).is_some();
         (ui::PANEL_WIDTH, if outliner { outliner::OUTLINER_WIDTH } else { 0.0 })
     }
 
@@ -811,14 +818,13 @@ impl ApplicationHandler for App {
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
-        let (left, right) = self.side_panels();
         let Some(gfx) = &mut self.gfx else { return };
         if !matches!(event, WindowEvent::RedrawRequested) {
             log::trace!("window event {event:?}");
         }
         // Tab is object mode's key, not egui's focus step, unless a text
         // field has the keyboard or a dialog asks (its buttons take Tab).
-        let asking = self.ui.prompt_open || self.ui.recover.is_some() || self.ui.read_only.is_some();
+        let asking = self.ui.prompt_open || self.ui.recover.is_some() || self.ui.replace.is_some();
         let to_egui = asking
             || self.ui.dialog.is_some()
             || gfx.egui_state.egui_ctx().egui_wants_keyboard_input()
@@ -858,13 +864,23 @@ impl ApplicationHandler for App {
             _ => {}
         }
         // The prompt is modal: while it is open the scene gets no input. A
-        // wheel over the side panel is the panel's even where egui lets it
-        // go (at the end of its scroll range), never a zoom of the view.
-        let (scale, width) = (gfx.window.scale_factor(), f64::from(gfx.config.width));
-        let on_panel = |x: f64| x < f64::from(left) * scale || x > width - f64::from(right) * scale;
-        let wheel_on_panel = matches!(event, WindowEvent::MouseWheel { .. })
-            && (self.hover.pointer_over_ui || self.input.cursor().is_some_and(|(x, _)| on_panel(x)));
-        let consumed = response.consumed || self.ui.prompt_open || wheel_on_panel;
+        // press or a wheel where egui drew is egui's, whatever egui said:
+        // its verdict comes from the hover of the last frame, so a pointer
+        // moved onto a button and pressed before the next frame reached the
+        // scene behind it (issue 47, item 1). A wheel over the side panel is
+        // the panel's even where egui lets it go (at the end of its scroll
+        // range), never a zoom of the view.
+        let starts = matches!(
+            event,
+            WindowEvent::MouseInput { state: winit::event::ElementState::Pressed, .. } | WindowEvent::MouseWheel { .. }
+        );
+        let on_ui = starts
+            && (self.hover.pointer_over_ui
+                || self
+                    .input
+                    .cursor()
+                    .is_some_and(|at| preview::ui_at(gfx.egui_state.egui_ctx(), self.hover.view, at)));
+        let consumed = response.consumed || self.ui.prompt_open || on_ui;
         let extruding = matches!(self.gesture, Gesture::Extrude { .. });
         for command in self.input.on_event(&event, consumed, self.state.tool, extruding) {
             self.execute(command, event_loop);

@@ -35,11 +35,24 @@ pub(super) struct Hover {
     pub pick: Option<super::state::Pick>,
     /// The cursor is over a panel: the scene takes no clicks.
     pub pointer_over_ui: bool,
+    /// The part of the window the panels left to the view in the last
+    /// frame, in points (`None` before the first frame).
+    pub view: Option<egui::Rect>,
     /// What an extrude from the face under the cursor (Ctrl held) or the
     /// Ctrl+drag under way would move.
     pub extrude_preview: Option<ExtrudePreview>,
     /// What a Shift+click fill with Paint would recolour.
     pub fill_preview: Option<FillPreview>,
+}
+
+/// Whether egui drew at window pixel `at` in the last frame: outside the
+/// view the panels left, or on a window, dialog, menu, popup or the axis
+/// gizmo. Decided by position, not by egui's hover (which lags a frame).
+pub(super) fn ui_at(ctx: &egui::Context, view: Option<egui::Rect>, (x, y): (f64, f64)) -> bool {
+    let scale = f64::from(ctx.pixels_per_point());
+    let at = egui::pos2((x / scale) as f32, (y / scale) as f32);
+    view.is_some_and(|view| !view.contains(at))
+        || ctx.layer_id_at(at).is_some_and(|layer| layer.order != egui::Order::Background)
 }
 
 impl App {

@@ -186,6 +186,13 @@ impl EditorState {
     }
 
     /// `mode` on, or back to the brush when it is on already.
+    /// The tool whose button is lit: the one a left press applies, so none
+    /// in select and object mode, where a press picks (issue 47, item 4:
+    /// "Attach" stayed lit beside "Object" and "Select").
+    pub fn lit_tool(&self) -> Option<Tool> {
+        self.mode.uses_brush().then_some(self.tool)
+    }
+
     pub fn toggle_mode(&mut self, mode: Mode) {
         self.mode = if self.mode == mode { Mode::Brush } else { mode };
     }
@@ -205,6 +212,18 @@ impl EditorState {
 mod tests {
     use super::*;
     use octovox::scene::{Op, Shape};
+
+    /// One lit button says the one mode: a tool is lit only where a press
+    /// applies it, and choosing one in select or object mode goes back to
+    /// the brush (`App`'s `SetTool`).
+    #[test]
+    fn a_tool_is_lit_only_where_a_press_applies_it() {
+        let mut state = EditorState::default();
+        for (mode, lit) in [(Mode::Brush, true), (Mode::Line, true), (Mode::Select, false), (Mode::Object, false)] {
+            state.mode = mode;
+            assert_eq!(state.lit_tool(), lit.then_some(state.tool), "{mode:?}");
+        }
+    }
 
     #[test]
     fn attach_places_in_front_of_the_face() {

@@ -142,8 +142,9 @@ pub struct UiState {
     /// An action waiting for the unsaved-changes prompt.
     pub pending: Option<Pending>,
     pub prompt_open: bool,
-    /// A read-only file the user is asked about overwriting.
-    pub read_only: Option<PathBuf>,
+    /// A file the user is asked about replacing: a read-only one, or an
+    /// existing file other than the document's own (a Save As onto it).
+    pub replace: Option<Replace>,
     /// A crash-recovery journal found beside the document just opened, and
     /// why applying it needs a second thought (its document changed since).
     pub recover: Option<(PathBuf, Option<String>)>,
@@ -154,6 +155,14 @@ pub struct UiState {
     pub journal_warning: Option<String>,
     /// Last message for the user, whether it is an error, and when it came.
     pub message: Option<(String, bool, std::time::Instant)>,
+}
+
+/// A file a save would replace, which the user is asked about first.
+#[derive(Clone, Debug)]
+pub struct Replace {
+    pub path: PathBuf,
+    /// It is read-only (else: it exists and is not the document's own).
+    pub read_only: bool,
 }
 
 impl UiState {
@@ -229,7 +238,7 @@ pub fn show(
     super::gizmo::show(ui.ctx(), &state.camera, right, &mut out);
     dialog(ui.ctx(), ui_state, &mut out);
     prompt(ui.ctx(), ui_state, &mut out);
-    read_only_prompt(ui.ctx(), ui_state, &mut out);
+    replace_prompt(ui.ctx(), ui_state, &mut out);
     recover_prompt(ui.ctx(), ui_state, &mut out);
     out
 }
@@ -324,7 +333,9 @@ fn tool_panel(ui: &mut egui::Ui, state: &mut EditorState, tools: &mut Tools, com
     ui.heading("Tool");
     ui.horizontal(|ui| {
         for tool in Tool::ALL {
-            ui.selectable_value(&mut state.tool, tool, tool_label(tool));
+            if ui.selectable_label(state.lit_tool() == Some(tool), tool_label(tool)).clicked() {
+                commands.push(Command::SetTool(tool));
+            }
         }
     });
     ui.horizontal(|ui| {
@@ -786,24 +797,25 @@ fn recover_prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Com
 }
 
 /// Asks before a save replaces a read-only file.
-fn read_only_prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
-    let Some(path) = ui_state.read_only.clone() else { return };
-    let modal = egui::Modal::new(egui::Id::unique("read-only")).show(ctx, |ui| {
-        ui.heading("Read-only file");
-        ui.label(format!("{} is read-only. Overwrite it?", path.display()));
+fn replace_prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
+    let Some(Replace { path, read_only }) = ui_state.replace.clone() else { return };
+    let modal = egui::Modal::new(egui::Id::unique("replace")).show(ctx, |ui| {
+        ui.heading(if read_only { "Read-only file" } else { "Replace the file?" });
+        let what = if read_only { "is read-only" } else { "already exists" };
+        ui.label(format!("{} {what}. Replace it?", path.display()));
         ui.horizontal(|ui| {
-            if ui.button("Overwrite").clicked() {
-                ui_state.read_only = None;
+            if ui.button("Replace").clicked() {
+                ui_state.replace = None;
                 out.push(Command::SaveOver(path.clone()));
             }
             if ui.button("Cancel").clicked() {
-                ui_state.read_only = None;
+                ui_state.replace = None;
             }
         });
     });
     // Escape or a click outside cancels, as Cancel does.
     if modal.should_close() {
-        ui_state.read_only = None;
+        ui_state.replace = None;
     }
 }
 

@@ -65,41 +65,29 @@ pub fn wait_for_exit(app: &mut KillOnDrop, timeout: Duration, what: &str) -> std
     }
 }
 
-/// Starts Xvfb on a free display number derived from the process id and
-/// waits until it accepts connections.
-/// `slot` separates the tests of this binary, which run in parallel.
-pub fn start_xvfb(slot: u32) -> (KillOnDrop, String) {
-    let base = 100 + std::process::id() % 400 + slot * 500;
-    let number = (base..base + 200)
-        .find(|n| {
-            !Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() && !Path::new(&format!("/tmp/.X{n}-lock")).exists()
-        })
-        .expect("no free X display number");
-    let display = format!(":{number}");
+/// Starts Xvfb on a display number it finds free itself (`-displayfd`:
+/// the server picks the number and writes it once it accepts connections),
+/// so tests that run side by side never share a server.
+pub fn start_xvfb() -> (KillOnDrop, String) {
     // -noreset: by default the server resets when its last client leaves,
     // and the app's connection right after the readiness probe can fail.
-    let child = Command::new("Xvfb")
-        .args([&display, "-screen", "0", "1600x1000x24", "-nolisten", "tcp", "-noreset"])
-        .stdout(Stdio::null())
+    let mut child = Command::new("Xvfb")
+        .args(["-displayfd", "1", "-screen", "0", "1600x1000x24", "-nolisten", "tcp", "-noreset"])
+        .stdout(Stdio::piped())
         .stderr(Stdio::null())
         .spawn()
         .expect("cannot start Xvfb");
+    let stdout = child.stdout.take().expect("stdout is piped");
     let guard = KillOnDrop(child, "Xvfb");
-    let deadline = Instant::now() + Duration::from_secs(30);
-    loop {
-        let ok = Command::new("xdotool")
-            .arg("getdisplaygeometry")
-            .env("DISPLAY", &display)
-            .stderr(Stdio::null())
-            .output()
-            .is_ok_and(|o| o.status.success());
-        if ok {
-            break;
-        }
-        assert!(Instant::now() < deadline, "Xvfb on {display} did not accept connections within 30 s");
-        std::thread::sleep(Duration::from_millis(100));
-    }
-    (guard, display)
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        let mut line = String::new();
+        let _ = BufReader::new(stdout).read_line(&mut line);
+        let _ = tx.send(line);
+    });
+    let line = rx.recv_timeout(Duration::from_secs(30)).expect("Xvfb named no display within 30 s");
+    let number: u32 = line.trim().parse().unwrap_or_else(|_| panic!("Xvfb wrote {line:?}, not a display number"));
+    (guard, format!(":{number}"))
 }
 
 pub fn xdotool(display: &str, args: &[&str]) -> String {

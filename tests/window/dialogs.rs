@@ -53,7 +53,7 @@ fn open_and_save_as_go_through_the_native_dialog_or_the_browser() {
     std::fs::set_permissions(&zenity, std::os::unix::fs::PermissionsExt::from_mode(0o755)).unwrap();
     let path = format!("{}:{}", bin.display(), std::env::var("PATH").unwrap());
 
-    let (_xvfb, display) = start_xvfb(10);
+    let (_xvfb, display) = start_xvfb();
     let args = [a.display().to_string(), "--size".into(), "640x480".into()];
     let (_app, mut lines, window) = open_ready_with(&display, &root, &args, &[("PATH", &path)]);
 

@@ -54,7 +54,7 @@ fn click_attach_save_erase_save_in_a_real_window() {
     assert!(!original_voxels.contains(&placed));
     eprintln!("click at ({x}, {y}): hits {hit_voxel} through face {normal}; attach goes to {placed}");
 
-    let (_xvfb, display) = start_xvfb(0);
+    let (_xvfb, display) = start_xvfb();
     let args = document_args(&file, &camera, &[]);
     let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
 
@@ -175,7 +175,7 @@ fn slow_load_keeps_the_window_live() {
     let fifo = dir.path().join("slow.vox");
     assert!(Command::new("mkfifo").arg(&fifo).status().unwrap().success());
 
-    let (_xvfb, display) = start_xvfb(1);
+    let (_xvfb, display) = start_xvfb();
     let args = ["--size", "640x480", "--render-scale", "0.5", "--no-shadows"].map(String::from);
     let (mut app, mut lines, window) = open_ready(&display, dir.path(), &args);
 
@@ -224,7 +224,7 @@ fn set_read_only(file: &std::path::Path, read_only: bool) {
 fn a_window_wider_than_8192_pixels_opens_and_draws() {
     require_window_tools();
     let dir = tempfile::tempdir().unwrap();
-    let (_xvfb, display) = start_xvfb(2);
+    let (_xvfb, display) = start_xvfb();
     let args =
         ["--size", "8193x300", "--render-scale", "0.25", "--no-shadows", "--bench-frames", "3"].map(String::from);
     let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
@@ -242,7 +242,7 @@ fn the_window_path_traces_the_showroom_at_rest() {
         require_tool(tool);
     }
     let dir = tempfile::tempdir().unwrap();
-    let (_xvfb, display) = start_xvfb(3);
+    let (_xvfb, display) = start_xvfb();
     let args = ["--demo", "showroom", "--size", "480x320", "--samples", "6"].map(String::from);
     let (_app, mut lines, _stderr) = spawn_app(&display, dir.path(), &args);
     lines.wait_for("octovox: ready", Duration::from_secs(90));
@@ -262,7 +262,7 @@ fn the_noise_estimate_falls_while_the_camera_rests() {
         require_tool(tool);
     }
     let dir = tempfile::tempdir().unwrap();
-    let (_xvfb, display) = start_xvfb(27);
+    let (_xvfb, display) = start_xvfb();
     let args = ["--demo", "showroom", "--size", "480x320", "--samples", "16"].map(String::from);
     let (_app, mut lines, _stderr) = spawn_app(&display, dir.path(), &args);
     lines.wait_for("octovox: ready", Duration::from_secs(90));
@@ -309,7 +309,7 @@ fn alt_click_picks_a_colour_and_shift_click_paint_fills_with_it() {
     };
     let (x, y, voxel, normal) = stable_pixel(scene.drawn(), &camera, |v, n| scene.voxel(v) == 77 && n == IVec3::Z);
     let args = document_args(&file, &camera, &["--shading", "preview"]);
-    let (_xvfb, display) = start_xvfb(4);
+    let (_xvfb, display) = start_xvfb();
     let (_app, mut lines, window) = open_ready(&display, dir.path(), &args);
     xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y.to_string()]);
     xdotool(&display, &["keydown", "alt", "click", "1", "keyup", "alt"]);
@@ -353,7 +353,7 @@ fn a_mirrored_stroke_places_both_sides_and_undoes_in_one_step() {
     let placed = voxel + normal;
     let image = |p: IVec3| IVec3::new(15 - p.x, p.y, p.z);
     let args = document_args(&file, &camera, &["--shading", "preview", "--replay", &script.display().to_string()]);
-    let (_xvfb, display) = start_xvfb(5);
+    let (_xvfb, display) = start_xvfb();
     let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
     let window = find_window(&display, &mut app, &stderr_path);
     lines.wait_for("replay:", Duration::from_secs(90));
@@ -392,7 +392,7 @@ fn a_dragged_line_in_line_mode() {
     let (xb, yb, vb, nb) = stable_pixel(scene.drawn(), &camera, |v, n| n == IVec3::Y && v.x > 11);
     let (a, b) = (va + na, vb + nb);
     let args = document_args(&file, &camera, &["--shading", "preview"]);
-    let (_xvfb, display) = start_xvfb(6);
+    let (_xvfb, display) = start_xvfb();
     let (_app, mut lines, window) = open_ready(&display, dir.path(), &args);
     xdotool(&display, &["key", "l"]);
     xdotool(&display, &["mousemove", "--window", &window, &xa.to_string(), &ya.to_string()]);
@@ -453,7 +453,7 @@ fn pixels_changed(
 fn the_wheel_over_the_panel_never_zooms_the_view() {
     require_window_tools();
     let dir = tempfile::tempdir().unwrap();
-    let (_xvfb, display) = start_xvfb(19);
+    let (_xvfb, display) = start_xvfb();
     let args = ["--size", "800x600", "--spp", "1"].map(String::from);
     let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
     let window = find_window(&display, &mut app, &stderr_path);

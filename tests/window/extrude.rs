@@ -51,7 +51,7 @@ fn ctrl_drag_extrudes_a_face_in_a_real_window() {
     let end = (x as f32 + 2.0 * (b.0 - a.0), y as f32 + 2.0 * (b.1 - a.1));
     assert!(end.1 > 40.0, "the drag stays in the window: {end:?}");
 
-    let (_xvfb, display) = start_xvfb(8);
+    let (_xvfb, display) = start_xvfb();
     let args = document_args(&file, &camera, &[]);
     let (_app, mut lines, window) = open_ready(&display, dir.path(), &args);
     xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y.to_string()]);

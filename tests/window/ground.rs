@@ -50,7 +50,7 @@ fn new_then_a_click_on_the_ground_places_a_voxel_at_y_0() {
     let (x, y, ground) = stable_ground_pixel(&camera);
     assert_eq!((ground.y, ground.x.abs() < VOLUME, ground.z.abs() < VOLUME), (-1, true, true), "{ground}");
 
-    let (_xvfb, display) = start_xvfb(24);
+    let (_xvfb, display) = start_xvfb();
     let args = ["--size".to_owned(), format!("{WIDTH}x{HEIGHT}")];
     let (_app, mut lines, window) = open_ready(&display, dir.path(), &args);
     let before = screenshot_x(&display, &dir.path().join("demo.png"));

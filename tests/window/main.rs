@@ -15,3 +15,4 @@ mod panel;
 mod record;
 mod recovery;
 mod select;
+mod stray;

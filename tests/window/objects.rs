@@ -58,7 +58,7 @@ fn a_click_picks_the_object_it_hits_and_edits_its_model() {
     let model = objects.list()[owner].placement.model;
     let before = model_sizes(&file);
 
-    let (_xvfb, display) = start_xvfb(21);
+    let (_xvfb, display) = start_xvfb();
     let (_app, mut lines, window) = open_ready(&display, dir.path(), &document_args(&file, &camera, &[]));
     click(&display, &window, &mut lines, x, y);
     assert!(lines.seen.iter().any(|l| *l == format!("ran: object {owner}")), "{:?}", lines.seen);
@@ -88,7 +88,7 @@ fn ctrl_h_hides_the_picked_object_and_the_file_keeps_it() {
     let shows = pixels_of(&scene, &camera, owner);
     assert!(shows.len() > 20, "object {owner} covers {} pixels", shows.len());
 
-    let (_xvfb, display) = start_xvfb(22);
+    let (_xvfb, display) = start_xvfb();
     let (_app, mut lines, window) = open_ready(&display, dir.path(), &document_args(&file, &camera, &[]));
     // Paint picks the object without changing its shape.
     xdotool(&display, &["key", "g"]);
@@ -131,7 +131,7 @@ fn object_edits_survive_a_kill() {
     let model = objects.list()[owner].placement.model;
     let before = model_sizes(&file);
 
-    let (_xvfb, display) = start_xvfb(23);
+    let (_xvfb, display) = start_xvfb();
     let (mut app, mut lines, window) = open_ready(&display, dir.path(), &document_args(&file, &camera, &[]));
     click(&display, &window, &mut lines, x, y);
     // Before object lines were journaled, this hide was lost at recovery.
@@ -180,7 +180,7 @@ fn tab_object_mode_picks_moves_drags_turns_and_deletes_objects() {
     };
     let (before, sizes) = (translation(&file), model_sizes(&file));
 
-    let (_xvfb, display) = start_xvfb(23);
+    let (_xvfb, display) = start_xvfb();
     let (_app, mut lines, window) = open_ready(&display, dir.path(), &document_args(&file, &camera, &[]));
     xdotool(&display, &["key", "Tab"]);
     xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y.to_string()]);
@@ -323,7 +323,7 @@ fn the_outliner_eye_hides_an_object_and_a_drag_regroups_it() {
         attributes.get("_hidden").cloned()
     };
 
-    let (_xvfb, display) = start_xvfb(24);
+    let (_xvfb, display) = start_xvfb();
     let (_app, mut lines, window) = open_ready(&display, dir.path(), &document_args(&file, &camera, &[]));
     let before = resting_shot(&display, &window, dir.path(), "eye-before");
     let (row, depth) = outline_row(objects, owner);
@@ -396,4 +396,40 @@ fn the_outliner_eye_hides_an_object_and_a_drag_regroups_it() {
     lines.wait_for("layer:", Duration::from_secs(30));
     save(&display, &mut lines, &file);
     assert_eq!(layer_name(&file).as_deref(), Some("forest"), "the layer is renamed in the file");
+}
+
+/// Issue 48, item 4, in the window: a layer renamed `color` (a word the
+/// `layer` line reads as a keyword) was journaled as `layer 0 color`, which
+/// does not parse, so `recover` refused the whole journal after a kill and
+/// every edit in it was lost. The rename is journaled in quotes: after a
+/// kill, `octovox recover` gives the file with the layer named `color`, as
+/// `dot_vox` reads it.
+#[test]
+fn a_layer_renamed_to_a_keyword_survives_a_kill() {
+    let (dir, file, scene) = groups_document();
+    let (lo, hi) = scene.solid_bounds().unwrap();
+    let camera = Camera::framing(lo, hi, 50.0);
+    let (_xvfb, display) = start_xvfb();
+    let (mut app, mut lines, window) = open_ready(&display, dir.path(), &document_args(&file, &camera, &[]));
+    let (x, y) = (LAYER_NAME_X.to_string(), FIRST_LAYER_Y.to_string());
+    xdotool(&display, &["mousemove", "--window", &window, &x, &y]);
+    std::thread::sleep(Duration::from_millis(300));
+    xdotool(&display, &["click", "--repeat", "2", "--delay", "80", "1"]);
+    std::thread::sleep(Duration::from_millis(500));
+    xdotool(&display, &["key", "ctrl+a"]);
+    xdotool(&display, &["type", "color"]);
+    xdotool(&display, &["key", "Return"]);
+    lines.wait_for("layer:", Duration::from_secs(30));
+    app.0.kill().unwrap();
+    app.0.wait().unwrap();
+
+    let recovered = dir.path().join("recovered.vox");
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_octovox"))
+        .args(["recover", file.to_str().unwrap(), "-o", recovered.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "recover: {}", String::from_utf8_lossy(&run.stderr));
+    let data = dot_vox::load_bytes(&std::fs::read(&recovered).unwrap()).unwrap();
+    assert_eq!(data.layers[0].attributes.get("_name").map(String::as_str), Some("color"));
+    assert_eq!(data.layers[0].attributes.get("_hidden"), None, "not read as `layer 0 hide`");
 }

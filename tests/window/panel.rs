@@ -27,7 +27,7 @@ fn palette_pixels(shot: &image::RgbImage) -> Vec<[u8; 3]> {
 fn choosing_a_brush_moves_no_palette_swatch() {
     require_window_tools();
     let dir = tempfile::tempdir().unwrap();
-    let (_xvfb, display) = start_xvfb(25);
+    let (_xvfb, display) = start_xvfb();
     // The demo scene: MagicaVoxel's default palette, 255 distinct swatches.
     let args = ["--size".to_owned(), format!("{WIDTH}x{HEIGHT}")];
     let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);

@@ -20,7 +20,7 @@ fn recorded_window_session_replays_to_the_same_voxels() {
     let (dir, file, original, camera) = torus_document();
     let (x, y, _, _) = stable_pixel(original.drawn(), &camera, |_, _| true);
 
-    let (_xvfb, display) = start_xvfb(17);
+    let (_xvfb, display) = start_xvfb();
     let script = dir.path().join("session.ovr");
     let args = document_args(&file, &camera, &["--record", &script.display().to_string()]);
     let (mut app, mut lines, window) = open_ready(&display, dir.path(), &args);
@@ -66,7 +66,7 @@ fn window_plays_a_script_through_the_edit_path() {
          rgb 9 200 100 50\nmaterial 9 emit _emit 1\nundo\nexpect effects sun sky metal\nsave out.vox\n",
     )
     .unwrap();
-    let (_xvfb, display) = start_xvfb(18);
+    let (_xvfb, display) = start_xvfb();
     let recording = dir.path().join("rec.ovr");
     let args = [
         "--size".to_string(),
@@ -133,7 +133,7 @@ fn a_played_script_renders_and_checks_images_as_octovox_replay_does() {
         ),
     )
     .unwrap();
-    let (_xvfb, display) = start_xvfb(20);
+    let (_xvfb, display) = start_xvfb();
     let args = ["--size".to_string(), "640x480".into(), "--replay".into(), script.display().to_string()];
     let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
     find_window(&display, &mut app, &stderr_path);

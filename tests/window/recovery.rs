@@ -37,7 +37,7 @@ fn a_killed_window_loses_no_finished_edit() {
         pixels.push((x, y));
     }
 
-    let (_xvfb, display) = start_xvfb(7);
+    let (_xvfb, display) = start_xvfb();
     let args = document_args(&file, &camera, &[]);
     let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
     let window = find_window(&display, &mut app, &stderr_path);
@@ -143,7 +143,7 @@ fn an_untitled_scene_is_recovered_after_a_kill() {
     let mut expected: HashSet<(IVec3, u8)> = demo.voxels().into_iter().collect();
     expected.extend(edits.iter().map(|p| (*p, 5)));
 
-    let (_xvfb, display) = start_xvfb(11);
+    let (_xvfb, display) = start_xvfb();
     let args = ["--size".to_string(), "640x480".into(), "--replay".into(), "edits.ovr".into()];
     let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
     find_window(&display, &mut app, &stderr_path);
@@ -207,7 +207,7 @@ fn undo_past_a_save_selections_and_old_clipboards_survive_a_kill() {
     let run = octovox(&["replay", "--cpu", "--force", s(&headless_dir.path().join("play.ovr"))]);
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stdout));
 
-    let (_xvfb, display) = start_xvfb(12);
+    let (_xvfb, display) = start_xvfb();
     let args = ["doc.vox".to_string(), "--size".into(), "640x480".into(), "--replay".into(), "play.ovr".into()];
     let (mut app, mut lines, stderr_path) = spawn_app(&display, window_dir.path(), &args);
     find_window(&display, &mut app, &stderr_path);
@@ -267,7 +267,7 @@ fn a_move_as_the_first_edit_is_recovered_and_a_changed_document_refused() {
     let (dir, file) = small_document();
     let script = "select -8 -2 -7 7 2 8\nmove 0 10 0\n";
     let expected = replayed(&file, script);
-    let (_xvfb, display) = start_xvfb(13);
+    let (_xvfb, display) = start_xvfb();
     let (mut app, mut lines) = play_in_window(&display, dir.path(), script, &[]);
     assert_eq!(lines.wait_for("replay:", Duration::from_secs(90)), "replay: 0 passed, 0 failed");
     app.0.kill().unwrap();
@@ -286,7 +286,12 @@ fn a_move_as_the_first_edit_is_recovered_and_a_changed_document_refused() {
     let journal = octovox::journal::journal_path(&file);
     let journal_text = std::fs::read_to_string(&journal).unwrap();
     let mut scene = octovox::io::load_scene(&file, 0).unwrap();
-    scene.apply_brush(&octovox::scene::Shape::Voxel(IVec3::new(0, 40, 0)), octovox::scene::Op::Place(9)).unwrap();
+    // Through the edit path: torus64.vox (7 layers) is a scene of one object.
+    let brush = octovox::edit::Edit::Brush {
+        shape: octovox::scene::Shape::Voxel(IVec3::new(0, 40, 0)),
+        op: octovox::scene::Op::Place(9),
+    };
+    brush.resolved(&scene).apply(&mut scene).unwrap();
     octovox::io::save_scene(&file, &scene, Default::default()).unwrap();
     let run = octovox(&["recover", s(&file), "-o", s(&recovered)]);
     let message = String::from_utf8_lossy(&run.stderr);
@@ -304,7 +309,7 @@ fn a_kill_between_the_save_and_the_journal_removal_replays_nothing_twice() {
     let (dir, file) = small_document();
     let script = "select -8 -2 -7 7 2 8\nmove 0 10 0\nsave doc.vox\n";
     let expected = replayed(&file, script);
-    let (_xvfb, display) = start_xvfb(14);
+    let (_xvfb, display) = start_xvfb();
     let (mut app, mut lines) = play_in_window(&display, dir.path(), script, &[("OCTOVOX_TEST_HOLD_AFTER_SAVE", "1")]);
     lines.wait_for("test hold:", Duration::from_secs(90));
     app.0.kill().unwrap();
@@ -337,7 +342,7 @@ fn a_second_window_leaves_the_live_journal_alone() {
     let (dir, file) = small_document();
     let first = "color 5\nplace 0 20 0\n";
     let expected = replayed(&file, first);
-    let (_xvfb, display) = start_xvfb(15);
+    let (_xvfb, display) = start_xvfb();
     let (mut app, mut lines) = play_in_window(&display, dir.path(), first, &[]);
     lines.wait_for("replay:", Duration::from_secs(90));
     let journal = octovox::journal::journal_path(&file);
@@ -369,7 +374,7 @@ fn a_journal_that_cannot_be_written_is_shown_and_leaves_nothing() {
     let long = dir.path().join(format!("{}.vox", "d".repeat(236)));
     std::fs::rename(&file, &long).unwrap();
     std::fs::write(dir.path().join("play.ovr"), "color 5\nplace 0 20 0\nplace 0 21 0\n").unwrap();
-    let (_xvfb, display) = start_xvfb(16);
+    let (_xvfb, display) = start_xvfb();
     let args = [s(&long).to_string(), "--size".into(), "640x480".into(), "--replay".into(), "play.ovr".into()];
     let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
     find_window(&display, &mut app, &stderr_path);
@@ -397,7 +402,7 @@ fn a_journal_that_cannot_be_written_is_shown_and_leaves_nothing() {
 fn the_recovered_scene_is_what_the_window_shows() {
     let (dir, file) = small_document();
     let script = "rgb 5 255 0 0\ncolor 5\nbrush sphere 20\npaint 0 0 0\n";
-    let (_xvfb, display) = start_xvfb(26);
+    let (_xvfb, display) = start_xvfb();
     let (mut app, mut lines) = play_in_window(&display, dir.path(), script, &[]);
     assert_eq!(lines.wait_for("replay:", Duration::from_secs(90)), "replay: 0 passed, 0 failed");
     app.0.kill().unwrap();

@@ -60,7 +60,7 @@ fn a_box_selection_moves_with_the_arrows_resizes_by_a_handle_and_copies() {
     let (xb, yb, ..) = stable_pixel(scene.drawn(), &camera, |v, n| v == IVec3::new(5, 1, 5) && n == IVec3::Z);
     let (xf, yf, ..) = stable_pixel(scene.drawn(), &camera, |v, n| v == IVec3::new(12, 0, 10) && n == IVec3::Y);
 
-    let (_xvfb, display) = start_xvfb(9);
+    let (_xvfb, display) = start_xvfb();
     let args = document_args(&file, &camera, &["--shading", "preview"]);
     let (mut app, mut lines, stderr_path) = spawn_app(&display, dir.path(), &args);
     let window = find_window(&display, &mut app, &stderr_path);
