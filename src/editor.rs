@@ -258,14 +258,17 @@ impl Editor {
             ))),
             ObjectRef::Name(name) => {
                 let own = |path: &str| path.rsplit('/').next().unwrap_or("").to_owned();
-                let found: Vec<usize> =
-                    (0..list.len()).filter(|&i| list[i].path == *name || own(&list[i].path) == *name).collect();
+                let named = |i: usize| {
+                    let path = objects.path(i);
+                    path == *name || own(&path) == *name
+                };
+                let found: Vec<usize> = (0..list.len()).filter(|&i| named(i)).collect();
                 match found.as_slice() {
                     [one] => Ok(*one),
                     [] => Err(EditorError::Object(format!("no object is named '{name}'"))),
                     many => {
                         let candidates: Vec<String> =
-                            many.iter().take(8).map(|&i| format!("{i} ({})", list[i].path)).collect();
+                            many.iter().take(8).map(|&i| format!("{i} ({})", objects.path(i))).collect();
                         Err(EditorError::Object(format!(
                             "{} objects are named '{name}': {}{}; name one by index or by its path",
                             many.len(),

@@ -96,7 +96,8 @@ fn tree(ui: &mut egui::Ui, objects: &Objects, state: &mut OutlinerState, out: &m
         }
         rows += 1;
         match row {
-            OutlineRow::Group { transform, name, hidden, .. } => {
+            OutlineRow::Group { transform, hidden, .. } => {
+                let name = objects.group_name(*transform);
                 let open = !state.collapsed.contains(transform);
                 ui.horizontal(|ui| {
                     indent(ui, depth);
@@ -106,7 +107,7 @@ fn tree(ui: &mut egui::Ui, objects: &Objects, state: &mut OutlinerState, out: &m
                     {
                         state.collapsed.insert(*transform);
                     }
-                    let text = if name.is_empty() { "(group)" } else { name.as_str() };
+                    let text = if name.is_empty() { "(group)" } else { name };
                     let text = egui::RichText::new(text).strong();
                     ui.label(if *hidden { text.weak() } else { text });
                 });
@@ -160,7 +161,8 @@ fn object_row(ui: &mut egui::Ui, objects: &Objects, index: usize, state: &mut Ou
     let text = if object.hidden { egui::RichText::new(label).weak() } else { egui::RichText::new(label) };
     let text = if marked { text.underline() } else { text };
     let row = ui.selectable_label(objects.selected == Some(index), text).interact(Sense::drag());
-    let path = if object.path.is_empty() { "(unnamed)" } else { &object.path };
+    let path = objects.path(index);
+    let path = if path.is_empty() { "(unnamed)" } else { &path };
     let row = row.on_hover_text(format!("{path} · model {} · drag to move it", object.placement.model));
     if row.clicked() {
         out.push(Command::Lines(vec![pick]));

@@ -51,7 +51,8 @@ fn object_lines(scene: &Scene) -> String {
     for (index, object) in objects.list().iter().enumerate() {
         let bounds =
             objects.world_box(index).map_or("-".to_owned(), |(lo, hi)| format!("{} .. {}", corner(lo), corner(hi)));
-        let name = if object.path.is_empty() { "-" } else { &object.path };
+        let path = objects.path(index);
+        let name = if path.is_empty() { "-" } else { &path };
         let layer = object.layer.map_or("-".to_owned(), |l| l.to_string());
         let shown = if object.hidden { "hidden" } else { "shown" };
         out += &format!("{index}\t{name}\tmodel {}\tlayer {layer}\t{shown}\t{bounds}\n", object.placement.model);

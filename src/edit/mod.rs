@@ -24,6 +24,10 @@ use crate::scene::{EditError, Material, Op, Patch, Scene, Shape};
 pub enum Edit {
     /// Apply a brush shape with an operation.
     Brush { shape: Shape, op: Op },
+    /// Empty the box `min..=max` (a selection's delete, cut or move): in a
+    /// scene of objects, in every object it covers (see
+    /// [`Edit::resolved_all`]), not only one.
+    Clear { min: glam::IVec3, max: glam::IVec3 },
     /// A brush in object `object`'s model (what a brush becomes in a scene
     /// of objects: see [`Edit::resolved`]).
     InObject { object: usize, shape: Shape, op: Op },
@@ -62,10 +66,34 @@ impl Edit {
         }
     }
 
+    /// The edits it becomes in `scene`: a [`Edit::Clear`] in a scene of
+    /// objects empties the box in each shown object holding voxels there
+    /// (issue 48, item 10: a delete around two objects emptied one), and is
+    /// refused as a whole when one of them is locked; in a scene of one
+    /// model it is a box brush. Any other edit is [`Edit::resolved`].
+    ///
+    /// # Errors
+    /// A locked object with voxels in the box.
+    pub fn resolved_all(self, scene: &Scene) -> Result<Vec<Edit>, EditError> {
+        let Edit::Clear { min, max } = self else { return Ok(vec![self.resolved(scene)]) };
+        let shape = Shape::Box { min, max };
+        let Some(objects) = scene.objects() else { return Ok(vec![Edit::Brush { shape, op: Op::Remove }]) };
+        let covered: Vec<usize> = (0..objects.list().len()).filter(|&i| objects.holds_voxels_in(i, min, max)).collect();
+        if let Some(&locked) = covered.iter().find(|&&i| objects.locked(i)) {
+            return Err(EditError::Objects(format!(
+                "object {locked} is locked and has voxels in the box: `object unlock` it, or select around it"
+            )));
+        }
+        Ok(covered.into_iter().map(|object| Edit::InObject { object, shape, op: Op::Remove }).collect())
+    }
+
     /// Applies the edit; returns the edit that undoes it. A refused edit
     /// changes nothing.
     pub fn apply(&self, scene: &mut Scene) -> Result<Edit, EditError> {
         match self {
+            Edit::Clear { min, max } => {
+                Ok(Edit::Restore(scene.apply_brush(&Shape::Box { min: *min, max: *max }, Op::Remove)?))
+            }
             // In a scene of objects the drawn tree follows the models: a brush
             // must go into one (see `Edit::resolved`); the scene refuses it.
             Edit::Brush { shape, op } => Ok(Edit::Restore(scene.apply_brush(shape, *op)?)),
@@ -106,9 +134,15 @@ impl Edit {
             Edit::Brush { shape, .. } | Edit::InObject { shape, .. } => {
                 shape.surface_voxels().saturating_mul(crate::scene::apply::EDIT_BYTES_PER_SURFACE_VOXEL)
             }
+            Edit::Clear { min, max } => Shape::Box { min: *min, max: *max }
+                .surface_voxels()
+                .saturating_mul(crate::scene::apply::EDIT_BYTES_PER_SURFACE_VOXEL),
             Edit::Restore(patch) | Edit::RestoreModel { patch, .. } => 2 * patch.heap_bytes() as u64,
             Edit::AddModel(model) => 2 * model.tree.pool().live_bytes(),
-            Edit::Palette { .. } | Edit::Graph(_) | Edit::PopModel => 0,
+            // The nodes it replaces and their undo copies, and the placements
+            // walked again (composing goes cell by cell: see `Objects`).
+            Edit::Graph(change) => change.estimated_bytes(),
+            Edit::Palette { .. } | Edit::PopModel => 0,
         })
     }
 
@@ -153,17 +187,7 @@ impl Default for History {
 impl History {
     /// Applies an edit and records it (into the open stroke, if any).
     pub fn apply(&mut self, scene: &mut Scene, edit: Edit) -> Result<(), EditError> {
-        let edit = edit.resolved(scene);
-        let inverse = edit.apply(scene)?;
-        self.undone.clear();
-        match &mut self.stroke {
-            Some(stroke) => {
-                stroke.edits.push(edit);
-                stroke.inverses.push(inverse);
-            }
-            None => self.push(Step { edits: vec![edit], inverses: vec![inverse] }),
-        }
-        Ok(())
+        self.apply_group(scene, vec![edit])
     }
 
     /// Applies several edits as one undo step (a fill), or as part of the
@@ -178,19 +202,20 @@ impl History {
         }
         let mut step = Step::default();
         for edit in edits {
-            let edit = edit.resolved(scene);
-            match edit.apply(scene) {
-                Ok(inverse) => {
+            let applied = edit.resolved_all(scene).and_then(|resolved| {
+                for edit in resolved {
+                    let inverse = edit.apply(scene)?;
                     step.edits.push(edit);
                     step.inverses.push(inverse);
                 }
-                Err(err) => {
-                    for inverse in step.inverses.iter().rev() {
-                        // Undoing what was just done cannot need more room than doing it.
-                        let _ = inverse.apply(scene);
-                    }
-                    return Err(err);
+                Ok(())
+            });
+            if let Err(err) = applied {
+                for inverse in step.inverses.iter().rev() {
+                    // Undoing what was just done cannot need more room than doing it.
+                    let _ = inverse.apply(scene);
                 }
+                return Err(err);
             }
         }
         if step.edits.is_empty() {
@@ -290,7 +315,7 @@ impl History {
 
 fn edit_bytes(edit: &Edit) -> usize {
     match edit {
-        Edit::Brush { .. } | Edit::InObject { .. } | Edit::PopModel => std::mem::size_of::<Edit>(),
+        Edit::Brush { .. } | Edit::Clear { .. } | Edit::InObject { .. } | Edit::PopModel => std::mem::size_of::<Edit>(),
         Edit::Graph(change) => change.heap_bytes(),
         Edit::AddModel(model) => usize::try_from(model.tree.pool().live_bytes()).unwrap_or(usize::MAX),
         Edit::Restore(patch) | Edit::RestoreModel { patch, .. } => patch.heap_bytes(),

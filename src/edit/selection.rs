@@ -86,7 +86,7 @@ impl Region {
 
     /// The edit that empties the box.
     pub fn clear_edit(&self) -> Edit {
-        Edit::Brush { shape: Shape::Box { min: self.min, max: self.max }, op: Op::Remove }
+        Edit::Clear { min: self.min, max: self.max }
     }
 }
 

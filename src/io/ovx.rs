@@ -424,14 +424,27 @@ fn read_payload(input: &mut Payload, with_objects: bool) -> Result<Scene, OvxErr
         }
     })?;
     let objects = if with_objects {
-        let (objects, taken) = read_objects(input, materials_len)?;
+        let (objects, composed, taken) = read_objects(input, materials_len)?;
         materials_len -= taken;
-        Some(objects)
+        Some((objects, composed))
     } else {
         None
     };
     palette.materials = decode_materials(&input.items::<u8>(materials_len, |_, _| Ok(()))?)?;
     let tree = Octree::from_parts(origin, depth, root, nodes, bricks).map_err(|e| corrupt(e.to_string()))?;
+    // The pool is what is drawn and saved, the objects what edits change:
+    // a file whose two disagree would save other voxels than it shows
+    // (issue 48, item 13: `convert` said "wrote 11 voxels" and wrote 19).
+    let objects = match objects {
+        Some((_, composed)) if !composed.same_voxels(&tree) => {
+            return Err(corrupt(format!(
+                "its objects place {} voxels and its pool holds {}, or other ones: they describe other scenes",
+                composed.solid_voxels(),
+                tree.solid_voxels()
+            )));
+        }
+        other => other.map(|(objects, _)| objects),
+    };
     Ok(match objects {
         Some(objects) => Scene::with_objects(palette, tree, objects),
         None => Scene::new(palette, tree),
@@ -439,9 +452,10 @@ fn read_payload(input: &mut Payload, with_objects: bool) -> Result<Scene, OvxErr
 }
 
 /// Reads the objects section (at most `room` bytes, the materials' least
-/// after it): its `.vox` bytes load as a scene whose objects are kept (the
-/// pool already holds what they draw). Returns them and the bytes taken.
-fn read_objects(input: &mut Payload, room: u64) -> Result<(Objects, u64), OvxError> {
+/// after it): its `.vox` bytes load as a scene whose objects are kept.
+/// Returns them, the octree they compose (which the pool must equal) and
+/// the bytes taken.
+fn read_objects(input: &mut Payload, room: u64) -> Result<(Objects, Octree, u64), OvxError> {
     let head = input.items::<u8>(OBJECTS_HEADER_BYTES, |_, _| Ok(()))?;
     let (len, frame) = (le_u64(&head, 0), le_u64(&head, 8));
     let most = (room - OBJECTS_HEADER_BYTES - MIN_MATERIALS_BYTES).min(super::vox::MAX_FILE_BYTES);
@@ -451,12 +465,13 @@ fn read_objects(input: &mut Payload, room: u64) -> Result<(Objects, u64), OvxErr
     let bytes = input.items::<u8>(len, |_, _| Ok(()))?;
     let frame = usize::try_from(frame).map_err(|_| corrupt(format!("frame {frame}")))?;
     let scene = super::vox::load_vox_scene(&bytes, frame).map_err(|e| corrupt(format!("its objects: {e}")))?.0;
+    let composed = scene.drawn().clone();
     let objects = scene.into_objects().ok_or_else(|| corrupt("its objects section holds a single model"))?;
     let left = room - OBJECTS_HEADER_BYTES - len;
     if left > MAX_MATERIALS_BYTES {
         return Err(corrupt(format!("{left} bytes of materials, past the {MAX_MATERIALS_BYTES} an .ovx holds")));
     }
-    Ok((objects, OBJECTS_HEADER_BYTES + len))
+    Ok((objects, composed, OBJECTS_HEADER_BYTES + len))
 }
 
 /// What one stored node can be told wrong by on its own, as it is read (a

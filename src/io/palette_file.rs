@@ -70,8 +70,12 @@ pub fn read_colors(path: &Path) -> Result<Vec<[u8; 3]>, PaletteFileError> {
         PaletteFormat::Png => png_colors(path, &bytes),
         PaletteFormat::Hex | PaletteFormat::Gpl => {
             let text = std::str::from_utf8(&bytes).map_err(|_| bad(path, 0, "it is not UTF-8 text".to_owned()))?;
-            let colors = if format == PaletteFormat::Hex { hex_colors(text) } else { gpl_colors(text) };
+            let text = clean_text(text);
+            let colors = if format == PaletteFormat::Hex { hex_colors(&text) } else { gpl_colors(&text) };
             let colors = colors.map_err(|(line, message)| bad(path, line, message))?;
+            if colors.is_empty() {
+                return Err(bad(path, 0, "it holds no colour".to_owned()));
+            }
             if colors.len() > MAX_ENTRIES {
                 let message = format!("{} colours; a palette holds at most {MAX_ENTRIES}", colors.len());
                 return Err(bad(path, 0, message));
@@ -79,6 +83,13 @@ pub fn read_colors(path: &Path) -> Result<Vec<[u8; 3]>, PaletteFileError> {
             Ok(colors)
         }
     }
+}
+
+/// The text as its twin without a byte-order mark and with `\n` line
+/// ends reads it: a UTF-8 byte-order mark (Windows editors write one) is
+/// dropped, and `\r\n` and lone `\r` (old Mac files) end lines as `\n` does.
+fn clean_text(text: &str) -> String {
+    text.strip_prefix('\u{feff}').unwrap_or(text).replace("\r\n", "\n").replace('\r', "\n")
 }
 
 fn bad(path: &Path, line: usize, message: String) -> PaletteFileError {
@@ -90,7 +101,12 @@ fn bad(path: &Path, line: usize, message: String) -> PaletteFileError {
 fn png_colors(path: &Path, bytes: &[u8]) -> Result<Vec<[u8; 3]>, PaletteFileError> {
     let image_error = |message: String| PaletteFileError::Image { path: path.to_path_buf(), message };
     let reader = || image::ImageReader::with_format(std::io::Cursor::new(bytes), image::ImageFormat::Png);
-    let (width, height) = reader().into_dimensions().map_err(|e| image_error(e.to_string()))?;
+    // The size from the header itself: the decoder refuses a huge one with
+    // "Memory limit exceeded", which names neither it nor the limit.
+    let (width, height) = match png_header_size(bytes) {
+        Some(size) => size,
+        None => reader().into_dimensions().map_err(|e| image_error(e.to_string()))?,
+    };
     if u64::from(width) * u64::from(height) > MAX_ENTRIES as u64 {
         return Err(image_error(format!(
             "a {width}×{height} image; a palette PNG has at most {MAX_ENTRIES} pixels (MagicaVoxel's are 256×1)"
@@ -98,6 +114,17 @@ fn png_colors(path: &Path, bytes: &[u8]) -> Result<Vec<[u8; 3]>, PaletteFileErro
     }
     let image = reader().decode().map_err(|e| image_error(e.to_string()))?.to_rgb8();
     Ok(image.pixels().map(|p| p.0).collect())
+}
+
+/// Width and height from a PNG's IHDR chunk (the first, by the format),
+/// when the bytes start like a PNG.
+fn png_header_size(bytes: &[u8]) -> Option<(u32, u32)> {
+    const SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', b'\r', b'\n', 0x1a, b'\n'];
+    if bytes.get(..8)? != SIGNATURE || bytes.get(12..16)? != b"IHDR" {
+        return None;
+    }
+    let word = |at: usize| Some(u32::from_be_bytes(bytes.get(at..at + 4)?.try_into().ok()?));
+    Some((word(16)?, word(20)?))
 }
 
 /// Lospec's `.hex`: one `RRGGBB` (or `#RRGGBB`) per line; blank lines skipped.

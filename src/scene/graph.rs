@@ -113,7 +113,14 @@ pub enum GraphError {
     /// The placed models hold more voxels than the caller allows.
     #[error("the scene holds more than {limit} voxels (at least {found})")]
     TooManyVoxels { limit: usize, found: usize },
+    /// Its placements would take more memory than the budget allows.
+    #[error(transparent)]
+    OverBudget(#[from] crate::budget::OverBudget),
 }
+
+/// Bytes a placement takes once walked, at most: its `Object`, outline row,
+/// name entry, cell map, GPU instance record and tree-of-boxes share.
+pub const BYTES_PER_PLACEMENT: u64 = 256;
 
 /// One placed model: what the walk found at an nSHP.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -122,8 +129,11 @@ pub struct Object {
     /// The nSHP node, and the nTRN right above it (whose `_t`/`_r` move it).
     pub shape_node: u32,
     pub transform_node: Option<u32>,
-    /// Names of the named transforms on the way down, joined by `/`.
-    pub path: String,
+    /// The last named transform on the way down, as an entry of the walk's
+    /// name table ([`Walked::path`] joins the names by `/`). Paths share
+    /// their beginnings there, so 131,072 objects under 17 levels of long
+    /// names take one entry a visit, not 100 KB each.
+    pub name: Option<u32>,
     /// Layer of its transform (`None` for none).
     pub layer: Option<u32>,
     /// Hidden itself, below a hidden transform, or on a hidden layer.
@@ -139,7 +149,7 @@ impl Object {
             placement: Placement { model, transform: Transform::IDENTITY, centred: false },
             shape_node: 0,
             transform_node: None,
-            path: String::new(),
+            name: None,
             layer: None,
             hidden: false,
             own_hidden: false,
@@ -166,7 +176,6 @@ impl SceneGraph {
             frame,
             voxel_limit,
             on_path: vec![false; self.nodes.len()],
-            names: Vec::new(),
             stack: vec![Step::Enter { id: 0, parent: None, context: Context::ROOT }],
             visits: 0,
             voxels: 0,
@@ -204,8 +213,8 @@ struct Context {
     /// The nearest nTRN above, and its layer.
     transform_node: Option<u32>,
     layer: Option<u32>,
-    /// Last named transform on the path, as an index into `Walk::names`.
-    name: Option<usize>,
+    /// Last named transform on the path, as an entry of `Walked::names`.
+    name: Option<u32>,
     /// Groups above, not counting the root's.
     depth: u32,
 }
@@ -240,9 +249,6 @@ struct Walk<'a> {
     voxel_limit: usize,
     /// Nodes on the path from the root to the node being visited.
     on_path: Vec<bool>,
-    /// Names met on the way down: (the name before it on its path, name).
-    /// Paths share their beginnings, so a deep chain costs one entry a level.
-    names: Vec<(Option<usize>, &'a str)>,
     stack: Vec<Step>,
     visits: usize,
     /// Voxels of all placements so far.
@@ -255,6 +261,35 @@ struct Walk<'a> {
 pub struct Walked {
     pub objects: Vec<Object>,
     pub outline: Vec<OutlineRow>,
+    /// The named transforms met, each with the entry above it on its path.
+    pub names: Vec<NameEntry>,
+}
+
+/// A named transform met on the way down: its node, and the named entry
+/// above it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct NameEntry {
+    pub parent: Option<u32>,
+    pub node: u32,
+}
+
+impl Walked {
+    /// The names of the named transforms down to entry `at`, joined by `/`
+    /// (empty for none), read from `graph`, the graph walked.
+    pub fn path(&self, graph: &SceneGraph, at: Option<u32>) -> String {
+        path_of(graph, &self.names, at)
+    }
+}
+
+/// [`Walked::path`] over a name table kept apart from its walk.
+pub fn path_of(graph: &SceneGraph, names: &[NameEntry], mut at: Option<u32>) -> String {
+    let mut parts = Vec::new();
+    while let Some(entry) = at.and_then(|i| names.get(i as usize)) {
+        parts.push(graph.node(entry.node).and_then(Node::name).unwrap_or_default());
+        at = entry.parent;
+    }
+    parts.reverse();
+    parts.join("/")
 }
 
 /// One row of the outline, in walk order: a group (the transform above an
@@ -262,8 +297,16 @@ pub struct Walked {
 /// above it.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum OutlineRow {
-    Group { transform: u32, name: String, depth: u32, hidden: bool },
-    Object { index: usize, depth: u32 },
+    /// `transform`'s name is the group's (`SceneGraph::node`).
+    Group {
+        transform: u32,
+        depth: u32,
+        hidden: bool,
+    },
+    Object {
+        index: usize,
+        depth: u32,
+    },
 }
 
 impl<'a> Walk<'a> {
@@ -300,9 +343,8 @@ impl<'a> Walk<'a> {
             NodeKind::Transform { frames, child, layer, .. } => {
                 let mut context = self.transformed(node, frames, *layer, context)?;
                 if parent.is_some() && self.leads_to_group(*child) {
-                    let name = node.name().unwrap_or_default().to_owned();
                     let (depth, hidden) = (context.depth, context.hidden);
-                    self.out.outline.push(OutlineRow::Group { transform: id, name, depth, hidden });
+                    self.out.outline.push(OutlineRow::Group { transform: id, depth, hidden });
                     context.depth += 1;
                 }
                 self.stack.push(Step::Enter { id: *child, parent: Some(id), context });
@@ -337,9 +379,11 @@ impl<'a> Walk<'a> {
         };
         let layer = (layer != u32::MAX).then_some(layer);
         let name = match node.name() {
-            Some(name) => {
-                self.names.push((context.name, name));
-                Some(self.names.len() - 1)
+            Some(_) => {
+                let entry =
+                    u32::try_from(self.out.names.len()).map_err(|_| GraphError::Bad("too many names".into()))?;
+                self.out.names.push(NameEntry { parent: context.name, node: node.id });
+                Some(entry)
             }
             None => context.name,
         };
@@ -372,27 +416,23 @@ impl<'a> Walk<'a> {
             return Err(GraphError::Bad(format!("more than {MAX_INSTANCES} model placements")));
         }
         let index = self.out.objects.len();
+        // Checked as the lists double: a shared graph of 52 nodes can place
+        // 131,072 objects (the file says nothing of it up front).
+        if (index + 1).is_power_of_two() && index >= 1024 {
+            let bytes = 2 * (index as u64 + 1) * BYTES_PER_PLACEMENT;
+            crate::budget::check(|| format!("placing {} models and more", index + 1), bytes)?;
+        }
         self.out.outline.push(OutlineRow::Object { index, depth: context.depth });
         self.out.objects.push(Object {
             placement: Placement { model, transform: context.transform, centred: true },
             shape_node: id,
             transform_node: context.transform_node,
-            path: self.path(context.name),
+            name: context.name,
             layer: context.layer,
             hidden: context.hidden,
             own_hidden: context.own_hidden,
         });
         Ok(())
-    }
-
-    fn path(&self, mut at: Option<usize>) -> String {
-        let mut names = Vec::new();
-        while let Some(i) = at {
-            names.push(self.names[i].1);
-            at = self.names[i].0;
-        }
-        names.reverse();
-        names.join("/")
     }
 }
 
@@ -511,11 +551,11 @@ mod tests {
             ],
             layers: vec![hidden_layer],
         };
-        let objects = graph.objects(&[10], 0, 100).unwrap();
-        let seen: Vec<(&str, bool, Option<u32>)> =
-            objects.iter().map(|o| (o.path.as_str(), o.hidden, o.layer)).collect();
-        assert_eq!(seen, [("house/door", true, Some(1)), ("", false, Some(0))]);
-        let house = OutlineRow::Group { transform: 2, name: "house".into(), depth: 0, hidden: false };
+        let walked = graph.walk(&[10], 0, 100).unwrap();
+        let seen: Vec<(String, bool, Option<u32>)> =
+            walked.objects.iter().map(|o| (walked.path(&graph, o.name), o.hidden, o.layer)).collect();
+        assert_eq!(seen, [("house/door".to_owned(), true, Some(1)), (String::new(), false, Some(0))]);
+        let house = OutlineRow::Group { transform: 2, depth: 0, hidden: false };
         let rows = [house, OutlineRow::Object { index: 0, depth: 1 }, OutlineRow::Object { index: 1, depth: 0 }];
         assert_eq!(graph.walk(&[10], 0, 100).unwrap().outline, rows, "the outline nests the door in the house");
         assert_eq!(graph.objects(&[10], 0, 15).unwrap_err(), GraphError::TooManyVoxels { limit: 15, found: 20 });
@@ -528,8 +568,9 @@ mod tests {
         let depth = 100_000u32;
         let mut nodes: Vec<Node> = (0..depth).map(|i| transform(i, i + 1, u32::MAX, "n")).collect();
         nodes.push(shape(depth, 0));
-        let objects = SceneGraph { nodes, layers: vec![] }.objects(&[1], 0, 10).unwrap();
-        assert_eq!(objects.len(), 1);
-        assert_eq!(objects[0].path.len(), 2 * depth as usize - 1);
+        let graph = SceneGraph { nodes, layers: vec![] };
+        let walked = graph.walk(&[1], 0, 10).unwrap();
+        assert_eq!(walked.objects.len(), 1);
+        assert_eq!(walked.path(&graph, walked.objects[0].name).len(), 2 * depth as usize - 1);
     }
 }

@@ -13,7 +13,9 @@ use std::collections::HashMap;
 
 use glam::IVec3;
 
-use super::graph::{self, GraphError, Layer, Node, NodeKind, Object, OutlineRow, SceneGraph, Walked};
+use super::graph::{
+    self, GraphError, Layer, NameEntry, Node, NodeKind, Object, OutlineRow, SceneGraph, Walked, path_of,
+};
 use super::octree::{Octree, WORLD_LIMIT};
 use super::transform::{CellMap, Rotation, Transform};
 use super::{EditError, Op, Patch, Shape};
@@ -76,6 +78,8 @@ pub struct Objects {
     /// The walk at `frame`, and each object's cell map.
     objects: Vec<Object>,
     outline: Vec<OutlineRow>,
+    /// The walk's named transforms, which objects' paths are made of.
+    names: Vec<NameEntry>,
     maps: Vec<CellMap>,
     /// The object edits go to, by index in walk order.
     pub selected: Option<usize>,
@@ -112,6 +116,7 @@ impl Objects {
             frame,
             objects: Vec::new(),
             outline: Vec::new(),
+            names: Vec::new(),
             maps: Vec::new(),
             selected: None,
             new_layer: None,
@@ -124,7 +129,7 @@ impl Objects {
     fn walk(&mut self, voxel_limit: usize) -> Result<(), ObjectsError> {
         let voxels: Vec<usize> =
             self.models.iter().map(|m| usize::try_from(m.tree.solid_voxels()).unwrap_or(usize::MAX)).collect();
-        Walked { objects: self.objects, outline: self.outline } = match &self.graph {
+        Walked { objects: self.objects, outline: self.outline, names: self.names } = match &self.graph {
             Some(graph) => graph.walk(&voxels, self.frame, voxel_limit)?,
             None => self.frame_object()?,
         };
@@ -158,12 +163,24 @@ impl Objects {
             )));
         }
         let outline = vec![OutlineRow::Object { index: 0, depth: 0 }];
-        Ok(Walked { objects: vec![Object::frame(self.frame)], outline })
+        Ok(Walked { objects: vec![Object::frame(self.frame)], outline, names: Vec::new() })
     }
 
     /// The objects in walk order.
     pub fn list(&self) -> &[Object] {
         &self.objects
+    }
+
+    /// Object `index`'s path: the names of the named transforms down to it,
+    /// joined by `/` (built when asked: objects share their paths' beginnings).
+    pub fn path(&self, index: usize) -> String {
+        let (Some(graph), Some(object)) = (&self.graph, self.objects.get(index)) else { return String::new() };
+        path_of(graph, &self.names, object.name)
+    }
+
+    /// The name of a group's transform `transform` (empty for none).
+    pub fn group_name(&self, transform: u32) -> &str {
+        self.graph.as_ref().and_then(|g| g.node(transform)).and_then(Node::name).unwrap_or_default()
     }
 
     /// The groups and objects in walk order, as the Outliner shows them.
@@ -240,6 +257,16 @@ impl Objects {
         }
     }
 
+    /// Whether object `index` is shown and its model has a voxel in the
+    /// world box `lo..=hi`.
+    pub fn holds_voxels_in(&self, index: usize, lo: IVec3, hi: IVec3) -> bool {
+        let Some(object) = self.objects.get(index).filter(|o| !o.hidden) else { return false };
+        let (mlo, mhi) = self.maps[index].invert_box(lo, hi);
+        let mut any = false;
+        self.models[object.placement.model].tree.for_each_solid_cell_in(mlo, mhi, |_, _, _| any = true);
+        any
+    }
+
     /// The visible object drawn at world cell `at` (the last in walk order
     /// holding a voxel there), if any.
     pub fn owner_at(&self, at: IVec3) -> Option<usize> {
@@ -279,6 +306,14 @@ impl Objects {
             .placement
             .model;
         self.unlocked(&[index])?;
+        // A reference shares the model: an edit through an unlocked
+        // placement would change a locked one too (issue 48, item 11).
+        if let Some(k) = (0..self.objects.len()).find(|&k| self.objects[k].placement.model == model && self.locked(k)) {
+            return Err(EditError::Objects(format!(
+                "object {k} is locked and places the same model as object {index} (a reference): \
+                 `object unlock` it, or `object unique` this one to edit a copy"
+            )));
+        }
         let local = self.maps[index].invert_shape(shape);
         let patch = self.models[model].tree.apply_brush(&local, op)?;
         self.recompose_model(tree, model, local.bounds())?;
@@ -634,6 +669,11 @@ impl Objects {
                 "the objects hold {voxels} voxels; a merge takes at most {MERGE_LIMIT} (one model of 256³)"
             )));
         }
+        // The new model's octree, before it is built: its sources' pools,
+        // twice over for cells their grids cut differently, and the undo copy.
+        let pools: u64 =
+            all.iter().map(|&k| self.models[self.objects[k].placement.model].tree.pool().live_bytes()).sum();
+        crate::budget::check(|| format!("merging {} objects", all.len()), 4 * pools)?;
         let target = self.maps[index];
         let boxes: Vec<(IVec3, IVec3)> =
             all.iter().filter_map(|&k| self.world_box(k)).map(|(lo, hi)| target.invert_box(lo, hi)).collect();
@@ -796,7 +836,18 @@ pub struct GraphChange {
     pub remove_layers: Vec<u32>,
 }
 
+/// Bytes a changed node or layer takes while a change is applied: it, the
+/// node it replaces (the undo's copy) and their attribute maps.
+const BYTES_PER_CHANGED_NODE: u64 = 2048;
+
 impl GraphChange {
+    /// Peak bytes applying it may take beyond the walk itself (whose
+    /// placements the budget checks as it goes: `graph::BYTES_PER_PLACEMENT`).
+    pub fn estimated_bytes(&self) -> u64 {
+        let count = self.nodes.len() + self.layers.len() + self.remove.len() + self.remove_layers.len();
+        count as u64 * BYTES_PER_CHANGED_NODE
+    }
+
     /// Applies it to `graph`; returns the change that undoes it.
     fn apply(&self, graph: &mut SceneGraph) -> GraphChange {
         let mut inverse = GraphChange::default();

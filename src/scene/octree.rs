@@ -328,6 +328,32 @@ impl Octree {
         out
     }
 
+    /// Whether `other` holds the same voxels (same cells, same values),
+    /// whatever either's root and pool: the counts first, then every solid
+    /// cell of this tree against the cells of `other` in its box. No voxel
+    /// list is made.
+    pub fn same_voxels(&self, other: &Octree) -> bool {
+        if self.counts() != other.counts() {
+            return false;
+        }
+        let mut same = true;
+        self.for_each_solid_cell(|min, size, value| {
+            if !same {
+                return;
+            }
+            let max = min + IVec3::splat(size - 1);
+            let mut matching = 0i64;
+            other.for_each_solid_cell_in(min, max, |cell, edge, found| {
+                if found == value {
+                    let (a, b) = (cell.max(min), (cell + IVec3::splat(edge - 1)).min(max));
+                    matching += (b - a + IVec3::ONE).as_i64vec3().element_product();
+                }
+            });
+            same = matching == i64::from(size).pow(3);
+        });
+        same
+    }
+
     /// Inclusive bounds of the solid voxels, or `None` for an empty tree.
     pub fn solid_bounds(&self) -> Option<(IVec3, IVec3)> {
         let mut bounds: Option<(IVec3, IVec3)> = None;

@@ -9,6 +9,7 @@
 mod common;
 
 mod bench_cli;
+mod budgets;
 mod export;
 mod export_scene;
 mod fuzz_corpus;

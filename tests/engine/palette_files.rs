@@ -168,3 +168,36 @@ fn palette_save_replaces_an_existing_file_only_with_force() {
         assert_ne!(std::fs::read(&path).unwrap(), before, "{name} with --force");
     }
 }
+
+/// Issue 48, item 14: a palette file with a UTF-8 byte-order mark or
+/// old-Mac (CR-only) line ends was refused quoting an invisible character;
+/// it reads as its clean twin. An empty .hex was taken as no colours; it is
+/// refused. A PNG whose header claims 2^31 × 2^31 said "Memory limit
+/// exceeded"; it names its size and the limit.
+#[test]
+fn odd_but_fair_palette_files_read_like_their_twins_and_bad_ones_say_why() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("bom.hex"), "\u{feff}102030\n405060\n").unwrap();
+    std::fs::write(dir.path().join("cr.hex"), "102030\r405060\r").unwrap();
+    std::fs::write(dir.path().join("bom.gpl"), "\u{feff}GIMP Palette\r\nName: x\r\n16 32 48 a\r\n64 80 96 b\r\n")
+        .unwrap();
+    std::fs::write(dir.path().join("cr.gpl"), "GIMP Palette\rName: x\r16 32 48\r64 80 96\r").unwrap();
+    for name in ["bom.hex", "cr.hex", "bom.gpl", "cr.gpl"] {
+        let script = format!("new\npalette load {name}\nexpect palette 1 16 32 48\nexpect palette 2 64 80 96\n");
+        let (ok, text) = replay(dir.path(), &script);
+        assert!(ok && text.contains("2 passed, 0 failed"), "{name}: {text}");
+    }
+    std::fs::write(dir.path().join("empty.hex"), "\n\n").unwrap();
+    let (ok, text) = replay(dir.path(), "new\npalette load empty.hex\n");
+    assert!(!ok && text.contains("empty.hex") && text.contains("holds no colour"), "{text}");
+    // A PNG signature and an IHDR claiming 2^31 × 2^31 (CRC left wrong: the
+    // size must be read, and refused, before anything else).
+    let mut png = vec![0x89, b'P', b'N', b'G', b'\r', b'\n', 0x1a, b'\n', 0, 0, 0, 13];
+    png.extend_from_slice(b"IHDR");
+    png.extend_from_slice(&(1u32 << 31).to_be_bytes());
+    png.extend_from_slice(&(1u32 << 31).to_be_bytes());
+    png.extend_from_slice(&[8, 2, 0, 0, 0, 0, 0, 0, 0]);
+    std::fs::write(dir.path().join("huge.png"), png).unwrap();
+    let (ok, text) = replay(dir.path(), "new\npalette load huge.png\n");
+    assert!(!ok && text.contains("2147483648×2147483648") && text.contains("256×1"), "{text}");
+}

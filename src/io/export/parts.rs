@@ -157,7 +157,7 @@ impl Exported {
 /// Object `index`'s groups and name: its path of named transforms, of which
 /// the last is its own when its transform is named; `object N` otherwise.
 fn names(objects: &Objects, index: usize) -> (Vec<String>, String) {
-    let path = &objects.list()[index].path;
+    let path = objects.path(index);
     let mut groups: Vec<String> = path.split('/').filter(|s| !s.is_empty()).map(str::to_owned).collect();
     let own = objects.transform_node(index).ok().and_then(Node::name);
     match own {

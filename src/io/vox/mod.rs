@@ -95,6 +95,7 @@ impl From<crate::scene::graph::GraphError> for VoxError {
             GraphError::Cycle(node) => VoxError::SceneCycle(node),
             GraphError::Bad(problem) => VoxError::BadSceneGraph(problem),
             GraphError::TooManyVoxels { limit, found } => VoxError::TooManyVoxels { limit, found },
+            GraphError::OverBudget(over) => VoxError::OverBudget(over),
         }
     }
 }
