@@ -199,6 +199,14 @@ impl Objects {
         Some(self.maps[index].apply_box(lo, hi))
     }
 
+    /// The world box of object `index`'s model's root cube: it holds every
+    /// voxel the object may show, and takes no walk of the model.
+    fn reach(&self, index: usize) -> (IVec3, IVec3) {
+        let tree = &self.models[self.objects[index].placement.model].tree;
+        let lo = tree.origin();
+        self.maps[index].apply_box(lo, lo + IVec3::splat(tree.size() - 1))
+    }
+
     /// Builds the octree of every visible object, in walk order.
     pub fn compose(&self) -> Result<Octree, EditError> {
         let boxes: Vec<(IVec3, IVec3)> = self.visible().filter_map(|i| self.world_box(i)).collect();
@@ -232,8 +240,10 @@ impl Objects {
             tree.apply_brush(&Shape::Box { min, max }, Op::Remove)?;
         }
         for index in self.visible() {
-            let reaches = self.world_box(index).is_some_and(|(a, b)| a.cmple(hi).all() && b.cmpge(lo).all());
-            if reaches {
+            // The model's root cube, not its voxels' box: as good a test
+            // (the copy below visits only cells in the box) at no cost.
+            let (a, b) = self.reach(index);
+            if a.cmple(hi).all() && b.cmpge(lo).all() {
                 self.insert_placed(tree, index, (lo, hi));
             }
         }

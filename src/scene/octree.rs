@@ -357,14 +357,31 @@ impl Octree {
     /// Inclusive bounds of the solid voxels, or `None` for an empty tree.
     pub fn solid_bounds(&self) -> Option<(IVec3, IVec3)> {
         let mut bounds: Option<(IVec3, IVec3)> = None;
-        self.for_each_solid_cell(|min, size, _| {
-            let max = min + IVec3::splat(size - 1);
-            bounds = Some(match bounds {
-                None => (min, max),
-                Some((lo, hi)) => (lo.min(min), hi.max(max)),
-            });
-        });
+        self.bounds_under(self.root, self.origin, self.depth, &mut bounds);
         bounds
+    }
+
+    /// Grows `bounds` by the solid cells under `word`, skipping every
+    /// subtree whose cube lies inside the bounds found so far (it cannot
+    /// widen them): a scene of objects asks for its models' bounds on every
+    /// edit, and a walk of every cell made a one-voxel edit of a 17,000-voxel
+    /// model take a millisecond.
+    fn bounds_under(&self, word: u32, min: IVec3, level: u32, bounds: &mut Option<(IVec3, IVec3)>) {
+        let max = min + IVec3::splat((1 << level) - 1);
+        if word == 0 || bounds.is_some_and(|(lo, hi)| min.cmpge(lo).all() && max.cmple(hi).all()) {
+            return;
+        }
+        if !is_pointer(word) || level <= 1 {
+            return self.visit_cells(word, min, level, &mut |cell, edge, _| {
+                let far = cell + IVec3::splat(edge - 1);
+                *bounds = Some(bounds.map_or((cell, far), |(lo, hi)| (lo.min(cell), hi.max(far))));
+            });
+        }
+        let half = 1 << (level - 1);
+        let children = *self.node(word);
+        for (octant, child) in children.into_iter().enumerate() {
+            self.bounds_under(child, min + octant_offset(octant) * half, level - 1, bounds);
+        }
     }
 
     /// Frees every slot under `word`.

@@ -433,3 +433,26 @@ fn a_layer_renamed_to_a_keyword_survives_a_kill() {
     assert_eq!(data.layers[0].attributes.get("_name").map(String::as_str), Some("color"));
     assert_eq!(data.layers[0].attributes.get("_hidden"), None, "not read as `layer 0 hide`");
 }
+
+/// Issue 48, item 2, in the window: `object move 2000000 0 0` was refused,
+/// but the scene graph kept the move, and the window's next Ctrl+S replaced
+/// the document with a file octovox then refused to open. Played here in
+/// the window (`--replay`), then Ctrl+S: the file opens, drawing what it
+/// drew before.
+#[test]
+fn a_refused_move_in_the_window_saves_a_file_that_opens() {
+    let (dir, file, scene) = groups_document();
+    let (lo, hi) = scene.solid_bounds().unwrap();
+    let camera = Camera::framing(lo, hi, 50.0);
+    let script = dir.path().join("far.ovr");
+    std::fs::write(&script, "object 0\nobject move 2000000 0 0\n").unwrap();
+    let (_xvfb, display) = start_xvfb();
+    let args = document_args(&file, &camera, &["--replay", script.to_str().unwrap()]);
+    let (_app, mut lines, _window) = open_ready(&display, dir.path(), &args);
+    let refused = lines.wait_for("replay: ", Duration::from_secs(60));
+    assert!(refused.contains("1 failed"), "{refused}: {:?}", lines.seen);
+    assert!(lines.seen.iter().any(|l| l.contains("wider than 2^20")), "{:?}", lines.seen);
+    save(&display, &mut lines, &file);
+    let saved = octovox::io::load_scene(&file, 0).unwrap_or_else(|e| panic!("the saved file does not open: {e}"));
+    assert_eq!(saved.voxels(), scene.voxels(), "it draws what it drew");
+}
