@@ -14,7 +14,7 @@ use octovox::script::{Command as Line, LayerLine, ObjectLine, ObjectRef};
 use super::command::Command;
 
 /// Width of the right panel in points.
-pub const OUTLINER_WIDTH: f32 = 250.0;
+pub const OUTLINER_WIDTH: f32 = 280.0;
 
 /// The picked object's colour: its box in the view, the Outliner's drop line.
 pub const PICKED: Color32 = Color32::from_rgb(255, 190, 60);
@@ -149,6 +149,7 @@ fn object_row(ui: &mut egui::Ui, objects: &Objects, index: usize, state: &mut Ou
     if lock.on_hover_text("lock: no edits, moves or picks by a click").changed() {
         out.push(Command::Lines(vec![pick.clone(), Line::Object(ObjectLine::Lock(locked))]));
     }
+    layer_choice(ui, objects, index, &pick, out);
     let marked = state.merge.contains(&index);
     let can_mark = objects.selected.is_some_and(|p| p != index);
     let mark = ui.add_enabled(can_mark, egui::Button::new(if marked { "−" } else { "+" }).small());
@@ -170,6 +171,32 @@ fn object_row(ui: &mut egui::Ui, objects: &Objects, index: usize, state: &mut Ou
     if row.drag_started() {
         state.dragging = Some(index);
     }
+}
+
+/// The layer an object is on, as MagicaVoxel's outliner shows it, and a
+/// menu of the layers that puts it on another (`object layer N`): what a
+/// layer's eye hides is then on screen.
+fn layer_choice(ui: &mut egui::Ui, objects: &Objects, index: usize, pick: &Line, out: &mut Vec<Command>) {
+    let layers = objects.layer_list();
+    if layers.is_empty() {
+        return;
+    }
+    let current = objects.list()[index].layer;
+    let label = current.map_or("L–".to_owned(), |id| format!("L{id}"));
+    // A menu button as wide as its label, so the row keeps room for the name.
+    let response = ui.menu_button(label, |ui| {
+        for layer in layers {
+            let name = layer.name();
+            let id = layer.id.to_string();
+            let text = if name.is_empty() || name == id { id } else { format!("{id} {name}") };
+            if ui.selectable_label(current == Some(layer.id), text).clicked() && current != Some(layer.id) {
+                out.push(Command::Lines(vec![pick.clone(), Line::Object(ObjectLine::Layer(layer.id))]));
+                ui.close();
+            }
+        }
+    });
+    let name = current.and_then(|id| layers.iter().find(|l| l.id == id)).map_or("none", |l| l.name());
+    response.response.on_hover_text(format!("on layer {name}: its eye below hides it; click to move it"));
 }
 
 /// While a row is dragged, the line where it would go; when it is let go

@@ -222,7 +222,10 @@ pub(super) fn bench_edit(quick: bool) -> anyhow::Result<(String, String)> {
     }
     let objects = edits_in_objects(at, quick)?;
     md += &objects_table(&objects);
-    let json = serde_json::json!({ "one_model": rows, "scene_of_objects": objects });
+    // One list: the one-model rows, then the scene-of-objects rows (their
+    // own keys: objects_us, one_model_us, …).
+    let mut json: Vec<serde_json::Value> = rows.iter().map(serde_json::to_value).collect::<Result<_, _>>()?;
+    json.extend(objects.iter().map(serde_json::to_value).collect::<Result<Vec<_>, _>>()?);
     Ok((md, serde_json::to_string_pretty(&json)?))
 }
 

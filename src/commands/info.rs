@@ -29,7 +29,9 @@ pub fn run(file: &Path, json: bool, objects: bool, frame: usize) -> anyhow::Resu
         ));
     }
     if json {
-        say!("{}", serde_json::to_string_pretty(&summary.to_json(file))?)?;
+        let mut value = summary.to_json(file);
+        value["objects"] = object_json(&scene);
+        say!("{}", serde_json::to_string_pretty(&value)?)?;
     } else if objects {
         std::io::Write::write_all(&mut std::io::stdout().lock(), object_lines(&scene).as_bytes())?;
     } else {
@@ -58,6 +60,29 @@ fn object_lines(scene: &Scene) -> String {
         out += &format!("{index}\t{name}\tmodel {}\tlayer {layer}\t{shown}\t{bounds}\n", object.placement.model);
     }
     out
+}
+
+/// `info --json`'s objects, in walk order: index, name path, model, layer,
+/// whether hidden (itself, above, or by its layer) and world box (a scene
+/// of one model is object 0).
+fn object_json(scene: &Scene) -> serde_json::Value {
+    let bounds = |b: Option<(glam::IVec3, glam::IVec3)>| b.map(|(lo, hi)| [lo.to_array(), hi.to_array()]);
+    let Some(objects) = scene.objects() else {
+        let one = serde_json::json!({"index": 0, "path": "", "model": 0, "layer": null, "hidden": false,
+            "bounds": bounds(scene.solid_bounds())});
+        return serde_json::Value::Array(vec![one]);
+    };
+    let rows = objects.list().iter().enumerate().map(|(index, object)| {
+        serde_json::json!({
+            "index": index,
+            "path": objects.path(index),
+            "model": object.placement.model,
+            "layer": object.layer,
+            "hidden": object.hidden,
+            "bounds": bounds(objects.world_box(index)),
+        })
+    });
+    serde_json::Value::Array(rows.collect())
 }
 
 /// The numbers `info` reports.
@@ -116,7 +141,6 @@ impl Summary {
         serde_json::json!({
             "file": file.display().to_string(),
             "models": self.models,
-            "objects": self.models,
             "stored_models": self.stored_models,
             "layers": self.layers.iter().map(|(id, name, hidden)| serde_json::json!({"id": id, "name": name, "hidden": hidden})).collect::<Vec<_>>(),
             "groups": self.groups,

@@ -19,9 +19,9 @@ pub const HEIGHT: u32 = 600;
 /// stay clear of both.
 pub const FREE_X: u32 = 300;
 pub const FREE_Y: u32 = 60;
-/// A scene of objects has the Outliner over the window's right 250 points
+/// A scene of objects has the Outliner over the window's right 280 points
 /// (`src/app/outliner.rs`).
-pub const OUTLINER_X: u32 = WIDTH - 250;
+pub const OUTLINER_X: u32 = WIDTH - 280;
 
 /// Kills a child process when dropped (also when the test panics).
 pub struct KillOnDrop(pub Child, pub &'static str);

@@ -56,6 +56,31 @@ fn test_groups_walks_nested_groups() {
     assert_eq!(info["models"], 19);
 }
 
+/// Issue 47, item 5: `info --json` lists each object with its name path,
+/// layer, hidden flag and model: all 19 objects of test_groups.vox are on
+/// layer 0, which is why hiding the other seven layers hides nothing.
+#[test]
+fn json_lists_every_object_with_its_path_layer_and_model() {
+    let info = info_json("format/test_groups.vox", &[]);
+    let objects = info["objects"].as_array().unwrap();
+    assert_eq!(objects.len(), 19);
+    for (index, object) in objects.iter().enumerate() {
+        assert_eq!(object["index"], index);
+        assert_eq!(object["layer"], 0, "{object}");
+        assert_eq!(object["hidden"], false);
+        assert!(object["model"].as_u64().unwrap() < 15, "{object}");
+        assert!(object["bounds"].is_array(), "{object}");
+    }
+    let paths: Vec<&str> = objects.iter().map(|o| o["path"].as_str().unwrap()).collect();
+    assert_eq!((paths[0], paths[15]), ("characters", "text"), "{paths:?}");
+    let one = info_json("magicavoxel/chr_knight.vox", &[]);
+    assert_eq!(
+        one["objects"],
+        serde_json::json!([{"index": 0, "path": "", "model": 0, "layer": null,
+        "hidden": false, "bounds": [one["min"], one["max"]]}])
+    );
+}
+
 #[test]
 fn axes_version_200_with_groups() {
     let info = info_json("format/axes.vox", &[]);

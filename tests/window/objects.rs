@@ -270,7 +270,10 @@ const FIRST_ROW_Y: u32 = 110;
 const ROW_PITCH: u32 = 23;
 const EYE_X: u32 = OUTLINER_X + 16;
 const INDENT: u32 = 12;
-const NAME_FROM_EYE: u32 = 110;
+const NAME_FROM_EYE: u32 = 146;
+/// An object row's layer button (`L0`), and its menu's first entry below it.
+const LAYER_FROM_EYE: u32 = 72;
+const MENU_FIRST: u32 = 27;
 /// The first layer's row in the Layers panel below the rows, and its name.
 const FIRST_LAYER_Y: u32 = 500;
 const LAYER_NAME_X: u32 = OUTLINER_X + 112;
@@ -411,6 +414,9 @@ fn a_layer_renamed_to_a_keyword_survives_a_kill() {
     let camera = Camera::framing(lo, hi, 50.0);
     let (_xvfb, display) = start_xvfb();
     let (mut app, mut lines, window) = open_ready(&display, dir.path(), &document_args(&file, &camera, &[]));
+    // Past the path tracer's first frames (whose kernels compile on
+    // lavapipe): a double click must fall within egui's double-click time.
+    lines.wait_for("noise: ", Duration::from_secs(90));
     let (x, y) = (LAYER_NAME_X.to_string(), FIRST_LAYER_Y.to_string());
     xdotool(&display, &["mousemove", "--window", &window, &x, &y]);
     std::thread::sleep(Duration::from_millis(300));
@@ -455,4 +461,35 @@ fn a_refused_move_in_the_window_saves_a_file_that_opens() {
     save(&display, &mut lines, &file);
     let saved = octovox::io::load_scene(&file, 0).unwrap_or_else(|e| panic!("the saved file does not open: {e}"));
     assert_eq!(saved.voxels(), scene.voxels(), "it draws what it drew");
+}
+
+/// Issue 47, item 5: each Outliner row shows its object's layer (`L0`), and
+/// its menu moves the object to another layer: a click on object `k`'s `L0`
+/// and on layer 2 in the menu, then Ctrl+S; `dot_vox` reads the transform
+/// on layer 2.
+#[test]
+fn the_outliner_shows_an_objects_layer_and_moves_it() {
+    let (dir, file, scene) = groups_document();
+    let objects = scene.objects().unwrap();
+    let (lo, hi) = scene.solid_bounds().unwrap();
+    let camera = Camera::framing(lo, hi, 50.0);
+    let index = (0..objects.list().len()).find(|&i| (outline_row(objects, i).0 as usize) < ROWS_SHOWN).unwrap();
+    let node = objects.list()[index].transform_node.unwrap();
+    let (_xvfb, display) = start_xvfb();
+    let (_app, mut lines, window) = open_ready(&display, dir.path(), &document_args(&file, &camera, &[]));
+    let (row, depth) = outline_row(objects, index);
+    let (x, y) = (EYE_X + INDENT * depth + LAYER_FROM_EYE, FIRST_ROW_Y + ROW_PITCH * row);
+    xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y.to_string()]);
+    std::thread::sleep(Duration::from_millis(300));
+    xdotool(&display, &["click", "1"]);
+    std::thread::sleep(Duration::from_millis(700));
+    let entry = y + MENU_FIRST + 2 * ROW_PITCH;
+    xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &entry.to_string()]);
+    std::thread::sleep(Duration::from_millis(300));
+    xdotool(&display, &["click", "1"]);
+    lines.wait_for("object:", Duration::from_secs(30));
+    save(&display, &mut lines, &file);
+    let data = dot_vox::load_bytes(&std::fs::read(&file).unwrap()).unwrap();
+    let dot_vox::SceneNode::Transform { layer_id, .. } = &data.scenes[node as usize] else { panic!("node {node}") };
+    assert_eq!(*layer_id, 2, "object {index} is on layer 2");
 }
