@@ -9,6 +9,9 @@ mod commands;
 fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = cli::Cli::parse();
+    if cli.command.is_some() {
+        quiet_device_select();
+    }
     match commands::run(cli) {
         Ok(code) => code,
         // A closed pipe (`octovox info x.vox | head -1`) is a normal end.
@@ -17,6 +20,26 @@ fn main() -> ExitCode {
             eprintln!("octovox: error: {}", error_chain(&err));
             ExitCode::FAILURE
         }
+    }
+}
+
+/// Mesa's implicit Vulkan layer `VK_LAYER_MESA_device_select` connects to
+/// Wayland to rank the GPUs, and where `XDG_RUNTIME_DIR` is not set (a
+/// shell over SSH, a cron job) libwayland prints "error: XDG_RUNTIME_DIR is
+/// invalid…" twice, though nothing failed. A command without a window
+/// needs no ranking (wgpu picks the adapter), so it turns the layer off the
+/// way the layer documents (`NODEVICE_SELECT=1`), unless the user set it.
+fn quiet_device_select() {
+    let runtime_dir = std::env::var_os("XDG_RUNTIME_DIR").filter(|d| std::path::Path::new(d).is_dir());
+    if runtime_dir.is_some() || std::env::var_os("NODEVICE_SELECT").is_some() {
+        return;
+    }
+    log::debug!("XDG_RUNTIME_DIR is not set: Mesa's device-select layer is turned off (NODEVICE_SELECT=1)");
+    #[expect(unsafe_code, reason = "std::env::set_var is unsafe in Rust 2024; see SAFETY")]
+    // SAFETY: called first thing in `main`, before any thread is spawned
+    // (no other thread can read or write the environment meanwhile).
+    unsafe {
+        std::env::set_var("NODEVICE_SELECT", "1");
     }
 }
 

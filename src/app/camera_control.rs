@@ -91,9 +91,45 @@ pub fn frame_model(camera: &mut Camera, bounds: Option<(glam::IVec3, glam::IVec3
     }
 }
 
+/// The camera a new document starts with: the default view (perspective,
+/// from the front-right-top) with `fov_y_deg`, framing `bounds` (a file's
+/// voxels, or a new scene's working volume) so that it fills the view, as
+/// MagicaVoxel opens on its volume. Nothing of the last document's view
+/// (an orthographic top view, say) carries over.
+pub fn fresh_camera(fov_y_deg: f32, bounds: Option<(glam::IVec3, glam::IVec3)>) -> Camera {
+    let mut camera = Camera { fov_y_deg, ..Camera::default() };
+    frame_model(&mut camera, bounds);
+    camera
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Issue 47, item 7: a new scene showed its 32³ volume with voxels about
+    /// 8 px wide (it framed a box twice the volume); an orthographic view
+    /// carried over into the next file. The volume now spans most of the
+    /// view's height, in perspective.
+    #[test]
+    fn a_new_scene_fills_the_view_with_its_volume_in_perspective() {
+        let state = super::super::state::EditorState::default();
+        let (lo, hi) = state.working_volume();
+        let camera = fresh_camera(50.0, Some((lo, hi)));
+        assert_eq!(camera.ortho, None);
+        let (width, height) = (1280, 720);
+        let basis = camera.basis(width, height, glam::IVec3::ZERO);
+        let ys: Vec<f32> = (0..8)
+            .map(|k| {
+                let corner = glam::IVec3::new(k & 1, (k >> 1) & 1, (k >> 2) & 1);
+                let p = (lo + corner * (hi - lo + glam::IVec3::ONE)).as_vec3();
+                basis.project(p).expect("in front of the eye").1
+            })
+            .collect();
+        let span = ys.iter().copied().fold(f32::MIN, f32::max) - ys.iter().copied().fold(f32::MAX, f32::min);
+        assert!(span > 0.6 * height as f32, "the volume spans {span} of {height} px");
+        let per_voxel = span / state.volume as f32;
+        assert!(per_voxel > 12.0, "{per_voxel} px per voxel");
+    }
 
     #[test]
     fn orbit_keeps_distance_and_target() {

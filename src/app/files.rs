@@ -5,10 +5,8 @@ use std::path::{Path, PathBuf};
 use std::sync::mpsc::{self, TryRecvError};
 use std::time::Instant;
 
-use glam::IVec3;
 use winit::event_loop::ActiveEventLoop;
 
-use octovox::camera::Camera;
 use octovox::io::atomic::WriteOptions;
 use octovox::io::output::same_file;
 use octovox::scene::Scene;
@@ -59,6 +57,7 @@ impl App {
         // rather than writing .vox bytes over the .obj.
         self.state.path = path.filter(|p| !octovox::io::is_mesh_path(p));
         self.state.dirty = false;
+        self.state.saved_state = Some(self.doc.editor.history.state_id());
         self.doc.editor.tools.color = first_used_color(&self.doc.editor.scene).unwrap_or(self.doc.editor.tools.color);
         let upload = self.upload();
         log::info!("scene uploaded: {} bytes", upload.bytes);
@@ -104,13 +103,11 @@ impl App {
         match action {
             Pending::New => {
                 self.replace_scene(Scene::default(), octovox::script::Command::New, None);
-                self.state.camera = Camera { fov_y_deg: self.state.camera.fov_y_deg, ..Camera::default() };
                 // An empty scene on the ground: a first click attaches at y = 0.
                 self.state.dirty = false;
-                // The volume with a margin of half its side: the side panel covers some of the view.
-                let (side, half) = (self.state.volume, self.state.volume / 2);
-                let view = (IVec3::new(-side, -half, -side), IVec3::new(side, side + half, side) - IVec3::ONE);
-                camera_control::frame_model(&mut self.state.camera, Some(view));
+                let volume = self.state.working_volume();
+                self.state.camera = camera_control::fresh_camera(self.state.camera.fov_y_deg, None);
+                self.frame_box(Some(volume));
                 report!("new: an empty scene on the ground");
             }
             Pending::Open(path) => self.start_loading(path),
@@ -140,6 +137,7 @@ impl App {
         self.replace_scene(scene, source, None);
         // What is shown is the scene plus its journal, not yet saved.
         self.state.dirty = true;
+        self.state.saved_state = None;
         if document.is_some() {
             match octovox::replay::Recorder::append(journal) {
                 Ok(recorder) => self.doc.journal = Some(recorder),
@@ -239,6 +237,7 @@ impl App {
                 self.doc.recent.add(path);
                 report!("saved: {}", path.display());
                 self.state.dirty = false;
+                self.state.saved_state = Some(self.doc.editor.history.state_id());
                 // The file now holds every edit: the journal starts again from it.
                 self.close_journal();
                 let absolute = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
@@ -312,6 +311,8 @@ impl App {
                 // A camera from the command line wins for the file it came with.
                 let keep_camera = self.args.camera.is_some() && self.args.file.as_ref() == Some(&loading.path);
                 if !keep_camera {
+                    // A new document starts in the default view, not the last one's.
+                    self.state.camera = camera_control::fresh_camera(self.state.camera.fov_y_deg, None);
                     self.frame_box(self.doc.editor.scene.solid_bounds());
                 }
                 self.ui.info(format!("opened {}", loading.path.display()));

@@ -264,13 +264,20 @@ impl App {
         }
     }
 
-    /// Follows up a change: the scene is unsaved; `record` writes it to the
+    /// Whether the scene differs from its file: the history is not at the
+    /// state it was saved or loaded at (undoing back to it is no change).
+    fn unsaved(&self) -> bool {
+        self.state.saved_state != Some(self.doc.editor.history.state_id())
+    }
+
+    /// Follows up a change: the scene is unsaved unless the change led back
+    /// to the saved state; `record` writes it to the
     /// recording and the journal *before* it is reported done (a crash
     /// after the report loses nothing); what changed goes to the GPU and
     /// everything that depends on the voxels is refreshed. Prints `WHAT: N
     /// bytes written` (the tests read it).
     fn after_change(&mut self, what: &str, record: impl Fn(&mut Recorder) -> std::io::Result<()>) {
-        self.state.dirty = true;
+        self.state.dirty = self.unsaved();
         self.ui.change_made();
         self.record(record);
         let upload = self.upload();

@@ -61,8 +61,12 @@ pub struct EditorState {
     pub settings: RenderSettings,
     /// The file Save writes to; `None` for a new or demo scene.
     pub path: Option<PathBuf>,
-    /// Edits since the last save or load.
+    /// The scene differs from the file (or there is no file to hold it).
     pub dirty: bool,
+    /// The history's state when the scene was last saved or loaded
+    /// (`History::state_id`); `None` when no state of it is in a file (a
+    /// recovered journal's scene).
+    pub saved_state: Option<u64>,
     /// Frame time to hold while the camera moves (the render scale drops
     /// as far as needed), milliseconds.
     pub frame_target_ms: f32,
@@ -117,6 +121,7 @@ impl Default for EditorState {
             settings: RenderSettings::default(),
             path: None,
             dirty: false,
+            saved_state: None,
             frame_target_ms: super::motion::DEFAULT_TARGET_MS,
             shading: Shading::default(),
             path_settings: PathSettings::default(),

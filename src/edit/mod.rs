@@ -157,6 +157,8 @@ impl Edit {
 struct Step {
     edits: Vec<Edit>,
     inverses: Vec<Edit>,
+    /// The state it leads to ([`History::state_id`]); 0 until recorded.
+    id: u64,
 }
 
 impl Step {
@@ -176,11 +178,23 @@ pub struct History {
     undone: Vec<Step>,
     stroke: Option<Step>,
     pub memory_limit_bytes: usize,
+    /// The last step id given out, and the state under the oldest step
+    /// kept (the id of the last one dropped for memory, else 0).
+    last_id: u64,
+    floor_id: u64,
 }
 
 impl Default for History {
     fn default() -> History {
-        History { done: VecDeque::new(), done_bytes: 0, undone: Vec::new(), stroke: None, memory_limit_bytes: 2 << 30 }
+        History {
+            done: VecDeque::new(),
+            done_bytes: 0,
+            undone: Vec::new(),
+            stroke: None,
+            memory_limit_bytes: 2 << 30,
+            last_id: 0,
+            floor_id: 0,
+        }
     }
 }
 
@@ -250,14 +264,30 @@ impl History {
         }
     }
 
-    fn push(&mut self, step: Step) {
+    fn push(&mut self, mut step: Step) {
+        if step.id == 0 {
+            self.last_id += 1;
+            step.id = self.last_id;
+        }
         self.done_bytes += step.bytes();
         self.done.push_back(step);
         while self.done_bytes > self.memory_limit_bytes && self.done.len() > 1 {
             if let Some(oldest) = self.done.pop_front() {
                 self.done_bytes -= oldest.bytes();
+                self.floor_id = oldest.id;
             }
         }
+    }
+
+    /// Names the state the steps have led to: equal ids, equal scenes. A
+    /// window compares it with the id it saved at, so undoing back to the
+    /// saved state is not an unsaved change (and a redo back past it is).
+    /// An open stroke with edits is a state of its own, never saved.
+    pub fn state_id(&self) -> u64 {
+        if self.stroke.as_ref().is_some_and(|s| !s.edits.is_empty()) {
+            return u64::MAX;
+        }
+        self.done.back().map_or(self.floor_id, |step| step.id)
     }
 
     /// Undoes the last step; false when there is none.
@@ -310,6 +340,9 @@ impl History {
         self.done_bytes = 0;
         self.undone.clear();
         self.stroke = None;
+        // A fresh floor: the state now is none that an id named before.
+        self.last_id += 1;
+        self.floor_id = self.last_id;
     }
 }
 
@@ -322,5 +355,50 @@ fn edit_bytes(edit: &Edit) -> usize {
         Edit::Palette { material, .. } => {
             std::mem::size_of::<Edit>() + material.params.iter().map(|(k, v)| k.len() + v.len() + 48).sum::<usize>()
         }
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+    use glam::IVec3;
+
+    fn place(history: &mut History, scene: &mut Scene, at: i32) {
+        history.apply(scene, Edit::Brush { shape: Shape::Voxel(IVec3::new(at, 0, 0)), op: Op::Place(3) }).unwrap();
+    }
+
+    /// Issue 47, item 7: undoing back to the saved state still asked to
+    /// save. The state id names where the steps have led: undo back to it
+    /// gives the same id, a new edit after an undo another one, and an open
+    /// stroke with edits is never a saved state.
+    #[test]
+    fn the_state_id_comes_back_with_undo_and_never_repeats_for_new_edits() {
+        let (mut history, mut scene) = (History::default(), Scene::default());
+        history.clear();
+        let loaded = history.state_id();
+        place(&mut history, &mut scene, 0);
+        let saved = history.state_id();
+        assert_ne!(saved, loaded);
+        place(&mut history, &mut scene, 1);
+        assert_ne!(history.state_id(), saved);
+        history.undo(&mut scene).unwrap();
+        assert_eq!(history.state_id(), saved, "undo back to the saved state");
+        history.undo(&mut scene).unwrap();
+        assert_eq!(history.state_id(), loaded);
+        history.redo(&mut scene).unwrap();
+        assert_eq!(history.state_id(), saved, "redo to it");
+        place(&mut history, &mut scene, 2);
+        let other = history.state_id();
+        history.undo(&mut scene).unwrap();
+        place(&mut history, &mut scene, 5);
+        assert!(![loaded, saved, other].contains(&history.state_id()), "a new edit is a new state");
+        history.begin_stroke();
+        place(&mut history, &mut scene, 7);
+        assert_eq!(history.state_id(), u64::MAX);
+        history.end_stroke();
+        assert_ne!(history.state_id(), u64::MAX);
+        history.clear();
+        assert!(![loaded, saved, other].contains(&history.state_id()), "a new scene is none of the old states");
     }
 }

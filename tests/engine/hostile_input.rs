@@ -661,3 +661,21 @@ fn a_seed_without_samples_or_past_the_last_is_refused() {
     assert_refused(&render(&["--spp", "1", "--seed", "4096"]), "4096");
     assert!(!png.exists(), "a refused render wrote {}", png.display());
 }
+
+/// Issue 47, item 7: the CLI printed "error: XDG_RUNTIME_DIR is invalid…"
+/// twice and then succeeded (Mesa's device-select layer probing Wayland).
+/// A command run without XDG_RUNTIME_DIR now says nothing of it.
+#[test]
+fn a_render_without_a_runtime_dir_prints_no_driver_noise() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r.png");
+    let run = Command::new(env!("CARGO_BIN_EXE_octovox"))
+        .args(["render", s(&torus()), "-o", s(&out), "--size", "64x36"])
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("NODEVICE_SELECT")
+        .output()
+        .unwrap();
+    let text = text(&run);
+    assert!(run.status.success(), "{text}");
+    assert!(!text.contains("XDG_RUNTIME_DIR"), "{text}");
+}
