@@ -358,6 +358,7 @@ impl App {
             Command::ApplyPreset(i) => {
                 if let Some(preset) = presets::PRESETS.get(i) {
                     preset.apply(&mut self.state);
+                    report!("preset: {}", preset.name);
                 }
             }
             Command::MeasurePresets => self.measure_presets(),

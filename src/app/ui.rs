@@ -567,12 +567,13 @@ fn render(ui: &mut egui::Ui, state: &mut EditorState, stats: &Stats) {
     ui.spacing_mut().slider_width = 64.0;
     ui.add(egui::Slider::new(&mut settings.render_scale, 0.25..=1.0).text("Render scale"))
         .on_hover_text("--render-scale: the fraction of the window's pixels traced per axis");
-    ui.add(egui::Slider::new(&mut settings.lod, 0.0..=16.0).step_by(0.5).text("Level of detail (px)")).on_hover_text(
-        "--lod: the preview stops at octree cells narrower than this many pixels \
+    ui.add(egui::Slider::new(&mut settings.lod, 0.0..=16.0).step_by(0.5).text("Detail (px)")).on_hover_text(
+        "--lod, level of detail: the preview stops at octree cells narrower than this many pixels \
          and draws them as one solid cell (0 = exact; the path tracer is always exact)",
     );
-    ui.add(egui::Slider::new(&mut state.frame_target_ms, 10.0..=100.0).text("Frame target (ms)"))
-        .on_hover_text("frame time to hold while the camera moves: the render scale drops as far as needed");
+    ui.add(egui::Slider::new(&mut state.frame_target_ms, 10.0..=100.0).text("Frame (ms)")).on_hover_text(
+        "frame target: the frame time to hold while the camera moves (the render scale drops as far as needed)",
+    );
     path_tracing(ui, state, stats);
 }
 
@@ -586,14 +587,18 @@ fn quality(ui: &mut egui::Ui, measured: Option<&[super::presets::Measured]>, out
         }
     });
     egui::Grid::new("presets").num_columns(3).show(ui, |ui| {
+        ui.label("");
+        ui.label("ms");
+        ui.label("FLIP").on_hover_text("the error against the reference preset, from this camera");
+        ui.end_row();
         for (i, preset) in super::presets::PRESETS.iter().enumerate() {
             if ui.small_button(preset.name).clicked() {
                 out.push(Command::ApplyPreset(i));
             }
             match measured.and_then(|m| m.get(i)) {
                 Some(m) => {
-                    ui.label(format!("{:.0} ms", m.ms));
-                    ui.label(format!("FLIP {:.3}", m.flip));
+                    ui.label(format!("{:.0}", m.ms));
+                    ui.label(format!("{:.3}", m.flip));
                 }
                 None => {
                     ui.label("");
@@ -618,10 +623,17 @@ fn path_tracing(ui: &mut egui::Ui, state: &mut EditorState, stats: &Stats) {
             "--denoise: the accumulation filtered by its first hits (colour, face, depth) \
              and its variance; off: the raw samples",
         );
-        ui.label(noise_text(stats, state.sample_target)).on_hover_text(
-            "the raw samples' estimated noise: the RMS standard error of the displayed pixels \
-             (render --target-error stops on it)",
-        );
+        // Two lines' room whatever the text says, so nothing below moves
+        // when it changes (issue 47, item 2: a wrapped line pushed the
+        // preset buttons down 15 px under the pointer).
+        let height = 2.0 * ui.text_style_height(&egui::TextStyle::Body) + ui.spacing().item_spacing.y;
+        let (rect, _) = ui.allocate_exact_size(egui::vec2(ui.available_width(), height), Sense::hover());
+        ui.scope_builder(egui::UiBuilder::new().max_rect(rect), |ui| {
+            ui.add(egui::Label::new(noise_text(stats, state.sample_target)).wrap()).on_hover_text(
+                "the raw samples' estimated noise: the RMS standard error of the displayed pixels \
+                 (render --target-error stops on it)",
+            );
+        });
     });
 }
 
@@ -647,10 +659,10 @@ pub fn noise_text(stats: &Stats, sample_target: u32) -> String {
 fn path_knobs(ui: &mut egui::Ui, state: &mut EditorState) {
     let path = &mut state.path_settings;
     ui.add(egui::Slider::new(&mut path.bounces, 0..=16).text("Bounces")).on_hover_text("--bounces");
-    ui.add(egui::Slider::new(&mut path.shadow_samples, 1..=16).text("Shadow samples"))
+    ui.add(egui::Slider::new(&mut path.shadow_samples, 1..=16).text("Shadow rays"))
         .on_hover_text("--shadow-samples: shadow rays toward the sun and the emitters per hit");
-    ui.add(egui::Slider::new(&mut state.sample_target, 1..=4096).logarithmic(true).text("Samples per pixel"))
-        .on_hover_text("--spp: the path tracer stops at this many samples while the camera rests");
+    ui.add(egui::Slider::new(&mut state.sample_target, 1..=4096).logarithmic(true).text("Samples/px"))
+        .on_hover_text("--spp: samples per pixel; the path tracer stops there while the camera rests");
     ui.horizontal(|ui| {
         ui.checkbox(&mut path.sun, "Sun");
         egui::ComboBox::from_id_salt("sky").selected_text(format!("sky: {:?}", path.sky)).show_ui(ui, |ui| {
@@ -671,17 +683,20 @@ fn stats(ui: &mut egui::Ui, info: &Info) {
     let tree = info.scene.drawn();
     let pool = tree.pool();
     let trace = if info.timestamps { "GPU" } else { "wall" };
-    egui::Grid::new("stats").num_columns(2).show(ui, |ui| {
+    // Two columns that share the panel: a long value wraps in its own.
+    let column = (ui.available_width() - ui.spacing().item_spacing.x) / 2.0;
+    egui::Grid::new("stats").num_columns(2).max_col_width(column).show(ui, |ui| {
+        // Values wrap within the panel rather than run past its edge.
         let mut row = |name: &str, value: String| {
             ui.label(name);
-            ui.label(value);
+            ui.add(egui::Label::new(value).wrap());
             ui.end_row();
         };
         row("fps", format!("{:.1}", s.fps));
         row("frame", format!("{:.2} ms", s.frame_ms));
         row("trace", format!("{:.2} ms ({trace})", s.trace_ms));
         row("present", format!("{:.2} ms", s.present_ms));
-        row("  acquire · draw · submit", format!("{:.1} · {:.1} · {:.1} ms", s.acquire_ms, s.draw_ms, s.submit_ms));
+        row("  acq · draw · sub", format!("{:.1} · {:.1} · {:.1} ms", s.acquire_ms, s.draw_ms, s.submit_ms));
         row("panels", format!("{:.2} ms", s.panels_ms));
         row("scale", format!("{:.2}{}", s.scale, if s.moving { " (moving)" } else { "" }));
         if let Some(path) = &s.path {

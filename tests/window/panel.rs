@@ -61,3 +61,44 @@ fn choosing_a_brush_moves_no_palette_swatch() {
         assert_eq!(moved, 0, "choosing {name} changed {moved} pixels of the palette");
     }
 }
+
+/// The Render panel's presets after eight wheel notches down the panel of
+/// an 800×600 window (the sections above them keep their heights), and the
+/// strip of the panel they sit in.
+const PRESETS: [(&str, u32); 5] =
+    [("draft", 415), ("preview", 438), ("path: quick", 461), ("path: good", 484), ("reference", 507)];
+const PRESET_STRIP: (u32, u32, u32, u32) = (20, 400, 200, 520);
+
+/// Issue 47, item 2: a quick click on a preset did nothing, and after a
+/// preset switch a noise line wrapped and pushed the presets down 15 px, so
+/// the spot that meant "good" meant "reference". Every preset takes an
+/// instant move and a quick click (press and release at once), and after
+/// every switch the presets are where they were, pixel for pixel.
+#[test]
+fn every_preset_takes_a_quick_click_and_none_moves() {
+    require_window_tools();
+    let dir = tempfile::tempdir().unwrap();
+    let (_xvfb, display) = start_xvfb();
+    let args = ["--size".to_owned(), format!("{WIDTH}x{HEIGHT}")];
+    let (_app, mut lines, window) = open_ready(&display, dir.path(), &args);
+    lines.wait_for("noise: ", Duration::from_secs(90));
+    xdotool(&display, &["mousemove", "--window", &window, "200", "300"]);
+    std::thread::sleep(Duration::from_millis(300));
+    for _ in 0..8 {
+        xdotool(&display, &["click", "5"]);
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    let strip = |shot: &image::RgbImage| {
+        let (x0, y0, x1, y1) = PRESET_STRIP;
+        (y0..y1).flat_map(|y| (x0..x1).map(move |x| shot.get_pixel(x, y).0)).collect::<Vec<_>>()
+    };
+    let before = strip(&resting_shot(&display, &window, dir.path(), "presets-before"));
+    for (name, y) in PRESETS {
+        xdotool(&display, &["mousemove", "--window", &window, "48", &y.to_string(), "click", "1"]);
+        let applied = lines.wait_for("preset:", Duration::from_secs(20));
+        assert_eq!(applied, format!("preset: {name}"), "a quick click on {name}");
+        let after = strip(&resting_shot(&display, &window, dir.path(), &format!("presets-{name}")));
+        let moved = after.iter().zip(&before).filter(|(a, b)| a != b).count();
+        assert_eq!(moved, 0, "after {name}, {moved} pixels of the presets changed");
+    }
+}
