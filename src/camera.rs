@@ -103,6 +103,46 @@ impl Camera {
         Camera { eye: center + dir * distance, target: center, fov_y_deg, ortho: None }
     }
 
+    /// A camera looking at the box `min..=max` (voxel corners) from where
+    /// [`Camera::framing`] looks, as close as it can be with every point of
+    /// `points` (the corners of the voxels, or of the box) inside `FILL` of
+    /// an image of `aspect` (width / height): the model fills the frame, as
+    /// a final render wants (the bounding sphere [`Camera::framing`] fits
+    /// left a model about 40 % of it).
+    pub fn filling(min: IVec3, max: IVec3, points: &[DVec3], fov_y_deg: f32, aspect: f64) -> Camera {
+        /// The part of the half-frame the farthest point may reach.
+        const FILL: f64 = 0.9;
+        let framed = Camera::framing(min, max, fov_y_deg);
+        let (lo, hi) = (min.as_dvec3(), max.as_dvec3() + DVec3::ONE);
+        let center = (lo + hi) * 0.5;
+        let back = (framed.eye - framed.target).normalize();
+        let (forward, right, up) = Camera { eye: center + back, target: center, ..framed }.axes();
+        let tan_y = (f64::from(clamp_fov(fov_y_deg)).to_radians() * 0.5).tan();
+        let tan_x = tan_y * aspect.max(1e-3);
+        // Each point in the camera's axes, once: (along forward, right, up).
+        let relative: Vec<(f64, f64, f64)> =
+            points.iter().map(|p| *p - center).map(|c| (c.dot(forward), c.dot(right).abs(), c.dot(up).abs())).collect();
+        let fits = |distance: f64| {
+            relative.iter().all(|&(f, r, u)| {
+                let depth = distance + f;
+                depth > 0.0 && r <= FILL * depth * tan_x && u <= FILL * depth * tan_y
+            })
+        };
+        // The framing distance holds the whole box: bisect down to the
+        // nearest that still holds every point, never inside the box.
+        let radius = (hi - lo).length() * 0.5;
+        let (mut near, mut far) = (radius, (framed.eye - framed.target).length().max(radius * 4.0));
+        for _ in 0..40 {
+            let mid = 0.5 * (near + far);
+            if fits(mid) {
+                far = mid;
+            } else {
+                near = mid;
+            }
+        }
+        Camera { eye: center + back * far, target: center, fov_y_deg, ortho: None }
+    }
+
     /// This camera moved to show the whole box `min..=max` (voxel corners),
     /// as [`Camera::framing`] does, but keeping its viewing direction (and
     /// projection: an orthographic one gets the height that shows the box).

@@ -412,6 +412,36 @@ pub fn parse_camera(s: &str) -> Result<(DVec3, DVec3), String> {
     Ok((eye, target))
 }
 
+/// The camera given on the command line, or one that fills an image of
+/// `size` with the scene's box (what `render` takes by default).
+pub fn camera_or_filling(
+    camera: Option<(DVec3, DVec3)>,
+    fov: f32,
+    scene: &octovox::scene::Scene,
+    (width, height): (u32, u32),
+) -> Camera {
+    /// Past this many cells the box's corners stand for the voxels'.
+    const MOST_CELLS: usize = 1 << 18;
+    let (None, Some((lo, hi))) = (camera, scene.solid_bounds()) else { return camera_or_framing(camera, fov, scene) };
+    let mut points = Vec::new();
+    let mut cells = 0usize;
+    scene.drawn().for_each_solid_cell(|min, size, _| {
+        cells += 1;
+        if cells <= MOST_CELLS {
+            let (a, b) = (min.as_dvec3(), (min + glam::IVec3::splat(size)).as_dvec3());
+            points.extend(
+                (0..8).map(|k| DVec3::new([a.x, b.x][k & 1], [a.y, b.y][(k >> 1) & 1], [a.z, b.z][(k >> 2) & 1])),
+            );
+        }
+    });
+    if cells > MOST_CELLS {
+        let (a, b) = (lo.as_dvec3(), (hi + glam::IVec3::ONE).as_dvec3());
+        points =
+            (0..8).map(|k| DVec3::new([a.x, b.x][k & 1], [a.y, b.y][(k >> 1) & 1], [a.z, b.z][(k >> 2) & 1])).collect();
+    }
+    Camera::filling(lo, hi, &points, fov, f64::from(width) / f64::from(height.max(1)))
+}
+
 /// The camera given on the command line, or one framing the scene.
 pub fn camera_or_framing(camera: Option<(DVec3, DVec3)>, fov: f32, scene: &octovox::scene::Scene) -> Camera {
     match camera {

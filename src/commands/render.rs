@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use anyhow::Context;
 
-use crate::cli::{PathArgs, RenderArgs, camera_or_framing};
+use crate::cli::{PathArgs, RenderArgs, camera_or_filling};
 use octovox::camera::Camera;
 use octovox::gpu::{PathView, Renderer};
 use octovox::io::atomic::WriteOptions;
@@ -71,7 +71,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<ExitCode> {
     };
     octovox::budget::check(|| format!("a {}x{} render", args.size.0, args.size.1), pixels * per_pixel)?;
     let mut scene = open_scene(args.file.as_deref(), args.frame, args.demo)?;
-    let camera = Camera { ortho: args.ortho, ..camera_or_framing(args.camera, args.fov, &scene) };
+    let camera = Camera { ortho: args.ortho, ..camera_or_filling(args.camera, args.fov, &scene, args.size) };
     let traced = octovox::settings::scaled_size(args.size, args.render_scale);
     let (image, stats) = if traced_path {
         path_traced(&mut scene, &camera, args, traced)?

@@ -178,3 +178,34 @@ fn orthographic_renders_do_not_depend_on_the_eye_distance() {
     let perspective = render("p.png", near, &[]);
     assert!(octovox::io::png::differing_fraction(&perspective, &gpu[1]) > 0.1);
 }
+
+/// Issue 47, item 8: `render` without `--camera` framed the bounding
+/// sphere, and the model filled about 40 % of the frame. It now frames the
+/// voxels themselves: in a normals image (black where no voxel is), the
+/// model spans at least 60 % of the frame's shorter side, and touches no
+/// edge.
+#[test]
+fn a_default_render_fills_the_frame_with_the_model() {
+    let dir = tempfile::tempdir().unwrap();
+    for model in ["seed/torus64.vox", "seed/teapot256.vox", "magicavoxel/chr_knight.vox", "magicavoxel/monu1.vox"] {
+        let out = dir.path().join("normals.png");
+        let file = common::assets().join("vox").join(model);
+        let run = std::process::Command::new(env!("CARGO_BIN_EXE_octovox"))
+            .args(["render", file.to_str().unwrap(), "--cpu", "--view", "normals", "--size", "160x90", "--force"])
+            .arg("-o")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(run.status.success(), "{model}: {}", String::from_utf8_lossy(&run.stderr));
+        let image = image::open(&out).unwrap().to_rgb8();
+        let solid: Vec<(u32, u32)> =
+            image.enumerate_pixels().filter(|(_, _, p)| p.0 != [0, 0, 0]).map(|(x, y, _)| (x, y)).collect();
+        let span = |pick: fn(&(u32, u32)) -> u32| {
+            solid.iter().map(pick).max().unwrap() - solid.iter().map(pick).min().unwrap() + 1
+        };
+        let (width, height) = (span(|p| p.0), span(|p| p.1));
+        assert!(width.max(height) as f64 >= 0.6 * 90.0, "{model}: {width}×{height} of 160×90");
+        let touches = solid.iter().any(|&(x, y)| x == 0 || y == 0 || x == 159 || y == 89);
+        assert!(!touches, "{model} is cut by the frame's edge");
+    }
+}

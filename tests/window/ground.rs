@@ -15,11 +15,18 @@ use octovox::trace::pick;
 /// The working volume of a new scene (`DEFAULT_VOLUME` in src/app/state.rs).
 const VOLUME: i32 = 32;
 
-/// The camera New leaves: the default one, framing the working volume with
-/// a margin of half its side (as src/app/files.rs does).
+/// The camera New leaves: the default one framing the working volume, then
+/// panned by half the left panel's 236 points so the volume sits in the
+/// view's middle (as src/app/files.rs and `App::frame_box` do).
 fn new_scene_camera() -> Camera {
-    let (side, half) = (VOLUME, VOLUME / 2);
-    Camera::default().reframed(IVec3::new(-side, -half, -side), IVec3::new(side - 1, side + half - 1, side - 1))
+    let half = VOLUME / 2;
+    let lo = IVec3::new(-half, 0, -half);
+    let mut camera = Camera::default().reframed(lo, lo + IVec3::splat(VOLUME - 1));
+    let (_, right, _) = camera.axes();
+    let shift = -right * 118.0 * camera.view_height() / f64::from(HEIGHT);
+    camera.eye += shift;
+    camera.target += shift;
+    camera
 }
 
 /// A pixel clear of the panels whose 5×5 neighbourhood lands on one ground

@@ -477,6 +477,9 @@ fn the_outliner_shows_an_objects_layer_and_moves_it() {
     let node = objects.list()[index].transform_node.unwrap();
     let (_xvfb, display) = start_xvfb();
     let (_app, mut lines, window) = open_ready(&display, dir.path(), &document_args(&file, &camera, &[]));
+    // Past the first path-traced frames, whose kernels compile on lavapipe:
+    // the menu must be up before the second click.
+    lines.wait_for("noise: ", Duration::from_secs(90));
     let (row, depth) = outline_row(objects, index);
     let (x, y) = (EYE_X + INDENT * depth + LAYER_FROM_EYE, FIRST_ROW_Y + ROW_PITCH * row);
     xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y.to_string()]);
