@@ -31,7 +31,10 @@ fn main() -> ExitCode {
 /// way the layer documents (`NODEVICE_SELECT=1`), unless the user set it.
 fn quiet_device_select() {
     let runtime_dir = std::env::var_os("XDG_RUNTIME_DIR").filter(|d| std::path::Path::new(d).is_dir());
-    if runtime_dir.is_some() || std::env::var_os("NODEVICE_SELECT").is_some() {
+    // A user's own choice of GPU goes through the layer: leave it on then.
+    let chosen =
+        ["NODEVICE_SELECT", "MESA_VK_DEVICE_SELECT", "DRI_PRIME"].iter().any(|v| std::env::var_os(v).is_some());
+    if runtime_dir.is_some() || chosen {
         return;
     }
     log::debug!("XDG_RUNTIME_DIR is not set: Mesa's device-select layer is turned off (NODEVICE_SELECT=1)");

@@ -237,7 +237,9 @@ impl App {
                 self.doc.recent.add(path);
                 report!("saved: {}", path.display());
                 self.state.dirty = false;
-                self.state.saved_state = Some(self.doc.editor.history.state_id());
+                // Saved in the middle of a stroke: the state the stroke
+                // ends in gets a new id, so it will count as unsaved.
+                self.state.saved_state = Some(self.doc.editor.history.state_id()).filter(|&id| id != u64::MAX);
                 // The file now holds every edit: the journal starts again from it.
                 self.close_journal();
                 let absolute = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());

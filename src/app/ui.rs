@@ -825,12 +825,15 @@ fn replace_prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Com
             }
             if ui.button("Cancel").clicked() {
                 ui_state.replace = None;
+                // What waited for the save (a Quit, an Open) waits no more.
+                ui_state.pending = None;
             }
         });
     });
     // Escape or a click outside cancels, as Cancel does.
     if modal.should_close() {
         ui_state.replace = None;
+        ui_state.pending = None;
     }
 }
 

@@ -7,8 +7,6 @@
 
 use super::{GpuContext, GpuError};
 
-const BLIT_WGSL: &str = include_str!("../../shaders/blit.wgsl");
-
 /// How the blit meets what the target already holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BlitMode {
@@ -30,7 +28,7 @@ impl BlitPass {
     /// A blit into targets of `target_format`.
     pub fn new(gpu: &GpuContext, target_format: wgpu::TextureFormat, mode: BlitMode) -> Result<BlitPass, GpuError> {
         let device = &gpu.device;
-        let module = gpu.shader("blit.wgsl", BLIT_WGSL)?;
+        let module = gpu.module(super::shaders::Module::Blit)?;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("blit bind group layout"),
             entries: &[

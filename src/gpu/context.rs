@@ -92,6 +92,11 @@ impl GpuContext {
         Ok(GpuContext { instance, adapter, device, queue, adapter_name, timestamps: !features.is_empty() })
     }
 
+    /// Compiles one of octovox's shader modules ([`super::shaders`]).
+    pub fn module(&self, module: super::shaders::Module) -> Result<wgpu::ShaderModule, GpuError> {
+        self.shader(module.label(), &module.source())
+    }
+
     /// Compiles WGSL; a bad shader is an error value instead of a crash.
     pub fn shader(&self, name: &str, source: &str) -> Result<wgpu::ShaderModule, GpuError> {
         self.validated(name, |device| {

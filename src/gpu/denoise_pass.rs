@@ -7,12 +7,11 @@ use super::context::compute_pipeline;
 use super::layout::{
     DenoiseUniforms, buffer_entry, buffer_resource, constants_buffer, constants_entry, output_entry, output_texture,
 };
-use super::prelude::with_prelude;
 use super::readback::{read_storage, read_texture_rgba8};
+use super::shaders::Module;
 use super::{GpuContext, GpuError, PathPass};
 use crate::trace::denoise::{Frame, ITERATIONS};
 
-const DENOISE_WGSL: &str = include_str!("../../shaders/denoise.wgsl");
 /// The dispatches of a filter: `prepare`, the iterations, `finish`.
 pub const STAGES: usize = ITERATIONS as usize + 2;
 /// The side of a workgroup, in pixels (`@workgroup_size(8, 8)`).
@@ -77,7 +76,7 @@ impl DenoisePass {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let module = gpu.shader("denoise.wgsl", &with_prelude(&[DENOISE_WGSL]))?;
+        let module = gpu.module(Module::Denoise)?;
         let pipeline = |entry: &str| compute_pipeline(device, &pipeline_layout, &module, entry, &[], "denoiser");
         Ok(DenoisePass {
             prepare: pipeline("prepare")?,

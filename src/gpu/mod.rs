@@ -10,6 +10,7 @@ pub mod prelude;
 pub mod readback;
 pub mod renderer;
 pub mod scene_buffers;
+pub mod shaders;
 pub mod timer;
 pub mod trace_pass;
 

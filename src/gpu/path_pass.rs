@@ -20,19 +20,14 @@ use super::layout::{
     FrameUniforms, PathUniforms, buffer_entry, buffer_resource, constants_buffer, constants_entry, output_entry,
     output_texture,
 };
-use super::prelude::with_prelude;
 use super::readback::{read_storage, read_texture_rgba8};
+use super::shaders::Module;
 use super::{GpuContext, GpuError, SceneBuffers};
 use crate::camera::RayBasis;
 use crate::settings::PathSettings;
 use crate::trace::denoise::{Guide, Sums};
 use crate::trace::path::lights::Emitter;
 use crate::trace::path::materials::{Effects, GpuMaterial};
-
-const COMMON_WGSL: &str = include_str!("../../shaders/common.wgsl");
-const SVO_WGSL: &str = include_str!("../../shaders/trace_svo.wgsl");
-const INSTANCES_WGSL: &str = include_str!("../../shaders/instances.wgsl");
-const PATH_WGSL: &str = include_str!("../../shaders/path.wgsl");
 
 /// A kernel: compiled, or being compiled on a worker thread.
 enum Compiled {
@@ -211,7 +206,7 @@ impl PathPass {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let module = gpu.shader("path.wgsl", &with_prelude(&[COMMON_WGSL, SVO_WGSL, INSTANCES_WGSL, PATH_WGSL]))?;
+        let module = gpu.module(Module::Path)?;
         let frame_buf = constants_buffer(device, "path frame uniforms", std::mem::size_of::<FrameUniforms>());
         let path_buf = constants_buffer(device, "path uniforms", std::mem::size_of::<PathUniforms>());
         let materials_buf =

@@ -7,17 +7,11 @@ use super::context::compute_pipeline;
 use super::layout::{
     FLOOR_ROW, FrameUniforms, ROW_TILES, buffer_entry, constants_buffer, constants_entry, output_entry, output_texture,
 };
-use super::prelude::with_prelude;
 use super::readback::{read_storage, read_texture_rgba8};
+use super::shaders::Module;
 use super::{GpuContext, GpuError, SceneBuffers};
 use crate::settings::{RenderSettings, TraceMode};
 use crate::trace::Hit;
-
-const COMMON_WGSL: &str = include_str!("../../shaders/common.wgsl");
-const SVO_WGSL: &str = include_str!("../../shaders/trace_svo.wgsl");
-const INSTANCES_WGSL: &str = include_str!("../../shaders/instances.wgsl");
-const GRID_WGSL: &str = include_str!("../../shaders/trace_grid.wgsl");
-const FLOOR_WGSL: &str = include_str!("../../shaders/floor.wgsl");
 
 /// What a frame dispatches.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -121,8 +115,8 @@ impl TracePass {
             bind_group_layouts: &[Some(&layout), Some(&args_layout)],
             immediate_size: 0,
         });
-        let svo = gpu.shader("trace_svo.wgsl", &with_prelude(&[COMMON_WGSL, SVO_WGSL, INSTANCES_WGSL]))?;
-        let grid = gpu.shader("trace_grid.wgsl", &with_prelude(&[COMMON_WGSL, GRID_WGSL]))?;
+        let svo = gpu.module(Module::TraceSvo)?;
+        let grid = gpu.module(Module::TraceGrid)?;
         let pipeline = |module, entry, constants: &[(&str, f64)], label| {
             compute_pipeline(&gpu.device, &pipeline_layout, module, entry, constants, label)
         };
@@ -134,7 +128,7 @@ impl TracePass {
         let exact = svo_kernels(&gpu.device, &pipeline_layout, &svo, (false, false))?;
         let tile_dispatch =
             compute_pipeline(&gpu.device, &args_pipeline_layout, &svo, "tile_dispatch", &[tile], "tile dispatch")?;
-        let floor_module = gpu.shader("floor.wgsl", &with_prelude(&[COMMON_WGSL, FLOOR_WGSL]))?;
+        let floor_module = gpu.module(Module::Floor)?;
         let floor = pipeline(&floor_module, "main", &[], "floor")?;
         let uniform_buf = constants_buffer(device, "frame uniforms", std::mem::size_of::<FrameUniforms>());
         let target = Self::make_target(device, 1, 1, false);

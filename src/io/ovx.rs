@@ -464,7 +464,7 @@ fn read_objects(input: &mut Payload, room: u64) -> Result<(Objects, Octree, u64)
     }
     let bytes = input.items::<u8>(len, |_, _| Ok(()))?;
     let frame = usize::try_from(frame).map_err(|_| corrupt(format!("frame {frame}")))?;
-    let scene = super::vox::load_vox_scene(&bytes, frame).map_err(|e| corrupt(format!("its objects: {e}")))?.0;
+    let scene = super::vox::load_vox_objects(&bytes, frame).map_err(|e| corrupt(format!("its objects: {e}")))?.0;
     let composed = scene.drawn().clone();
     let objects = scene.into_objects().ok_or_else(|| corrupt("its objects section holds a single model"))?;
     let left = room - OBJECTS_HEADER_BYTES - len;

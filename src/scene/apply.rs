@@ -419,13 +419,13 @@ impl Octree {
         }
     }
 
-    /// Makes every voxel of the cube `min..min + size` inside the root hold
-    /// `value` (1..=255), writing uniform words where the cube covers whole
+    /// Makes every voxel of the box `min..=max` inside the root hold
+    /// `value` (1..=255), writing uniform words where the box covers whole
     /// cells: what composing a scene of objects copies a model's uniform
     /// cells with, so that a big solid region costs its surface, not its
     /// volume. Nothing is recorded for undo (the models hold the truth).
-    pub fn fill_cube(&mut self, min: IVec3, size: i32, value: u8) {
-        let shape = Shape::Box { min, max: min + IVec3::splat(size - 1) };
+    pub fn fill_box(&mut self, min: IVec3, max: IVec3, value: u8) {
+        let shape = Shape::Box { min, max };
         let mut scratch = Patch::default();
         self.root = self.brush_word(self.root, self.origin, self.depth, &shape, Op::Place(value), &mut scratch);
     }

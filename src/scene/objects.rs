@@ -326,7 +326,11 @@ impl Objects {
         }
         let local = self.maps[index].invert_shape(shape);
         let patch = self.models[model].tree.apply_brush(&local, op)?;
-        self.recompose_model(tree, model, local.bounds())?;
+        // Nothing changed (a delete over cells another placement of the
+        // model already emptied): nothing to compose again.
+        if patch.bounds().is_some() {
+            self.recompose_model(tree, model, local.bounds())?;
+        }
         Ok((model, patch))
     }
 
@@ -909,30 +913,25 @@ impl GraphChange {
     }
 }
 
-/// Min corners of the boxes of at most [`COMPOSE_BOX`] a side that tile `lo..=hi`.
 /// Writes the solid cells of `from` inside its box `lo..=hi` into `to`
 /// (which holds where they go), each cell `p` at `map(p)`, over what is
 /// there; `map` is a signed permutation and a shift (a cell map or a chain
-/// of them). A uniform cell wholly inside the box goes in as one cube (a
-/// signed permutation maps a cube onto a cube), so a solid region costs its
-/// surface; single voxels and cells the box cuts go in batches of at most
-/// [`PLACED_BATCH`], so memory stays small whatever the model.
+/// of them). The part of a uniform cell in the box goes in as one box (a
+/// signed permutation maps a box onto a box), so a solid region costs its
+/// surface; single voxels go in batches of at most [`PLACED_BATCH`], so
+/// memory stays small whatever the model.
 fn copy_cells(from: &Octree, (lo, hi): (IVec3, IVec3), to: &mut Octree, map: impl Fn(IVec3) -> IVec3) {
     let mut batch: Vec<(IVec3, u8)> = Vec::new();
     from.for_each_solid_cell_in(lo, hi, |min, size, value| {
-        let max = min + IVec3::splat(size - 1);
-        if size > 1 && min.cmpge(lo).all() && max.cmple(hi).all() {
-            to.fill_cube(map(min).min(map(max)), size, value);
+        // The part of the cell in the box: one box of one value, which a
+        // signed permutation maps onto a box.
+        let (clo, chi) = (min.max(lo), (min + IVec3::splat(size - 1)).min(hi));
+        if clo != chi {
+            let (a, b) = (map(clo), map(chi));
+            to.fill_box(a.min(b), a.max(b), value);
             return;
         }
-        let (clo, chi) = (min.max(lo), max.min(hi));
-        for z in clo.z..=chi.z {
-            for y in clo.y..=chi.y {
-                for x in clo.x..=chi.x {
-                    batch.push((map(IVec3::new(x, y, z)), value));
-                }
-            }
-        }
+        batch.push((map(clo), value));
         if batch.len() >= PLACED_BATCH {
             to.insert_voxels(&batch);
             batch.clear();
@@ -941,6 +940,7 @@ fn copy_cells(from: &Octree, (lo, hi): (IVec3, IVec3), to: &mut Octree, map: imp
     to.insert_voxels(&batch);
 }
 
+/// Min corners of the boxes of at most [`COMPOSE_BOX`] a side that tile `lo..=hi`.
 fn boxes_of(lo: IVec3, hi: IVec3) -> Vec<IVec3> {
     let steps = |a: i32, b: i32| (a..=b).step_by(COMPOSE_BOX as usize);
     let mut out = Vec::new();

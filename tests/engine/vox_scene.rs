@@ -889,3 +889,28 @@ fn a_selection_acts_on_every_object_it_covers() {
         assert_eq!(editor.scene.voxels(), before, "{line} changed nothing");
     }
 }
+
+/// A scene of one object whose graph says no more than where its model is
+/// (what `object unlock` or a turn back can leave) saved as .ovx: its
+/// objects section reads back as objects, not refused as "a single model".
+#[test]
+fn an_ovx_of_one_plain_object_opens() {
+    let mut plain = Scene::default();
+    plain
+        .apply_brush(
+            &octovox::scene::Shape::Box { min: glam::IVec3::ZERO, max: glam::IVec3::splat(3) },
+            octovox::scene::Op::Place(7),
+        )
+        .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let vox = dir.path().join("plain.vox");
+    octovox::io::save_scene(&vox, &plain, Default::default()).unwrap();
+    let bytes = std::fs::read(&vox).unwrap();
+    assert!(load(&bytes).objects().is_none(), "octovox's own plain file loads as one model");
+    let one = octovox::io::vox::load_vox_objects(&bytes, 0).unwrap().0;
+    assert_eq!(one.objects().unwrap().list().len(), 1);
+    let ovx = dir.path().join("one.ovx");
+    octovox::io::save_scene(&ovx, &one, Default::default()).unwrap();
+    let again = octovox::io::load_scene(&ovx, 0).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(again.voxels(), plain.voxels());
+}

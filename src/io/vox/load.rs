@@ -87,6 +87,20 @@ pub struct VoxMeta {
 /// # Errors
 /// As [`load_vox`].
 pub fn load_vox_scene(bytes: &[u8], frame: usize) -> Result<(Scene, VoxMeta), VoxError> {
+    load_scene_as(bytes, frame, false)
+}
+
+/// [`load_vox_scene`], keeping the objects whatever the file is: what an
+/// .ovx's objects section is read with (a scene of objects saved it, even
+/// one whose graph has become plain).
+///
+/// # Errors
+/// As [`load_vox`].
+pub fn load_vox_objects(bytes: &[u8], frame: usize) -> Result<(Scene, VoxMeta), VoxError> {
+    load_scene_as(bytes, frame, true)
+}
+
+fn load_scene_as(bytes: &[u8], frame: usize, keep_objects: bool) -> Result<(Scene, VoxMeta), VoxError> {
     let parsed = parse(bytes, frame)?;
     let visible = || parsed.objects.iter().filter(|o| !o.hidden).map(|o| &o.placement);
     let largest = visible().map(|p| parsed.layout.model_voxels[p.model]).max().unwrap_or(0);
@@ -97,7 +111,7 @@ pub fn load_vox_scene(bytes: &[u8], frame: usize) -> Result<(Scene, VoxMeta), Vo
         largest as u64 * BYTES_PER_STREAMED_VOXEL + (total + stored) as u64 * POOL_BYTES_PER_VOXEL,
     )?;
     let (palette, meta) = parsed.palette_and_meta();
-    if parsed.keeps_objects() {
+    if keep_objects || parsed.keeps_objects() {
         let objects = parsed.into_objects(frame)?;
         let scene = Scene::compose(palette, objects).map_err(|e| VoxError::BadSceneGraph(e.to_string()))?;
         return Ok((scene, meta));
@@ -187,6 +201,24 @@ impl Parsed {
             || self.objects.iter().any(|o| o.hidden)
             || !self.layout.kept.is_empty()
             || !is_plain(&self.layout.graph)
+            || !self.tight()
+    }
+
+    /// Whether the model's grid is its voxels' box: a bare model is saved
+    /// cropped to its voxels, so a grid with empty margins (MagicaVoxel's
+    /// box) is kept by keeping the objects.
+    fn tight(&self) -> bool {
+        self.data.models.iter().all(|model| {
+            let fold = |f: fn(u8, u8) -> u8, start: u8, axis: fn(&dot_vox::Voxel) -> u8| {
+                model.voxels.iter().map(axis).fold(start, f)
+            };
+            let axes: [fn(&dot_vox::Voxel) -> u8; 3] = [|v| v.x, |v| v.y, |v| v.z];
+            let size = [model.size.x, model.size.y, model.size.z];
+            model.voxels.is_empty()
+                || axes.iter().zip(size).all(|(&axis, edge)| {
+                    fold(u8::min, u8::MAX, axis) == 0 && u32::from(fold(u8::max, 0, axis)) + 1 == edge
+                })
+        })
     }
 
     /// The models as octrees in their own grids, the graph and the kept chunks.
@@ -222,8 +254,10 @@ fn is_plain(graph: &crate::scene::graph::SceneGraph) -> bool {
     let plain_node = |node: &crate::scene::graph::Node| {
         node.attributes.is_empty()
             && match &node.kind {
-                NodeKind::Transform { frames, .. } => {
-                    frames.len() <= 1 && frames.iter().all(|f| f.keys().all(|k| k == "_t"))
+                NodeKind::Transform { frames, layer, .. } => {
+                    frames.len() <= 1
+                        && frames.iter().all(|f| f.keys().all(|k| k == "_t"))
+                        && (*layer == 0 || *layer == u32::MAX)
                 }
                 NodeKind::Group { .. } => true,
                 NodeKind::Shape { models } => models.len() == 1 && models[0].1.is_empty(),

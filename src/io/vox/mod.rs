@@ -19,7 +19,7 @@ mod validate;
 
 use std::path::PathBuf;
 
-pub use load::{VoxMeta, load_vox, load_vox_file, load_vox_scene, load_vox_scene_file};
+pub use load::{VoxMeta, load_vox, load_vox_file, load_vox_objects, load_vox_scene, load_vox_scene_file};
 pub use save::{encode_objects, encode_vox, save_objects, save_tree, save_vox};
 
 /// Most voxels one load may produce (after scene-graph instancing).
