@@ -59,3 +59,153 @@ impl Module {
         }
     }
 }
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use std::mem::{offset_of, size_of};
+
+    use super::Module;
+    use crate::gpu::layout::{DenoiseUniforms, FrameUniforms, PathUniforms};
+    use crate::trace::path::lights::Emitter;
+    use crate::trace::path::materials::GpuMaterial;
+    use wgpu::naga;
+
+    /// A Rust struct that a WGSL struct of the same name in `module` must
+    /// match byte for byte: its size and each member's offset.
+    struct Twin {
+        module: Module,
+        wgsl: &'static str,
+        size: usize,
+        offsets: Vec<(&'static str, usize)>,
+    }
+
+    macro_rules! twin {
+        ($module:expr, $wgsl:literal, $ty:ty, [$($field:ident),* $(,)?]) => {
+            Twin {
+                module: $module,
+                wgsl: $wgsl,
+                size: size_of::<$ty>(),
+                offsets: vec![$((stringify!($field), offset_of!($ty, $field))),*],
+            }
+        };
+    }
+
+    fn twins() -> Vec<Twin> {
+        vec![
+            twin!(
+                Module::TraceSvo,
+                "FrameUniforms",
+                FrameUniforms,
+                [
+                    eye,
+                    root,
+                    forward,
+                    depth,
+                    right,
+                    view,
+                    up,
+                    width,
+                    grid_min,
+                    height,
+                    grid_dims,
+                    highlight_on,
+                    highlight_min,
+                    hit_records,
+                    highlight_max,
+                    brick_base,
+                    max_iterations,
+                    lod_per_t,
+                    ortho,
+                    lod_at_start,
+                    ground_on,
+                    ground_step,
+                    ground_y,
+                    ground_x0,
+                    ground_x1,
+                    ground_z0,
+                    ground_z1,
+                    instance_nodes,
+                ]
+            ),
+            twin!(
+                Module::Path,
+                "PathUniforms",
+                PathUniforms,
+                [
+                    sky_horizon,
+                    sample_index,
+                    sky_zenith,
+                    bounces,
+                    shadow_samples,
+                    emitter_count,
+                    first_row,
+                    end_row,
+                    first_sample,
+                ]
+            ),
+            twin!(
+                Module::Denoise,
+                "DenoiseUniforms",
+                DenoiseUniforms,
+                [eye, width, forward, height, at_start, per_t, step, light,]
+            ),
+            twin!(Module::Path, "Material", GpuMaterial, [kind, roughness, metalness, ior, transparency, emission]),
+            twin!(Module::Path, "Emitter", Emitter, [min, size, cdf, index]),
+        ]
+    }
+
+    /// The members of struct `name` in `module`'s WGSL, as naga lays them
+    /// out (name, offset), and its size.
+    fn wgsl_layout(module: &naga::Module, name: &str) -> (Vec<(String, u32)>, u32) {
+        let (_, ty) = module.types.iter().find(|(_, ty)| ty.name.as_deref() == Some(name)).unwrap();
+        let naga::TypeInner::Struct { members, span } = &ty.inner else { panic!("{name} is not a struct") };
+        (members.iter().map(|m| (m.name.clone().unwrap_or_default(), m.offset)).collect(), *span)
+    }
+
+    /// Issue 46, item 4: `FrameUniforms` had no size or offset check (only
+    /// `PathUniforms` had one). Every struct the passes bind is parsed from
+    /// the WGSL the GPU compiles, and its size and every member's offset
+    /// must equal the Rust twin's; a WGSL member the twin lacks fails too
+    /// (`_pad…` members excepted: the twin pads as it likes).
+    #[test]
+    fn every_bound_struct_matches_its_rust_twin_byte_for_byte() {
+        for twin in twins() {
+            let source = twin.module.source();
+            let module =
+                naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{}: {e}", twin.module.label()));
+            let (members, span) = wgsl_layout(&module, twin.wgsl);
+            assert_eq!(span as usize, twin.size, "{}: WGSL size {span}, Rust {}", twin.wgsl, twin.size);
+            for (name, offset) in members.iter().filter(|(name, _)| !name.starts_with("_pad")) {
+                let rust = twin.offsets.iter().find(|(field, _)| field == name).map(|(_, at)| *at);
+                assert_eq!(rust, Some(*offset as usize), "{}.{name}: WGSL offset {offset}, Rust {rust:?}", twin.wgsl);
+            }
+        }
+    }
+
+    /// Every module parses, and none binds two variables to one slot (the
+    /// path module concatenates trace_svo.wgsl and path.wgsl: a binding one
+    /// uses and the other reuses would collide the day an entry point
+    /// used both).
+    #[test]
+    fn no_module_binds_two_variables_to_one_slot() {
+        for module in Module::ALL {
+            let parsed = naga::front::wgsl::parse_str(&module.source()).unwrap_or_else(|e| panic!("{module:?}: {e}"));
+            let mut seen = std::collections::HashMap::new();
+            for (_, var) in parsed.global_variables.iter() {
+                if let Some(binding) = &var.binding {
+                    let name = var.name.clone().unwrap_or_default();
+                    if let Some(other) = seen.insert((binding.group, binding.binding), name.clone()) {
+                        // Known: path.wgsl's `guides` and trace_svo.wgsl's
+                        // `traced` share binding 12; no entry point uses both.
+                        let pair = [other.as_str(), name.as_str()];
+                        assert!(
+                            pair.contains(&"guides") && pair.contains(&"traced"),
+                            "{module:?}: {pair:?} share {binding:?}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
