@@ -187,7 +187,8 @@ pub struct RenderArgs {
     pub output: PathBuf,
     #[arg(long, value_parser = parse_size, default_value = "1280x720")]
     pub size: (u32, u32),
-    /// EX,EY,EZ:TX,TY,TZ; without it, a camera that frames the whole model.
+    /// EX,EY,EZ:TX,TY,TZ; without it, a camera from the front-right-top that
+    /// brings the model as close as it can with all of it in the frame.
     #[arg(long, value_parser = parse_camera, allow_hyphen_values = true)]
     pub camera: Option<(DVec3, DVec3)>,
     /// Vertical field of view in degrees (1..=179).
