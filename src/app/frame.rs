@@ -208,7 +208,10 @@ impl App {
         let acquired = Instant::now();
         let device = gfx.renderer.gpu.device.clone();
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
-        let wants_path = path_traced(&self.state, self.frames.motion.moving());
+        // While a file loads, previews only: a path-traced sample of a big
+        // view takes seconds on a CPU adapter, and the closed prompt or the
+        // progress would not show until it ended (issue 47, item 6).
+        let wants_path = path_traced(&self.state, self.frames.motion.moving()) && self.doc.loading.is_none();
         let (scene, state) = (&self.doc.editor.scene, &self.state);
         let view = PathView { scene, camera: &state.camera, size: trace_size, settings: &state.path_settings };
         // Select mode tints the selected voxels in path-traced frames too
