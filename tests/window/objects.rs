@@ -137,15 +137,7 @@ fn object_edits_survive_a_kill() {
     // Before object lines were journaled, this hide was lost at recovery.
     xdotool(&display, &["key", "ctrl+h"]);
     lines.wait_for("object:", Duration::from_secs(30));
-    app.0.kill().unwrap();
-    app.0.wait().unwrap();
-
-    let recovered = dir.path().join("recovered.vox");
-    let run = std::process::Command::new(env!("CARGO_BIN_EXE_octovox"))
-        .args(["recover", file.to_str().unwrap(), "-o", recovered.to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let recovered = kill_and_recover(&mut app, dir.path(), &file);
     let mut expected = before;
     expected[model] += 1;
     assert_eq!(model_sizes(&recovered), expected, "the attached voxel is in model {model}");
@@ -280,6 +272,34 @@ const LAYER_NAME_X: u32 = OUTLINER_X + 112;
 /// Rows shown without scrolling the Outliner.
 const ROWS_SHOWN: usize = 14;
 
+/// A double click on the first layer's name in the Layers panel, `name`
+/// typed over it and Enter; waits for the change.
+fn rename_first_layer(display: &str, window: &str, lines: &mut Lines, name: &str) {
+    let (x, y) = (LAYER_NAME_X.to_string(), FIRST_LAYER_Y.to_string());
+    xdotool(display, &["mousemove", "--window", window, &x, &y]);
+    std::thread::sleep(Duration::from_millis(300));
+    xdotool(display, &["click", "--repeat", "2", "--delay", "80", "1"]);
+    std::thread::sleep(Duration::from_millis(500));
+    xdotool(display, &["key", "ctrl+a"]);
+    xdotool(display, &["type", name]);
+    xdotool(display, &["key", "Return"]);
+    lines.wait_for("layer:", Duration::from_secs(30));
+}
+
+/// Kills the window (its journal stays) and runs `octovox recover` on
+/// `file`; the recovered file's path.
+fn kill_and_recover(app: &mut KillOnDrop, dir: &std::path::Path, file: &std::path::Path) -> std::path::PathBuf {
+    app.0.kill().unwrap();
+    app.0.wait().unwrap();
+    let recovered = dir.join("recovered.vox");
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_octovox"))
+        .args(["recover", file.to_str().unwrap(), "-o", recovered.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(run.status.success(), "recover: {}", String::from_utf8_lossy(&run.stderr));
+    recovered
+}
+
 /// Object `index`'s row in the Outliner (from the top), and its depth.
 fn outline_row(objects: &octovox::scene::objects::Objects, index: usize) -> (u32, u32) {
     use octovox::scene::graph::OutlineRow;
@@ -388,15 +408,7 @@ fn the_outliner_eye_hides_an_object_and_a_drag_regroups_it() {
         data.layers[0].attributes.get("_name").cloned()
     };
     assert_ne!(layer_name(&file).as_deref(), Some("forest"));
-    let (x, y) = (LAYER_NAME_X.to_string(), FIRST_LAYER_Y.to_string());
-    xdotool(&display, &["mousemove", "--window", &window, &x, &y]);
-    std::thread::sleep(Duration::from_millis(300));
-    xdotool(&display, &["click", "--repeat", "2", "--delay", "80", "1"]);
-    std::thread::sleep(Duration::from_millis(500));
-    xdotool(&display, &["key", "ctrl+a"]);
-    xdotool(&display, &["type", "forest"]);
-    xdotool(&display, &["key", "Return"]);
-    lines.wait_for("layer:", Duration::from_secs(30));
+    rename_first_layer(&display, &window, &mut lines, "forest");
     save(&display, &mut lines, &file);
     assert_eq!(layer_name(&file).as_deref(), Some("forest"), "the layer is renamed in the file");
 }
@@ -417,24 +429,8 @@ fn a_layer_renamed_to_a_keyword_survives_a_kill() {
     // Past the path tracer's first frames (whose kernels compile on
     // lavapipe): a double click must fall within egui's double-click time.
     lines.wait_for("noise: ", Duration::from_secs(90));
-    let (x, y) = (LAYER_NAME_X.to_string(), FIRST_LAYER_Y.to_string());
-    xdotool(&display, &["mousemove", "--window", &window, &x, &y]);
-    std::thread::sleep(Duration::from_millis(300));
-    xdotool(&display, &["click", "--repeat", "2", "--delay", "80", "1"]);
-    std::thread::sleep(Duration::from_millis(500));
-    xdotool(&display, &["key", "ctrl+a"]);
-    xdotool(&display, &["type", "color"]);
-    xdotool(&display, &["key", "Return"]);
-    lines.wait_for("layer:", Duration::from_secs(30));
-    app.0.kill().unwrap();
-    app.0.wait().unwrap();
-
-    let recovered = dir.path().join("recovered.vox");
-    let run = std::process::Command::new(env!("CARGO_BIN_EXE_octovox"))
-        .args(["recover", file.to_str().unwrap(), "-o", recovered.to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(run.status.success(), "recover: {}", String::from_utf8_lossy(&run.stderr));
+    rename_first_layer(&display, &window, &mut lines, "color");
+    let recovered = kill_and_recover(&mut app, dir.path(), &file);
     let data = dot_vox::load_bytes(&std::fs::read(&recovered).unwrap()).unwrap();
     assert_eq!(data.layers[0].attributes.get("_name").map(String::as_str), Some("color"));
     assert_eq!(data.layers[0].attributes.get("_hidden"), None, "not read as `layer 0 hide`");
