@@ -872,23 +872,24 @@ impl ApplicationHandler for App {
             _ => {}
         }
         // The prompt is modal: while it is open the scene gets no input. A
-        // press or a wheel where egui drew is egui's, whatever egui said:
-        // its verdict comes from the hover of the last frame, so a pointer
+        // press or a wheel is egui's where egui drew in the last frame and
+        // the scene's elsewhere, decided by the pointer's position: egui's
+        // own verdict comes from the hover of the last frame, so a pointer
         // moved onto a button and pressed before the next frame reached the
-        // scene behind it (issue 47, item 1). A wheel over the side panel is
-        // the panel's even where egui lets it go (at the end of its scroll
+        // scene behind it (issue 47, item 1), and one moved off the panel
+        // onto the model lost its click. A wheel over the side panel is the
+        // panel's even where egui lets it go (at the end of its scroll
         // range), never a zoom of the view.
         let starts = matches!(
             event,
             WindowEvent::MouseInput { state: winit::event::ElementState::Pressed, .. } | WindowEvent::MouseWheel { .. }
         );
-        let on_ui = starts
-            && (self.hover.pointer_over_ui
-                || self
-                    .input
-                    .cursor()
-                    .is_some_and(|at| preview::ui_at(gfx.egui_state.egui_ctx(), self.hover.view, at)));
-        let consumed = response.consumed || self.ui.prompt_open || on_ui;
+        let consumed = match (starts, self.hover.view, self.input.cursor()) {
+            (true, Some(view), Some(at)) => preview::ui_at(gfx.egui_state.egui_ctx(), Some(view), at),
+            // Before the first frame, and for releases, motion and keys:
+            // egui's verdict.
+            _ => response.consumed || (starts && self.hover.pointer_over_ui),
+        } || self.ui.prompt_open;
         let extruding = matches!(self.gesture, Gesture::Extrude { .. });
         for command in self.input.on_event(&event, consumed, self.state.tool, extruding) {
             self.execute(command, event_loop);

@@ -69,6 +69,14 @@ fn an_instant_click_on_a_panel_or_a_dialog_edits_nothing() {
             lines.seen
         );
     }
+    // And the other way: from the panel straight onto the model, a click
+    // edits (it was lost: egui still said the pointer was its own).
+    let (px, py) = (PANEL[0].1, PANEL[0].2);
+    instant_click(&display, &window, (px, py), x, y);
+    lines.wait_for("edit:", Duration::from_secs(20));
+    xdotool(&display, &["key", "ctrl+z"]);
+    lines.wait_for("undo:", Duration::from_secs(20));
+    lines.seen.retain(|l| !l.starts_with("edit:"));
     // The Save As browser's name field, over the model.
     xdotool(&display, &["key", "ctrl+shift+s"]);
     wait_for_browser(&mut lines);
