@@ -424,21 +424,21 @@ pub fn camera_or_filling(
     /// Past this many cells the box's corners stand for the voxels'.
     const MOST_CELLS: usize = 1 << 18;
     let (None, Some((lo, hi))) = (camera, scene.solid_bounds()) else { return camera_or_framing(camera, fov, scene) };
+    // The corners of the cells `lo..hi` (corner coordinates, `hi` one past).
+    let corners = |lo: glam::IVec3, hi: glam::IVec3| {
+        let (a, b) = (lo.as_dvec3(), hi.as_dvec3());
+        (0..8).map(move |k| DVec3::new([a.x, b.x][k & 1], [a.y, b.y][(k >> 1) & 1], [a.z, b.z][(k >> 2) & 1]))
+    };
     let mut points = Vec::new();
     let mut cells = 0usize;
     scene.drawn().for_each_solid_cell(|min, size, _| {
         cells += 1;
         if cells <= MOST_CELLS {
-            let (a, b) = (min.as_dvec3(), (min + glam::IVec3::splat(size)).as_dvec3());
-            points.extend(
-                (0..8).map(|k| DVec3::new([a.x, b.x][k & 1], [a.y, b.y][(k >> 1) & 1], [a.z, b.z][(k >> 2) & 1])),
-            );
+            points.extend(corners(min, min + glam::IVec3::splat(size)));
         }
     });
     if cells > MOST_CELLS {
-        let (a, b) = (lo.as_dvec3(), (hi + glam::IVec3::ONE).as_dvec3());
-        points =
-            (0..8).map(|k| DVec3::new([a.x, b.x][k & 1], [a.y, b.y][(k >> 1) & 1], [a.z, b.z][(k >> 2) & 1])).collect();
+        points = corners(lo, hi + glam::IVec3::ONE).collect();
     }
     Camera::filling(lo, hi, &points, fov, f64::from(width) / f64::from(height.max(1)))
 }

@@ -285,7 +285,7 @@ impl Editor {
     /// is not the picked one already (what a click runs before its edit).
     /// A scene of one object has none to pick: its edits go to it.
     pub fn object_line_at(&self, voxel: IVec3) -> Option<Command> {
-        let objects = self.scene.objects().filter(|o| o.list().len() > 1)?;
+        let objects = self.scene.pickable_objects()?;
         let owner = objects.owner_at(voxel).filter(|&i| objects.selected != Some(i) && !objects.locked(i))?;
         Some(Command::Object(ObjectLine::Pick(ObjectRef::Index(owner))))
     }

@@ -56,7 +56,6 @@ impl App {
         // An imported mesh has no .vox to save back to: Save asks for one
         // rather than writing .vox bytes over the .obj.
         self.state.path = path.filter(|p| !octovox::io::is_mesh_path(p));
-        self.state.dirty = false;
         self.state.saved_state = Some(self.doc.editor.history.state_id());
         self.doc.editor.tools.color = first_used_color(&self.doc.editor.scene).unwrap_or(self.doc.editor.tools.color);
         let upload = self.upload();
@@ -67,7 +66,7 @@ impl App {
 
     /// Runs `action` now, or first asks about unsaved changes.
     pub(super) fn guard_unsaved(&mut self, action: Pending, event_loop: &ActiveEventLoop) {
-        if self.state.dirty {
+        if self.unsaved() {
             self.ui.pending = Some(action);
             self.ui.prompt_open = true;
         } else {
@@ -103,8 +102,6 @@ impl App {
         match action {
             Pending::New => {
                 self.replace_scene(Scene::default(), octovox::script::Command::New, None);
-                // An empty scene on the ground: a first click attaches at y = 0.
-                self.state.dirty = false;
                 let volume = self.state.working_volume();
                 self.state.camera = camera_control::fresh_camera(self.state.camera.fov_y_deg, None);
                 self.frame_box(Some(volume));
@@ -136,7 +133,6 @@ impl App {
         let source = document.clone().map_or(octovox::script::Command::New, octovox::script::Command::Load);
         self.replace_scene(scene, source, None);
         // What is shown is the scene plus its journal, not yet saved.
-        self.state.dirty = true;
         self.state.saved_state = None;
         if document.is_some() {
             match octovox::replay::Recorder::append(journal) {
@@ -236,7 +232,6 @@ impl App {
                 hold_for_tests_after_rename();
                 self.doc.recent.add(path);
                 report!("saved: {}", path.display());
-                self.state.dirty = false;
                 // Saved in the middle of a stroke: the state the stroke
                 // ends in gets a new id, so it will count as unsaved.
                 self.state.saved_state = Some(self.doc.editor.history.state_id()).filter(|&id| id != u64::MAX);

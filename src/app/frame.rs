@@ -143,7 +143,7 @@ impl App {
                 fill: self.hover.fill_preview.as_ref().map(|p| p.region),
                 paste,
                 eyedropper,
-                objects: super::outliner::outlined(&self.doc.editor.scene),
+                objects: self.doc.editor.scene.pickable_objects(),
                 ground: self.doc.editor.ground,
             };
             let (state, ui_state, tools) = (&mut self.state, &mut self.ui, &mut self.doc.editor.tools);

@@ -52,7 +52,6 @@ impl App {
             return self.scene_replaced(line.clone(), None);
         }
         if matches!(outcome, Outcome::Changed) {
-            self.state.dirty = self.unsaved();
             // A journal that the line starts begins with the selection before it.
             self.open_journal(selection);
         }

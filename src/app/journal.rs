@@ -132,7 +132,7 @@ impl App {
     /// `selection`: the selection in force before the change (a `move` as
     /// the first edit moves it).
     pub(super) fn open_journal(&mut self, selection: Option<octovox::edit::selection::Region>) {
-        if self.doc.journal.is_some() || !self.state.dirty || self.doc.journal_start.lines.is_empty() {
+        if self.doc.journal.is_some() || !self.unsaved() || self.doc.journal_start.lines.is_empty() {
             return;
         }
         let path = self.journal_file();

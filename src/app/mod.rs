@@ -184,7 +184,7 @@ impl App {
         let instance = self.instance.take().context("the window was created twice")?;
         let (width, height) = self.args.size;
         let attributes = Window::default_attributes()
-            .with_title(self.state.title())
+            .with_title(self.state.title(self.unsaved()))
             .with_inner_size(winit::dpi::PhysicalSize::new(width, height));
         let window = Arc::new(event_loop.create_window(attributes).context("cannot create the window")?);
         let surface = instance.create_surface(window.clone()).context("cannot create a surface for the window")?;
@@ -266,18 +266,16 @@ impl App {
 
     /// Whether the scene differs from its file: the history is not at the
     /// state it was saved or loaded at (undoing back to it is no change).
-    fn unsaved(&self) -> bool {
+    pub(super) fn unsaved(&self) -> bool {
         self.state.saved_state != Some(self.doc.editor.history.state_id())
     }
 
-    /// Follows up a change: the scene is unsaved unless the change led back
-    /// to the saved state; `record` writes it to the
-    /// recording and the journal *before* it is reported done (a crash
+    /// Follows up a change: `record` writes it to the recording and the
+    /// journal *before* it is reported done (a crash
     /// after the report loses nothing); what changed goes to the GPU and
     /// everything that depends on the voxels is refreshed. Prints `WHAT: N
     /// bytes written` (the tests read it).
     fn after_change(&mut self, what: &str, record: impl Fn(&mut Recorder) -> std::io::Result<()>) {
-        self.state.dirty = self.unsaved();
         self.ui.change_made();
         self.record(record);
         let upload = self.upload();
@@ -307,7 +305,7 @@ impl App {
 
     fn update_title(&self) {
         if let Some(gfx) = &self.gfx {
-            gfx.window.set_title(&self.state.title());
+            gfx.window.set_title(&self.state.title(self.unsaved()));
         }
     }
 
@@ -467,7 +465,7 @@ impl App {
 
     /// Widths in points of the panels at the window's left and right sides.
     fn side_panels(&self) -> (f32, f32) {
-        let outliner = outliner::outlined(&self.doc.editor.scene).is_some();
+        let outliner = self.doc.editor.scene.pickable_objects().is_some();
         (ui::PANEL_WIDTH, if outliner { outliner::OUTLINER_WIDTH } else { 0.0 })
     }
 
@@ -885,7 +883,7 @@ impl ApplicationHandler for App {
             WindowEvent::MouseInput { state: winit::event::ElementState::Pressed, .. } | WindowEvent::MouseWheel { .. }
         );
         let consumed = match (starts, self.hover.view, self.input.cursor()) {
-            (true, Some(view), Some(at)) => preview::ui_at(gfx.egui_state.egui_ctx(), Some(view), at),
+            (true, Some(view), Some(at)) => preview::ui_at(gfx.egui_state.egui_ctx(), view, at),
             // Before the first frame, and for releases, motion and keys:
             // egui's verdict.
             _ => response.consumed || (starts && self.hover.pointer_over_ui),

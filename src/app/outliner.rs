@@ -46,13 +46,6 @@ pub struct OutlinerState {
     pub dragging: Option<usize>,
 }
 
-/// The objects the Outliner shows: those of a scene of several. A file of
-/// one object (kept whole for saving: its graph, layers and chunks) is
-/// shown and edited as one model, with no Outliner to pick from.
-pub fn outlined(scene: &octovox::scene::Scene) -> Option<&Objects> {
-    scene.objects().filter(|objects| objects.list().len() > 1)
-}
-
 /// Draws the panel; what the user asked for goes to `out`.
 pub fn show(ui: &mut egui::Ui, objects: &Objects, state: &mut OutlinerState, out: &mut Vec<Command>) {
     egui::Panel::right("outliner").resizable(false).exact_size(OUTLINER_WIDTH).show(ui, |ui| {

@@ -48,11 +48,10 @@ pub(super) struct Hover {
 /// Whether egui drew at window pixel `at` in the last frame: outside the
 /// view the panels left, or on a window, dialog, menu, popup or the axis
 /// gizmo. Decided by position, not by egui's hover (which lags a frame).
-pub(super) fn ui_at(ctx: &egui::Context, view: Option<egui::Rect>, (x, y): (f64, f64)) -> bool {
+pub(super) fn ui_at(ctx: &egui::Context, view: egui::Rect, (x, y): (f64, f64)) -> bool {
     let scale = f64::from(ctx.pixels_per_point());
     let at = egui::pos2((x / scale) as f32, (y / scale) as f32);
-    view.is_some_and(|view| !view.contains(at))
-        || ctx.layer_id_at(at).is_some_and(|layer| layer.order != egui::Order::Background)
+    !view.contains(at) || ctx.layer_id_at(at).is_some_and(|layer| layer.order != egui::Order::Background)
 }
 
 impl App {

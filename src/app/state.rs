@@ -61,11 +61,10 @@ pub struct EditorState {
     pub settings: RenderSettings,
     /// The file Save writes to; `None` for a new or demo scene.
     pub path: Option<PathBuf>,
-    /// The scene differs from the file (or there is no file to hold it).
-    pub dirty: bool,
     /// The history's state when the scene was last saved or loaded
     /// (`History::state_id`); `None` when no state of it is in a file (a
-    /// recovered journal's scene).
+    /// recovered journal's scene, or one saved in the middle of a stroke).
+    /// Whether there are unsaved changes is derived from it (`App::unsaved`).
     pub saved_state: Option<u64>,
     /// Frame time to hold while the camera moves (the render scale drops
     /// as far as needed), milliseconds.
@@ -120,7 +119,6 @@ impl Default for EditorState {
             camera: Camera::default(),
             settings: RenderSettings::default(),
             path: None,
-            dirty: false,
             saved_state: None,
             frame_target_ms: super::motion::DEFAULT_TARGET_MS,
             shading: Shading::default(),
@@ -203,13 +201,13 @@ impl EditorState {
     }
 
     /// Title-bar text: file name and an asterisk for unsaved changes.
-    pub fn title(&self) -> String {
+    pub fn title(&self, unsaved: bool) -> String {
         let name = self
             .path
             .as_ref()
             .and_then(|p| p.file_name())
             .map_or_else(|| "untitled".to_string(), |n| n.to_string_lossy().into_owned());
-        format!("octovox — {name}{}", if self.dirty { " *" } else { "" })
+        format!("octovox — {name}{}", if unsaved { " *" } else { "" })
     }
 }
 

@@ -437,15 +437,8 @@ impl Octree {
     fn move_root(&mut self, origin: IVec3, extent: i64) {
         let depth = (extent.max(1) as u64).next_power_of_two().trailing_zeros();
         let mut moved = Octree::empty(origin, depth);
-        // The copy's own undo record is not wanted: the edit's patch holds
-        // the cells it changes.
-        let mut scratch = Patch::default();
-        self.for_each_solid_cell(|min, size, value| {
-            let shape = Shape::Box { min, max: min + IVec3::splat(size - 1) };
-            let op = Op::Place(value);
-            moved.root = moved.brush_word(moved.root, moved.origin, moved.depth, &shape, op, &mut scratch);
-            scratch = Patch::default();
-        });
+        // The copy keeps no undo record: the edit's patch holds the cells it changes.
+        self.for_each_solid_cell(|min, size, value| moved.fill_box(min, min + IVec3::splat(size - 1), value));
         // New slots are all dirty, so the next flush uploads the whole tree.
         *self = moved;
     }

@@ -130,7 +130,7 @@ pub struct Object {
     pub shape_node: u32,
     pub transform_node: Option<u32>,
     /// The last named transform on the way down, as an entry of the walk's
-    /// name table ([`Walked::path`] joins the names by `/`). Paths share
+    /// name table ([`path_of`] joins the names by `/`). Paths share
     /// their beginnings there, so 131,072 objects under 17 levels of long
     /// names take one entry a visit, not 100 KB each.
     pub name: Option<u32>,
@@ -273,15 +273,9 @@ pub struct NameEntry {
     pub node: u32,
 }
 
-impl Walked {
-    /// The names of the named transforms down to entry `at`, joined by `/`
-    /// (empty for none), read from `graph`, the graph walked.
-    pub fn path(&self, graph: &SceneGraph, at: Option<u32>) -> String {
-        path_of(graph, &self.names, at)
-    }
-}
-
-/// [`Walked::path`] over a name table kept apart from its walk.
+/// The names of the named transforms down to entry `at` of `names` (a
+/// walk's [`Walked::names`]), joined by `/` (empty for none), read from
+/// `graph`, the graph walked.
 pub fn path_of(graph: &SceneGraph, names: &[NameEntry], mut at: Option<u32>) -> String {
     let mut parts = Vec::new();
     while let Some(entry) = at.and_then(|i| names.get(i as usize)) {
@@ -553,7 +547,7 @@ mod tests {
         };
         let walked = graph.walk(&[10], 0, 100).unwrap();
         let seen: Vec<(String, bool, Option<u32>)> =
-            walked.objects.iter().map(|o| (walked.path(&graph, o.name), o.hidden, o.layer)).collect();
+            walked.objects.iter().map(|o| (path_of(&graph, &walked.names, o.name), o.hidden, o.layer)).collect();
         assert_eq!(seen, [("house/door".to_owned(), true, Some(1)), (String::new(), false, Some(0))]);
         let house = OutlineRow::Group { transform: 2, depth: 0, hidden: false };
         let rows = [house, OutlineRow::Object { index: 0, depth: 1 }, OutlineRow::Object { index: 1, depth: 0 }];
@@ -571,6 +565,6 @@ mod tests {
         let graph = SceneGraph { nodes, layers: vec![] };
         let walked = graph.walk(&[1], 0, 10).unwrap();
         assert_eq!(walked.objects.len(), 1);
-        assert_eq!(walked.path(&graph, walked.objects[0].name).len(), 2 * depth as usize - 1);
+        assert_eq!(path_of(&graph, &walked.names, walked.objects[0].name).len(), 2 * depth as usize - 1);
     }
 }

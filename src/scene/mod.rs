@@ -104,6 +104,13 @@ impl Scene {
         self.objects.as_deref()
     }
 
+    /// The objects of a scene of several, to pick among. A scene of one
+    /// object (kept whole for saving: its graph, layers and chunks) is
+    /// shown and edited as one model: nothing to pick, its edits go to it.
+    pub fn pickable_objects(&self) -> Option<&objects::Objects> {
+        self.objects().filter(|objects| objects.list().len() > 1)
+    }
+
     /// The objects when the scene is drawn as instances of its models: a
     /// scene where some model is placed more than once (a reference). Then
     /// each model is stored once on the GPU too, and a move writes one

@@ -31,8 +31,8 @@ const MANY_PLACEMENTS: usize = 64;
 /// largest a .vox file stores in one.
 const MERGE_LIMIT: u64 = 1 << 24;
 
-/// Voxels composing gathers before writing them into the drawn tree (cells
-/// a composed box cuts, or single voxels): 16 bytes each, 1 MiB a batch.
+/// Single voxels composing gathers before writing them into the tree they
+/// go to: 16 bytes each, 1 MiB a batch.
 const PLACED_BATCH: usize = 1 << 16;
 
 /// Largest box one removal covers while composing (a brush's widest).

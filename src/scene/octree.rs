@@ -373,8 +373,8 @@ impl Octree {
         }
         if !is_pointer(word) || level <= 1 {
             return self.visit_cells(word, min, level, &mut |cell, edge, _| {
-                let far = cell + IVec3::splat(edge - 1);
-                *bounds = Some(bounds.map_or((cell, far), |(lo, hi)| (lo.min(cell), hi.max(far))));
+                let grown = super::grow_bounds(*bounds, cell);
+                *bounds = Some(super::grow_bounds(Some(grown), cell + IVec3::splat(edge - 1)));
             });
         }
         let half = 1 << (level - 1);

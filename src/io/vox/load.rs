@@ -209,15 +209,14 @@ impl Parsed {
     /// box) is kept by keeping the objects.
     fn tight(&self) -> bool {
         self.data.models.iter().all(|model| {
-            let fold = |f: fn(u8, u8) -> u8, start: u8, axis: fn(&dot_vox::Voxel) -> u8| {
-                model.voxels.iter().map(axis).fold(start, f)
-            };
-            let axes: [fn(&dot_vox::Voxel) -> u8; 3] = [|v| v.x, |v| v.y, |v| v.z];
+            let (mut lo, mut hi) = ([u8::MAX; 3], [0u8; 3]);
+            for v in &model.voxels {
+                for (axis, c) in [v.x, v.y, v.z].into_iter().enumerate() {
+                    (lo[axis], hi[axis]) = (lo[axis].min(c), hi[axis].max(c));
+                }
+            }
             let size = [model.size.x, model.size.y, model.size.z];
-            model.voxels.is_empty()
-                || axes.iter().zip(size).all(|(&axis, edge)| {
-                    fold(u8::min, u8::MAX, axis) == 0 && u32::from(fold(u8::max, 0, axis)) + 1 == edge
-                })
+            model.voxels.is_empty() || (0..3).all(|axis| lo[axis] == 0 && u32::from(hi[axis]) + 1 == size[axis])
         })
     }
 
