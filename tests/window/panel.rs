@@ -48,6 +48,10 @@ fn choosing_a_brush_moves_no_palette_swatch() {
         xdotool(&display, &["mousedown", "1"]);
         std::thread::sleep(Duration::from_millis(100));
         xdotool(&display, &["mouseup", "1"]);
+        // The pointer stays on the button until the app has run a pass over
+        // the click: egui tests a release against the pointer's latest
+        // place, so a move away in the same (slow, path-traced) frame lost it.
+        std::thread::sleep(Duration::from_millis(1500));
         // The frame that shows the click may come after a path-traced one
         // (a band, or a stage of the denoiser): look for up to 10 s.
         let mut after = shot(name);
