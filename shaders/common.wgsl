@@ -47,6 +47,11 @@ struct FrameUniforms {
     // Nodes of the instance tree in `instances` (0: the pool holds one
     // model, traced from `root`). See src/scene/instances.rs.
     instance_nodes: u32,
+    // 1: rays land on the ground plane y = plane_y (`ground_landing`).
+    plane_on: u32,
+    plane_y: i32,
+    _pad0: u32,
+    _pad1: u32,
 }
 
 // Read-only storage, not uniform: see `constants_entry` in src/gpu/trace_pass.rs.
@@ -222,6 +227,39 @@ fn normal_vector(code: u32) -> vec3<f32> {
     return select(vec3<f32>(0.0), vec3<f32>(select(-1.0, 1.0, code % 2u == 1u)), on_axis & vec3<bool>(valid));
 }
 
+// Twin of `ground::landing` in src/trace/ground.rs: the ground cell a ray
+// coming down from above the plane lands on before `hit` (a voxel counts as
+// behind the plane when its cell lies below it), as a hit on that cell's top
+// face of the surface GROUND_SURFACE; else `hit`. Shaded views only; a ray
+// that gave up stays one.
+fn ground_landing(r: Ray, hit: Hit) -> Hit {
+    let found = hit.found || hit.value != 0u;
+    let plane = f32(u.plane_y);
+    let gave_up_here = !found && hit.iterations >= u.max_iterations;
+    if (u.plane_on == 0u || u.view != VIEW_SHADED || gave_up_here || r.d.y >= 0.0 || r.o.y <= plane) {
+        return hit;
+    }
+    if (found && hit.voxel.y >= u.plane_y) {
+        return hit;
+    }
+    let t = plane_t(r, 1u, plane);
+    let p = r.o + r.d * t;
+    var ground: Hit;
+    ground.value = GROUND_SURFACE;
+    ground.voxel = vec3<i32>(i32(floor(p.x)), u.plane_y - 1, i32(floor(p.z)));
+    ground.normal_code = 3u;
+    ground.iterations = hit.iterations;
+    ground.t = t;
+    ground.found = true;
+    ground.instance = NO_INSTANCE;
+    return ground;
+}
+
+// A surface's colour: its palette entry's, or the ground's.
+fn surface_albedo(value: u32) -> vec3<f32> {
+    return select(unpack4x8unorm(palette[min(value, 255u)]).rgb, GROUND_ALBEDO, value == GROUND_SURFACE);
+}
+
 // The shadow ray starts in the empty voxel in front of the entered face.
 fn shadow_ray(hit: Hit) -> Ray {
     let o = vec3<f32>(hit.voxel) + normal_vector(hit.normal_code) + vec3<f32>(0.5);
@@ -250,7 +288,8 @@ fn heat(x_in: f32) -> vec3<f32> {
 }
 
 fn in_highlight(hit: Hit) -> bool {
-    return hit.value != 0u && all(hit.voxel >= u.highlight_min) && all(hit.voxel <= u.highlight_max);
+    let voxel = hit.value != 0u && hit.value != GROUND_SURFACE;
+    return voxel && all(hit.voxel >= u.highlight_min) && all(hit.voxel <= u.highlight_max);
 }
 
 // A ray that ran out of iterations before it hit or left the tree.
@@ -275,7 +314,7 @@ fn shade(hit: Hit, d: vec3<f32>, in_shadow: bool) -> vec3<f32> {
             if (hit.value == 0u) {
                 return select(sky_color(d), GAVE_UP_COLOR, gave_up(hit));
             }
-            let albedo = unpack4x8unorm(palette[hit.value]).rgb;
+            let albedo = surface_albedo(hit.value);
             let lambert = max(dot(n, SUN_DIR), 0.0);
             let sun = select(lambert, 0.0, in_shadow);
             let sky = select(0.5 + 0.5 * n.y, 0.0, hit.normal_code == 0u);
@@ -315,7 +354,7 @@ fn ground_line(r: Ray, until: f32) -> f32 {
 fn write_pixel(px: vec2<u32>, hit: Hit, d: vec3<f32>, in_shadow: bool) {
     var rgb = shade(hit, d, in_shadow);
     if (u.ground_on != 0u) {
-        let until = select(NO_VOXEL_T, hit.t, hit.value != 0u);
+        let until = select(NO_VOXEL_T, hit.t, hit.value != 0u && hit.value != GROUND_SURFACE);
         rgb = overlaid(rgb, 0.0, ground_line(pixel_ray(px), until));
     }
     // Uniform branches: skipped as a whole when off.
@@ -329,6 +368,7 @@ fn write_pixel(px: vec2<u32>, hit: Hit, d: vec3<f32>, in_shadow: bool) {
         return;
     }
     let iterations = select(min(hit.iterations, GAVE_UP_RECORD - 1u), GAVE_UP_RECORD, gave_up(hit));
-    let info = hit.value | (hit.normal_code << 8u) | (min(hit.level, 31u) << 11u) | (iterations << 16u);
+    // The ground records as no voxel (value 0) with its cell and normal.
+    let info = (hit.value & 0xffu) | (hit.normal_code << 8u) | (min(hit.level, 31u) << 11u) | (iterations << 16u);
     hit_records[px.y * u.width + px.x] = vec4<u32>(bitcast<u32>(hit.voxel.x), bitcast<u32>(hit.voxel.y), bitcast<u32>(hit.voxel.z), info);
 }

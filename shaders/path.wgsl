@@ -84,7 +84,7 @@ fn left_to_samples(kind: u32) -> bool {
 
 // Twin of `PathScene::demodulation_albedo`.
 fn demodulation_albedo(value: u32) -> vec3<f32> {
-    return select(albedo_of(value), vec3<f32>(1.0), left_to_samples(materials[value].kind));
+    return select(surface_albedo(value), vec3<f32>(1.0), left_to_samples(material_of(value).kind));
 }
 
 // ---- random numbers (twin of src/trace/path/rng.rs) ----
@@ -159,12 +159,17 @@ fn smith_g1(c: f32, alpha: f32) -> f32 {
 
 // ---- the scene ----
 
-fn albedo_of(index: u32) -> vec3<f32> {
-    return unpack4x8unorm(palette[index]).rgb;
+// A surface's material: its palette entry's, or the ground's (diffuse,
+// as `PathScene` has it).
+fn material_of(index: u32) -> Material {
+    if (index == GROUND_SURFACE) {
+        return Material(MATERIAL_DIFFUSE, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    }
+    return materials[index];
 }
 
 fn is_glass(index: u32) -> bool {
-    return materials[index].kind == MATERIAL_GLASS;
+    return material_of(index).kind == MATERIAL_GLASS;
 }
 
 fn ior_of(index: u32) -> f32 {
@@ -297,7 +302,7 @@ fn emitter_light(p: vec3<f32>, n: vec3<f32>, lobe: Lobe) -> vec3<f32> {
     let before = select(emitters[max(i, 1u) - 1u].cdf, 0.0, i == 0u);
     let size = f32(e.size);
     let pdf = (e.cdf - before) / emitters[pu.emitter_count - 1u].cdf / (f32(faces) * size * size);
-    let radiance = albedo_of(e.index) * materials[e.index].emission;
+    let radiance = surface_albedo(e.index) * materials[e.index].emission;
     return radiance * lobe_eval(lobe, n, l) * (cos_s * cos_l / (dist2 * pdf));
 }
 
@@ -362,7 +367,7 @@ fn glass_interface(d: vec3<f32>, n: vec3<f32>, medium: u32, value: u32) -> Scatt
     }
     let cos_t = sqrt(1.0 - sin2_t);
     s.dir = eta * d + (eta * cos_i - cos_t) * h;
-    s.weight = select(vec3<f32>(1.0), albedo_of(value), value != 0u);
+    s.weight = select(vec3<f32>(1.0), surface_albedo(value), value != 0u);
     s.medium = value;
     s.ok = dot(s.dir, n) < 0.0;
     return s;
@@ -406,9 +411,9 @@ fn radiance(ray_in: Ray) -> vec3<f32> {
     var transmissions = 0u;
     var first = true;
     loop {
-        let hit = trace_scene(ray, 0.0, medium, inside, vec2<f32>(0.0));
+        let hit = ground_landing(ray, trace_scene(ray, 0.0, medium, inside, vec2<f32>(0.0)));
         if (first) {
-            first_t = select(NO_VOXEL_T, hit.t, hit.found && hit.value != 0u);
+            first_t = select(NO_VOXEL_T, hit.t, hit.found && hit.value != 0u && hit.value != GROUND_SURFACE);
         }
         if (hit.iterations >= u.max_iterations && !hit.found) {
             return radiance + beta * GAVE_UP_COLOR;
@@ -423,7 +428,7 @@ fn radiance(ray_in: Ray) -> vec3<f32> {
         let n = normal_vector(hit.normal_code);
         let d = normalize(ray.d);
         let value = hit.value;
-        let m = materials[value];
+        let m = material_of(value);
         if (first) {
             first_albedo = demodulation_albedo(value);
             first_tint = select(0.0, 1.0, u.highlight_on != 0u && in_highlight(hit));
@@ -434,7 +439,7 @@ fn radiance(ray_in: Ray) -> vec3<f32> {
         let leaving = GLASS && medium != 0u && (value == 0u || is_glass(value));
         if (!leaving && EMIT && m.kind == MATERIAL_EMIT) {
             if (!lights_counted) {
-                radiance += beta * albedo_of(value) * m.emission;
+                radiance += beta * surface_albedo(value) * m.emission;
             }
             return radiance;
         }
@@ -454,7 +459,7 @@ fn radiance(ray_in: Ray) -> vec3<f32> {
             return radiance;
         } else if (METAL && m.kind == MATERIAL_METAL) {
             bounces += 1u;
-            let albedo = albedo_of(value);
+            let albedo = surface_albedo(value);
             let p_spec = 0.5 + 0.5 * m.metalness;
             if (rng_next() < p_spec) {
                 let lobe = glossy_lobe(-d, albedo, m);
@@ -480,7 +485,7 @@ fn radiance(ray_in: Ray) -> vec3<f32> {
             }
         } else {
             bounces += 1u;
-            let albedo = albedo_of(value);
+            let albedo = surface_albedo(value);
             radiance += beta * albedo * direct(p, n, diffuse_lobe());
             let u1 = rng_next();
             let u2 = rng_next();
@@ -506,9 +511,9 @@ fn clamp_sample(v: vec3<f32>) -> vec3<f32> {
 // may filter it (twin of `PathScene::guide`).
 fn write_guide(px: vec2<u32>, pixel: u32) {
     let r = pixel_ray(px);
-    let hit = trace_scene(r, 0.0, 0u, NO_INSTANCE, vec2<f32>(0.0));
+    let hit = ground_landing(r, trace_scene(r, 0.0, 0u, NO_INSTANCE, vec2<f32>(0.0)));
     var guide = vec4<u32>(0u);
-    if (hit.found && hit.normal_code != 0u && !left_to_samples(materials[hit.value].kind)) {
+    if (hit.found && hit.normal_code != 0u && !left_to_samples(material_of(hit.value).kind)) {
         guide = vec4<u32>(bitcast<vec3<u32>>(surface_point(r, hit)), hit.normal_code | GUIDE_FILTERED);
     }
     guides[pixel] = guide;

@@ -60,7 +60,7 @@ fn main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let r = pixel_ray(gid.xy);
-    let hit = trace_grid(r);
+    let hit = ground_landing(r, trace_grid(r));
     var in_shadow = false;
     if (SHADOWS && u.view == VIEW_SHADED && hit.value != 0u && hit.normal_code != 0u) {
         in_shadow = trace_grid(shadow_ray(hit)).value != 0u;

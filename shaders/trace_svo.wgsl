@@ -344,7 +344,8 @@ fn beam(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let best = beam_search(gid.xy);
     beam_distance[gid.y * tiles.x + gid.x] = best;
-    if (best < BEAM_NONE) {
+    // With a ground, rays that meet no voxel still land on it.
+    if (best < BEAM_NONE || u.plane_on != 0u) {
         traced.list[atomicAdd(&traced.count, 1u)] = gid.x | (gid.y << 16u);
     }
 }
@@ -401,11 +402,11 @@ fn main(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_id) lid
     let r = pixel_ray(px);
     let distance = beam_distance[pixel.z];
     let t_start = max(distance - 1.0, 0.0) / length(r.d);
-    let hit = trace_scene(r, t_start, 0u, NO_INSTANCE, camera_footprint());
+    let hit = ground_landing(r, trace_scene(r, t_start, 0u, NO_INSTANCE, camera_footprint()));
     var in_shadow = false;
     if (SHADOWS && u.view == VIEW_SHADED && hit.value != 0u && hit.normal_code != 0u) {
         // The shadow ray keeps the footprint the camera ray had at the hit
-        // voxel's depth (`hit_depth` in src/trace/render.rs).
+        // cell's depth (`cell_depth` in src/trace/render.rs).
         let depth = dot(vec3<f32>(hit.voxel) + vec3<f32>(0.5) - u.eye, u.forward);
         let footprint = u.lod_at_start + u.lod_per_t * depth;
         in_shadow = trace_scene(shadow_ray(hit), 0.0, 0u, NO_INSTANCE, vec2<f32>(footprint, 0.0)).value != 0u;

@@ -209,6 +209,13 @@ pub struct RenderArgs {
     /// Turn sun shadows off (preview shading).
     #[arg(long)]
     pub no_shadows: bool,
+    /// Stand the model on a ground plane under its lowest voxel, which
+    /// takes its shadow (the default; in the preview and the path tracer).
+    #[arg(long, overrides_with = "no_ground")]
+    pub ground: bool,
+    /// Leave the model in the sky, with no ground under it.
+    #[arg(long, overrides_with = "ground")]
+    pub no_ground: bool,
     #[arg(long, default_value_t = 0)]
     pub frame: usize,
     /// Replace OUTPUT even if it is the input or an existing .vox/.obj/.ovr.
@@ -292,6 +299,7 @@ impl PathArgs {
             sun: !self.no_sun,
             sky: self.sky,
             seed: self.seed,
+            ground: None,
         }
     }
 }

@@ -109,7 +109,8 @@ pub fn render_setting(
             Ok((ms, upscale(renderer.read_image()?, size)))
         }
         Setting::Preview { mode, render_scale, lod } => {
-            let settings = RenderSettings { mode, view: View::Shaded, shadows: true, render_scale: 1.0, lod };
+            let settings =
+                RenderSettings { mode, view: View::Shaded, shadows: true, render_scale: 1.0, lod, ground: None };
             let traced = scaled_size(size, render_scale);
             if mode == TraceMode::Grid {
                 let grid = crate::trace::grid::DenseGrid::from_octree(scene.drawn())

@@ -70,11 +70,21 @@ pub struct RenderSettings {
     /// Level of detail: camera rays stop at octree cells narrower than this
     /// many pixels (0 = exact; the SVO preview only).
     pub lod: f32,
+    /// The world height of the ground plane drawn under the scene
+    /// (`crate::trace::ground`), if one is.
+    pub ground: Option<i32>,
 }
 
 impl Default for RenderSettings {
     fn default() -> RenderSettings {
-        RenderSettings { mode: TraceMode::Svo, view: View::Shaded, shadows: true, render_scale: 1.0, lod: 0.0 }
+        RenderSettings {
+            mode: TraceMode::Svo,
+            view: View::Shaded,
+            shadows: true,
+            render_scale: 1.0,
+            lod: 0.0,
+            ground: None,
+        }
     }
 }
 
@@ -133,6 +143,9 @@ pub struct PathSettings {
     /// (a reference that shares the first samples of the image it measures
     /// flatters it: 64 of 256 shared take a quarter off its RMS error).
     pub seed: u32,
+    /// The world height of the ground plane paths may land on
+    /// (`crate::trace::ground`), if there is one.
+    pub ground: Option<i32>,
 }
 
 impl Default for PathSettings {
@@ -144,6 +157,7 @@ impl Default for PathSettings {
             sun: true,
             sky: Sky::Gradient,
             seed: 0,
+            ground: None,
         }
     }
 }

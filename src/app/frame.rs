@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 use winit::event_loop::ActiveEventLoop;
 
 use octovox::gpu::{FrameInput, PathView, Submitted};
-use octovox::settings::{Shading, TraceMode, View};
+use octovox::settings::{PathSettings, RenderSettings, Shading, TraceMode, View};
 use octovox::trace::grid::DenseGrid;
 
 use super::gesture::Gesture;
@@ -213,7 +213,11 @@ impl App {
         // progress would not show until it ended (issue 47, item 6).
         let wants_path = path_traced(&self.state, self.frames.motion.moving()) && self.doc.loading.is_none();
         let (scene, state) = (&self.doc.editor.scene, &self.state);
-        let view = PathView { scene, camera: &state.camera, size: trace_size, settings: &state.path_settings };
+        // Where clicks build on the ground, the ground plane is drawn, and
+        // takes the voxels' shadows.
+        let plane = self.doc.editor.ground.then_some(0);
+        let path_settings = PathSettings { ground: plane, ..state.path_settings };
+        let view = PathView { scene, camera: &state.camera, size: trace_size, settings: &path_settings };
         // Select mode tints the selected voxels in path-traced frames too
         // (not the brush's reach, which follows the pointer: every move
         // would start the accumulation over).
@@ -240,7 +244,8 @@ impl App {
                     .pick
                     .map(|pick| self.state.preview_box(&self.doc.editor.tools, &pick, self.gesture.line_start())),
             };
-            FrameInput::preview(scene, &state.camera, trace_size, &state.settings, highlight)
+            let settings = RenderSettings { ground: plane, ..state.settings };
+            FrameInput::preview(scene, &state.camera, trace_size, &settings, highlight)
         };
         if let Err(err) = gfx.renderer.encode(&mut encoder, &input) {
             log::error!("trace failed: {err}");

@@ -349,6 +349,7 @@ pub(super) fn bench_render(quick: bool, lod: f32) -> anyhow::Result<(String, Str
             shadows: false,
             render_scale: 1.0,
             lod: if mode == TraceMode::Svo { lod } else { 0.0 },
+            ground: None,
         };
         let modes = [TraceMode::Grid, TraceMode::Svo];
         // Warm up all three, then alternate frames so machine noise hits them alike.

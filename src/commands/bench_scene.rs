@@ -144,7 +144,7 @@ pub fn bench_scene(quick: bool) -> anyhow::Result<(String, String)> {
     let (lo, hi) = merged.solid_bounds().context("an empty forest")?;
     let camera = Camera::framing(lo, hi, 50.0);
     let settings =
-        RenderSettings { mode: TraceMode::Svo, view: View::Shaded, shadows: false, render_scale: 1.0, lod: 0.0 };
+        RenderSettings { mode: TraceMode::Svo, view: View::Shaded, shadows: false, render_scale: 1.0, lod: 0.0, ground: None };
     let (mut forest_frames, mut merged_frames) = (Vec::new(), Vec::new());
     for round in 0..=frames {
         let pairs = [

@@ -14,7 +14,7 @@ use octovox::io::png::save_png;
 use octovox::quality::{Accumulated, accumulate};
 use octovox::scene::Scene;
 use octovox::scene::demo::BuiltIn;
-use octovox::settings::{RenderSettings, TraceMode, View};
+use octovox::settings::{PathSettings, RenderSettings, TraceMode, View};
 use octovox::trace::denoise::{Frame, denoise, noise_estimate};
 use octovox::trace::grid::DenseGrid;
 use octovox::trace::path::{render_cpu, to_image};
@@ -88,6 +88,13 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// The world height of the ground plane (`--ground`, the default; none with
+/// `--no-ground`): under the lowest voxel, or at 0 in an empty scene.
+fn ground_height(scene: &Scene, args: &RenderArgs) -> Option<i32> {
+    let lowest = scene.solid_bounds().map_or(0, |(lo, _)| lo.y);
+    (!args.no_ground).then_some(lowest)
+}
+
 /// What `--stats` prints.
 #[derive(serde::Serialize, Default)]
 struct Stats {
@@ -117,6 +124,7 @@ fn preview(
         shadows: !args.no_shadows,
         render_scale: 1.0,
         lod: args.lod,
+        ground: ground_height(scene, args),
     };
     let grid = match args.mode {
         TraceMode::Grid => Some(DenseGrid::from_octree(scene.drawn())?),
@@ -148,9 +156,9 @@ fn path_traced(
     args: &RenderArgs,
     size: (u32, u32),
 ) -> anyhow::Result<(image::RgbaImage, Stats)> {
-    let settings = args.path.settings();
+    let settings = PathSettings { ground: ground_height(scene, args), ..args.path.settings() };
     if args.cpu {
-        return path_traced_cpu(scene, camera, args, size);
+        return path_traced_cpu(scene, camera, &settings, args, size);
     }
     let mut renderer = Renderer::headless().context("no GPU for rendering (try --cpu)")?;
     log::info!("path tracing on {}", renderer.gpu.adapter_name);
@@ -210,12 +218,13 @@ pub(crate) fn oidn_image(renderer: &Renderer, size: (u32, u32)) -> anyhow::Resul
 fn path_traced_cpu(
     scene: &Scene,
     camera: &Camera,
+    settings: &PathSettings,
     args: &RenderArgs,
     size: (u32, u32),
 ) -> anyhow::Result<(image::RgbaImage, Stats)> {
     let spp = args.path.samples();
     let start = Instant::now();
-    let frame = render_cpu(scene, camera, size, &args.path.settings(), spp);
+    let frame = render_cpu(scene, camera, size, settings, spp);
     let ms = start.elapsed().as_secs_f64() * 1e3 / f64::from(spp);
     let filter_start = Instant::now();
     let pixels = if args.path.oidn {

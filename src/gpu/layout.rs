@@ -85,6 +85,11 @@ pub struct FrameUniforms {
     pub ground_z1: i32,
     /// Nodes of the instance tree (0: the pool holds one model, `root`).
     pub instance_nodes: u32,
+    /// 1: rays land on the ground plane y = `plane_y` (tree-local; see
+    /// `crate::trace::ground`).
+    pub plane_on: u32,
+    pub plane_y: i32,
+    pub _pad: [u32; 2],
 }
 
 impl FrameUniforms {
@@ -127,6 +132,13 @@ impl FrameUniforms {
             instance_nodes: buffers.instance_nodes.unwrap_or(0),
             ..FrameUniforms::default()
         }
+    }
+
+    /// The same uniforms with the ground plane at world height `plane`, if
+    /// one, in a tree whose local coordinates start at `origin`.
+    pub fn with_plane(self, plane: Option<i32>, origin: IVec3) -> FrameUniforms {
+        let Some(y) = plane else { return self };
+        FrameUniforms { plane_on: 1, plane_y: y - origin.y, ..self }
     }
 
     /// The same uniforms drawing `ground` (world voxels) in a tree whose

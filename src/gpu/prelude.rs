@@ -43,6 +43,8 @@ pub fn shared_constants() -> String {
     line("SUN_COS", "f32", format!("{:?}", path::sun_cos()));
     line("SUN_IRRADIANCE", "f32", format!("{:?}", path::SUN_IRRADIANCE));
     line("SUN_RADIANCE", "f32", format!("{:?}", path::sun_radiance()));
+    line("GROUND_ALBEDO", "vec3<f32>", vec3(crate::trace::ground::GROUND_ALBEDO));
+    line("GROUND_SURFACE", "u32", format!("{}u", path::GROUND_SURFACE));
     line("MAX_SAMPLE_RADIANCE", "f32", format!("{:?}", path::MAX_SAMPLE_RADIANCE));
     line("R2_STEP_X", "u32", format!("{}u", path::rng::R2_STEP[0]));
     line("R2_STEP_Y", "u32", format!("{}u", path::rng::R2_STEP[1]));

@@ -71,6 +71,8 @@ pub struct Preview<'a> {
     /// An inclusive world-space voxel box to tint.
     pub highlight: Option<(IVec3, IVec3)>,
     pub kernel: Kernel,
+    /// The world height of the ground plane, if one is drawn.
+    pub ground: Option<i32>,
 }
 
 impl<'a> FrameInput<'a> {
@@ -82,8 +84,8 @@ impl<'a> FrameInput<'a> {
         settings: &RenderSettings,
         highlight: Option<(IVec3, IVec3)>,
     ) -> FrameInput<'a> {
-        let (view, lod, kernel) = (settings.view, settings.lod, Kernel::from(settings));
-        FrameInput::Trace(Preview { scene, camera, size, view, lod, highlight, kernel })
+        let (view, lod, kernel, ground) = (settings.view, settings.lod, Kernel::from(settings), settings.ground);
+        FrameInput::Trace(Preview { scene, camera, size, view, lod, highlight, kernel, ground })
     }
 }
 
@@ -279,8 +281,16 @@ impl Renderer {
     /// # Errors
     /// As [`Renderer::render`].
     pub fn render_floor(&mut self, scene: &Scene, camera: &Camera, size: (u32, u32)) -> Result<f64, GpuError> {
-        let floor =
-            Preview { scene, camera, size, view: View::Shaded, lod: 0.0, highlight: None, kernel: Kernel::Floor };
+        let floor = Preview {
+            scene,
+            camera,
+            size,
+            view: View::Shaded,
+            lod: 0.0,
+            highlight: None,
+            kernel: Kernel::Floor,
+            ground: None,
+        };
         let input = FrameInput::Trace(floor);
         Ok(self.render_frame(&input)?.ms)
     }
@@ -337,7 +347,7 @@ impl Renderer {
     }
 
     fn encode_trace(&mut self, encoder: &mut wgpu::CommandEncoder, preview: &Preview) -> Result<(), GpuError> {
-        let Preview { scene, camera, size, view, lod, highlight, kernel } = *preview;
+        let Preview { scene, camera, size, view, lod, highlight, kernel, ground } = *preview;
         // A scene drawn as instances runs the kernels with the instance walk.
         let instances = self.buffers.instance_nodes.is_some();
         let tree = scene.drawn();
@@ -349,6 +359,7 @@ impl Renderer {
             hit_records: u32::from(self.hit_records),
             ..FrameUniforms::new(&basis, tree, &self.buffers, view, highlight, Footprint::of_pixels(&basis, lod))
                 .with_ground(self.ground, tree.origin())
+                .with_plane(ground, tree.origin())
         };
         self.records_written = self.hit_records;
         self.shown = Shown::Trace;
@@ -432,7 +443,8 @@ impl Renderer {
         };
         let (drawn, highlight) = (scene.drawn(), key.highlight);
         let frame = FrameUniforms::new(&key.basis, drawn, &self.buffers, View::Shaded, highlight, Footprint::EXACT)
-            .with_ground(key.ground, drawn.origin());
+            .with_ground(key.ground, drawn.origin())
+            .with_plane(settings.ground, drawn.origin());
         self.path.prepare(gpu, &self.buffers, &frame, &path);
         let instances = self.buffers.instance_nodes.is_some();
         let rows = end_row - first_row;

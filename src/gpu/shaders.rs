@@ -126,6 +126,8 @@ mod tests {
                     ground_z0,
                     ground_z1,
                     instance_nodes,
+                    plane_on,
+                    plane_y,
                 ]
             ),
             twin!(

@@ -150,14 +150,14 @@ impl Runner {
     }
 
     fn render_image(&mut self) -> Result<image::RgbaImage, HostError> {
+        // The ground plane where the window draws one (`ground on`).
+        let settings = RenderSettings { ground: self.editor.ground.then_some(0), ..self.settings };
         match &mut self.mode {
             RunnerMode::Gpu(renderer) => {
-                renderer.render(&self.editor.scene, &self.camera, self.viewport, &self.settings, None)?;
+                renderer.render(&self.editor.scene, &self.camera, self.viewport, &settings, None)?;
                 Ok(renderer.read_image()?)
             }
-            RunnerMode::Cpu => {
-                Ok(render_scene_cpu(&self.editor.scene, None, &self.camera, self.viewport, &self.settings))
-            }
+            RunnerMode::Cpu => Ok(render_scene_cpu(&self.editor.scene, None, &self.camera, self.viewport, &settings)),
         }
     }
 }

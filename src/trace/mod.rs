@@ -4,6 +4,7 @@
 
 pub mod denoise;
 pub mod grid;
+pub mod ground;
 pub mod instanced;
 pub mod oidn;
 pub mod path;

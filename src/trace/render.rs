@@ -5,6 +5,7 @@ use glam::{IVec3, Vec3};
 use rayon::prelude::*;
 
 use super::grid::{self, DenseGrid};
+use super::ground::{self, Landing};
 use super::instanced::Traced;
 use super::{Footprint, Hit, Ray};
 use crate::camera::{Camera, RayBasis};
@@ -41,17 +42,49 @@ pub fn trace_image(tracer: &Tracer, basis: &RayBasis, footprint: Footprint) -> V
 }
 
 /// Colours hit records into RGBA8 pixels. `shadow` says, per pixel, whether
-/// the sun is blocked (all false when shadows are off).
-pub fn shade_image(hits: &[Hit], basis: &RayBasis, palette: &Palette, view: View, shadow: &[bool]) -> Vec<[u8; 4]> {
+/// the sun is blocked (all false when shadows are off); `grounds`, where the
+/// pixel's ray lands on the ground instead (empty without a ground).
+pub fn shade_image(
+    hits: &[Hit],
+    grounds: &[Option<Landing>],
+    basis: &RayBasis,
+    palette: &Palette,
+    view: View,
+    shadow: &[bool],
+) -> Vec<[u8; 4]> {
     hits.par_iter()
         .enumerate()
         .map(|(i, hit)| {
             let x = i as u32 % basis.width;
             let y = i as u32 / basis.width;
             let dir = basis.ray(x, y).1;
-            shade(hit, dir, palette, view, shadow.get(i).copied().unwrap_or(false))
+            let in_shadow = shadow.get(i).copied().unwrap_or(false);
+            match grounds.get(i) {
+                Some(Some(_)) if view == View::Shaded => display_rgba(ground::shaded(in_shadow)),
+                _ => shade(hit, dir, palette, view, in_shadow),
+            }
         })
         .collect()
+}
+
+/// Where each pixel's ray lands on the ground at tree-local height `y`
+/// before the voxel it hit ([`ground::landing`]); a ray that gave up lands
+/// nowhere (it stays magenta).
+pub fn ground_landings(hits: &[Hit], basis: &RayBasis, y: i32) -> Vec<Option<Landing>> {
+    hits.par_iter()
+        .enumerate()
+        .map(|(i, hit)| {
+            let (origin, dir) = basis.ray(i as u32 % basis.width, i as u32 / basis.width);
+            let found = if hit.is_hit() { Some(hit.voxel) } else { None };
+            if hit.gave_up() { None } else { ground::landing(&Ray::new(origin, dir), y, found) }
+        })
+        .collect()
+}
+
+/// The ray toward the sun from the ground cell a ray landed on: from the
+/// centre of the empty cell above it, as from a voxel's top face.
+pub fn ground_shadow_ray(landing: &Landing) -> Ray {
+    Ray::new((landing.cell + IVec3::Y).as_vec3() + Vec3::splat(0.5), Vec3::from(SUN_DIR))
 }
 
 /// The ray toward the sun from a hit: it starts at the centre of the empty
@@ -67,8 +100,8 @@ pub fn shadow_ray(hit: &Hit) -> Option<Ray> {
 
 /// The hit voxel's depth along the view axis: the camera ray's t there, near
 /// enough, from integers alone so the GPU (`hit_depth` in WGSL) agrees.
-pub fn hit_depth(hit: &Hit, basis: &RayBasis) -> f32 {
-    (hit.voxel.as_vec3() + Vec3::splat(0.5) - basis.eye).dot(basis.forward)
+pub fn cell_depth(cell: IVec3, basis: &RayBasis) -> f32 {
+    (cell.as_vec3() + Vec3::splat(0.5) - basis.eye).dot(basis.forward)
 }
 
 /// Colour of a ray that ran out of iterations before it hit or left the
@@ -149,18 +182,27 @@ pub fn render_scene_cpu(
             hits.len()
         );
     }
+    let grounds = match settings.ground {
+        Some(y) if settings.view == View::Shaded => ground_landings(&hits, &basis, y - scene.origin().y),
+        _ => Vec::new(),
+    };
     let shadows: Vec<bool> = if settings.shadows {
         // A shadow ray keeps the footprint its camera ray had at the hit.
-        hits.par_iter()
-            .map(|hit| {
-                shadow_ray(hit).is_some_and(|ray| tracer.trace(&ray, footprint.at(hit_depth(hit, &basis))).is_hit())
+        (0..hits.len())
+            .into_par_iter()
+            .map(|i| {
+                let ray = match grounds.get(i) {
+                    Some(Some(landing)) => Some((ground_shadow_ray(landing), landing.cell)),
+                    _ => shadow_ray(&hits[i]).map(|ray| (ray, hits[i].voxel)),
+                };
+                ray.is_some_and(|(ray, cell)| tracer.trace(&ray, footprint.at(cell_depth(cell, &basis))).is_hit())
             })
             .collect()
     } else {
         Vec::new()
     };
     let bytes: Vec<u8> =
-        shade_image(&hits, &basis, &scene.palette, settings.view, &shadows).into_iter().flatten().collect();
+        shade_image(&hits, &grounds, &basis, &scene.palette, settings.view, &shadows).into_iter().flatten().collect();
     // shade_image yields exactly width * height pixels, so this cannot fail.
     image::RgbaImage::from_raw(basis.width, basis.height, bytes).unwrap_or_default()
 }

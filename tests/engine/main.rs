@@ -13,6 +13,7 @@ mod budgets;
 mod export;
 mod export_scene;
 mod fuzz_corpus;
+mod ground;
 mod hostile_input;
 mod instanced;
 mod mesh_import;

@@ -209,3 +209,47 @@ fn a_default_render_fills_the_frame_with_the_model() {
         assert!(!touches, "{model} is cut by the frame's edge");
     }
 }
+
+/// Issue 47, item 8: `render` stands the model on a ground plane by
+/// default, and the model's shadow falls on it. The pixels where no voxel
+/// is (black in a normals image) show the ground instead of the sky that
+/// `--no-ground` leaves there, and part of that ground is in shadow:
+/// darker than 0.6 of the ground's median. (monu1's shadow falls behind
+/// it, seen from the default camera, which stands on the sun's side.)
+#[test]
+fn a_default_render_stands_the_model_on_a_ground_that_takes_its_shadow() {
+    let dir = tempfile::tempdir().unwrap();
+    let render = |file: &std::path::Path, name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let run = std::process::Command::new(env!("CARGO_BIN_EXE_octovox"))
+            .args(["render", file.to_str().unwrap(), "--cpu", "--size", "160x90", "--force"])
+            .args(extra)
+            .arg("-o")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+        image::open(&out).unwrap().to_rgb8()
+    };
+    let models = [("seed/teapot256.vox", true), ("magicavoxel/chr_knight.vox", true), ("magicavoxel/monu1.vox", false)];
+    for (model, shadow_in_view) in models {
+        let file = common::assets().join("vox").join(model);
+        let normals = render(&file, "normals.png", &["--view", "normals"]);
+        let ground = render(&file, "ground.png", &[]);
+        let sky = render(&file, "sky.png", &["--no-ground"]);
+        let empty: Vec<(u32, u32)> =
+            normals.enumerate_pixels().filter(|(_, _, p)| p.0 == [0, 0, 0]).map(|(x, y, _)| (x, y)).collect();
+        assert!(empty.len() > 160 * 90 / 10, "{model}: {} pixels beside the model", empty.len());
+        let changed = empty.iter().filter(|&&(x, y)| ground.get_pixel(x, y) != sky.get_pixel(x, y)).count();
+        assert!(changed * 10 >= empty.len() * 9, "{model}: the ground shows on {changed} of {} pixels", empty.len());
+        let mut greys: Vec<u32> =
+            empty.iter().map(|&(x, y)| ground.get_pixel(x, y).0.iter().map(|&c| u32::from(c)).sum::<u32>()).collect();
+        greys.sort_unstable();
+        let median = greys[greys.len() / 2];
+        let shadowed = greys.iter().filter(|&&g| f64::from(g) < 0.6 * f64::from(median)).count();
+        println!("{model}: ground median {median}, {shadowed} of {} pixels in shadow", greys.len());
+        if shadow_in_view {
+            assert!(shadowed >= 30, "{model}: {shadowed} ground pixels in shadow");
+        }
+    }
+}

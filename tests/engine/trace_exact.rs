@@ -280,8 +280,14 @@ fn a_tree_two_to_the_twenty_wide() {
 /// Each pixel's GPU hit (SVO, no shadows) against the reference for that
 /// pixel's ray as the CPU computes it.
 fn gpu_tally(renderer: &mut Renderer, scene: &octovox::scene::Scene, camera: &Camera, size: (u32, u32)) -> Tally {
-    let settings =
-        RenderSettings { mode: TraceMode::Svo, view: View::Shaded, shadows: false, render_scale: 1.0, lod: 0.0 };
+    let settings = RenderSettings {
+        mode: TraceMode::Svo,
+        view: View::Shaded,
+        shadows: false,
+        render_scale: 1.0,
+        lod: 0.0,
+        ground: None,
+    };
     renderer.render(scene, camera, size, &settings, None).unwrap();
     let tree = scene.drawn();
     let basis = camera.basis(size.0, size.1, tree.origin());

@@ -7,5 +7,6 @@
 mod common;
 
 mod denoise;
+mod ground;
 mod path_trace;
 mod trace_gpu;

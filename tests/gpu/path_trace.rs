@@ -48,7 +48,7 @@ fn furnace() -> PathSettings {
     PathSettings { bounces: 32, sun: false, sky: Sky::White, ..PathSettings::default() }
 }
 
-fn mean(pixels: &[Vec3]) -> Vec3 {
+pub(crate) fn mean(pixels: &[Vec3]) -> Vec3 {
     pixels.iter().sum::<Vec3>() / pixels.len() as f32
 }
 
@@ -205,7 +205,7 @@ fn a_mirror_shows_the_reflected_colour() {
 }
 
 /// Renders `spp` samples on the GPU and returns the mean radiance.
-fn render_gpu(
+pub(crate) fn render_gpu(
     scene: &mut Scene,
     camera: &Camera,
     size: (u32, u32),
@@ -557,8 +557,14 @@ fn the_ground_grid_is_hidden_by_the_voxels_in_front_of_it() {
         a.pixels().zip(b.pixels()).enumerate().filter(|(_, (p, q))| p != q).map(|(i, _)| i).collect()
     };
 
-    let settings =
-        RenderSettings { mode: TraceMode::Svo, view: View::Shaded, shadows: false, render_scale: 1.0, lod: 0.0 };
+    let settings = RenderSettings {
+        mode: TraceMode::Svo,
+        view: View::Shaded,
+        shadows: false,
+        render_scale: 1.0,
+        lod: 0.0,
+        ground: None,
+    };
     let preview = |renderer: &mut Renderer| {
         renderer.render(&scene, &camera, size, &settings, None).unwrap();
         renderer.read_image().unwrap()
@@ -604,7 +610,7 @@ fn the_ground_grid_is_hidden_by_the_voxels_in_front_of_it() {
 
 /// The material scene as a model placed three times (a reference each:
 /// turned, mirrored), a scene drawn as instances.
-fn instanced_material_scene() -> Scene {
+pub(crate) fn instanced_material_scene() -> Scene {
     use octovox::scene::graph::{Attributes, Layer, Node, NodeKind, SceneGraph};
     use octovox::scene::objects::{Model, Objects};
     let single = material_scene();

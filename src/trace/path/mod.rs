@@ -25,6 +25,7 @@ use self::materials::{Effects, GpuMaterial, MATERIAL_EMIT, MATERIAL_GLASS, MATER
 use self::rng::Rng;
 use super::Footprint;
 use super::denoise::{Guide, Sums};
+use super::ground::{self, GROUND_ALBEDO, Landing};
 use super::instanced::Traced;
 use super::render::GAVE_UP_COLOR;
 use super::svo::Crossing;
@@ -43,6 +44,10 @@ pub const MAX_SAMPLE_RADIANCE: f32 = 32.0;
 /// Most passes through glass surfaces in one path (they do not count as
 /// bounces, so that clear glass does not darken what lies behind it).
 pub const MAX_TRANSMISSIONS: u32 = 16;
+
+/// The ground's entry in [`PathScene`]'s material and albedo tables, after
+/// the palette's 256 (the shaders get it from `crate::gpu::prelude`).
+pub const GROUND_SURFACE: usize = 256;
 
 /// Cosine of the sun's angular radius.
 pub fn sun_cos() -> f32 {
@@ -66,8 +71,11 @@ pub fn effects_for(scene: &Scene, settings: &PathSettings) -> Effects {
 /// A scene prepared for path tracing.
 pub struct PathScene<'a> {
     pub traced: Traced<'a>,
+    /// Every palette entry's, then the ground's ([`GROUND_SURFACE`]).
     pub materials: Vec<GpuMaterial>,
     pub albedo: Vec<Vec3>,
+    /// The tree-local height of the ground plane, if there is one.
+    pub ground: Option<i32>,
     pub lights: Vec<Emitter>,
     pub effects: Effects,
     pub settings: PathSettings,
@@ -78,10 +86,15 @@ impl PathScene<'_> {
         let palette = &scene.palette;
         let effects = effects_for(scene, settings);
         let lights = if effects.emit { lights::emitters(scene.drawn(), palette) } else { Vec::new() };
+        let mut materials = materials::material_table(palette);
+        let mut albedo: Vec<Vec3> = (0..=255u8).map(|i| materials::albedo(palette, i)).collect();
+        materials.push(GpuMaterial::default());
+        albedo.push(Vec3::from(GROUND_ALBEDO));
         PathScene {
             traced: Traced::of(scene),
-            materials: materials::material_table(palette),
-            albedo: (0..=255u8).map(|i| materials::albedo(palette, i)).collect(),
+            materials,
+            albedo,
+            ground: settings.ground.map(|y| y - scene.origin().y),
             lights,
             effects,
             settings: *settings,
@@ -119,9 +132,26 @@ impl PathScene<'_> {
     /// The colour a first hit on `value` contributes to the pixel's mean
     /// albedo: its own, or white where the pixel is left to its samples.
     /// Twin of `demodulation_albedo` in `shaders/path.wgsl`.
-    fn demodulation_albedo(&self, value: u8) -> Vec3 {
-        let kind = self.materials[usize::from(value)].kind;
-        if self.left_to_samples(kind) { Vec3::ONE } else { self.albedo[usize::from(value)] }
+    fn demodulation_albedo(&self, surface: usize) -> Vec3 {
+        let kind = self.materials[surface].kind;
+        if self.left_to_samples(kind) { Vec3::ONE } else { self.albedo[surface] }
+    }
+
+    /// Where `ray` lands on the ground before the voxel it found, if it does.
+    fn landing(&self, ray: &Ray, c: &Crossing) -> Option<Landing> {
+        let found = c.found.then_some(c.hit.voxel);
+        ground::landing(ray, self.ground?, found).filter(|_| !c.hit.gave_up)
+    }
+
+    /// The surface a ray meets: where, its normal, the voxel value (0 for
+    /// the ground) and the entry of the material and albedo tables; `None`
+    /// when it meets nothing or starts inside a solid voxel.
+    fn surface(&self, ray: &Ray, c: &Crossing) -> Option<(Vec3, Vec3, u8, usize)> {
+        if let Some(land) = self.landing(ray, c) {
+            return Some((land.point(ray), Vec3::Y, 0, GROUND_SURFACE));
+        }
+        (c.found && c.hit.normal != IVec3::ZERO)
+            .then(|| (surface_point(ray, c), c.hit.normal.as_vec3(), c.hit.value, usize::from(c.hit.value)))
     }
 
     /// The denoiser's guide of pixel (x, y): the first hit of its centre
@@ -130,13 +160,12 @@ impl PathScene<'_> {
         let (origin, dir) = basis.ray(x, y);
         let ray = Ray::new(origin, dir);
         let c = self.cross(&ray, 0, None);
-        if !c.found || c.hit.gave_up || c.hit.normal == IVec3::ZERO {
-            return Guide::LEFT;
+        match self.surface(&ray, &c) {
+            Some((p, n, _, surface)) if !self.left_to_samples(self.materials[surface].kind) => {
+                Guide::filtered(p, normal_code(n.as_ivec3()))
+            }
+            _ => Guide::LEFT,
         }
-        if self.left_to_samples(self.materials[usize::from(c.hit.value)].kind) {
-            return Guide::LEFT;
-        }
-        Guide::filtered(surface_point(&ray, &c), normal_code(c.hit.normal))
     }
 
     /// The radiance along a camera ray; `first_albedo` gets the first hit's
@@ -155,20 +184,17 @@ impl PathScene<'_> {
             if c.hit.gave_up {
                 return radiance + beta * GAVE_UP_COLOR;
             }
-            if !c.found {
+            let Some((p, n, value, surface)) = self.surface(&ray, &c) else {
+                if c.found {
+                    // The ray started inside a solid voxel: nothing to see.
+                    return radiance;
+                }
                 return radiance + beta * self.environment(ray.dir, lights_counted);
-            }
-            if c.hit.normal == IVec3::ZERO {
-                // The ray started inside a solid voxel: nothing to see.
-                return radiance;
-            }
-            let p = surface_point(&ray, &c);
-            let n = c.hit.normal.as_vec3();
+            };
             let d = ray.dir.normalize();
-            let value = c.hit.value;
-            let material = self.materials[usize::from(value)];
+            let material = self.materials[surface];
             if first {
-                *first_albedo = self.demodulation_albedo(value);
+                *first_albedo = self.demodulation_albedo(surface);
                 first = false;
             }
             let glass = |index: u8| self.materials[usize::from(index)].kind == MATERIAL_GLASS;
@@ -177,7 +203,7 @@ impl PathScene<'_> {
             let leaving = self.effects.glass && medium != 0 && (value == 0 || glass(value));
             if !leaving && self.effects.emit && material.kind == MATERIAL_EMIT {
                 if !lights_counted {
-                    radiance += beta * self.albedo[usize::from(value)] * material.emission;
+                    radiance += beta * self.albedo[surface] * material.emission;
                 }
                 return radiance;
             }
@@ -197,7 +223,7 @@ impl PathScene<'_> {
                 return radiance;
             } else if self.effects.metal && material.kind == MATERIAL_METAL {
                 bounces += 1;
-                let albedo = self.albedo[usize::from(value)];
+                let albedo = self.albedo[surface];
                 let p_spec = 0.5 + 0.5 * material.metalness;
                 if rng.uniform() < p_spec {
                     let lobe = Lobe::glossy(-d, albedo, &material);
@@ -220,7 +246,7 @@ impl PathScene<'_> {
                 }
             } else {
                 bounces += 1;
-                let albedo = self.albedo[usize::from(value)];
+                let albedo = self.albedo[surface];
                 radiance += beta * albedo * self.direct(p, n, &Lobe::DIFFUSE, rng);
                 dir = cosine_direction(n, rng.uniform(), rng.uniform());
                 beta *= albedo;
