@@ -1,6 +1,7 @@
 //! `octovox bench scene`: a forest of 2,000 rotated references of one tree
 //! against the same voxels as one merged model, in one run: load time, frame
-//! time, pool bytes, and the bytes an object move writes to the GPU pool.
+//! time, pool bytes, and the bytes an object move writes to the GPU pool;
+//! and path tracing a small scene of objects against it merged.
 
 use std::time::Instant;
 
@@ -10,14 +11,14 @@ use serde::Serialize;
 
 use octovox::camera::Camera;
 use octovox::editor::Editor;
-use octovox::gpu::Renderer;
+use octovox::gpu::{PathView, Renderer};
 use octovox::io::vox::{encode_objects, encode_vox, load_vox_scene};
 use octovox::scene::graph::{Attributes, Node, NodeKind, SceneGraph};
 use octovox::scene::objects::{Model, Objects};
 use octovox::scene::transform::Rotation;
-use octovox::scene::{Octree, Palette, Scene};
+use octovox::scene::{Instancing, Octree, Palette, Scene};
 use octovox::script::{Command, ObjectLine, ObjectRef};
-use octovox::settings::{RenderSettings, TraceMode, View};
+use octovox::settings::{PathSettings, RenderSettings, TraceMode, View};
 
 use super::bench::{header, median};
 
@@ -42,6 +43,71 @@ struct SceneRow {
     move_bytes_written: u64,
     rotate_bytes_written: u64,
     hide_bytes_written: u64,
+    path: PathRow,
+}
+
+/// Path tracing a small scene of objects (issue 47, item 9): the file as
+/// the scene draws it against its voxels merged into one model.
+#[derive(Serialize)]
+struct PathRow {
+    file: &'static str,
+    objects: usize,
+    voxels: u64,
+    /// How the scene is drawn: "instances" or "composed" (`Scene::instanced`).
+    drawn_as: &'static str,
+    width: u32,
+    height: u32,
+    samples: usize,
+    ms_per_sample_drawn: f64,
+    /// The same scene drawn as instances (`Instancing::References`: how
+    /// it was drawn before `Instancing::Auto`).
+    ms_per_sample_instances: f64,
+    ms_per_sample_merged: f64,
+}
+
+/// The small scene of objects the path row traces.
+const PATH_SCENE: &str = "vox/format/test_groups.vox";
+
+/// Median milliseconds per path-traced sample of the scene in `PATH_SCENE`
+/// as it is drawn, as instances, and as its voxels in one model, the three
+/// alternating after one warm-up sample each (which compiles the kernel).
+fn path_row(quick: bool) -> anyhow::Result<PathRow> {
+    let (width, height, samples) = if quick { (320, 180, 2) } else { (1280, 720, 6) };
+    let file = super::bench::assets().join(PATH_SCENE);
+    let mut scene = octovox::io::load_scene(&file, 0)?;
+    let mut instances = octovox::io::load_scene(&file, 0)?;
+    instances.set_instancing(Instancing::References);
+    let mut merged = Scene::new(scene.palette.clone(), scene.drawn().clone());
+    let (lo, hi) = merged.solid_bounds().context("an empty scene")?;
+    let camera = Camera::framing(lo, hi, 50.0);
+    let settings = PathSettings::default();
+    let renderer = || Renderer::headless().context("bench scene needs a GPU (lavapipe works)");
+    let mut renderers = [renderer()?, renderer()?, renderer()?];
+    let mut times = [Vec::new(), Vec::new(), Vec::new()];
+    for round in 0..=samples {
+        let scenes = [&mut scene, &mut instances, &mut merged];
+        for ((scene, renderer), times) in scenes.into_iter().zip(&mut renderers).zip(&mut times) {
+            renderer.sync(scene);
+            let view = PathView { scene, camera: &camera, size: (width, height), settings: &settings };
+            let frame = renderer.render_path(&view, round == 0)?;
+            if round > 0 {
+                times.push(frame.ms);
+            }
+        }
+    }
+    let [drawn_ms, instances_ms, merged_ms] = times;
+    Ok(PathRow {
+        file: PATH_SCENE,
+        objects: scene.objects().map_or(1, |o| o.list().len()),
+        voxels: merged.solid_voxels(),
+        drawn_as: if scene.instanced().is_some() { "instances" } else { "composed" },
+        width,
+        height,
+        samples,
+        ms_per_sample_drawn: median(drawn_ms),
+        ms_per_sample_instances: median(instances_ms),
+        ms_per_sample_merged: median(merged_ms),
+    })
 }
 
 /// A tree in MagicaVoxel's axes (z up): a trunk and a round crown.
@@ -143,8 +209,14 @@ pub fn bench_scene(quick: bool) -> anyhow::Result<(String, String)> {
     let (mut forest_renderer, mut merged_renderer) = (renderer()?, renderer()?);
     let (lo, hi) = merged.solid_bounds().context("an empty forest")?;
     let camera = Camera::framing(lo, hi, 50.0);
-    let settings =
-        RenderSettings { mode: TraceMode::Svo, view: View::Shaded, shadows: false, render_scale: 1.0, lod: 0.0, ground: None };
+    let settings = RenderSettings {
+        mode: TraceMode::Svo,
+        view: View::Shaded,
+        shadows: false,
+        render_scale: 1.0,
+        lod: 0.0,
+        ground: None,
+    };
     let (mut forest_frames, mut merged_frames) = (Vec::new(), Vec::new());
     for round in 0..=frames {
         let pairs = [
@@ -192,6 +264,7 @@ pub fn bench_scene(quick: bool) -> anyhow::Result<(String, String)> {
         move_bytes_written,
         rotate_bytes_written,
         hide_bytes_written,
+        path: path_row(quick)?,
     };
     Ok((report(&row), serde_json::to_string_pretty(&[row])?))
 }
@@ -248,5 +321,29 @@ fn report(r: &SceneRow) -> String {
     md += &format!("| bytes written by one `object move` | {} | | | ≤ 256 |\n", r.move_bytes_written);
     md += &format!("| bytes written by one `object rotate z` | {} | | | ≤ 256 |\n", r.rotate_bytes_written);
     md += &format!("| bytes written by one `object hide` | {} | | | ≤ 256 |\n", r.hide_bytes_written);
+    md + &path_report(&r.path)
+}
+
+fn path_report(p: &PathRow) -> String {
+    let mut md = format!(
+        "\n## Path tracing a small scene of objects\n\n`{}`: {} objects, {} voxels. *As drawn*: as `Scene::instanced` \
+         chooses (**{}**); *instances*: drawn as instances, as every scene with a reference was before that choice; \
+         *merged*: its voxels as one model. {}×{}, the path tracer's defaults, median of {} samples after one warm-up \
+         each, the three alternating.\n\n",
+        p.file, p.objects, p.voxels, p.drawn_as, p.width, p.height, p.samples
+    );
+    md += "| ms per sample | as drawn | instances | merged | as drawn / merged | instances / merged | target |\n";
+    md += "|---|---|---|---|---|---|---|\n";
+    let merged = p.ms_per_sample_merged.max(1e-9);
+    md += &format!(
+        "| {}×{} | {:.1} | {:.1} | {:.1} | {:.3} | {:.3} | ≤ 1.5 |\n",
+        p.width,
+        p.height,
+        p.ms_per_sample_drawn,
+        p.ms_per_sample_instances,
+        p.ms_per_sample_merged,
+        p.ms_per_sample_drawn / merged,
+        p.ms_per_sample_instances / merged
+    );
     md
 }

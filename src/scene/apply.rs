@@ -82,7 +82,8 @@ impl Scene {
     /// voxels).
     pub fn take_uploads_within(&mut self, max_bytes: u64) -> Result<SceneUpload, PoolTooLarge> {
         let origin = self.tree.origin();
-        match self.objects.as_deref_mut().filter(|o| o.has_references()) {
+        let instanced = self.instanced().is_some();
+        match self.objects.as_deref_mut().filter(|_| instanced) {
             None => Ok(SceneUpload::Tree(self.tree.pool_mut().flush_within(max_bytes)?)),
             Some(objects) => Ok(SceneUpload::Objects(self.gpu.take(objects, origin, max_bytes)?)),
         }

@@ -74,18 +74,49 @@ pub struct Scene {
     objects: Option<Box<objects::Objects>>,
     /// What the GPU holds of a scene of objects.
     gpu: instances::GpuCopy,
+    /// When a scene of objects is drawn as instances.
+    instancing: Instancing,
+}
+
+/// When a scene of objects is drawn as instances of its models rather than
+/// composed into one octree ([`Scene::instanced`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Instancing {
+    /// Where a model is placed twice and instances save at least half the
+    /// bytes ([`INSTANCE_SAVING`]): composed is faster where it is small.
+    #[default]
+    Auto,
+    /// Wherever a model is placed twice: to measure and test the instance
+    /// walk on scenes that `Auto` draws composed.
+    References,
+}
+
+/// Instances are drawn where they take at most 1/INSTANCE_SAVING of the
+/// bytes the objects composed take.
+pub const INSTANCE_SAVING: u64 = 2;
+
+/// Whether `objects`, composed as `composed`, are drawn as instances: some
+/// model is placed twice, and its pools and instance words take at most
+/// 1/[`INSTANCE_SAVING`] of the composed tree's.
+fn draws_instances(objects: &objects::Objects, composed: &Octree) -> bool {
+    if !objects.has_references() {
+        return false;
+    }
+    let instances = objects.pool_bytes() + instances::word_bytes(objects.list().len());
+    composed.pool().live_bytes() > INSTANCE_SAVING.saturating_mul(instances)
 }
 
 impl Scene {
     /// A scene of one model.
     pub fn new(palette: Palette, tree: Octree) -> Scene {
-        Scene { palette, tree, objects: None, gpu: instances::GpuCopy::default() }
+        Scene { palette, tree, objects: None, gpu: instances::GpuCopy::default(), instancing: Instancing::Auto }
     }
 
     /// A scene of objects whose visible ones `tree` draws, composed (what a
     /// loader that stores the composed tree reads back).
     pub fn with_objects(palette: Palette, tree: Octree, objects: objects::Objects) -> Scene {
-        Scene { palette, tree, objects: Some(Box::new(objects)), gpu: instances::GpuCopy::default() }
+        let gpu = instances::GpuCopy::default();
+        Scene { palette, tree, objects: Some(Box::new(objects)), gpu, instancing: Instancing::Auto }
     }
 
     /// A scene of objects, its drawn tree composed from them.
@@ -112,14 +143,24 @@ impl Scene {
     }
 
     /// The objects when the scene is drawn as instances of its models: a
-    /// scene where some model is placed more than once (a reference). Then
-    /// each model is stored once on the GPU too, and a move writes one
-    /// record. A scene whose every model is placed once (a big model saved
-    /// in 256³ blocks, say) is drawn as its objects composed into one
-    /// octree: no memory to save, and CPU-emulated GPUs trace one octree
-    /// 2.5x faster than instances (docs/bench/scene.md).
+    /// scene where some model is placed more than once (a reference), and
+    /// where that saves at least half of what its objects composed take
+    /// ([`draws_instances`]). Then each model is stored once on the GPU
+    /// too, and a move writes one record. Any other scene of objects (a big
+    /// model saved in 256³ blocks, or a few small references) is drawn as
+    /// its objects composed into one octree: CPU-emulated GPUs trace one
+    /// octree 2.5–3.5x faster than instances (docs/bench/scene.md).
     pub fn instanced(&self) -> Option<&objects::Objects> {
-        self.objects().filter(|o| o.has_references())
+        self.objects().filter(|o| match self.instancing {
+            Instancing::Auto => draws_instances(o, &self.tree),
+            Instancing::References => o.has_references(),
+        })
+    }
+
+    /// Sets when the scene is drawn as instances (the GPU copy follows at
+    /// the next upload).
+    pub fn set_instancing(&mut self, instancing: Instancing) {
+        self.instancing = instancing;
     }
 
     /// Takes the objects out (a loader that keeps only them).

@@ -638,7 +638,8 @@ pub(crate) fn instanced_material_scene() -> Scene {
     }
     let layers = vec![Layer { id: 0, attributes: Attributes::new(), reserved: u32::MAX }];
     let objects = Objects::new(Some(SceneGraph { nodes, layers }), vec![model], Vec::new(), 0, usize::MAX).unwrap();
-    let scene = Scene::compose(single.palette.clone(), objects).unwrap();
+    let mut scene = Scene::compose(single.palette.clone(), objects).unwrap();
+    scene.set_instancing(octovox::scene::Instancing::References);
     assert!(scene.instanced().is_some());
     scene
 }
