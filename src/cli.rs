@@ -1,4 +1,4 @@
-//! Command-line interface: one enum variant per subcommand.
+//! Command-line interface: one enum variant per subcommand ([`CliCommand`]).
 
 use std::path::PathBuf;
 
@@ -13,7 +13,7 @@ use octovox::settings::{TraceMode, View};
 #[command(allow_negative_numbers = true)]
 pub struct Cli {
     #[command(subcommand)]
-    pub command: Option<Command>,
+    pub command: Option<CliCommand>,
     #[command(flatten)]
     pub window: WindowArgs,
     /// Most memory one step may take (4G, 512M, …); larger loads, imports,
@@ -78,7 +78,7 @@ pub struct WindowArgs {
 }
 
 #[derive(Subcommand, Debug)]
-pub enum Command {
+pub enum CliCommand {
     /// Print what a .vox file holds: models, voxels, extent, palette and materials used.
     Info {
         file: PathBuf,

@@ -13,7 +13,7 @@ use crate::edit::{Edit, History};
 use crate::scene::objects::Objects;
 use crate::scene::transform::CellMap;
 use crate::scene::{EditError, Op, Palette, Scene};
-use crate::script::{Command, ObjectLine, ObjectRef, PaletteLine};
+use crate::script::{Line, ObjectLine, ObjectRef, PaletteLine};
 use crate::settings::PathSettings;
 
 /// Why a line could not run. A refused line changes nothing.
@@ -111,51 +111,51 @@ impl Editor {
 
     /// Carries out one line. `Err` is a line that could not run (a refused
     /// edit changes nothing).
-    pub fn run(&mut self, command: &Command) -> Result<Outcome, EditorError> {
+    pub fn run(&mut self, command: &Line) -> Result<Outcome, EditorError> {
         let tools = self.tools;
         let changed = match command {
-            Command::New | Command::Demo(_) => {
+            Line::New | Line::Demo(_) => {
                 self.set_scene(built_scene(command).unwrap_or_default());
                 return Ok(Outcome::Replaced);
             }
-            Command::Brush(brush) => self.set(|e| e.tools.brush = *brush),
-            Command::Ground(on) => self.set(|e| e.ground = *on),
-            Command::Color(c) => self.set(|e| e.tools.color = *c),
-            Command::Mirror(plane) => self.set(|e| e.tools.mirror.apply_line(*plane)),
-            Command::Pick(p) => {
+            Line::Brush(brush) => self.set(|e| e.tools.brush = *brush),
+            Line::Ground(on) => self.set(|e| e.ground = *on),
+            Line::Color(c) => self.set(|e| e.tools.color = *c),
+            Line::Mirror(plane) => self.set(|e| e.tools.mirror.apply_line(*plane)),
+            Line::Pick(p) => {
                 let color = picked_color(&self.scene, *p)?;
                 self.set(|e| e.tools.color = color)
             }
-            Command::Place(p) => self.apply_mirrored(vec![brush_edit(&tools, *p, Op::Place(tools.color))])?,
-            Command::Remove(p) => self.apply_mirrored(vec![brush_edit(&tools, *p, Op::Remove)])?,
-            Command::Paint(p) => self.apply_mirrored(vec![brush_edit(&tools, *p, Op::Paint(tools.color))])?,
-            Command::Line(a, b) => {
+            Line::Place(p) => self.apply_mirrored(vec![brush_edit(&tools, *p, Op::Place(tools.color))])?,
+            Line::Remove(p) => self.apply_mirrored(vec![brush_edit(&tools, *p, Op::Remove)])?,
+            Line::Paint(p) => self.apply_mirrored(vec![brush_edit(&tools, *p, Op::Paint(tools.color))])?,
+            Line::Segment(a, b) => {
                 let edits = crate::edit::brush::line_edits(&tools.brush, tools.color, *a, *b)?;
                 self.apply_mirrored(edits)?
             }
             // Fills and extrudes are not mirrored: their regions follow the
             // colours and faces, not the brush.
-            Command::Fill(p) => {
+            Line::Fill(p) => {
                 let edits = crate::edit::fill::fill_edits(self.scene.drawn(), *p, tools.color)?;
                 self.commit(edits)?
             }
-            Command::Extrude(p, normal, layers) => {
+            Line::Extrude(p, normal, layers) => {
                 let edits = crate::edit::extrude::extrude_edits(self.scene.drawn(), *p, *normal, *layers)?;
                 self.commit(edits)?
             }
-            Command::Rgb(..) | Command::Material(..) => match palette_edit(command, &self.scene.palette) {
+            Line::Rgb(..) | Line::Material(..) => match palette_edit(command, &self.scene.palette) {
                 Some(edit) => self.commit(vec![edit])?,
                 None => false,
             },
-            Command::Palette(PaletteLine::Set { first, colors }) => {
+            Line::Palette(PaletteLine::Set { first, colors }) => {
                 self.commit(palette_colors(&self.scene.palette, *first, colors))?
             }
-            Command::Palette(PaletteLine::Preset(name)) => {
+            Line::Palette(PaletteLine::Preset(name)) => {
                 let colors =
                     crate::io::palette_file::preset(name).ok_or_else(|| EditorError::NoPreset(name.clone()))?;
                 self.commit(palette_colors(&self.scene.palette, 1, &colors))?
             }
-            Command::ExpectPalette(index, want) => {
+            Line::ExpectPalette(index, want) => {
                 let [r, g, b, _] = self.scene.palette.color(*index);
                 let got = format!("{r} {g} {b}");
                 return Ok(checked(
@@ -164,49 +164,49 @@ impl Editor {
                     got,
                 ));
             }
-            Command::Undo(n) => self.repeat(*n, true)?,
-            Command::Redo(n) => self.repeat(*n, false)?,
-            Command::Select(None) => self.set(|e| e.selection = None),
-            Command::Select(Some((a, b))) => {
+            Line::Undo(n) => self.repeat(*n, true)?,
+            Line::Redo(n) => self.repeat(*n, false)?,
+            Line::Select(None) => self.set(|e| e.selection = None),
+            Line::Select(Some((a, b))) => {
                 let region = Region::new(*a, *b)?;
                 self.set(|e| e.selection = Some(region))
             }
-            Command::Copy => {
+            Line::Copy => {
                 let block = selection::copy(self.scene.drawn(), self.selected()?)?;
                 self.set(|e| e.clipboard = Some(block))
             }
-            Command::Cut => {
+            Line::Cut => {
                 let region = self.selected()?;
                 let block = selection::copy(self.scene.drawn(), region)?;
                 let changed = self.commit(vec![region.clear_edit()])?;
                 self.clipboard = Some(block);
                 changed
             }
-            Command::Delete => self.commit(vec![self.selected()?.clear_edit()])?,
-            Command::Paste(at) => {
+            Line::Delete => self.commit(vec![self.selected()?.clear_edit()])?,
+            Line::Paste(at) => {
                 let block = self.clipboard.as_ref().ok_or(EditorError::NothingToPaste)?;
                 let region = block.region_at(*at).inside_world()?;
                 let changed = self.commit(block.place_edits(*at))?;
                 self.selection = Some(region);
                 changed
             }
-            Command::Move(by) => self.move_selection(*by)?,
-            Command::Rotate(axis) => self.turn_selection(*axis, false)?,
-            Command::Flip(axis) => self.turn_selection(*axis, true)?,
-            Command::ExpectVoxel(p, want) => {
+            Line::Move(by) => self.move_selection(*by)?,
+            Line::Rotate(axis) => self.turn_selection(*axis, false)?,
+            Line::Flip(axis) => self.turn_selection(*axis, true)?,
+            Line::ExpectVoxel(p, want) => {
                 let got = self.scene.voxel(*p);
                 return Ok(checked(got == *want, format!("voxel {p} = {want}"), got));
             }
-            Command::ExpectCount(want) => {
+            Line::ExpectCount(want) => {
                 let got = self.scene.solid_voxels();
                 return Ok(checked(got == *want, format!("{want} voxels"), got));
             }
-            Command::ExpectEffects(want) => {
+            Line::ExpectEffects(want) => {
                 let (ok, got) = effects_match(&self.scene, want);
                 return Ok(checked(ok, format!("effects [{}]", want.join(" ")), format!("[{}]", got.join(" "))));
             }
-            Command::Object(line) => self.object_line(line)?,
-            Command::Layer(id, line) => match line.attribute() {
+            Line::Object(line) => self.object_line(line)?,
+            Line::Layer(id, line) => match line.attribute() {
                 None => {
                     self.scene.set_new_layer(*id)?;
                     true
@@ -216,24 +216,24 @@ impl Editor {
                     self.commit(vec![Edit::Graph(Box::new(change))])?
                 }
             },
-            Command::ExpectObjects(want) => {
+            Line::ExpectObjects(want) => {
                 let got = self.scene.objects().map_or(1, |o| o.list().len());
                 return Ok(checked(got == *want, format!("{want} objects"), got));
             }
-            Command::ExpectModels(want) => {
+            Line::ExpectModels(want) => {
                 let got = self.scene.objects().map_or(1, |o| o.models.len());
                 return Ok(checked(got == *want, format!("{want} models"), got));
             }
-            Command::Load(_)
-            | Command::Palette(PaletteLine::Load(_) | PaletteLine::Save(_))
-            | Command::Camera { .. }
-            | Command::Projection(_)
-            | Command::Viewport(..)
-            | Command::Click { .. }
-            | Command::Save(_)
-            | Command::Render(_)
-            | Command::ExpectWritten(_)
-            | Command::ExpectImage(..) => return Ok(Outcome::Host),
+            Line::Load(_)
+            | Line::Palette(PaletteLine::Load(_) | PaletteLine::Save(_))
+            | Line::Camera { .. }
+            | Line::Projection(_)
+            | Line::Viewport(..)
+            | Line::Click { .. }
+            | Line::Save(_)
+            | Line::Render(_)
+            | Line::ExpectWritten(_)
+            | Line::ExpectImage(..) => return Ok(Outcome::Host),
         };
         Ok(if changed { Outcome::Changed } else { Outcome::State })
     }
@@ -284,10 +284,10 @@ impl Editor {
     /// The `object N` line that picks the object drawn at `voxel`, when that
     /// is not the picked one already (what a click runs before its edit).
     /// A scene of one object has none to pick: its edits go to it.
-    pub fn object_line_at(&self, voxel: IVec3) -> Option<Command> {
+    pub fn object_line_at(&self, voxel: IVec3) -> Option<Line> {
         let objects = self.scene.pickable_objects()?;
         let owner = objects.owner_at(voxel).filter(|&i| objects.selected != Some(i) && !objects.locked(i))?;
-        Some(Command::Object(ObjectLine::Pick(ObjectRef::Index(owner))))
+        Some(Line::Object(ObjectLine::Pick(ObjectRef::Index(owner))))
     }
 
     /// The objects of a scene of several, or why an `object`/`layer` line
@@ -473,20 +473,20 @@ enum Picks {
 }
 
 /// The scene a `new` or `demo` line makes; `None` for other lines.
-fn built_scene(command: &Command) -> Option<Scene> {
+fn built_scene(command: &Line) -> Option<Scene> {
     match command {
-        Command::New => Some(Scene::default()),
-        Command::Demo(built_in) => Some(built_in.scene()),
+        Line::New => Some(Scene::default()),
+        Line::Demo(built_in) => Some(built_in.scene()),
         _ => None,
     }
 }
 
 /// The edit a palette line (`rgb`, `material`) makes on `palette`; `None`
 /// for other lines.
-fn palette_edit(command: &Command, palette: &Palette) -> Option<Edit> {
+fn palette_edit(command: &Line, palette: &Palette) -> Option<Edit> {
     let (index, color, material) = match command {
-        Command::Rgb(index, [r, g, b]) => (*index, [*r, *g, *b, 255], palette.material(*index).clone()),
-        Command::Material(index, material) => (*index, palette.color(*index), (**material).clone()),
+        Line::Rgb(index, [r, g, b]) => (*index, [*r, *g, *b, 255], palette.material(*index).clone()),
+        Line::Material(index, material) => (*index, palette.color(*index), (**material).clone()),
         _ => return None,
     };
     Some(Edit::Palette { index, color, material: Box::new(material) })

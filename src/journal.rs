@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 
 use crate::replay::{Runner, RunnerMode};
 use crate::scene::Scene;
-use crate::script::{Command, Script};
+use crate::script::{Line, Script};
 
 /// The journal of `document`: `.NAME.octovox-journal.ovr` beside it.
 pub fn journal_path(document: &Path) -> PathBuf {
@@ -240,7 +240,7 @@ pub fn read(journal: &Path, document: Option<&Path>, checks: Checks) -> Result<S
     {
         return Err(RecoverError::Saved { path: journal.to_path_buf(), saved_to });
     }
-    if let (Some(then), Command::Load(source)) = (notes.source, first)
+    if let (Some(then), Line::Load(source)) = (notes.source, first)
         && !checks.allow_changed_source
     {
         let now = FileStamp::of(source);
@@ -254,12 +254,12 @@ pub fn read(journal: &Path, document: Option<&Path>, checks: Checks) -> Result<S
 
 /// The journal's own lines: one scene line, first, that makes the scene
 /// the journal edits, and no line that writes a file. Returns the scene line.
-fn check_lines<'a>(journal: &Path, script: &'a Script, document: Option<&Path>) -> Result<&'a Command, RecoverError> {
+fn check_lines<'a>(journal: &Path, script: &'a Script, document: Option<&Path>) -> Result<&'a Line, RecoverError> {
     let failed = |message: String| RecoverError::Failed { path: journal.to_path_buf(), message };
-    let is_scene = |c: &Command| matches!(c, Command::Load(_) | Command::New | Command::Demo(_));
-    let first = script.lines.iter().find(|l| !matches!(l.command, Command::Viewport(..))).map(|l| &l.command);
+    let is_scene = |c: &Line| matches!(c, Line::Load(_) | Line::New | Line::Demo(_));
+    let first = script.lines.iter().find(|l| !matches!(l.command, Line::Viewport(..))).map(|l| &l.command);
     // A journal only edits: one that writes files (planted, or damaged) is refused.
-    if let Some(line) = script.lines.iter().find(|l| matches!(l.command, Command::Save(_) | Command::Render(_))) {
+    if let Some(line) = script.lines.iter().find(|l| matches!(l.command, Line::Save(_) | Line::Render(_))) {
         return Err(failed(format!("line {} writes a file ('{}'), which no journal does", line.number, line.command)));
     }
     // It makes its scene once: a second scene line would edit another file.
@@ -270,7 +270,7 @@ fn check_lines<'a>(journal: &Path, script: &'a Script, document: Option<&Path>) 
         )));
     }
     let owned = match (first, document) {
-        (Some(Command::Load(owner)), Some(document)) => {
+        (Some(Line::Load(owner)), Some(document)) => {
             let id = |p: &Path| std::fs::canonicalize(p).ok();
             let owner = id(owner);
             owner.is_some() && (owner == id(document) || owner == id(&snapshot_path(journal)))
@@ -397,7 +397,7 @@ mod tests {
     fn a_journal_a_window_holds_is_live() {
         let (_dir, document, journal) = document();
         let mut recorder = crate::replay::Recorder::journal(&journal, "test").unwrap();
-        recorder.scene(Command::Load(document.clone())).unwrap();
+        recorder.scene(Line::Load(document.clone())).unwrap();
         assert!(is_live(&journal));
         let err = recover(&document, Checks::default()).unwrap_err();
         assert!(matches!(err, RecoverError::Live { .. }), "{err}");

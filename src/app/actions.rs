@@ -5,7 +5,7 @@
 use glam::IVec3;
 use winit::keyboard::KeyCode;
 
-use super::command::{Command, Nudge};
+use super::command::{AppCommand, Nudge};
 use super::state::Tool;
 use octovox::script::ObjectLine;
 
@@ -18,27 +18,27 @@ pub struct Action {
     /// The menu that lists it (`None`: keyboard only, or a second key of
     /// an action a menu already lists).
     pub menu: Option<&'static str>,
-    pub command: Command,
+    pub command: AppCommand,
 }
 
-const fn key(label: &'static str, key: KeyCode, menu: Option<&'static str>, command: Command) -> Action {
+const fn key(label: &'static str, key: KeyCode, menu: Option<&'static str>, command: AppCommand) -> Action {
     Action { label, key, ctrl: false, shift: false, menu, command }
 }
 
-const fn ctrl(label: &'static str, key: KeyCode, menu: Option<&'static str>, command: Command) -> Action {
+const fn ctrl(label: &'static str, key: KeyCode, menu: Option<&'static str>, command: AppCommand) -> Action {
     Action { label, key, ctrl: true, shift: false, menu, command }
 }
 
-const fn ctrl_shift(label: &'static str, key: KeyCode, menu: Option<&'static str>, command: Command) -> Action {
+const fn ctrl_shift(label: &'static str, key: KeyCode, menu: Option<&'static str>, command: AppCommand) -> Action {
     Action { label, key, ctrl: true, shift: true, menu, command }
 }
 
 const fn turn(label: &'static str, code: KeyCode, axis: usize, flip: bool) -> Action {
-    Action { label, key: code, ctrl: false, shift: flip, menu: EDIT, command: Command::Turn { axis, flip } }
+    Action { label, key: code, ctrl: false, shift: flip, menu: EDIT, command: AppCommand::Turn { axis, flip } }
 }
 
 const fn nudge(label: &'static str, code: KeyCode, direction: Nudge) -> Action {
-    key(label, code, None, Command::Nudge(direction))
+    key(label, code, None, AppCommand::Nudge(direction))
 }
 
 const FILE: Option<&str> = Some("File");
@@ -48,38 +48,38 @@ const VIEW: Option<&str> = Some("View");
 const OBJECT: Option<&str> = Some("Object");
 
 const fn object(label: &'static str, code: KeyCode, line: ObjectLine) -> Action {
-    Action { label, key: code, ctrl: true, shift: false, menu: OBJECT, command: Command::Object(line) }
+    Action { label, key: code, ctrl: true, shift: false, menu: OBJECT, command: AppCommand::Object(line) }
 }
 
 /// Every keyboard action, in menu order.
 pub static ACTIONS: [Action; 49] = [
-    ctrl("New", KeyCode::KeyN, FILE, Command::New),
-    ctrl("Open…", KeyCode::KeyO, FILE, Command::AskOpen),
-    ctrl("Save", KeyCode::KeyS, FILE, Command::Save),
-    ctrl_shift("Save As…", KeyCode::KeyS, FILE, Command::AskSaveAs),
-    ctrl("Export mesh…", KeyCode::KeyE, FILE, Command::AskExport),
-    key("Screenshot", KeyCode::F12, FILE, Command::Screenshot),
-    ctrl("Quit", KeyCode::KeyQ, FILE, Command::Quit),
-    ctrl("Undo", KeyCode::KeyZ, EDIT, Command::Undo),
-    ctrl_shift("Redo", KeyCode::KeyZ, EDIT, Command::Redo),
-    ctrl("Redo", KeyCode::KeyY, None, Command::Redo),
-    ctrl("Copy selection", KeyCode::KeyC, EDIT, Command::Copy),
-    ctrl("Cut selection", KeyCode::KeyX, EDIT, Command::Cut),
-    ctrl("Paste on the face under the cursor", KeyCode::KeyV, EDIT, Command::PasteAtCursor),
-    key("Delete selection", KeyCode::Delete, EDIT, Command::DeleteSelection),
-    key("Select none", KeyCode::Escape, EDIT, Command::SelectNone),
+    ctrl("New", KeyCode::KeyN, FILE, AppCommand::New),
+    ctrl("Open…", KeyCode::KeyO, FILE, AppCommand::AskOpen),
+    ctrl("Save", KeyCode::KeyS, FILE, AppCommand::Save),
+    ctrl_shift("Save As…", KeyCode::KeyS, FILE, AppCommand::AskSaveAs),
+    ctrl("Export mesh…", KeyCode::KeyE, FILE, AppCommand::AskExport),
+    key("Screenshot", KeyCode::F12, FILE, AppCommand::Screenshot),
+    ctrl("Quit", KeyCode::KeyQ, FILE, AppCommand::Quit),
+    ctrl("Undo", KeyCode::KeyZ, EDIT, AppCommand::Undo),
+    ctrl_shift("Redo", KeyCode::KeyZ, EDIT, AppCommand::Redo),
+    ctrl("Redo", KeyCode::KeyY, None, AppCommand::Redo),
+    ctrl("Copy selection", KeyCode::KeyC, EDIT, AppCommand::Copy),
+    ctrl("Cut selection", KeyCode::KeyX, EDIT, AppCommand::Cut),
+    ctrl("Paste on the face under the cursor", KeyCode::KeyV, EDIT, AppCommand::PasteAtCursor),
+    key("Delete selection", KeyCode::Delete, EDIT, AppCommand::DeleteSelection),
+    key("Select none", KeyCode::Escape, EDIT, AppCommand::SelectNone),
     turn("Turn selection about x", KeyCode::KeyX, 0, false),
     turn("Turn selection about y", KeyCode::KeyY, 1, false),
     turn("Turn selection about z", KeyCode::KeyZ, 2, false),
     turn("Flip selection along x", KeyCode::KeyX, 0, true),
     turn("Flip selection along y", KeyCode::KeyY, 1, true),
     turn("Flip selection along z", KeyCode::KeyZ, 2, true),
-    key("Attach tool", KeyCode::KeyT, TOOLS, Command::SetTool(Tool::Attach)),
-    key("Erase tool", KeyCode::KeyR, TOOLS, Command::SetTool(Tool::Erase)),
-    key("Paint tool", KeyCode::KeyG, TOOLS, Command::SetTool(Tool::Paint)),
-    key("Line mode", KeyCode::KeyL, TOOLS, Command::ToggleLine),
-    key("Box select mode", KeyCode::KeyB, TOOLS, Command::ToggleSelect),
-    key("Object mode", KeyCode::Tab, OBJECT, Command::ToggleObject),
+    key("Attach tool", KeyCode::KeyT, TOOLS, AppCommand::SetTool(Tool::Attach)),
+    key("Erase tool", KeyCode::KeyR, TOOLS, AppCommand::SetTool(Tool::Erase)),
+    key("Paint tool", KeyCode::KeyG, TOOLS, AppCommand::SetTool(Tool::Paint)),
+    key("Line mode", KeyCode::KeyL, TOOLS, AppCommand::ToggleLine),
+    key("Box select mode", KeyCode::KeyB, TOOLS, AppCommand::ToggleSelect),
+    key("Object mode", KeyCode::Tab, OBJECT, AppCommand::ToggleObject),
     object("Duplicate object", KeyCode::KeyD, ObjectLine::Duplicate { reference: false }),
     Action {
         label: "Duplicate object as a reference",
@@ -87,29 +87,29 @@ pub static ACTIONS: [Action; 49] = [
         ctrl: false,
         shift: true,
         menu: OBJECT,
-        command: Command::Object(ObjectLine::Duplicate { reference: true }),
+        command: AppCommand::Object(ObjectLine::Duplicate { reference: true }),
     },
     object("Make object unique", KeyCode::KeyU, ObjectLine::Unique),
     object("Turn object about y", KeyCode::KeyR, ObjectLine::Rotate(1)),
     object("Hide object", KeyCode::KeyH, ObjectLine::Hide(true)),
     object("Delete object", KeyCode::Delete, ObjectLine::Delete),
-    key("Frame model", KeyCode::KeyF, VIEW, Command::FrameModel),
+    key("Frame model", KeyCode::KeyF, VIEW, AppCommand::FrameModel),
     Action {
         label: "Frame selection",
         key: KeyCode::KeyF,
         ctrl: false,
         shift: true,
         menu: VIEW,
-        command: Command::FrameSelection,
+        command: AppCommand::FrameSelection,
     },
-    key("Orthographic or perspective", KeyCode::KeyO, VIEW, Command::ToggleProjection),
-    key("Orthographic or perspective", KeyCode::Numpad5, None, Command::ToggleProjection),
-    key("Front view", KeyCode::Numpad1, VIEW, Command::ViewFrom(IVec3::Z)),
-    ctrl("Back view", KeyCode::Numpad1, VIEW, Command::ViewFrom(IVec3::NEG_Z)),
-    key("Right view", KeyCode::Numpad3, VIEW, Command::ViewFrom(IVec3::X)),
-    ctrl("Left view", KeyCode::Numpad3, VIEW, Command::ViewFrom(IVec3::NEG_X)),
-    key("Top view", KeyCode::Numpad7, VIEW, Command::ViewFrom(IVec3::Y)),
-    ctrl("Bottom view", KeyCode::Numpad7, VIEW, Command::ViewFrom(IVec3::NEG_Y)),
+    key("Orthographic or perspective", KeyCode::KeyO, VIEW, AppCommand::ToggleProjection),
+    key("Orthographic or perspective", KeyCode::Numpad5, None, AppCommand::ToggleProjection),
+    key("Front view", KeyCode::Numpad1, VIEW, AppCommand::ViewFrom(IVec3::Z)),
+    ctrl("Back view", KeyCode::Numpad1, VIEW, AppCommand::ViewFrom(IVec3::NEG_Z)),
+    key("Right view", KeyCode::Numpad3, VIEW, AppCommand::ViewFrom(IVec3::X)),
+    ctrl("Left view", KeyCode::Numpad3, VIEW, AppCommand::ViewFrom(IVec3::NEG_X)),
+    key("Top view", KeyCode::Numpad7, VIEW, AppCommand::ViewFrom(IVec3::Y)),
+    ctrl("Bottom view", KeyCode::Numpad7, VIEW, AppCommand::ViewFrom(IVec3::NEG_Y)),
     nudge("Move selection left", KeyCode::ArrowLeft, Nudge::Left),
     nudge("Move selection right", KeyCode::ArrowRight, Nudge::Right),
     nudge("Move selection away", KeyCode::ArrowUp, Nudge::Away),
@@ -121,7 +121,7 @@ pub static ACTIONS: [Action; 49] = [
 impl Action {
     /// Held down, the key repeats the action (nudging); others fire once.
     pub fn repeats(&self) -> bool {
-        matches!(self.command, Command::Nudge(_))
+        matches!(self.command, AppCommand::Nudge(_))
     }
 }
 

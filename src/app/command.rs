@@ -49,7 +49,7 @@ pub enum Choice {
 }
 
 #[derive(Clone, Debug, PartialEq)]
-pub enum Command {
+pub enum AppCommand {
     /// Edit with `tool` at the window pixel `(x, y)` (physical pixels).
     PointerEdit {
         phase: StrokePhase,
@@ -96,7 +96,7 @@ pub enum Command {
     /// Script lines a panel or dialog asks for, run in order (the Objects
     /// panel's `object N` and `object hide`, the Layers panel's `layer N
     /// hide`, the palette's `palette preset`, `load` and `save`).
-    Lines(Vec<octovox::script::Command>),
+    Lines(Vec<octovox::script::Line>),
     /// Edit ▸ Copy, Cut, Delete, Select none: the `copy`, `cut`, `delete`
     /// and `select off` lines.
     Copy,

@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use super::command::Command;
+use super::command::AppCommand;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DialogKind {
@@ -42,14 +42,14 @@ impl DialogKind {
     }
 
     /// What the chosen path does.
-    pub fn command(self, path: PathBuf) -> Command {
-        use octovox::script::{Command as Line, PaletteLine};
+    pub fn command(self, path: PathBuf) -> AppCommand {
+        use octovox::script::{Line, PaletteLine};
         match self {
-            DialogKind::Open => Command::Open(path),
-            DialogKind::SaveAs => Command::SaveAs(path),
-            DialogKind::Export => Command::Export(path),
-            DialogKind::LoadPalette => Command::Lines(vec![Line::Palette(PaletteLine::Load(path))]),
-            DialogKind::SavePalette => Command::Lines(vec![Line::Palette(PaletteLine::Save(path))]),
+            DialogKind::Open => AppCommand::Open(path),
+            DialogKind::SaveAs => AppCommand::SaveAs(path),
+            DialogKind::Export => AppCommand::Export(path),
+            DialogKind::LoadPalette => AppCommand::Lines(vec![Line::Palette(PaletteLine::Load(path))]),
+            DialogKind::SavePalette => AppCommand::Lines(vec![Line::Palette(PaletteLine::Save(path))]),
         }
     }
 }

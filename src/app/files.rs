@@ -12,7 +12,7 @@ use octovox::io::output::same_file;
 use octovox::scene::Scene;
 
 use octovox::journal::{Checks, FileStamp};
-use octovox::script::Command::Load;
+use octovox::script::Line::Load;
 
 use super::dialog_kind::DialogKind;
 use super::document::Loading;
@@ -25,7 +25,7 @@ impl App {
     /// it whole; `source` is the script line that makes it (`load`, `new`,
     /// `demo`), which the recorder writes.
     /// `stamp` is the loaded file's as it was read (`JournalStart`).
-    pub(super) fn replace_scene(&mut self, scene: Scene, source: octovox::script::Command, stamp: Option<FileStamp>) {
+    pub(super) fn replace_scene(&mut self, scene: Scene, source: octovox::script::Line, stamp: Option<FileStamp>) {
         self.doc.editor.set_scene(scene);
         self.scene_replaced(source, stamp);
     }
@@ -33,11 +33,11 @@ impl App {
     /// Follows up a scene the editor just put in place (opened, or made by a
     /// `new` or `demo` line): the recording, a fresh journal, the title, and
     /// all of it to the GPU.
-    pub(super) fn scene_replaced(&mut self, source: octovox::script::Command, stamp: Option<FileStamp>) {
+    pub(super) fn scene_replaced(&mut self, source: octovox::script::Line, stamp: Option<FileStamp>) {
         let (path, line) = match source {
-            octovox::script::Command::Load(path) => {
+            octovox::script::Line::Load(path) => {
                 let absolute = std::fs::canonicalize(&path).unwrap_or_else(|_| path.clone());
-                (Some(path), octovox::script::Command::Load(absolute))
+                (Some(path), octovox::script::Line::Load(absolute))
             }
             line => (None, line),
         };
@@ -46,7 +46,7 @@ impl App {
         self.close_journal();
         // The line that makes the scene starts its journal (untitled ones too).
         self.doc.journal_start = match line {
-            octovox::script::Command::Load(path) => JournalStart { lines: vec![Load(path)], stamp },
+            octovox::script::Line::Load(path) => JournalStart { lines: vec![Load(path)], stamp },
             line => JournalStart::of(vec![line]),
         };
         self.gesture = Gesture::Idle;
@@ -101,7 +101,7 @@ impl App {
     pub(super) fn perform(&mut self, action: Pending, event_loop: &ActiveEventLoop) {
         match action {
             Pending::New => {
-                self.replace_scene(Scene::default(), octovox::script::Command::New, None);
+                self.replace_scene(Scene::default(), octovox::script::Line::New, None);
                 let volume = self.state.working_volume();
                 self.state.camera = camera_control::fresh_camera(self.state.camera.fov_y_deg, None);
                 self.frame_box(Some(volume));
@@ -130,7 +130,7 @@ impl App {
             Ok(scene) => scene,
             Err(err) => return self.ui.error(format!("cannot recover: {err}")),
         };
-        let source = document.clone().map_or(octovox::script::Command::New, octovox::script::Command::Load);
+        let source = document.clone().map_or(octovox::script::Line::New, octovox::script::Line::Load);
         self.replace_scene(scene, source, None);
         // What is shown is the scene plus its journal, not yet saved.
         self.state.saved_state = None;

@@ -5,7 +5,7 @@
 use egui::{Color32, Pos2, Sense, Stroke, Vec2};
 use glam::IVec3;
 
-use super::command::Command;
+use super::command::AppCommand;
 use octovox::camera::Camera;
 
 /// Side of the gizmo's square, in points.
@@ -37,7 +37,7 @@ fn projected(camera: &Camera) -> [(Vec2, f64); 6] {
 
 /// Draws the gizmo at the top right of the view, left of a panel `right`
 /// points wide; a click on an axis end asks for the view from it.
-pub fn show(ctx: &egui::Context, camera: &Camera, right: f32, out: &mut Vec<Command>) {
+pub fn show(ctx: &egui::Context, camera: &Camera, right: f32, out: &mut Vec<AppCommand>) {
     let at = Vec2::new(-8.0 - right, 32.0);
     egui::Area::new(egui::Id::unique("axis gizmo")).anchor(egui::Align2::RIGHT_TOP, at).show(ctx, |ui| {
         let (rect, response) = ui.allocate_exact_size(Vec2::splat(SIZE), Sense::click());
@@ -69,7 +69,7 @@ pub fn show(ctx: &egui::Context, camera: &Camera, right: f32, out: &mut Vec<Comm
         if response.clicked()
             && let Some(i) = response.interact_pointer_pos().and_then(nearest)
         {
-            out.push(Command::ViewFrom(ENDS[i].0));
+            out.push(AppCommand::ViewFrom(ENDS[i].0));
         }
         response.on_hover_text("click an axis end to look from that side · O: orthographic or perspective");
     });

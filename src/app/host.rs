@@ -14,7 +14,7 @@ use octovox::editor::{Editor, Outcome};
 use octovox::io::atomic::WriteOptions;
 use octovox::io::output::{OutputKind, check_output};
 use octovox::replay::{Host, HostError, Ran, Recorder, StepError, StepResult, step};
-use octovox::script::Command as Line;
+use octovox::script::Line;
 use octovox::settings::RenderSettings;
 use octovox::trace::pick;
 
@@ -74,8 +74,7 @@ impl App {
             (Outcome::Changed, _) if gesture => self.after_change("edit", ran),
             (Outcome::Changed, _) => {
                 // The line's command word names it in the printed line (`fill: N bytes written`).
-                let text = line.to_string();
-                self.after_change(text.split(' ').next().unwrap_or("edit"), ran);
+                self.after_change(line.word(), ran);
             }
             _ => {
                 self.record(ran);

@@ -1,5 +1,5 @@
 //! Mouse and keyboard: turns winit events that egui did not consume into
-//! [`Command`]s, and remembers what is held (buttons, fly keys, modifiers).
+//! [`AppCommand`]s, and remembers what is held (buttons, fly keys, modifiers).
 
 use std::collections::HashSet;
 
@@ -7,7 +7,7 @@ use glam::DVec3;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::keyboard::{KeyCode, ModifiersState, PhysicalKey};
 
-use super::command::{Command, StrokePhase};
+use super::command::{AppCommand, StrokePhase};
 use super::state::Tool;
 
 /// A right press becomes an orbit once the pointer moved this far (pixels);
@@ -76,7 +76,7 @@ impl Input {
     /// starts nothing, but releases and motion are always tracked so that no
     /// button stays stuck. `extruding`: a Ctrl+drag extrude is under way
     /// (the window's gesture), so motion and the release go to it.
-    pub fn on_event(&mut self, event: &WindowEvent, consumed: bool, tool: Tool, extruding: bool) -> Vec<Command> {
+    pub fn on_event(&mut self, event: &WindowEvent, consumed: bool, tool: Tool, extruding: bool) -> Vec<AppCommand> {
         let mut out = Vec::new();
         match event {
             WindowEvent::ModifiersChanged(m) => self.modifiers = m.state(),
@@ -85,7 +85,7 @@ impl Input {
                 if self.left {
                     self.left = false;
                     if let Some((x, y)) = self.cursor {
-                        out.push(Command::PointerEdit { phase: StrokePhase::End, tool, x, y });
+                        out.push(AppCommand::PointerEdit { phase: StrokePhase::End, tool, x, y });
                     }
                 }
                 self.middle = false;
@@ -100,20 +100,20 @@ impl Input {
                         if !*moved && ((x - start.0).powi(2) + (y - start.1).powi(2)).sqrt() > CLICK_SLOP_PIXELS {
                             *moved = true;
                             // Catch up with the motion made inside the slop.
-                            out.push(Command::Orbit { dx: x - start.0, dy: y - start.1 });
+                            out.push(AppCommand::Orbit { dx: x - start.0, dy: y - start.1 });
                         } else if *moved {
-                            out.push(Command::Orbit { dx, dy });
+                            out.push(AppCommand::Orbit { dx, dy });
                         }
                     } else if self.middle {
-                        out.push(Command::Pan { dx, dy });
+                        out.push(AppCommand::Pan { dx, dy });
                     }
                 }
                 self.cursor = Some((x, y));
                 if self.left {
-                    out.push(Command::PointerEdit { phase: StrokePhase::Move, tool, x, y });
+                    out.push(AppCommand::PointerEdit { phase: StrokePhase::Move, tool, x, y });
                 }
                 if extruding {
-                    out.push(Command::ExtrudeDrag { phase: StrokePhase::Move, x, y });
+                    out.push(AppCommand::ExtrudeDrag { phase: StrokePhase::Move, x, y });
                 }
             }
             WindowEvent::MouseInput { state, button, .. } => {
@@ -123,35 +123,35 @@ impl Input {
                     // Shift+click with Paint: flood fill.
                     (MouseButton::Left, true) if !consumed && self.modifiers.shift_key() && tool == Tool::Paint => {
                         if let Some((x, y)) = at {
-                            out.push(Command::FillAt { x, y });
+                            out.push(AppCommand::FillAt { x, y });
                         }
                     }
                     // Ctrl+drag from a face: extrude.
                     (MouseButton::Left, true) if !consumed && self.modifiers.control_key() => {
                         if let Some((x, y)) = at {
-                            out.push(Command::ExtrudeDrag { phase: StrokePhase::Begin, x, y });
+                            out.push(AppCommand::ExtrudeDrag { phase: StrokePhase::Begin, x, y });
                         }
                     }
                     (MouseButton::Left, false) if extruding => {
                         let (x, y) = at.unwrap_or_default();
-                        out.push(Command::ExtrudeDrag { phase: StrokePhase::End, x, y });
+                        out.push(AppCommand::ExtrudeDrag { phase: StrokePhase::End, x, y });
                     }
                     // Alt+click: the eyedropper.
                     (MouseButton::Left, true) if !consumed && self.modifiers.alt_key() => {
                         if let Some((x, y)) = at {
-                            out.push(Command::PickColor { x, y });
+                            out.push(AppCommand::PickColor { x, y });
                         }
                     }
                     (MouseButton::Left, true) if !consumed && !self.left => {
                         if let Some((x, y)) = at {
                             self.left = true;
-                            out.push(Command::PointerEdit { phase: StrokePhase::Begin, tool, x, y });
+                            out.push(AppCommand::PointerEdit { phase: StrokePhase::Begin, tool, x, y });
                         }
                     }
                     (MouseButton::Left, false) if self.left => {
                         self.left = false;
                         let (x, y) = at.unwrap_or_default();
-                        out.push(Command::PointerEdit { phase: StrokePhase::End, tool, x, y });
+                        out.push(AppCommand::PointerEdit { phase: StrokePhase::End, tool, x, y });
                     }
                     (MouseButton::Right, true) if !consumed => {
                         if let Some(p) = at {
@@ -161,7 +161,7 @@ impl Input {
                     (MouseButton::Right, false) => {
                         // A right click without drag erases while Attach is active.
                         if let (Some((_, false)), Some((x, y)), Tool::Attach) = (self.right, at, tool) {
-                            out.push(Command::PointerEdit { phase: StrokePhase::Click, tool: Tool::Erase, x, y });
+                            out.push(AppCommand::PointerEdit { phase: StrokePhase::Click, tool: Tool::Erase, x, y });
                         }
                         self.right = None;
                     }
@@ -175,7 +175,7 @@ impl Input {
                     MouseScrollDelta::LineDelta(_, y) => f64::from(*y),
                     MouseScrollDelta::PixelDelta(p) => p.y / PIXELS_PER_LINE,
                 };
-                out.push(Command::Zoom { steps, at: self.cursor });
+                out.push(AppCommand::Zoom { steps, at: self.cursor });
             }
             WindowEvent::KeyboardInput { event, is_synthetic, .. } => {
                 log::debug!(
@@ -198,7 +198,7 @@ impl Input {
     /// key held when the window gains focus) counts as held but fires no
     /// shortcut: the real press, when the key was pressed just as the focus
     /// came, follows it, and a toggle would fire twice.
-    fn on_key(&mut self, key: KeyInput, consumed: bool) -> Option<Command> {
+    fn on_key(&mut self, key: KeyInput, consumed: bool) -> Option<AppCommand> {
         if key.state == ElementState::Released {
             self.keys.remove(&key.code);
             return None;
@@ -215,10 +215,10 @@ impl Input {
 
     /// Keyboard shortcuts (physical keys, so they work on any layout), from
     /// the one table of actions.
-    fn shortcut(&self, code: KeyCode, repeat: bool) -> Option<Command> {
+    fn shortcut(&self, code: KeyCode, repeat: bool) -> Option<AppCommand> {
         let action = super::actions::for_key(code, self.modifiers.control_key(), self.modifiers.shift_key(), repeat)?;
         // While the right button is held, WASDQE fly, and F is not "frame".
-        if action.command == Command::FrameModel && self.right.is_some() {
+        if action.command == AppCommand::FrameModel && self.right.is_some() {
             return None;
         }
         Some(action.command.clone())
@@ -238,7 +238,7 @@ mod tests {
         let mut input = Input::default();
         // The focus arrives while B is down: winit's synthetic press, then the real one.
         assert_eq!(input.on_key(press(KeyCode::KeyB, true), false), None);
-        assert_eq!(input.on_key(press(KeyCode::KeyB, false), false), Some(Command::ToggleSelect));
+        assert_eq!(input.on_key(press(KeyCode::KeyB, false), false), Some(AppCommand::ToggleSelect));
         let release = KeyInput { state: ElementState::Released, ..press(KeyCode::KeyB, false) };
         assert_eq!(input.on_key(release, false), None);
     }

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use octovox::journal::{FileStamp, RecoverError};
 use octovox::replay::Recorder;
-use octovox::script::Command as Line;
+use octovox::script::Line;
 
 use super::App;
 

@@ -65,7 +65,7 @@ use octovox::trace::pick;
 
 use crate::cli::WindowArgs;
 use clock::FrameClock;
-pub use command::{Choice, Command, Nudge, Pending, StrokePhase};
+pub use command::{AppCommand, Choice, Nudge, Pending, StrokePhase};
 use dialog_kind::DialogKind;
 use document::Document;
 use egui_layers::EguiLayers;
@@ -165,7 +165,7 @@ impl App {
             Some(path) => app.start_loading(path),
             None => {
                 let built_in = app.args.demo.unwrap_or_default();
-                app.replace_scene(built_in.scene(), octovox::script::Command::Demo(built_in), None);
+                app.replace_scene(built_in.scene(), octovox::script::Line::Demo(built_in), None);
                 if app.args.camera.is_none() {
                     app.frame_box(app.doc.editor.scene.solid_bounds());
                 }
@@ -253,12 +253,12 @@ impl App {
         if (if undo { undoable } else { redoable }) == 0 {
             return self.ui.info(format!("nothing to {what}"));
         }
-        self.act(if undo { octovox::script::Command::Undo(1) } else { octovox::script::Command::Redo(1) }, what);
+        self.act(if undo { octovox::script::Line::Undo(1) } else { octovox::script::Line::Redo(1) }, what);
     }
 
     /// A mouse or key action as an editor line; a refusal goes to the
     /// message line as `what refused: …`.
-    fn act(&mut self, line: octovox::script::Command, what: &str) {
+    fn act(&mut self, line: octovox::script::Line, what: &str) {
         if let Err(err) = self.run_line(&line) {
             self.ui.error(format!("{what} refused: {err}"));
         }
@@ -313,83 +313,83 @@ impl App {
 
     /// Carries out one command. Panels, keys, the mouse and played replay
     /// scripts all end up here.
-    fn execute(&mut self, command: Command, event_loop: &ActiveEventLoop) {
+    fn execute(&mut self, command: AppCommand, event_loop: &ActiveEventLoop) {
         let busy_loading = self.doc.loading.is_some();
         match command {
-            Command::PointerEdit { phase, tool, x, y } if !busy_loading => self.pointer_edit(phase, tool, x, y),
-            Command::ExtrudeDrag { phase, x, y } if !busy_loading => self.extrude_drag(phase, x, y),
-            Command::EditPalette { edit, dragging } if !busy_loading => self.palette_edit(edit, dragging),
-            Command::Cut if !busy_loading => self.act(octovox::script::Command::Cut, "cut"),
+            AppCommand::PointerEdit { phase, tool, x, y } if !busy_loading => self.pointer_edit(phase, tool, x, y),
+            AppCommand::ExtrudeDrag { phase, x, y } if !busy_loading => self.extrude_drag(phase, x, y),
+            AppCommand::EditPalette { edit, dragging } if !busy_loading => self.palette_edit(edit, dragging),
+            AppCommand::Cut if !busy_loading => self.act(octovox::script::Line::Cut, "cut"),
             // Object mode: Delete and X/Y/Z act on the picked object.
-            Command::DeleteSelection if !busy_loading && self.state.mode == Mode::Object => {
-                self.act(octovox::script::Command::Object(octovox::script::ObjectLine::Delete), "object")
+            AppCommand::DeleteSelection if !busy_loading && self.state.mode == Mode::Object => {
+                self.act(octovox::script::Line::Object(octovox::script::ObjectLine::Delete), "object")
             }
-            Command::Turn { axis, flip: false } if !busy_loading && self.state.mode == Mode::Object => {
-                self.act(octovox::script::Command::Object(octovox::script::ObjectLine::Rotate(axis)), "object")
+            AppCommand::Turn { axis, flip: false } if !busy_loading && self.state.mode == Mode::Object => {
+                self.act(octovox::script::Line::Object(octovox::script::ObjectLine::Rotate(axis)), "object")
             }
-            Command::Turn { flip: true, .. } if self.state.mode == Mode::Object => {
+            AppCommand::Turn { flip: true, .. } if self.state.mode == Mode::Object => {
                 self.ui.info("an object turns (X, Y, Z) but does not flip");
             }
-            Command::DeleteSelection if !busy_loading => self.act(octovox::script::Command::Delete, "delete"),
-            Command::PasteAtCursor if !busy_loading => self.paste_at_cursor(),
-            Command::Nudge(nudge) if !busy_loading => self.nudge(nudge),
-            Command::Turn { axis, flip: false } if !busy_loading => {
-                self.act(octovox::script::Command::Rotate(axis), "rotate")
+            AppCommand::DeleteSelection if !busy_loading => self.act(octovox::script::Line::Delete, "delete"),
+            AppCommand::PasteAtCursor if !busy_loading => self.paste_at_cursor(),
+            AppCommand::Nudge(nudge) if !busy_loading => self.nudge(nudge),
+            AppCommand::Turn { axis, flip: false } if !busy_loading => {
+                self.act(octovox::script::Line::Rotate(axis), "rotate")
             }
-            Command::Turn { axis, flip: true } if !busy_loading => {
-                self.act(octovox::script::Command::Flip(axis), "flip")
+            AppCommand::Turn { axis, flip: true } if !busy_loading => {
+                self.act(octovox::script::Line::Flip(axis), "flip")
             }
-            Command::Undo if !busy_loading => self.undo_redo(true),
-            Command::Redo if !busy_loading => self.undo_redo(false),
-            Command::PointerEdit { .. }
-            | Command::Cut
-            | Command::DeleteSelection
-            | Command::PasteAtCursor
-            | Command::Nudge(_)
-            | Command::Turn { .. }
-            | Command::ExtrudeDrag { .. }
-            | Command::EditPalette { .. }
-            | Command::Undo
-            | Command::Redo => {
+            AppCommand::Undo if !busy_loading => self.undo_redo(true),
+            AppCommand::Redo if !busy_loading => self.undo_redo(false),
+            AppCommand::PointerEdit { .. }
+            | AppCommand::Cut
+            | AppCommand::DeleteSelection
+            | AppCommand::PasteAtCursor
+            | AppCommand::Nudge(_)
+            | AppCommand::Turn { .. }
+            | AppCommand::ExtrudeDrag { .. }
+            | AppCommand::EditPalette { .. }
+            | AppCommand::Undo
+            | AppCommand::Redo => {
                 self.ui.info("still loading…");
             }
-            Command::ApplyPreset(i) => {
+            AppCommand::ApplyPreset(i) => {
                 if let Some(preset) = presets::PRESETS.get(i) {
                     preset.apply(&mut self.state);
                     report!("preset: {}", preset.name);
                 }
             }
-            Command::MeasurePresets => self.measure_presets(),
-            Command::ToggleLine => self.toggle_mode(Mode::Line),
-            Command::ToggleSelect => self.toggle_mode(Mode::Select),
-            Command::ToggleObject => self.toggle_mode(Mode::Object),
-            Command::Copy => match self.run_line(&octovox::script::Command::Copy) {
+            AppCommand::MeasurePresets => self.measure_presets(),
+            AppCommand::ToggleLine => self.toggle_mode(Mode::Line),
+            AppCommand::ToggleSelect => self.toggle_mode(Mode::Select),
+            AppCommand::ToggleObject => self.toggle_mode(Mode::Object),
+            AppCommand::Copy => match self.run_line(&octovox::script::Line::Copy) {
                 Ok(_) => {
                     let voxels = self.doc.editor.clipboard().map_or(0, octovox::edit::selection::Block::voxels);
                     self.ui.info(format!("copied {voxels} voxels"));
                 }
                 Err(err) => self.ui.error(format!("copy refused: {err}")),
             },
-            Command::SelectNone => self.act(octovox::script::Command::Select(None), "select"),
-            Command::Object(line) => self.act(octovox::script::Command::Object(line), "object"),
-            Command::Lines(lines) => {
+            AppCommand::SelectNone => self.act(octovox::script::Line::Select(None), "select"),
+            AppCommand::Object(line) => self.act(octovox::script::Line::Object(line), "object"),
+            AppCommand::Lines(lines) => {
                 for line in lines {
-                    let text = line.to_string();
-                    self.act(line, text.split(' ').next().unwrap_or("line"));
+                    let word = line.word();
+                    self.act(line, word);
                 }
             }
-            Command::FillAt { x, y } => {
+            AppCommand::FillAt { x, y } => {
                 if let Some(pick) = self.pick_or_say(x, y, "no voxel there to fill") {
-                    self.act(octovox::script::Command::Fill(pick.voxel), "fill");
+                    self.act(octovox::script::Line::Fill(pick.voxel), "fill");
                 }
             }
-            Command::PickColor { x, y } => {
+            AppCommand::PickColor { x, y } => {
                 if let Some(pick) = self.pick_or_say(x, y, "no voxel there to pick a colour from") {
-                    self.act(octovox::script::Command::Pick(pick.voxel), "pick");
+                    self.act(octovox::script::Line::Pick(pick.voxel), "pick");
                     report!("picked colour {}", self.doc.editor.tools.color);
                 }
             }
-            Command::SetTool(tool) => {
+            AppCommand::SetTool(tool) => {
                 // A tool is what a press applies: select and object mode,
                 // where a press picks, give way to the brush.
                 if !self.state.mode.uses_brush() {
@@ -397,56 +397,56 @@ impl App {
                 }
                 self.state.tool = tool;
             }
-            Command::Orbit { dx, dy } => camera_control::orbit(&mut self.state.camera, dx, dy),
-            Command::Pan { dx, dy } => {
+            AppCommand::Orbit { dx, dy } => camera_control::orbit(&mut self.state.camera, dx, dy),
+            AppCommand::Pan { dx, dy } => {
                 let height = self.gfx.as_ref().map_or(1, |g| g.config.height);
                 camera_control::pan(&mut self.state.camera, dx, dy, height);
             }
-            Command::Zoom { steps, at } => {
+            AppCommand::Zoom { steps, at } => {
                 // Toward the voxel under the cursor (a pick that fails zooms to the target).
                 let toward = at.and_then(|(x, y)| self.pick_or_ground(x, y).ok().flatten());
                 let toward = toward.map(|pick| pick.voxel.as_dvec3() + glam::DVec3::splat(0.5));
                 camera_control::zoom(&mut self.state.camera, steps, toward);
             }
-            Command::ToggleProjection => camera_control::toggle_projection(&mut self.state.camera),
-            Command::ViewFrom(side) => camera_control::view_from(&mut self.state.camera, side.as_dvec3()),
-            Command::FrameModel => self.frame_box(self.doc.editor.scene.solid_bounds()),
-            Command::FrameSelection => {
+            AppCommand::ToggleProjection => camera_control::toggle_projection(&mut self.state.camera),
+            AppCommand::ViewFrom(side) => camera_control::view_from(&mut self.state.camera, side.as_dvec3()),
+            AppCommand::FrameModel => self.frame_box(self.doc.editor.scene.solid_bounds()),
+            AppCommand::FrameSelection => {
                 let selected = self.doc.editor.selection.map(|r| (r.min, r.max));
                 self.frame_box(selected.or_else(|| self.doc.editor.scene.solid_bounds()));
             }
-            Command::New => self.guard_unsaved(Pending::New, event_loop),
-            Command::Open(path) => self.guard_unsaved(Pending::Open(path), event_loop),
-            Command::Quit => self.guard_unsaved(Pending::Quit, event_loop),
-            Command::Save => match self.state.path.clone() {
+            AppCommand::New => self.guard_unsaved(Pending::New, event_loop),
+            AppCommand::Open(path) => self.guard_unsaved(Pending::Open(path), event_loop),
+            AppCommand::Quit => self.guard_unsaved(Pending::Quit, event_loop),
+            AppCommand::Save => match self.state.path.clone() {
                 Some(path) => {
                     self.save_document(&path, WriteOptions::default());
                 }
                 None => self.ask_path(DialogKind::SaveAs, "saves/untitled.vox".into()),
             },
-            Command::SaveAs(path) => self.save_as(path, WriteOptions::default(), event_loop),
-            Command::SaveOver(path) => self.save_as(path, WriteOptions::forced(true), event_loop),
-            Command::AskOpen => {
+            AppCommand::SaveAs(path) => self.save_as(path, WriteOptions::default(), event_loop),
+            AppCommand::SaveOver(path) => self.save_as(path, WriteOptions::forced(true), event_loop),
+            AppCommand::AskOpen => {
                 let start = self.state.path.as_ref().map(|p| p.display().to_string()).unwrap_or_default();
                 self.ask_path(DialogKind::Open, start);
             }
-            Command::AskSaveAs => {
+            AppCommand::AskSaveAs => {
                 let start = self.state.path.as_ref().map_or("saves/untitled.vox".into(), |p| p.display().to_string());
                 self.ask_path(DialogKind::SaveAs, start);
             }
-            Command::AskExport => {
+            AppCommand::AskExport => {
                 let start = self.state.path.as_ref().map_or("saves/untitled.obj".into(), |p| p.with_extension("obj"));
                 self.ask_path(DialogKind::Export, start.display().to_string());
             }
-            Command::AskPalette { save } => {
+            AppCommand::AskPalette { save } => {
                 let kind = if save { DialogKind::SavePalette } else { DialogKind::LoadPalette };
                 self.ask_path(kind, if save { "saves/palette.png".into() } else { String::new() });
             }
-            Command::Export(path) => self.export(&path),
-            Command::Screenshot => self.frames.screenshot_requested = true,
-            Command::Resolve(choice) => self.resolve(choice, event_loop),
-            Command::RecoverJournal(journal, checks) => self.recover_journal(&journal, checks),
-            Command::DiscardJournal(journal) => {
+            AppCommand::Export(path) => self.export(&path),
+            AppCommand::Screenshot => self.frames.screenshot_requested = true,
+            AppCommand::Resolve(choice) => self.resolve(choice, event_loop),
+            AppCommand::RecoverJournal(journal, checks) => self.recover_journal(&journal, checks),
+            AppCommand::DiscardJournal(journal) => {
                 let _ = std::fs::remove_file(journal);
             }
         }
@@ -584,7 +584,7 @@ impl App {
             }
             StrokePhase::Move => {}
             StrokePhase::End | StrokePhase::Click => match (self.end_line().or(target), target) {
-                (Some(a), Some(b)) => self.act(octovox::script::Command::Line(a, b), "line"),
+                (Some(a), Some(b)) => self.act(octovox::script::Line::Segment(a, b), "line"),
                 (Some(_), None) => self.ui.info(format!("no line drawn: it ends on the sky ({why})")),
                 (None, _) => {}
             },
@@ -613,7 +613,7 @@ impl App {
                 let layers = self.extrude_layers(x, y);
                 let Gesture::Extrude { face: pick, .. } = std::mem::take(&mut self.gesture) else { return };
                 let Some(layers) = layers.filter(|l| *l != 0) else { return };
-                self.act(octovox::script::Command::Extrude(pick.voxel, pick.normal, layers), "extrude");
+                self.act(octovox::script::Line::Extrude(pick.voxel, pick.normal, layers), "extrude");
             }
             StrokePhase::Click => {}
         }
@@ -670,10 +670,10 @@ impl App {
         let palette = &self.doc.editor.scene.palette;
         let mut lines = Vec::new();
         if palette.color(index)[..3] != [r, g, b] {
-            lines.push(octovox::script::Command::Rgb(index, [r, g, b]));
+            lines.push(octovox::script::Line::Rgb(index, [r, g, b]));
         }
         if *palette.material(index) != *material {
-            lines.push(octovox::script::Command::Material(index, material));
+            lines.push(octovox::script::Line::Material(index, material));
         }
         if !matches!(self.gesture, Gesture::Palette) {
             self.doc.editor.history.begin_stroke();
@@ -785,8 +785,8 @@ impl App {
 
     /// Whether `line` is a step of the gesture under way (a mouse stroke,
     /// a held palette control) rather than an action that ends it.
-    fn continues_gesture(&self, line: &octovox::script::Command) -> bool {
-        use octovox::script::Command as Line;
+    fn continues_gesture(&self, line: &octovox::script::Line) -> bool {
+        use octovox::script::Line;
         match line {
             Line::Place(_) | Line::Remove(_) | Line::Paint(_) | Line::Object(octovox::script::ObjectLine::Pick(_)) => {
                 self.gesture.stroke().is_some_and(|s| s.applying)
@@ -842,7 +842,7 @@ impl ApplicationHandler for App {
         }
         match &event {
             WindowEvent::CloseRequested => {
-                self.execute(Command::Quit, event_loop);
+                self.execute(AppCommand::Quit, event_loop);
                 return;
             }
             WindowEvent::Resized(size) => {
@@ -857,7 +857,7 @@ impl ApplicationHandler for App {
                 return;
             }
             WindowEvent::DroppedFile(path) => {
-                self.execute(Command::Open(path.clone()), event_loop);
+                self.execute(AppCommand::Open(path.clone()), event_loop);
                 return;
             }
             WindowEvent::RedrawRequested => {

@@ -9,9 +9,9 @@ use egui::{Color32, Sense, Stroke};
 
 use octovox::scene::graph::OutlineRow;
 use octovox::scene::objects::Objects;
-use octovox::script::{Command as Line, LayerLine, ObjectLine, ObjectRef};
+use octovox::script::{LayerLine, Line, ObjectLine, ObjectRef};
 
-use super::command::Command;
+use super::command::AppCommand;
 
 /// Width of the right panel in points.
 pub const OUTLINER_WIDTH: f32 = 280.0;
@@ -47,7 +47,7 @@ pub struct OutlinerState {
 }
 
 /// Draws the panel; what the user asked for goes to `out`.
-pub fn show(ui: &mut egui::Ui, objects: &Objects, state: &mut OutlinerState, out: &mut Vec<Command>) {
+pub fn show(ui: &mut egui::Ui, objects: &Objects, state: &mut OutlinerState, out: &mut Vec<AppCommand>) {
     egui::Panel::right("outliner").resizable(false).exact_size(OUTLINER_WIDTH).show(ui, |ui| {
         egui::ScrollArea::vertical().id_salt("scene panel").show(ui, |ui| {
             let models = objects.models.len();
@@ -67,7 +67,7 @@ pub fn show(ui: &mut egui::Ui, objects: &Objects, state: &mut OutlinerState, out
 /// The rows of groups and objects; a group's arrow folds it, an object's
 /// name dragged onto another object's row puts it before or after that one
 /// (`object before|after N`), in that one's group.
-fn tree(ui: &mut egui::Ui, objects: &Objects, state: &mut OutlinerState, out: &mut Vec<Command>) {
+fn tree(ui: &mut egui::Ui, objects: &Objects, state: &mut OutlinerState, out: &mut Vec<AppCommand>) {
     let list = objects.list();
     state.merge.retain(|&i| i < list.len() && objects.selected != Some(i));
     state.dragging = state.dragging.filter(|&i| i < list.len());
@@ -129,18 +129,24 @@ fn indent(ui: &mut egui::Ui, depth: u32) {
 
 /// One object's row: the eye, the lock, the merge mark, and the name that
 /// picks the object when clicked and moves it when dragged.
-fn object_row(ui: &mut egui::Ui, objects: &Objects, index: usize, state: &mut OutlinerState, out: &mut Vec<Command>) {
+fn object_row(
+    ui: &mut egui::Ui,
+    objects: &Objects,
+    index: usize,
+    state: &mut OutlinerState,
+    out: &mut Vec<AppCommand>,
+) {
     let object = &objects.list()[index];
     let pick = Line::Object(ObjectLine::Pick(ObjectRef::Index(index)));
     let mut shown = !object.own_hidden;
     if ui.checkbox(&mut shown, "").on_hover_text("show or hide").changed() {
-        out.push(Command::Lines(vec![pick.clone(), Line::Object(ObjectLine::Hide(!shown))]));
+        out.push(AppCommand::Lines(vec![pick.clone(), Line::Object(ObjectLine::Hide(!shown))]));
     }
     let mut locked = objects.locked(index);
     let icon = if locked { "🔒" } else { "🔓" };
     let lock = ui.toggle_value(&mut locked, icon);
     if lock.on_hover_text("lock: no edits, moves or picks by a click").changed() {
-        out.push(Command::Lines(vec![pick.clone(), Line::Object(ObjectLine::Lock(locked))]));
+        out.push(AppCommand::Lines(vec![pick.clone(), Line::Object(ObjectLine::Lock(locked))]));
     }
     layer_choice(ui, objects, index, &pick, out);
     let marked = state.merge.contains(&index);
@@ -159,7 +165,7 @@ fn object_row(ui: &mut egui::Ui, objects: &Objects, index: usize, state: &mut Ou
     let path = if path.is_empty() { "(unnamed)" } else { &path };
     let row = row.on_hover_text(format!("{path} · model {} · drag to move it", object.placement.model));
     if row.clicked() {
-        out.push(Command::Lines(vec![pick]));
+        out.push(AppCommand::Lines(vec![pick]));
     }
     if row.drag_started() {
         state.dragging = Some(index);
@@ -169,7 +175,7 @@ fn object_row(ui: &mut egui::Ui, objects: &Objects, index: usize, state: &mut Ou
 /// The layer an object is on, as MagicaVoxel's outliner shows it, and a
 /// menu of the layers that puts it on another (`object layer N`): what a
 /// layer's eye hides is then on screen.
-fn layer_choice(ui: &mut egui::Ui, objects: &Objects, index: usize, pick: &Line, out: &mut Vec<Command>) {
+fn layer_choice(ui: &mut egui::Ui, objects: &Objects, index: usize, pick: &Line, out: &mut Vec<AppCommand>) {
     let layers = objects.layer_list();
     if layers.is_empty() {
         return;
@@ -183,7 +189,7 @@ fn layer_choice(ui: &mut egui::Ui, objects: &Objects, index: usize, pick: &Line,
             let id = layer.id.to_string();
             let text = if name.is_empty() || name == id { id } else { format!("{id} {name}") };
             if ui.selectable_label(current == Some(layer.id), text).clicked() && current != Some(layer.id) {
-                out.push(Command::Lines(vec![pick.clone(), Line::Object(ObjectLine::Layer(layer.id))]));
+                out.push(AppCommand::Lines(vec![pick.clone(), Line::Object(ObjectLine::Layer(layer.id))]));
                 ui.close();
             }
         }
@@ -194,7 +200,12 @@ fn layer_choice(ui: &mut egui::Ui, objects: &Objects, index: usize, pick: &Line,
 
 /// While a row is dragged, the line where it would go; when it is let go
 /// over another object's row, the lines that move it there.
-fn drop_target(ui: &mut egui::Ui, targets: &[(usize, egui::Rect)], state: &mut OutlinerState, out: &mut Vec<Command>) {
+fn drop_target(
+    ui: &mut egui::Ui,
+    targets: &[(usize, egui::Rect)],
+    state: &mut OutlinerState,
+    out: &mut Vec<AppCommand>,
+) {
     let Some(dragged) = state.dragging else { return };
     let (pointer, down) = ui.input(|i| (i.pointer.interact_pos(), i.pointer.any_down()));
     let over = pointer.and_then(|p| {
@@ -211,7 +222,7 @@ fn drop_target(ui: &mut egui::Ui, targets: &[(usize, egui::Rect)], state: &mut O
     }
     state.dragging = None;
     if let Some((target, _, after)) = place {
-        out.push(Command::Lines(vec![
+        out.push(AppCommand::Lines(vec![
             Line::Object(ObjectLine::Pick(ObjectRef::Index(dragged))),
             Line::Object(ObjectLine::Regroup(ObjectRef::Index(target), after)),
         ]));
@@ -231,13 +242,13 @@ fn toggle(set: &mut Vec<usize>, index: usize) {
 /// The button that merges the objects marked with + into the picked one
 /// (`object merge N…`, one undo step). Always there, so that the rows
 /// below stay put.
-fn merge_row(ui: &mut egui::Ui, objects: &Objects, merge: &mut Vec<usize>, out: &mut Vec<Command>) {
+fn merge_row(ui: &mut egui::Ui, objects: &Objects, merge: &mut Vec<usize>, out: &mut Vec<AppCommand>) {
     ui.horizontal(|ui| {
         let ready = objects.selected.is_some() && !merge.is_empty();
         let button = ui.add_enabled(ready, egui::Button::new(format!("Merge {} marked", merge.len())));
         if button.on_hover_text("+ marks objects to merge into the picked one").clicked() {
             let others = merge.drain(..).map(ObjectRef::Index).collect();
-            out.push(Command::Lines(vec![Line::Object(ObjectLine::Merge(others))]));
+            out.push(AppCommand::Lines(vec![Line::Object(ObjectLine::Merge(others))]));
         }
         if ui.add_enabled(!merge.is_empty(), egui::Button::new("Clear")).clicked() {
             merge.clear();
@@ -247,7 +258,7 @@ fn merge_row(ui: &mut egui::Ui, objects: &Objects, merge: &mut Vec<usize>, out: 
 
 /// The Layers panel: each layer's eye, colour, whether new objects go on
 /// it, and its name.
-fn layers(ui: &mut egui::Ui, objects: &Objects, state: &mut OutlinerState, out: &mut Vec<Command>) {
+fn layers(ui: &mut egui::Ui, objects: &Objects, state: &mut OutlinerState, out: &mut Vec<AppCommand>) {
     let picking = &mut state.layer_color;
     let layers = objects.layer_list();
     let Some(active) = objects.layer_for_new() else { return };
@@ -256,7 +267,7 @@ fn layers(ui: &mut egui::Ui, objects: &Objects, state: &mut OutlinerState, out: 
         ui.horizontal(|ui| {
             let mut shown = !layer.hidden();
             if ui.checkbox(&mut shown, "").on_hover_text("show or hide").changed() {
-                out.push(Command::Lines(vec![Line::Layer(layer.id, LayerLine::Hide(!shown))]));
+                out.push(AppCommand::Lines(vec![Line::Layer(layer.id, LayerLine::Hide(!shown))]));
             }
             let mut color = picking.filter(|(id, _)| *id == layer.id).map_or(layer.color(), |(_, c)| c);
             if ui.color_edit_button_srgb(&mut color).on_hover_text("colour").changed() {
@@ -264,7 +275,7 @@ fn layers(ui: &mut egui::Ui, objects: &Objects, state: &mut OutlinerState, out: 
             }
             let new_here = ui.radio(active == layer.id, "").on_hover_text("new objects go on this layer");
             if new_here.clicked() && active != layer.id {
-                out.push(Command::Lines(vec![Line::Layer(layer.id, LayerLine::Active)]));
+                out.push(AppCommand::Lines(vec![Line::Layer(layer.id, LayerLine::Active)]));
             }
             layer_name(ui, layer, &mut state.layer_name, out);
         });
@@ -276,7 +287,7 @@ fn layers(ui: &mut egui::Ui, objects: &Objects, state: &mut OutlinerState, out: 
         *picking = None;
         let current = layers.iter().find(|l| l.id == id).map(|l| l.color());
         if current.is_some_and(|c| c != color) {
-            out.push(Command::Lines(vec![Line::Layer(id, LayerLine::Color(color))]));
+            out.push(AppCommand::Lines(vec![Line::Layer(id, LayerLine::Color(color))]));
         }
     }
 }
@@ -287,7 +298,7 @@ fn layer_name(
     ui: &mut egui::Ui,
     layer: &octovox::scene::graph::Layer,
     editing: &mut Option<(u32, String)>,
-    out: &mut Vec<Command>,
+    out: &mut Vec<AppCommand>,
 ) {
     if let Some((_, text)) = editing.as_mut().filter(|(id, _)| *id == layer.id) {
         let field = ui.add(egui::TextEdit::singleline(text).desired_width(110.0));
@@ -297,7 +308,7 @@ fn layer_name(
         if field.lost_focus() {
             let name = text.trim().to_owned();
             if ui.input(|i| i.key_pressed(egui::Key::Enter)) && !name.is_empty() && name != layer.name() {
-                out.push(Command::Lines(vec![Line::Layer(layer.id, LayerLine::Name(name))]));
+                out.push(AppCommand::Lines(vec![Line::Layer(layer.id, LayerLine::Name(name))]));
             }
             *editing = None;
         }
@@ -313,7 +324,7 @@ fn layer_name(
 /// The picked object's name, editable: Enter renames it (`object rename`,
 /// an undo step). Always there, disabled with no object picked, so that
 /// the rows below stay put.
-fn rename_row(ui: &mut egui::Ui, objects: &Objects, rename: &mut (Option<usize>, String), out: &mut Vec<Command>) {
+fn rename_row(ui: &mut egui::Ui, objects: &Objects, rename: &mut (Option<usize>, String), out: &mut Vec<AppCommand>) {
     let picked = objects.selected;
     if rename.0 != picked {
         let own = picked.and_then(|i| objects.transform_node(i).ok()).and_then(octovox::scene::graph::Node::name);
@@ -325,7 +336,7 @@ fn rename_row(ui: &mut egui::Ui, objects: &Objects, rename: &mut (Option<usize>,
             let field = ui.add(egui::TextEdit::singleline(&mut rename.1).desired_width(150.0));
             let entered = field.lost_focus() && ui.input(|i| i.key_pressed(egui::Key::Enter));
             if let (true, Some(index)) = (entered && !rename.1.trim().is_empty(), picked) {
-                out.push(Command::Lines(vec![
+                out.push(AppCommand::Lines(vec![
                     Line::Object(ObjectLine::Pick(ObjectRef::Index(index))),
                     Line::Object(ObjectLine::Rename(rename.1.trim().to_owned())),
                 ]));

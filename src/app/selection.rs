@@ -9,7 +9,7 @@ use glam::{DVec3, IVec3, Vec3};
 
 use octovox::camera::Camera;
 use octovox::edit::selection::Region;
-use octovox::script::Command as Line;
+use octovox::script::Line;
 
 use super::gesture::{Gesture, SelectDrag};
 use super::state::Mode;

@@ -1,5 +1,5 @@
 //! The egui panels. They read the plain editor state, bind its knobs (tool,
-//! brush, colour, render settings) directly, and return [`Command`]s for
+//! brush, colour, render settings) directly, and return [`AppCommand`]s for
 //! everything that acts (edits, files, camera moves).
 //!
 //! Layout: a menu bar on top, a tool panel on the left and, for a scene of
@@ -16,7 +16,7 @@ use octovox::scene::{Material, MaterialKind, Palette, Scene};
 use octovox::settings::{EffectsChoice, Shading, Sky, TraceMode, View};
 
 use super::browser::Answer;
-use super::command::{Choice, Command, Pending};
+use super::command::{AppCommand, Choice, Pending};
 use super::state::{BrushKind, EditorState, Mode, Pick, Tool};
 use glam::{IVec3, Vec3};
 use octovox::edit::brush::Brush;
@@ -211,7 +211,7 @@ pub fn show(
     tools: &mut Tools,
     ui_state: &mut UiState,
     info: &Info,
-) -> Vec<Command> {
+) -> Vec<AppCommand> {
     let mut out = Vec::new();
     egui::Panel::top("menu").show(ui, |ui| menu_bar(ui, info, ui_state, &mut out));
     if let Some(objects) = info.objects {
@@ -243,7 +243,7 @@ pub fn show(
     out
 }
 
-fn menu_bar(ui: &mut egui::Ui, info: &Info, ui_state: &mut UiState, out: &mut Vec<Command>) {
+fn menu_bar(ui: &mut egui::Ui, info: &Info, ui_state: &mut UiState, out: &mut Vec<AppCommand>) {
     egui::MenuBar::new().ui(ui, |ui| {
         for (menu, actions) in super::actions::menus() {
             ui.menu_button(menu, |ui| {
@@ -252,7 +252,7 @@ fn menu_bar(ui: &mut egui::Ui, info: &Info, ui_state: &mut UiState, out: &mut Ve
                     if ui.add_enabled(available(&action.command, info), egui::Button::new(text)).clicked() {
                         out.push(action.command.clone());
                     }
-                    if action.command == Command::AskOpen {
+                    if action.command == AppCommand::AskOpen {
                         recent_menu(ui, info, out);
                     }
                 }
@@ -274,12 +274,12 @@ fn menu_bar(ui: &mut egui::Ui, info: &Info, ui_state: &mut UiState, out: &mut Ve
 }
 
 /// File ▸ Open recent.
-fn recent_menu(ui: &mut egui::Ui, info: &Info, out: &mut Vec<Command>) {
+fn recent_menu(ui: &mut egui::Ui, info: &Info, out: &mut Vec<AppCommand>) {
     ui.add_enabled_ui(!info.recent.is_empty(), |ui| {
         ui.menu_button("Open recent", |ui| {
             for path in &info.recent {
                 if ui.button(path.display().to_string()).clicked() {
-                    out.push(Command::Open(path.clone()));
+                    out.push(AppCommand::Open(path.clone()));
                 }
             }
         });
@@ -287,24 +287,26 @@ fn recent_menu(ui: &mut egui::Ui, info: &Info, out: &mut Vec<Command>) {
 }
 
 /// Whether a menu entry can act now (greyed out otherwise).
-fn available(command: &Command, info: &Info) -> bool {
+fn available(command: &AppCommand, info: &Info) -> bool {
     match command {
-        Command::Undo => info.can_undo,
-        Command::Redo => info.can_redo,
-        Command::Copy | Command::Cut | Command::DeleteSelection | Command::SelectNone => info.selection.is_some(),
-        Command::PasteAtCursor => info.has_clipboard,
-        Command::Object(_) => info.objects.is_some_and(|o| o.selected.is_some()),
+        AppCommand::Undo => info.can_undo,
+        AppCommand::Redo => info.can_redo,
+        AppCommand::Copy | AppCommand::Cut | AppCommand::DeleteSelection | AppCommand::SelectNone => {
+            info.selection.is_some()
+        }
+        AppCommand::PasteAtCursor => info.has_clipboard,
+        AppCommand::Object(_) => info.objects.is_some_and(|o| o.selected.is_some()),
         _ => true,
     }
 }
 
 /// The ground (`ground on|off`) and the side of the working volume drawn on it.
-fn ground(ui: &mut egui::Ui, state: &mut EditorState, on: bool, out: &mut Vec<Command>) {
+fn ground(ui: &mut egui::Ui, state: &mut EditorState, on: bool, out: &mut Vec<AppCommand>) {
     ui.horizontal(|ui| {
         let mut shown = on;
         let tip = "clicks on empty space build on the ground at y = 0 (ground on|off)";
         if ui.checkbox(&mut shown, "Ground").on_hover_text(tip).changed() {
-            out.push(Command::Lines(vec![octovox::script::Command::Ground(shown)]));
+            out.push(AppCommand::Lines(vec![octovox::script::Line::Ground(shown)]));
         }
         ui.label("volume");
         let range = super::state::VOLUME_RANGE;
@@ -329,29 +331,29 @@ fn mirror(ui: &mut egui::Ui, tools: &mut Tools) {
     });
 }
 
-fn tool_panel(ui: &mut egui::Ui, state: &mut EditorState, tools: &mut Tools, commands: &mut Vec<Command>) {
+fn tool_panel(ui: &mut egui::Ui, state: &mut EditorState, tools: &mut Tools, commands: &mut Vec<AppCommand>) {
     ui.heading("Tool");
     ui.horizontal(|ui| {
         for tool in Tool::ALL {
             if ui.selectable_label(state.lit_tool() == Some(tool), tool_label(tool)).clicked() {
-                commands.push(Command::SetTool(tool));
+                commands.push(AppCommand::SetTool(tool));
             }
         }
     });
     ui.horizontal(|ui| {
         let line = ui.selectable_label(state.mode == Mode::Line, "Line (L)");
         if line.on_hover_text("press, drag and release: the brush along a line").clicked() {
-            commands.push(Command::ToggleLine);
+            commands.push(AppCommand::ToggleLine);
         }
         let select = ui.selectable_label(state.mode == Mode::Select, "Select (B)");
         let hint = "drag a box; drag a face of it to resize; Ctrl+C/X/V, Delete, arrows move it";
         if select.on_hover_text(hint).clicked() {
-            commands.push(Command::ToggleSelect);
+            commands.push(AppCommand::ToggleSelect);
         }
         let object = ui.selectable_label(state.mode == Mode::Object, "Object (Tab)");
         let hint = "click an object to pick it; drag it, or arrows and PageUp/PageDown, to move it; X/Y/Z turn it, Delete deletes it";
         if object.on_hover_text(hint).clicked() {
-            commands.push(Command::ToggleObject);
+            commands.push(AppCommand::ToggleObject);
         }
     });
     ui.label("Brush");
@@ -390,22 +392,22 @@ fn tool_panel(ui: &mut egui::Ui, state: &mut EditorState, tools: &mut Tools, com
     ui.small("left: apply · Ctrl+drag a face: extrude · right-drag: orbit · right-click: erase (Attach) · middle: pan · wheel: zoom · WASDQE + right: fly · F: frame");
 }
 
-fn palette(ui: &mut egui::Ui, tools: &mut Tools, palette: &Palette, out: &mut Vec<Command>) {
-    use octovox::script::{Command as Line, PaletteLine};
+fn palette(ui: &mut egui::Ui, tools: &mut Tools, palette: &Palette, out: &mut Vec<AppCommand>) {
+    use octovox::script::{Line, PaletteLine};
     ui.heading("Palette");
     ui.horizontal(|ui| {
         egui::ComboBox::from_id_salt("palette presets").selected_text("Preset").width(90.0).show_ui(ui, |ui| {
             for (name, _) in octovox::io::palette_file::PRESETS {
                 if ui.selectable_label(false, name).on_hover_text(format!("palette preset {name}")).clicked() {
-                    out.push(Command::Lines(vec![Line::Palette(PaletteLine::Preset(name.to_owned()))]));
+                    out.push(AppCommand::Lines(vec![Line::Palette(PaletteLine::Preset(name.to_owned()))]));
                 }
             }
         });
         if ui.button("Load…").on_hover_text("a MagicaVoxel .png, Lospec .hex or GIMP .gpl palette").clicked() {
-            out.push(Command::AskPalette { save: false });
+            out.push(AppCommand::AskPalette { save: false });
         }
         if ui.button("Save…").on_hover_text("as .png (256×1), .hex or .gpl").clicked() {
-            out.push(Command::AskPalette { save: true });
+            out.push(AppCommand::AskPalette { save: true });
         }
     });
     // One 16×16 block painted by hand: 256 widgets would be slow and loose.
@@ -453,7 +455,7 @@ fn palette(ui: &mut egui::Ui, tools: &mut Tools, palette: &Palette, out: &mut Ve
 
 /// The selected entry's colour, material kind and the parameters the path
 /// tracer reads; every change is an edit (undoable, saved in RGBA/MATL).
-fn material_editor(ui: &mut egui::Ui, index: u8, palette: &Palette, out: &mut Vec<Command>) {
+fn material_editor(ui: &mut egui::Ui, index: u8, palette: &Palette, out: &mut Vec<AppCommand>) {
     let [r, g, b, _] = palette.color(index);
     let mut rgb = [r, g, b];
     let old = palette.material(index);
@@ -508,7 +510,7 @@ fn material_editor(ui: &mut egui::Ui, index: u8, palette: &Palette, out: &mut Ve
         let color = [rgb[0], rgb[1], rgb[2], 255];
         let edit = octovox::edit::Edit::Palette { index, color, material: Box::new(material) };
         let dragging = ui.ctx().input(|i| i.pointer.any_down());
-        out.push(Command::EditPalette { edit, dragging });
+        out.push(AppCommand::EditPalette { edit, dragging });
     }
 }
 
@@ -579,11 +581,11 @@ fn render(ui: &mut egui::Ui, state: &mut EditorState, stats: &Stats) {
 
 /// Presets from draft to reference, with what each costs here and the error
 /// it buys once measured.
-fn quality(ui: &mut egui::Ui, measured: Option<&[super::presets::Measured]>, out: &mut Vec<Command>) {
+fn quality(ui: &mut egui::Ui, measured: Option<&[super::presets::Measured]>, out: &mut Vec<AppCommand>) {
     ui.horizontal(|ui| {
         ui.label("Quality");
         if ui.button("Measure").on_hover_text("time and error (FLIP) of each preset from this camera").clicked() {
-            out.push(Command::MeasurePresets);
+            out.push(AppCommand::MeasurePresets);
         }
     });
     egui::Grid::new("presets").num_columns(3).show(ui, |ui| {
@@ -593,7 +595,7 @@ fn quality(ui: &mut egui::Ui, measured: Option<&[super::presets::Measured]>, out
         ui.end_row();
         for (i, preset) in super::presets::PRESETS.iter().enumerate() {
             if ui.small_button(preset.name).clicked() {
-                out.push(Command::ApplyPreset(i));
+                out.push(AppCommand::ApplyPreset(i));
             }
             match measured.and_then(|m| m.get(i)) {
                 Some(m) => {
@@ -746,7 +748,7 @@ fn message(ui: &mut egui::Ui, ui_state: &mut UiState) {
     }
 }
 
-fn dialog(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
+fn dialog(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<AppCommand>) {
     let Some(browser) = &mut ui_state.dialog else { return };
     match browser.show(ctx) {
         Answer::Waiting => return,
@@ -756,7 +758,7 @@ fn dialog(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
     ui_state.dialog = None;
 }
 
-fn prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
+fn prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<AppCommand>) {
     if !ui_state.prompt_open {
         return;
     }
@@ -771,13 +773,13 @@ fn prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
         ui.label(format!("Save the changes before {what}?"));
         ui.horizontal(|ui| {
             if ui.button("Save").clicked() {
-                out.push(Command::Resolve(Choice::Save));
+                out.push(AppCommand::Resolve(Choice::Save));
             }
             if ui.button("Discard").clicked() {
-                out.push(Command::Resolve(Choice::Discard));
+                out.push(AppCommand::Resolve(Choice::Discard));
             }
             if ui.button("Cancel").clicked() {
-                out.push(Command::Resolve(Choice::Cancel));
+                out.push(AppCommand::Resolve(Choice::Cancel));
             }
         });
     });
@@ -786,7 +788,7 @@ fn prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
 /// Offers to apply a crash-recovery journal found beside the document;
 /// one started on other content than the document holds now is offered
 /// only with that said, as "Apply anyway".
-fn recover_prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
+fn recover_prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<AppCommand>) {
     let Some((journal, doubt)) = ui_state.recover.clone() else { return };
     egui::Modal::new(egui::Id::unique("recover")).show(ctx, |ui| {
         ui.heading("Recover unsaved edits?");
@@ -801,18 +803,18 @@ fn recover_prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Com
             if ui.button(format!("{apply}{}", if doubt.is_none() { " (Enter)" } else { "" })).clicked() || enter {
                 ui_state.recover = None;
                 let checks = octovox::journal::Checks { allow_changed_source: doubt.is_some() };
-                out.push(Command::RecoverJournal(journal.clone(), checks));
+                out.push(AppCommand::RecoverJournal(journal.clone(), checks));
             }
             if ui.button("Discard").clicked() {
                 ui_state.recover = None;
-                out.push(Command::DiscardJournal(journal.clone()));
+                out.push(AppCommand::DiscardJournal(journal.clone()));
             }
         });
     });
 }
 
 /// Asks before a save replaces a read-only file.
-fn replace_prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Command>) {
+fn replace_prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<AppCommand>) {
     let Some(Replace { path, read_only }) = ui_state.replace.clone() else { return };
     let modal = egui::Modal::new(egui::Id::unique("replace")).show(ctx, |ui| {
         ui.heading(if read_only { "Read-only file" } else { "Replace the file?" });
@@ -821,7 +823,7 @@ fn replace_prompt(ctx: &egui::Context, ui_state: &mut UiState, out: &mut Vec<Com
         ui.horizontal(|ui| {
             if ui.button("Replace").clicked() {
                 ui_state.replace = None;
-                out.push(Command::SaveOver(path.clone()));
+                out.push(AppCommand::SaveOver(path.clone()));
             }
             if ui.button("Cancel").clicked() {
                 ui_state.replace = None;

@@ -17,7 +17,7 @@ use octovox::scene::graph::{Attributes, Node, NodeKind, SceneGraph};
 use octovox::scene::objects::{Model, Objects};
 use octovox::scene::transform::Rotation;
 use octovox::scene::{Instancing, Octree, Palette, Scene};
-use octovox::script::{Command, ObjectLine, ObjectRef};
+use octovox::script::{Line, ObjectLine, ObjectRef};
 use octovox::settings::{PathSettings, RenderSettings, TraceMode, View};
 
 use super::bench::{header, median};
@@ -237,9 +237,9 @@ pub fn bench_scene(quick: bool) -> anyhow::Result<(String, String)> {
     let mut editor = Editor::default();
     editor.set_scene(forest_scene);
     let _ = editor.scene.take_uploads();
-    editor.run(&Command::Object(ObjectLine::Pick(ObjectRef::Index(5))))?;
+    editor.run(&Line::Object(ObjectLine::Pick(ObjectRef::Index(5))))?;
     let mut written = |line: ObjectLine| -> anyhow::Result<u64> {
-        editor.run(&Command::Object(line))?;
+        editor.run(&Line::Object(line))?;
         Ok(editor.scene.take_uploads().byte_count())
     };
     let move_bytes_written = written(ObjectLine::Move(IVec3::new(3, 0, 0)))?;

@@ -27,7 +27,7 @@ mod replay;
 
 use std::process::ExitCode;
 
-use crate::cli::{Cli, Command};
+use crate::cli::{Cli, CliCommand};
 
 /// `OCTOVOX_UPDATE_IMAGES=1` makes `expect image` write its reference.
 fn update_images() -> bool {
@@ -38,13 +38,15 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     octovox::budget::set_budget_bytes(cli.memory_budget);
     match cli.command {
         None => crate::app::run(cli.window),
-        Some(Command::Info { file, json, objects, frame }) => info::run(&file, json, objects, frame),
-        Some(Command::Convert { input, output, frame, force }) => convert::run(&input, &output, frame, force),
-        Some(Command::Import(args)) => import::run(&args),
-        Some(Command::Recover { file, output, force }) => recover::run(&file, &output, force),
-        Some(Command::Export { file, output, scale, frame, force }) => export::run(&file, &output, scale, frame, force),
-        Some(Command::Render(args)) => render::run(&args),
-        Some(Command::Bench(args)) => benches::run(&args),
-        Some(Command::Replay { scripts, cpu, force }) => replay::run(&scripts, cpu, force, update_images()),
+        Some(CliCommand::Info { file, json, objects, frame }) => info::run(&file, json, objects, frame),
+        Some(CliCommand::Convert { input, output, frame, force }) => convert::run(&input, &output, frame, force),
+        Some(CliCommand::Import(args)) => import::run(&args),
+        Some(CliCommand::Recover { file, output, force }) => recover::run(&file, &output, force),
+        Some(CliCommand::Export { file, output, scale, frame, force }) => {
+            export::run(&file, &output, scale, frame, force)
+        }
+        Some(CliCommand::Render(args)) => render::run(&args),
+        Some(CliCommand::Bench(args)) => benches::run(&args),
+        Some(CliCommand::Replay { scripts, cpu, force }) => replay::run(&scripts, cpu, force, update_images()),
     }
 }

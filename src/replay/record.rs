@@ -9,7 +9,7 @@ use crate::camera::Camera;
 use crate::edit::brush::Brush;
 use crate::edit::mirror::Mirror;
 use crate::editor::Tools;
-use crate::script::{Command, ObjectLine, PaletteLine};
+use crate::script::{Line, ObjectLine, PaletteLine};
 
 /// Writes script lines as the user works. Lines are flushed as they are
 /// written, so a crash loses nothing that was recorded.
@@ -72,7 +72,7 @@ impl Recorder {
         lock(&file, path)?;
         let mut recorder = Recorder::on(path, file);
         // The script may end with mirror planes on; this recorder starts with none.
-        recorder.command(&Command::Mirror(None))?;
+        recorder.command(&Line::Mirror(None))?;
         Ok(recorder)
     }
 
@@ -105,12 +105,12 @@ impl Recorder {
         self.line(&format!("#@ {text}"))
     }
 
-    fn command(&mut self, command: &Command) -> std::io::Result<()> {
+    fn command(&mut self, command: &Line) -> std::io::Result<()> {
         self.line(&command.to_string())
     }
 
     /// The scene was replaced: `load PATH` (absolute), or `demo`/`new`.
-    pub fn scene(&mut self, command: Command) -> std::io::Result<()> {
+    pub fn scene(&mut self, command: Line) -> std::io::Result<()> {
         self.done.clear();
         self.undone.clear();
         self.open_stroke = 0;
@@ -124,54 +124,54 @@ impl Recorder {
     /// they are. Brush, colour and mirror lines are written before the next
     /// edit that uses them; expectations and file lines are not part of a
     /// recording.
-    pub fn ran(&mut self, command: &Command, tools: &Tools, camera: &Camera, in_stroke: bool) -> std::io::Result<()> {
+    pub fn ran(&mut self, command: &Line, tools: &Tools, camera: &Camera, in_stroke: bool) -> std::io::Result<()> {
         let color = match command {
-            Command::Place(_) | Command::Paint(_) | Command::Line(..) | Command::Fill(_) => Some(tools.color),
-            Command::Remove(_)
-            | Command::Extrude(..)
-            | Command::Cut
-            | Command::Delete
-            | Command::Paste(_)
-            | Command::Move(_)
-            | Command::Rotate(_)
-            | Command::Flip(_)
-            | Command::Rgb(..)
-            | Command::Material(..)
-            | Command::Layer(..)
-            | Command::Palette(PaletteLine::Set { .. } | PaletteLine::Preset(_)) => None,
+            Line::Place(_) | Line::Paint(_) | Line::Segment(..) | Line::Fill(_) => Some(tools.color),
+            Line::Remove(_)
+            | Line::Extrude(..)
+            | Line::Cut
+            | Line::Delete
+            | Line::Paste(_)
+            | Line::Move(_)
+            | Line::Rotate(_)
+            | Line::Flip(_)
+            | Line::Rgb(..)
+            | Line::Material(..)
+            | Line::Layer(..)
+            | Line::Palette(PaletteLine::Set { .. } | PaletteLine::Preset(_)) => None,
             // Picking an object is tool state every later edit depends on.
-            Command::Object(ObjectLine::Pick(_)) => return self.command(command),
-            Command::Object(_) => None,
-            Command::Select(_) | Command::Copy => return self.command(command),
-            Command::Undo(n) => return (0..*n).try_for_each(|_| self.undo()),
-            Command::Redo(n) => return (0..*n).try_for_each(|_| self.redo()),
+            Line::Object(ObjectLine::Pick(_)) => return self.command(command),
+            Line::Object(_) => None,
+            Line::Select(_) | Line::Copy => return self.command(command),
+            Line::Undo(n) => return (0..*n).try_for_each(|_| self.undo()),
+            Line::Redo(n) => return (0..*n).try_for_each(|_| self.redo()),
             // Tool state is written before the edit that uses it; scene,
             // camera, file and expectation lines are not part of a recording.
-            Command::Load(_)
-            | Command::New
-            | Command::Demo(_)
-            | Command::Camera { .. }
-            | Command::Projection(_)
-            | Command::Viewport(..)
-            | Command::Brush(_)
+            Line::Load(_)
+            | Line::New
+            | Line::Demo(_)
+            | Line::Camera { .. }
+            | Line::Projection(_)
+            | Line::Viewport(..)
+            | Line::Brush(_)
             // Clicks are recorded as the edits they became: the ground is not needed.
-            | Command::Ground(_)
-            | Command::Color(_)
-            | Command::Mirror(_)
-            | Command::Pick(_)
-            | Command::Click { .. }
-            | Command::Save(_)
-            | Command::Render(_)
-            | Command::ExpectVoxel(..)
-            | Command::ExpectCount(_)
-            | Command::ExpectWritten(_)
-            | Command::ExpectImage(..)
-            | Command::ExpectEffects(_)
-            | Command::ExpectObjects(_)
-            | Command::ExpectModels(_)
-            | Command::ExpectPalette(..)
+            | Line::Ground(_)
+            | Line::Color(_)
+            | Line::Mirror(_)
+            | Line::Pick(_)
+            | Line::Click { .. }
+            | Line::Save(_)
+            | Line::Render(_)
+            | Line::ExpectVoxel(..)
+            | Line::ExpectCount(_)
+            | Line::ExpectWritten(_)
+            | Line::ExpectImage(..)
+            | Line::ExpectEffects(_)
+            | Line::ExpectObjects(_)
+            | Line::ExpectModels(_)
+            | Line::ExpectPalette(..)
             // A load runs as the `palette set` it became; a save is a file line.
-            | Command::Palette(PaletteLine::Load(_) | PaletteLine::Save(_)) => return Ok(()),
+            | Line::Palette(PaletteLine::Load(_) | PaletteLine::Save(_)) => return Ok(()),
         };
         if !in_stroke {
             self.end_step();
@@ -196,20 +196,20 @@ impl Recorder {
             let projection_was = self.camera.map(|c| c.ortho);
             self.camera = Some(*camera);
             let (eye, target) = (camera.eye, camera.target);
-            self.command(&Command::Camera { eye, target, fov: Some(camera.fov_y_deg) })?;
+            self.command(&Line::Camera { eye, target, fov: Some(camera.fov_y_deg) })?;
             if projection_was != Some(camera.ortho) {
-                self.command(&Command::Projection(camera.ortho))?;
+                self.command(&Line::Projection(camera.ortho))?;
             }
         }
         if self.brush != Some(brush) {
             self.brush = Some(brush);
-            self.command(&Command::Brush(brush))?;
+            self.command(&Line::Brush(brush))?;
         }
         if let Some(color) = color
             && self.color != Some(color)
         {
             self.color = Some(color);
-            self.command(&Command::Color(color))?;
+            self.command(&Line::Color(color))?;
         }
         Ok(())
     }
@@ -220,10 +220,10 @@ impl Recorder {
             return Ok(());
         }
         self.mirror = *mirror;
-        self.command(&Command::Mirror(None))?;
+        self.command(&Line::Mirror(None))?;
         for axis in 0..3 {
             if let Some(c) = mirror.plane(axis) {
-                self.command(&Command::Mirror(Some((axis, c))))?;
+                self.command(&Line::Mirror(Some((axis, c))))?;
             }
         }
         Ok(())
@@ -253,7 +253,7 @@ impl Recorder {
         match self.done.pop() {
             Some(n) => {
                 self.undone.push(n);
-                self.command(&Command::Undo(n))
+                self.command(&Line::Undo(n))
             }
             None => Ok(()),
         }
@@ -264,7 +264,7 @@ impl Recorder {
         match self.undone.pop() {
             Some(n) => {
                 self.done.push(n);
-                self.command(&Command::Redo(n))
+                self.command(&Line::Redo(n))
             }
             None => Ok(()),
         }

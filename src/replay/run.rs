@@ -13,7 +13,7 @@ use crate::gpu::Renderer;
 use crate::io::atomic::WriteOptions;
 use crate::io::output::{OutputKind, check_output};
 use crate::io::png::save_png;
-use crate::script::{Line, Script};
+use crate::script::{NumberedLine, Script};
 use crate::settings::RenderSettings;
 use crate::trace::pick;
 use crate::trace::render::render_scene_cpu;
@@ -115,7 +115,7 @@ impl Runner {
     ///
     /// # Errors
     /// As [`step`].
-    pub fn step(&mut self, base: &Path, line: &Line) -> Result<StepResult, StepError> {
+    pub fn step(&mut self, base: &Path, line: &NumberedLine) -> Result<StepResult, StepError> {
         let result = step(self, base, &line.command)?;
         if let StepResult::Ran(ran) = &result {
             match ran.outcome {

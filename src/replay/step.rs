@@ -15,7 +15,7 @@ use glam::{DVec3, IVec3};
 use crate::edit::selection::Region;
 use crate::editor::{Editor, EditorError, Outcome};
 use crate::io::png::{differing_fraction, load_png, save_png};
-use crate::script::{Command, PaletteLine, edit_command};
+use crate::script::{Line, PaletteLine, edit_command};
 use crate::trace::pick;
 
 /// The size of renders (and of the pixels `click` names headless) before a
@@ -103,12 +103,12 @@ pub enum StepResult {
 /// line starts begins with that).
 #[derive(Debug, PartialEq)]
 pub struct Ran {
-    pub line: Command,
+    pub line: Line,
     pub outcome: Outcome,
     pub selection: Option<Region>,
     /// The `object N` line a click ran first, when the voxel it hit is
     /// another object's (a recording or journal writes it before `line`).
-    pub picked: Option<Command>,
+    pub picked: Option<Line>,
 }
 
 /// A line that could not run: the script stops there.
@@ -154,7 +154,7 @@ pub enum HostError {
 ///
 /// # Errors
 /// A line that could not run; a refused edit changes nothing.
-pub fn step(host: &mut impl Host, base: &Path, line: &Command) -> Result<StepResult, StepError> {
+pub fn step(host: &mut impl Host, base: &Path, line: &Line) -> Result<StepResult, StepError> {
     let selection = host.editor().selection;
     let outcome = host.editor().run(line)?;
     match outcome {
@@ -165,13 +165,13 @@ pub fn step(host: &mut impl Host, base: &Path, line: &Command) -> Result<StepRes
 }
 
 /// The lines that are the host's own: files, the camera and pixels.
-fn host_line(host: &mut impl Host, base: &Path, line: &Command) -> Result<StepResult, StepError> {
+fn host_line(host: &mut impl Host, base: &Path, line: &Line) -> Result<StepResult, StepError> {
     match line {
-        Command::Load(path) => host.load(&base.join(path))?,
-        Command::Camera { eye, target, fov } => host.set_camera(*eye, *target, *fov),
-        Command::Viewport(w, h) => host.set_viewport(*w, *h),
-        Command::Projection(ortho) => host.set_projection(*ortho),
-        Command::Click { x, y, tool } => {
+        Line::Load(path) => host.load(&base.join(path))?,
+        Line::Camera { eye, target, fov } => host.set_camera(*eye, *target, *fov),
+        Line::Viewport(w, h) => host.set_viewport(*w, *h),
+        Line::Projection(ortho) => host.set_projection(*ortho),
+        Line::Click { x, y, tool } => {
             let expected = format!("pixel ({x}, {y}) to hit a voxel");
             let (voxel, normal) = match host.pick(*x, *y) {
                 Ok(Some((voxel, normal, value))) if value != 0 || *tool == crate::edit::brush::Tool::Attach => {
@@ -195,23 +195,23 @@ fn host_line(host: &mut impl Host, base: &Path, line: &Command) -> Result<StepRe
         }
         // The file's colours become the `palette set` line a recording or
         // journal keeps (it needs no file at recovery).
-        Command::Palette(PaletteLine::Load(path)) => {
+        Line::Palette(PaletteLine::Load(path)) => {
             let mut colors = crate::io::palette_file::read_colors(&base.join(path)).map_err(HostError::from)?;
             colors.truncate(255);
-            return step(host, base, &Command::Palette(PaletteLine::Set { first: 1, colors }));
+            return step(host, base, &Line::Palette(PaletteLine::Set { first: 1, colors }));
         }
-        Command::Palette(PaletteLine::Save(path)) => {
+        Line::Palette(PaletteLine::Save(path)) => {
             // An unknown format is named as a palette's, before the rule of outputs.
             crate::io::palette_file::PaletteFormat::of(path).map_err(HostError::from)?;
             host.save_palette(&base.join(path))?;
         }
-        Command::Save(path) => host.save(&base.join(path))?,
-        Command::Render(path) => host.render(&base.join(path))?,
-        Command::ExpectWritten(limit) => {
+        Line::Save(path) => host.save(&base.join(path))?,
+        Line::Render(path) => host.render(&base.join(path))?,
+        Line::ExpectWritten(limit) => {
             let got = host.last_written().ok_or(StepError::NeedsEarlier("expect written", "an edit"))?;
             return Ok(check(got <= *limit, format!("at most {limit} bytes written"), || format!("{got} bytes")));
         }
-        Command::ExpectImage(path, tolerance) => return expect_image(host, &base.join(path), *tolerance),
+        Line::ExpectImage(path, tolerance) => return expect_image(host, &base.join(path), *tolerance),
         // `Editor::run` answers every other line.
         _ => return Err(StepError::NotAHostLine(line.to_string())),
     }

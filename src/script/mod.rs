@@ -1,4 +1,4 @@
-//! The script language: its syntax tree ([`Command`], [`Line`],
+//! The script language: its syntax tree ([`Line`], [`NumberedLine`],
 //! [`Script`]), the parser and the printer. Scripts are run headless by
 //! `octovox replay`, played and recorded by the window and written by the
 //! crash journal; `docs/replay.md` describes them. This room knows no
@@ -18,7 +18,7 @@ pub use print::quoted;
 
 /// One line of a script.
 #[derive(Clone, Debug, PartialEq)]
-pub enum Command {
+pub enum Line {
     Load(PathBuf),
     New,
     /// The built-in demo scene (what the window opens without a file).
@@ -60,7 +60,7 @@ pub enum Command {
     ExpectEffects(Vec<String>),
     /// `line X1 Y1 Z1 X2 Y2 Z2`: the brush placed with the current colour at
     /// every cell of the line, ends included (one undo step).
-    Line(IVec3, IVec3),
+    Segment(IVec3, IVec3),
     /// `mirror x|y|z C`: later brush edits are also applied mirrored across
     /// the plane at C (a whole or half number); `mirror off` ends them all.
     Mirror(Option<(usize, f64)>),
@@ -114,6 +114,59 @@ pub enum Command {
     ExpectObjects(usize),
     /// `expect models N`: the scene stores N models (each once).
     ExpectModels(usize),
+}
+
+impl Line {
+    /// The command word the line starts with (`place`, `object`,
+    /// `expect`, …): what the window's messages name a line by.
+    pub fn word(&self) -> &'static str {
+        match self {
+            Line::Load(_) => "load",
+            Line::New => "new",
+            Line::Demo(_) => "demo",
+            Line::Camera { .. } => "camera",
+            Line::Viewport(..) => "viewport",
+            Line::Projection(Some(_)) => "ortho",
+            Line::Projection(None) => "perspective",
+            Line::Brush(_) => "brush",
+            Line::Ground(_) => "ground",
+            Line::Color(_) => "color",
+            Line::Place(_) => "place",
+            Line::Remove(_) => "remove",
+            Line::Paint(_) => "paint",
+            Line::Click { .. } => "click",
+            Line::Undo(_) => "undo",
+            Line::Redo(_) => "redo",
+            Line::Save(_) => "save",
+            Line::Render(_) => "render",
+            Line::ExpectVoxel(..)
+            | Line::ExpectCount(_)
+            | Line::ExpectWritten(_)
+            | Line::ExpectImage(..)
+            | Line::ExpectEffects(_)
+            | Line::ExpectPalette(..)
+            | Line::ExpectObjects(_)
+            | Line::ExpectModels(_) => "expect",
+            Line::Segment(..) => "line",
+            Line::Mirror(_) => "mirror",
+            Line::Fill(_) => "fill",
+            Line::Pick(_) => "pick",
+            Line::Extrude(..) => "extrude",
+            Line::Rgb(..) => "rgb",
+            Line::Material(..) => "material",
+            Line::Select(_) => "select",
+            Line::Copy => "copy",
+            Line::Cut => "cut",
+            Line::Delete => "delete",
+            Line::Paste(_) => "paste",
+            Line::Move(_) => "move",
+            Line::Rotate(_) => "rotate",
+            Line::Flip(_) => "flip",
+            Line::Object(_) => "object",
+            Line::Layer(..) => "layer",
+            Line::Palette(_) => "palette",
+        }
+    }
 }
 
 /// What an `object` line does.
@@ -198,23 +251,23 @@ pub enum ObjectRef {
 
 /// A parsed command with its 1-based line number.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Line {
+pub struct NumberedLine {
     pub number: usize,
-    pub command: Command,
+    pub command: Line,
 }
 
 /// A parsed script: its file (for messages and relative paths) and lines.
 #[derive(Clone, Debug)]
 pub struct Script {
     pub path: PathBuf,
-    pub lines: Vec<Line>,
+    pub lines: Vec<NumberedLine>,
 }
 
 /// The edit a `place`/`remove`/`paint` line (or a recorded click) becomes.
-pub fn edit_command(tool: Tool, at: IVec3) -> Command {
+pub fn edit_command(tool: Tool, at: IVec3) -> Line {
     match tool {
-        Tool::Attach => Command::Place(at),
-        Tool::Erase => Command::Remove(at),
-        Tool::Paint => Command::Paint(at),
+        Tool::Attach => Line::Place(at),
+        Tool::Erase => Line::Remove(at),
+        Tool::Paint => Line::Paint(at),
     }
 }

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{DVec3, IVec3};
 
-use super::{Command, LayerLine, Line, ObjectLine, ObjectRef, PaletteLine, Script};
+use super::{LayerLine, Line, NumberedLine, ObjectLine, ObjectRef, PaletteLine, Script};
 use crate::camera::{FOV_RANGE_DEG, check_fov};
 use crate::edit::brush::{Brush, Tool};
 use crate::scene::demo::BuiltIn;
@@ -287,7 +287,7 @@ pub fn parse_script(file: &Path, text: &str) -> Result<Script, Vec<ScriptError>>
         });
         match parsed {
             Ok(None) => {}
-            Ok(Some(command)) => lines.push(Line { number: index + 1, command }),
+            Ok(Some(command)) => lines.push(NumberedLine { number: index + 1, command }),
             Err((column, message)) => {
                 errors.push(ScriptError { file: file.to_path_buf(), line: index + 1, column, message })
             }
@@ -319,12 +319,12 @@ fn parse_count(text: &str) -> Result<u32, CountError> {
     }
 }
 
-fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
+fn parse_command(c: &mut Cursor) -> Result<Line, Fail> {
     let name = c.word("a command")?;
     Ok(match name.text.as_str() {
-        "load" => Command::Load(c.path()?),
-        "new" => Command::New,
-        "demo" => Command::Demo(match c.optional() {
+        "load" => Line::Load(c.path()?),
+        "new" => Line::New,
+        "demo" => Line::Demo(match c.optional() {
             None => BuiltIn::Terrain,
             Some(t) => BuiltIn::from_str(&t.text, true)
                 .map_err(|_| (t.column, format!("expected terrain, showroom or interior, found '{}'", t.text)))?,
@@ -344,64 +344,64 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
             };
             let (eye, target) = (DVec3::new(v[0], v[1], v[2]), DVec3::new(v[3], v[4], v[5]));
             crate::camera::check_camera(eye, target).map_err(|error| (name.column, error.to_string()))?;
-            Command::Camera { eye, target, fov }
+            Line::Camera { eye, target, fov }
         }
         "ortho" => {
             let t = c.word("the view's height in voxels")?;
             let height = t.text.parse::<f32>().ok().and_then(|h| crate::camera::check_ortho(h).ok());
             let (lo, hi) = (crate::camera::ORTHO_RANGE.start(), crate::camera::ORTHO_RANGE.end());
-            Command::Projection(Some(
+            Line::Projection(Some(
                 height.ok_or((t.column, format!("orthographic height '{}' must be {lo}..={hi} voxels", t.text)))?,
             ))
         }
-        "perspective" => Command::Projection(None),
-        "viewport" => Command::Viewport(c.int_in("width", 1..=8192)? as u32, c.int_in("height", 1..=8192)? as u32),
-        "brush" => Command::Brush(parse_brush(c)?),
+        "perspective" => Line::Projection(None),
+        "viewport" => Line::Viewport(c.int_in("width", 1..=8192)? as u32, c.int_in("height", 1..=8192)? as u32),
+        "brush" => Line::Brush(parse_brush(c)?),
         "ground" => {
             let t = c.word("on or off")?;
-            Command::Ground(match t.text.as_str() {
+            Line::Ground(match t.text.as_str() {
                 "on" => true,
                 "off" => false,
                 other => return Err((t.column, format!("expected on or off, found '{other}'"))),
             })
         }
-        "color" => Command::Color(c.int_in("palette index", 1..=255)? as u8),
+        "color" => Line::Color(c.int_in("palette index", 1..=255)? as u8),
         "rgb" => {
             let index = c.int_in("palette index", 1..=255)? as u8;
-            Command::Rgb(index, c.rgb()?)
+            Line::Rgb(index, c.rgb()?)
         }
-        "palette" => Command::Palette(parse_palette(c)?),
+        "palette" => Line::Palette(parse_palette(c)?),
         "material" => parse_material(c)?,
-        "place" => Command::Place(c.position()?),
-        "remove" => Command::Remove(c.position()?),
-        "paint" => Command::Paint(c.position()?),
-        "pick" => Command::Pick(c.position()?),
-        "fill" => Command::Fill(c.position()?),
+        "place" => Line::Place(c.position()?),
+        "remove" => Line::Remove(c.position()?),
+        "paint" => Line::Paint(c.position()?),
+        "pick" => Line::Pick(c.position()?),
+        "fill" => Line::Fill(c.position()?),
         "extrude" => {
             let (at, normal) = (c.position()?, c.position()?);
             let limit = i64::from(crate::scene::shape::MAX_BRUSH_EXTENT);
-            Command::Extrude(at, normal, c.int_in("layers", -limit..=limit)? as i32)
+            Line::Extrude(at, normal, c.int_in("layers", -limit..=limit)? as i32)
         }
-        "line" => Command::Line(c.position()?, c.position()?),
-        "select" if c.take("off") => Command::Select(None),
+        "line" => Line::Segment(c.position()?, c.position()?),
+        "select" if c.take("off") => Line::Select(None),
         "select" => {
             let (a, b) = (c.position()?, c.position()?);
             if (a - b).abs().max_element() >= MAX_BRUSH_EXTENT {
                 return Err((name.column, format!("a selection is at most {MAX_BRUSH_EXTENT} voxels wide")));
             }
-            Command::Select(Some((a, b)))
+            Line::Select(Some((a, b)))
         }
-        "copy" => Command::Copy,
-        "cut" => Command::Cut,
-        "delete" => Command::Delete,
-        "paste" => Command::Paste(c.position()?),
-        "move" => Command::Move(c.position()?),
-        "rotate" => Command::Rotate(c.axis()?),
-        "flip" => Command::Flip(c.axis()?),
+        "copy" => Line::Copy,
+        "cut" => Line::Cut,
+        "delete" => Line::Delete,
+        "paste" => Line::Paste(c.position()?),
+        "move" => Line::Move(c.position()?),
+        "rotate" => Line::Rotate(c.axis()?),
+        "flip" => Line::Flip(c.axis()?),
         "mirror" => {
             let axis = c.word("x, y, z or off")?;
             match axis.text.as_str() {
-                "off" => Command::Mirror(None),
+                "off" => Line::Mirror(None),
                 name @ ("x" | "y" | "z") => {
                     let token = c.word("the plane's coordinate")?;
                     let limit = f64::from(crate::scene::octree::WORLD_LIMIT);
@@ -412,7 +412,7 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
                                 format!("plane '{}' must be a whole or half number inside the world", token.text),
                             ),
                         )?;
-                    Command::Mirror(Some((usize::from(name.as_bytes()[0] - b'x'), plane)))
+                    Line::Mirror(Some((usize::from(name.as_bytes()[0] - b'x'), plane)))
                 }
                 other => return Err((axis.column, format!("expected x, y, z or off, found '{other}'"))),
             }
@@ -423,23 +423,23 @@ fn parse_command(c: &mut Cursor) -> Result<Command, Fail> {
             let t = c.word("attach, erase or paint")?;
             let tool = Tool::from_name(&t.text)
                 .ok_or((t.column, format!("expected attach, erase or paint, found '{}'", t.text)))?;
-            Command::Click { x, y, tool }
+            Line::Click { x, y, tool }
         }
         "undo" | "redo" => {
             let n = match c.optional() {
                 Some(t) => parse_count(&t.text).map_err(|error| (t.column, error.to_string()))?,
                 None => 1,
             };
-            if name.text == "undo" { Command::Undo(n) } else { Command::Redo(n) }
+            if name.text == "undo" { Line::Undo(n) } else { Line::Redo(n) }
         }
-        "save" => Command::Save(c.path()?),
-        "render" => Command::Render(c.path()?),
+        "save" => Line::Save(c.path()?),
+        "render" => Line::Render(c.path()?),
         "expect" => parse_expect(c)?,
-        "object" => Command::Object(parse_object(c)?),
+        "object" => Line::Object(parse_object(c)?),
         "layer" => {
             let id = c.int_in("layer id", 0..=i64::from(u32::MAX - 1))? as u32;
             let what = c.word("hide, show, color, active or a name")?;
-            Command::Layer(
+            Line::Layer(
                 id,
                 match what.text.as_str() {
                     _ if what.quoted => LayerLine::Name(what.text),
@@ -556,20 +556,20 @@ fn parse_brush(c: &mut Cursor) -> Result<Brush, Fail> {
     })
 }
 
-fn parse_expect(c: &mut Cursor) -> Result<Command, Fail> {
+fn parse_expect(c: &mut Cursor) -> Result<Line, Fail> {
     let what = c.word("voxel, count, written, image, effects, palette, objects or models")?;
     Ok(match what.text.as_str() {
         "voxel" => {
             let p = c.position()?;
-            Command::ExpectVoxel(p, c.int_in("palette index", 0..=255)? as u8)
+            Line::ExpectVoxel(p, c.int_in("palette index", 0..=255)? as u8)
         }
-        "count" => Command::ExpectCount(c.number("a voxel count")?),
+        "count" => Line::ExpectCount(c.number("a voxel count")?),
         "written" => {
             let op = c.word("<=")?;
             if op.text != "<=" {
                 return Err((op.column, format!("expected '<=', found '{}'", op.text)));
             }
-            Command::ExpectWritten(c.number("a byte count")?)
+            Line::ExpectWritten(c.number("a byte count")?)
         }
         "image" => {
             let path = c.path()?;
@@ -582,15 +582,15 @@ fn parse_expect(c: &mut Cursor) -> Result<Command, Fail> {
                     .ok_or((t.column, format!("tolerance '{}' must be a fraction in 0..=1", t.text)))?,
                 None => 0.0,
             };
-            Command::ExpectImage(path, tolerance)
+            Line::ExpectImage(path, tolerance)
         }
-        "effects" => Command::ExpectEffects(parse_effect_names(c)?),
+        "effects" => Line::ExpectEffects(parse_effect_names(c)?),
         "palette" => {
             let index = c.int_in("palette index", 1..=255)? as u8;
-            Command::ExpectPalette(index, c.rgb()?)
+            Line::ExpectPalette(index, c.rgb()?)
         }
-        "objects" => Command::ExpectObjects(c.number("an object count")?),
-        "models" => Command::ExpectModels(c.number("a model count")?),
+        "objects" => Line::ExpectObjects(c.number("an object count")?),
+        "models" => Line::ExpectModels(c.number("a model count")?),
         other => {
             return Err((
                 what.column,
@@ -602,7 +602,7 @@ fn parse_expect(c: &mut Cursor) -> Result<Command, Fail> {
 
 /// `material INDEX KIND [KEY VALUE]...`: the keys MATL chunks hold as
 /// numbers (`_rough`, `_metal`, `_ri`, `_emit`, …), each with a number.
-fn parse_material(c: &mut Cursor) -> Result<Command, Fail> {
+fn parse_material(c: &mut Cursor) -> Result<Line, Fail> {
     let index = c.int_in("palette index", 1..=255)? as u8;
     let kind_token = c.word("a material kind (diffuse, metal, glass, emit, media)")?;
     let kind = crate::scene::MaterialKind::from_vox_name(&format!("_{}", kind_token.text.trim_start_matches('_')))
@@ -627,7 +627,7 @@ fn parse_material(c: &mut Cursor) -> Result<Command, Fail> {
         }
         material.params.insert(key.text, value.to_string());
     }
-    Ok(Command::Material(index, Box::new(material)))
+    Ok(Line::Material(index, Box::new(material)))
 }
 
 /// `none`, or one or more of the effect names.
@@ -726,19 +726,23 @@ mod tests {
             again.lines.iter().map(|l| &l.command).collect::<Vec<_>>()
         );
         assert_eq!(script.lines.len(), 77);
+        // Each line's word is the one it is printed with.
+        for line in &script.lines {
+            assert_eq!(line.command.to_string().split(' ').next(), Some(line.command.word()), "{}", line.command);
+        }
     }
 
     #[test]
     fn quotes_keep_spaces_and_hashes_and_printing_quotes_them() {
         let text = "\u{feff}save \"../out/has#hash.vox\" # a comment\nload \"my models/a \\\"b\\\" \\\\.vox\"\nrender plain.png\n";
         let script = parse_script(Path::new("q.ovr"), text).unwrap();
-        let commands: Vec<&Command> = script.lines.iter().map(|l| &l.command).collect();
+        let commands: Vec<&Line> = script.lines.iter().map(|l| &l.command).collect();
         assert_eq!(
             commands,
             [
-                &Command::Save(PathBuf::from("../out/has#hash.vox")),
-                &Command::Load(PathBuf::from("my models/a \"b\" \\.vox")),
-                &Command::Render(PathBuf::from("plain.png")),
+                &Line::Save(PathBuf::from("../out/has#hash.vox")),
+                &Line::Load(PathBuf::from("my models/a \"b\" \\.vox")),
+                &Line::Render(PathBuf::from("plain.png")),
             ]
         );
         for command in commands {
@@ -756,7 +760,7 @@ mod tests {
     #[test]
     fn control_characters_in_names_round_trip() {
         for name in ["two\nlines.vox", "tab\there.vox", "bell\u{7}\r\u{1b}.vox", "mixed \"q\" \\ \n#.vox"] {
-            let command = Command::Load(PathBuf::from(name));
+            let command = Line::Load(PathBuf::from(name));
             let printed = command.to_string();
             assert!(!printed.contains('\n') && !printed.chars().any(char::is_control), "{printed:?}");
             let again = parse_script(Path::new("q.ovr"), &printed).unwrap();
@@ -784,12 +788,12 @@ mod tests {
         for name in &names {
             let r = || ObjectRef::Name(name.clone());
             let commands = [
-                Command::Layer(0, LayerLine::Name(name.clone())),
-                Command::Object(ObjectLine::Pick(r())),
-                Command::Object(ObjectLine::New(name.clone())),
-                Command::Object(ObjectLine::Rename(name.clone())),
-                Command::Object(ObjectLine::Regroup(r(), true)),
-                Command::Object(ObjectLine::Merge(vec![r(), ObjectRef::Index(3), r()])),
+                Line::Layer(0, LayerLine::Name(name.clone())),
+                Line::Object(ObjectLine::Pick(r())),
+                Line::Object(ObjectLine::New(name.clone())),
+                Line::Object(ObjectLine::Rename(name.clone())),
+                Line::Object(ObjectLine::Regroup(r(), true)),
+                Line::Object(ObjectLine::Merge(vec![r(), ObjectRef::Index(3), r()])),
             ];
             for command in commands {
                 let printed = command.to_string();
@@ -799,8 +803,8 @@ mod tests {
             }
         }
         // Plain names stay unquoted, so older journals read as they did.
-        assert_eq!(Command::Layer(2, LayerLine::Name("roof".to_owned())).to_string(), "layer 2 roof");
-        assert_eq!(Command::Layer(2, LayerLine::Name("hide".to_owned())).to_string(), "layer 2 \"hide\"");
+        assert_eq!(Line::Layer(2, LayerLine::Name("roof".to_owned())).to_string(), "layer 2 roof");
+        assert_eq!(Line::Layer(2, LayerLine::Name("hide".to_owned())).to_string(), "layer 2 \"hide\"");
         assert_eq!(errors("object \"\""), vec!["an empty object name at build.ovr:1:8"]);
     }
 

@@ -337,7 +337,7 @@ fn an_edit_goes_into_the_model_of_the_object_and_every_reference_shows_it() {
     assert_eq!(parsed.models[0].voxels.len(), 18);
     // Reading the saved file back gives what was drawn.
     assert_eq!(load(&saved_once).voxels(), editor.scene.voxels());
-    editor.run(&octovox::script::Command::Undo(1)).unwrap();
+    editor.run(&octovox::script::Line::Undo(1)).unwrap();
     assert_eq!(editor.scene.solid_voxels(), before);
     assert_eq!(editor.scene.objects().unwrap().models[0].tree.solid_voxels(), 17);
 }
@@ -467,7 +467,7 @@ fn a_hundred_thousand_objects_load_and_edit() {
         let (a, b) = (traced.trace(&ray, Default::default()), octovox::trace::svo::trace(editor.scene.drawn(), &ray));
         assert!(!a.gave_up && a.value == b.value && (a.voxel - b.voxel).abs().max_element() <= 1, "{a:?} {b:?}");
     }
-    editor.run(&octovox::script::Command::Undo(1)).unwrap();
+    editor.run(&octovox::script::Line::Undo(1)).unwrap();
     assert_eq!(editor.scene.solid_voxels(), before);
     assert!(started.elapsed().as_secs() < 120, "loaded in {loaded:?}, all in {:?}", started.elapsed());
 }

@@ -73,7 +73,7 @@ fn own_dir(what: &str) -> std::path::PathBuf {
 /// only edits: no line that writes a file (`save`, `render`) and one scene
 /// line at most (`load`, `new`, `demo`), with and without its document.
 pub fn journal(data: &[u8]) {
-    use octovox::script::Command;
+    use octovox::script::Line;
     static DOCUMENT: std::sync::Once = std::sync::Once::new();
     let document = Path::new(JOURNAL_DOCUMENT);
     DOCUMENT.call_once(|| {
@@ -89,10 +89,9 @@ pub fn journal(data: &[u8]) {
     std::fs::write(&journal, data).expect("the journal is written");
     for owner in [Some(document), None] {
         let Ok(script) = octovox::journal::read(&journal, owner, Default::default()) else { continue };
-        let writes = script.lines.iter().find(|l| matches!(l.command, Command::Save(_) | Command::Render(_)));
+        let writes = script.lines.iter().find(|l| matches!(l.command, Line::Save(_) | Line::Render(_)));
         assert!(writes.is_none(), "a journal read as good writes a file: '{}'", writes.map(|l| &l.command).unwrap());
-        let scenes =
-            script.lines.iter().filter(|l| matches!(l.command, Command::Load(_) | Command::New | Command::Demo(_)));
+        let scenes = script.lines.iter().filter(|l| matches!(l.command, Line::Load(_) | Line::New | Line::Demo(_)));
         assert!(scenes.count() <= 1, "a journal read as good makes more than one scene");
     }
 }
