@@ -7,7 +7,7 @@ use glam::IVec3;
 use super::fill::connected;
 use crate::edit::Edit;
 use crate::scene::shape::MAX_BRUSH_EXTENT;
-use crate::scene::{EditError, Octree, Op, Shape};
+use crate::scene::{EditError, Octree, Op, RegionError, Shape};
 
 /// Most faces one extrude moves; a larger region is refused before anything
 /// changes.
@@ -27,21 +27,18 @@ fn shows_face(tree: &Octree, p: IVec3, normal: IVec3) -> bool {
 /// than [`MAX_EXTRUDE_FACES`] faces.
 pub fn face_region(tree: &Octree, start: IVec3, normal: IVec3) -> Result<Vec<(IVec3, u8)>, EditError> {
     if normal.abs().element_sum() != 1 {
-        return Err(EditError::Brush(format!("extrude normal {normal} is not one of ±x, ±y, ±z")));
+        return Err(RegionError::NotAnAxis(normal).into());
     }
     if !shows_face(tree, start, normal) {
-        return Err(EditError::Brush(format!("voxel {start} shows no face toward {normal}")));
+        return Err(RegionError::NoFace { voxel: start, normal }.into());
     }
     let in_plane: Vec<IVec3> = [IVec3::X, IVec3::Y, IVec3::Z]
         .into_iter()
         .filter(|axis| axis.dot(normal) == 0)
         .flat_map(|axis| [axis, -axis])
         .collect();
-    let region = connected(start, &in_plane, MAX_EXTRUDE_FACES, |p| shows_face(tree, p, normal)).ok_or_else(|| {
-        EditError::Brush(format!(
-            "the face at {start} has more than {MAX_EXTRUDE_FACES} voxels: extrude refused, nothing changed"
-        ))
-    })?;
+    let region = connected(start, &in_plane, MAX_EXTRUDE_FACES, |p| shows_face(tree, p, normal))
+        .ok_or(RegionError::FaceTooLarge { start, limit: MAX_EXTRUDE_FACES })?;
     Ok(region.into_iter().map(|p| (p, tree.get(p))).collect())
 }
 
@@ -53,7 +50,7 @@ pub fn face_region(tree: &Octree, start: IVec3, normal: IVec3) -> Result<Vec<(IV
 /// As [`face_region`], and 0 layers or more than the brush extent.
 pub fn extrude_edits(tree: &Octree, start: IVec3, normal: IVec3, layers: i32) -> Result<Vec<Edit>, EditError> {
     if layers == 0 || layers.abs() > MAX_BRUSH_EXTENT {
-        return Err(EditError::Brush(format!("extrude by {layers} layers: use 1..={MAX_BRUSH_EXTENT} out or in")));
+        return Err(RegionError::ExtrudeLayers { layers, limit: MAX_BRUSH_EXTENT }.into());
     }
     let edits = face_region(tree, start, normal)?.into_iter().map(|(p, color)| {
         let (a, b, op) = if layers > 0 {

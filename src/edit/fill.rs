@@ -6,7 +6,7 @@ use std::collections::{HashSet, VecDeque};
 use glam::IVec3;
 
 use crate::edit::Edit;
-use crate::scene::{EditError, Octree, Op, Shape};
+use crate::scene::{EditError, Octree, Op, RegionError, Shape};
 
 /// Most voxels one fill recolours; a larger region is refused before
 /// anything changes.
@@ -19,14 +19,11 @@ pub const MAX_FILL_VOXELS: usize = 1 << 20;
 pub fn fill_region(tree: &Octree, start: IVec3) -> Result<Vec<IVec3>, EditError> {
     let value = tree.get(start);
     if value == 0 {
-        return Err(EditError::Brush(format!("no voxel at {start} to fill from")));
+        return Err(RegionError::NothingToFill(start).into());
     }
     let steps = [IVec3::X, IVec3::NEG_X, IVec3::Y, IVec3::NEG_Y, IVec3::Z, IVec3::NEG_Z];
-    connected(start, &steps, MAX_FILL_VOXELS, |p| tree.get(p) == value).ok_or_else(|| {
-        EditError::Brush(format!(
-            "the region at {start} has more than {MAX_FILL_VOXELS} voxels: fill refused, nothing changed"
-        ))
-    })
+    connected(start, &steps, MAX_FILL_VOXELS, |p| tree.get(p) == value)
+        .ok_or_else(|| RegionError::FillTooLarge { start, limit: MAX_FILL_VOXELS }.into())
 }
 
 /// The cells reachable from `start` (itself included, breadth first) by

@@ -17,7 +17,7 @@ pub mod selection;
 use std::collections::VecDeque;
 
 use crate::scene::objects::{GraphChange, Model};
-use crate::scene::{EditError, Material, Op, Patch, Scene, Shape};
+use crate::scene::{EditError, Material, ObjectRefusal, Op, Patch, Scene, Shape};
 
 /// One change to the scene.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -80,9 +80,7 @@ impl Edit {
         let Some(objects) = scene.objects() else { return Ok(vec![Edit::Brush { shape, op: Op::Remove }]) };
         let covered: Vec<usize> = (0..objects.list().len()).filter(|&i| objects.holds_voxels_in(i, min, max)).collect();
         if let Some(&locked) = covered.iter().find(|&&i| objects.locked(i)) {
-            return Err(EditError::Objects(format!(
-                "object {locked} is locked and has voxels in the box: `object unlock` it, or select around it"
-            )));
+            return Err(ObjectRefusal::LockedInBox(locked).into());
         }
         Ok(covered.into_iter().map(|object| Edit::InObject { object, shape, op: Op::Remove }).collect())
     }

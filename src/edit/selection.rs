@@ -8,7 +8,7 @@ use glam::IVec3;
 use crate::edit::Edit;
 use crate::scene::shape::MAX_BRUSH_EXTENT;
 use crate::scene::transform::CellMap;
-use crate::scene::{EditError, Octree, Op, Shape};
+use crate::scene::{EditError, Octree, Op, RegionError, Shape};
 
 /// Most voxels one copy holds (16 Mi).
 pub const MAX_CLIPBOARD_VOXELS: u64 = 1 << 24;
@@ -33,10 +33,8 @@ impl Region {
     pub fn new(a: IVec3, b: IVec3) -> Result<Region, EditError> {
         let region = Region { min: a.min(b), max: a.max(b) };
         if (region.max - region.min).max_element() >= MAX_BRUSH_EXTENT {
-            return Err(EditError::Brush(format!(
-                "selection {}..{} is wider than {MAX_BRUSH_EXTENT} voxels",
-                region.min, region.max
-            )));
+            let (min, max) = (region.min, region.max);
+            return Err(RegionError::SelectionTooWide { min, max, limit: MAX_BRUSH_EXTENT }.into());
         }
         Ok(region)
     }
@@ -164,9 +162,7 @@ pub fn copy(tree: &Octree, region: Region) -> Result<Block, EditError> {
         }
     });
     if voxels > MAX_CLIPBOARD_VOXELS {
-        return Err(EditError::Brush(format!(
-            "the selection holds {voxels} voxels; copy takes at most {MAX_CLIPBOARD_VOXELS}"
-        )));
+        return Err(RegionError::ClipboardTooLarge { voxels, limit: MAX_CLIPBOARD_VOXELS }.into());
     }
     let pieces_count = pieces.len() as u64;
     crate::budget::check(

@@ -18,6 +18,9 @@ pub enum GpuError {
     /// A size past what the adapter allows (a texture edge, a buffer binding).
     #[error("{0}")]
     TooLarge(String),
+    /// The scene's pool does not fit one buffer binding of the adapter.
+    #[error("{pool} ({adapter})")]
+    PoolTooLarge { pool: crate::gpu_pool::PoolTooLarge, adapter: String },
     /// wgpu reported a validation error while a frame was recorded.
     #[error("the GPU rejected the frame: {0}")]
     Validation(String),

@@ -182,7 +182,7 @@ pub struct Renderer {
     records_written: bool,
     /// Why the last sync could not upload the pool; frames fail with it
     /// until a sync succeeds.
-    pool_error: Option<String>,
+    pool_error: Option<crate::gpu_pool::PoolTooLarge>,
     /// What the frame being recorded holds, until it is submitted.
     recorded: Option<Recorded>,
 }
@@ -227,7 +227,7 @@ impl Renderer {
 
     /// Sends the pool's changes since the last call and the palette. A pool
     /// too large for one buffer binding is not sent: frames then fail with
-    /// [`GpuError::TooLarge`] saying so, until a sync succeeds.
+    /// [`GpuError::PoolTooLarge`] saying so, until a sync succeeds.
     pub fn sync(&mut self, scene: &mut Scene) -> UploadStats {
         self.buffers.upload_palette(&self.gpu.queue, &scene.palette);
         let limit = self.gpu.device.limits().max_storage_buffer_binding_size;
@@ -237,7 +237,7 @@ impl Renderer {
                 stats
             }
             Err(err) => {
-                self.pool_error = Some(format!("{err} ({})", self.gpu.adapter_name));
+                self.pool_error = Some(err);
                 UploadStats::default()
             }
         }
@@ -245,7 +245,10 @@ impl Renderer {
 
     /// The pool's upload error, as a frame's error.
     fn check_pool(&self) -> Result<(), GpuError> {
-        self.pool_error.clone().map_or(Ok(()), |message| Err(GpuError::TooLarge(message)))
+        match self.pool_error {
+            Some(pool) => Err(GpuError::PoolTooLarge { pool, adapter: self.gpu.adapter_name.clone() }),
+            None => Ok(()),
+        }
     }
 
     /// Uploads the dense grid the grid tracer walks.

@@ -40,16 +40,99 @@ pub enum EditError {
     TooWide { min: IVec3, max: IVec3 },
     #[error("invalid brush: {0}")]
     Shape(#[from] crate::scene::shape::ShapeError),
-    #[error("invalid brush: {0}")]
-    Brush(String),
+    /// A fill, extrude, selection or copy that cannot be made.
+    #[error(transparent)]
+    Region(#[from] RegionError),
     /// A change to a scene of objects that cannot be made (no such object
     /// or layer, a locked object, a file without a scene graph, …).
-    #[error("{0}")]
-    Objects(String),
+    #[error(transparent)]
+    Objects(#[from] ObjectRefusal),
+    /// The objects' scene graph, walked again after a change, refuses it.
+    #[error(transparent)]
+    Placement(#[from] super::objects::ObjectsError),
+    /// A transform or keyframe of the graph that cannot be read.
+    #[error(transparent)]
+    Graph(#[from] super::graph::GraphError),
+    /// A model's tree that cannot hold the cells asked for.
+    #[error(transparent)]
+    Build(#[from] super::build::BuildError),
     #[error("palette index 0 means empty; use remove, or a colour in 1..=255")]
     ZeroColor,
     #[error(transparent)]
     OverBudget(#[from] crate::budget::OverBudget),
+}
+
+/// Why a fill, an extrude, a selection or a copy was refused.
+#[derive(Debug, thiserror::Error, Clone, PartialEq, Eq)]
+pub enum RegionError {
+    #[error("no voxel at {0} to fill from")]
+    NothingToFill(IVec3),
+    #[error("the region at {start} has more than {limit} voxels: fill refused, nothing changed")]
+    FillTooLarge { start: IVec3, limit: usize },
+    #[error("extrude normal {0} is not one of ±x, ±y, ±z")]
+    NotAnAxis(IVec3),
+    #[error("voxel {voxel} shows no face toward {normal}")]
+    NoFace { voxel: IVec3, normal: IVec3 },
+    #[error("the face at {start} has more than {limit} voxels: extrude refused, nothing changed")]
+    FaceTooLarge { start: IVec3, limit: usize },
+    #[error("extrude by {layers} layers: use 1..={limit} out or in")]
+    ExtrudeLayers { layers: i32, limit: i32 },
+    #[error("selection {min}..{max} is wider than {limit} voxels")]
+    SelectionTooWide { min: IVec3, max: IVec3, limit: i32 },
+    #[error("the selection holds {voxels} voxels; copy takes at most {limit}")]
+    ClipboardTooLarge { voxels: u64, limit: u64 },
+}
+
+/// Why a change to a scene of objects was refused.
+#[derive(Debug, thiserror::Error, Clone, PartialEq, Eq)]
+pub enum ObjectRefusal {
+    #[error("a file of animation frames has no scene graph to change")]
+    NoGraph,
+    #[error("the scene has no objects")]
+    NoObjects,
+    #[error("the scene has no object to edit: `object new NAME` makes one")]
+    NothingToEdit,
+    #[error("there is no object {0}")]
+    NoObject(usize),
+    #[error("there is no model {0}")]
+    NoModel(usize),
+    #[error("there are no models")]
+    NoModels,
+    #[error("the scene has no layer {0}")]
+    NoLayer(u32),
+    #[error("the scene has no layers")]
+    NoLayers,
+    #[error("object {0} is locked and stays as it is: `object unlock` first")]
+    Locked(usize),
+    #[error(
+        "object {locked} is locked and places the same model as object {index} (a reference): `object unlock` it, \
+         or `object unique` this one to edit a copy"
+    )]
+    LockedReference { locked: usize, index: usize },
+    #[error("object {0} is locked and has voxels in the box: `object unlock` it, or select around it")]
+    LockedInBox(usize),
+    #[error("object {0} has no transform node")]
+    NoTransform(usize),
+    #[error("node {0} is not a transform")]
+    NotATransform(u32),
+    #[error("its shape is missing")]
+    NoShape,
+    #[error("model {0} is still placed")]
+    StillPlaced(usize),
+    #[error("merge needs other objects than the picked one, each once, of the {0} there are")]
+    MergeWhich(usize),
+    #[error("object {0} is hidden: show it (or its layer) to merge it")]
+    MergeHidden(usize),
+    #[error("the objects hold {voxels} voxels; a merge takes at most {limit} (one model of 256³)")]
+    MergeTooLarge { voxels: u64, limit: u64 },
+    #[error("an object goes before or after another object")]
+    RegroupSelf,
+    #[error("the scene graph has no top group to put an object in")]
+    NoTopGroup,
+    #[error("the object is not in a group (it is the whole scene)")]
+    NotInGroup,
+    #[error("no node ids are left")]
+    NoNodeIds,
 }
 
 /// Peak bytes an edit takes per surface voxel of its shape: bricks and
@@ -99,7 +182,7 @@ impl Scene {
     /// A scene of objects refuses it: a brush goes into an object's model.
     pub fn apply_brush(&mut self, shape: &Shape, op: Op) -> Result<Patch, EditError> {
         if self.objects.is_some() {
-            return Err(EditError::Objects("the scene has no object to edit: `object new NAME` makes one".to_owned()));
+            return Err(ObjectRefusal::NothingToEdit.into());
         }
         self.tree.apply_brush(shape, op)
     }
@@ -142,8 +225,7 @@ impl Scene {
     /// composes what it changes; an error when the scene has none.
     fn objects_and_drawn_mut(&mut self) -> Result<(&mut Objects, &mut Octree), EditError> {
         let Scene { tree, objects, .. } = self;
-        let objects =
-            objects.as_deref_mut().ok_or_else(|| EditError::Objects("the scene has no objects".to_owned()))?;
+        let objects = objects.as_deref_mut().ok_or(ObjectRefusal::NoObjects)?;
         Ok((objects, tree))
     }
 }

@@ -10,7 +10,7 @@ use super::octree::{MAX_DEPTH, MIN_DEPTH, Octree, octant_offset};
 use crate::gpu_pool::{Brick, Node, NodeSlot, POINTER_BIT, is_pointer, pointer_to, slot_of};
 
 /// Why a tree could not be built.
-#[derive(Debug, thiserror::Error, PartialEq, Eq)]
+#[derive(Clone, Debug, thiserror::Error, PartialEq, Eq)]
 pub enum BuildError {
     #[error("scene is {extent} voxels wide; the octree holds at most 2^{MAX_DEPTH}")]
     TooWide { extent: i64 },

@@ -15,7 +15,7 @@ pub mod shape;
 pub mod showroom;
 pub mod transform;
 
-pub use apply::{EditError, Patch, SceneUpload};
+pub use apply::{EditError, ObjectRefusal, Patch, RegionError, SceneUpload};
 pub use build::BuildError;
 pub use counts::VoxelCounts;
 pub use octree::Octree;
@@ -209,7 +209,7 @@ impl Scene {
     pub fn set_new_layer(&mut self, id: u32) -> Result<(), EditError> {
         match &mut self.objects {
             Some(objects) => objects.set_new_layer(id),
-            None => Err(EditError::Objects("the scene has no layers".to_owned())),
+            None => Err(apply::ObjectRefusal::NoLayers.into()),
         }
     }
 

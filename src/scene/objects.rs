@@ -18,10 +18,7 @@ use super::graph::{
 };
 use super::octree::{Octree, WORLD_LIMIT};
 use super::transform::{CellMap, Rotation, Transform};
-use super::{EditError, Op, Patch, Shape};
-
-/// What a graph change says about a file without a scene graph.
-const NO_GRAPH: &str = "a file of animation frames has no scene graph to change";
+use super::{EditError, ObjectRefusal, Op, Patch, Shape};
 
 /// Placements of one model beyond which an edit of it composes one box
 /// around them all (see `Objects::recompose_model`).
@@ -213,7 +210,7 @@ impl Objects {
         let Some(bounds) = boxes.iter().copied().reduce(|a, b| (a.0.min(b.0), a.1.max(b.1))) else {
             return Ok(Octree::default());
         };
-        let mut tree = Octree::empty_for(bounds.0, bounds.1).map_err(|e| EditError::Objects(e.to_string()))?;
+        let mut tree = Octree::empty_for(bounds.0, bounds.1)?;
         for index in self.visible() {
             self.insert_placed(&mut tree, index, bounds);
         }
@@ -260,9 +257,7 @@ impl Objects {
     /// Refuses a change to any of objects `indices` that is locked.
     fn unlocked(&self, indices: &[usize]) -> Result<(), EditError> {
         match indices.iter().find(|&&k| self.locked(k)) {
-            Some(k) => {
-                Err(EditError::Objects(format!("object {k} is locked and stays as it is: `object unlock` first")))
-            }
+            Some(k) => Err(ObjectRefusal::Locked(*k).into()),
             None => Ok(()),
         }
     }
@@ -309,20 +304,12 @@ impl Objects {
         shape: &Shape,
         op: Op,
     ) -> Result<(usize, Patch), EditError> {
-        let model = self
-            .objects
-            .get(index)
-            .ok_or_else(|| EditError::Objects(format!("there is no object {index}")))?
-            .placement
-            .model;
+        let model = self.objects.get(index).ok_or(ObjectRefusal::NoObject(index))?.placement.model;
         self.unlocked(&[index])?;
         // A reference shares the model: an edit through an unlocked
         // placement would change a locked one too (issue 48, item 11).
         if let Some(k) = (0..self.objects.len()).find(|&k| self.objects[k].placement.model == model && self.locked(k)) {
-            return Err(EditError::Objects(format!(
-                "object {k} is locked and places the same model as object {index} (a reference): \
-                 `object unlock` it, or `object unique` this one to edit a copy"
-            )));
+            return Err(ObjectRefusal::LockedReference { locked: k, index }.into());
         }
         let local = self.maps[index].invert_shape(shape);
         let patch = self.models[model].tree.apply_brush(&local, op)?;
@@ -337,12 +324,7 @@ impl Objects {
     /// Puts back a model's cells from an undo patch; returns the patch that
     /// undoes this.
     pub fn apply_patch(&mut self, tree: &mut Octree, model: usize, patch: &Patch) -> Result<Patch, EditError> {
-        let inverse = self
-            .models
-            .get_mut(model)
-            .ok_or_else(|| EditError::Objects(format!("there is no model {model}")))?
-            .tree
-            .apply_patch(patch)?;
+        let inverse = self.models.get_mut(model).ok_or(ObjectRefusal::NoModel(model))?.tree.apply_patch(patch)?;
         if let Some(bounds) = patch.bounds() {
             self.recompose_model(tree, model, bounds)?;
         }
@@ -382,14 +364,14 @@ impl Objects {
     /// Returns the change that undoes it; a change the walk refuses (a
     /// cycle) changes nothing.
     pub fn apply_change(&mut self, tree: &mut Octree, change: &GraphChange) -> Result<GraphChange, EditError> {
-        let graph = self.graph.as_mut().ok_or_else(|| EditError::Objects(NO_GRAPH.to_owned()))?;
+        let graph = self.graph.as_mut().ok_or(ObjectRefusal::NoGraph)?;
         let saved = graph.clone();
         let inverse = change.apply(graph);
         let before = self.drawn();
         if let Err(err) = self.walk(usize::MAX) {
             self.graph = Some(saved);
-            self.walk(usize::MAX).map_err(|e| EditError::Objects(e.to_string()))?;
-            return Err(EditError::Objects(err.to_string()));
+            self.walk(usize::MAX)?;
+            return Err(err.into());
         }
         let after = self.drawn();
         let mut counts: HashMap<(usize, CellMap), i64> = HashMap::new();
@@ -412,7 +394,7 @@ impl Objects {
                 // width): the graph goes back, and so do the cells already
                 // composed from it. A refused change leaves the scene as it was.
                 self.graph = Some(saved);
-                self.walk(usize::MAX).map_err(|e| EditError::Objects(e.to_string()))?;
+                self.walk(usize::MAX)?;
                 for &region in &regions[..done] {
                     self.recompose(tree, region)?;
                 }
@@ -437,10 +419,9 @@ impl Objects {
     /// Takes the last model back out (the undo of [`Objects::push_model`]),
     /// unless an object still places it.
     pub fn pop_model(&mut self) -> Result<Model, EditError> {
-        let last =
-            self.models.len().checked_sub(1).ok_or_else(|| EditError::Objects("there are no models".to_owned()))?;
+        let last = self.models.len().checked_sub(1).ok_or(ObjectRefusal::NoModels)?;
         if self.placements_of(last) > 0 {
-            return Err(EditError::Objects(format!("model {last} is still placed")));
+            return Err(ObjectRefusal::StillPlaced(last).into());
         }
         Ok(self.models.pop().expect("checked above"))
     }
@@ -448,26 +429,21 @@ impl Objects {
     /// The transform node of object `index` (what moves, turns, hides and
     /// names it).
     pub fn transform_node(&self, index: usize) -> Result<&Node, EditError> {
-        let graph = self.graph.as_ref().ok_or_else(|| EditError::Objects(NO_GRAPH.to_owned()))?;
-        let object =
-            self.objects.get(index).ok_or_else(|| EditError::Objects(format!("there is no object {index}")))?;
-        object
-            .transform_node
-            .and_then(|id| graph.node(id))
-            .ok_or_else(|| EditError::Objects(format!("object {index} has no transform node")))
+        let graph = self.graph.as_ref().ok_or(ObjectRefusal::NoGraph)?;
+        let object = self.objects.get(index).ok_or(ObjectRefusal::NoObject(index))?;
+        object.transform_node.and_then(|id| graph.node(id)).ok_or(ObjectRefusal::NoTransform(index).into())
     }
 
     /// The index of the keyframe of `node` shown now (the one a move or a
     /// turn changes), adding one to a node without any.
     fn shown_keyframe(&self, node: &mut Node) -> Result<usize, EditError> {
         let NodeKind::Transform { frames, .. } = &mut node.kind else {
-            return Err(EditError::Objects(format!("node {} is not a transform", node.id)));
+            return Err(ObjectRefusal::NotATransform(node.id).into());
         };
         if frames.is_empty() {
             frames.push(graph::Attributes::new());
         }
-        let shown =
-            graph::pick_keyframe(frames.iter(), self.frame, node.id).map_err(|e| EditError::Objects(e.to_string()))?;
+        let shown = graph::pick_keyframe(frames.iter(), self.frame, node.id)?;
         Ok(shown.unwrap_or(0))
     }
 
@@ -512,7 +488,7 @@ impl Objects {
         let mut node = self.transform_node(index)?.clone();
         let k = self.shown_keyframe(&mut node)?;
         let NodeKind::Transform { frames, .. } = &mut node.kind else { unreachable!("checked by shown_keyframe") };
-        let own = graph::parse_transform(&frames[k], node.id).map_err(|e| EditError::Objects(e.to_string()))?;
+        let own = graph::parse_transform(&frames[k], node.id)?;
         // The whole transform is parent · own, so the parent's rotation is whole · own⁻¹.
         let parent = self.objects[index].placement.transform.rotation.times(own.rotation.inverse());
         graph::write_transform(&mut frames[k], f(own, parent));
@@ -525,7 +501,7 @@ impl Objects {
     /// differ by (exact for groups without keyframes of their own).
     pub fn regrouped(&self, index: usize, target: usize, after: bool) -> Result<GraphChange, EditError> {
         if index == target || target >= self.objects.len() {
-            return Err(EditError::Objects("an object goes before or after another object".to_owned()));
+            return Err(ObjectRefusal::RegroupSelf.into());
         }
         self.unlocked(&[index])?;
         let mut node = self.transform_node(index)?.clone();
@@ -533,7 +509,7 @@ impl Objects {
         let delta = self.parent_placement(target)?.inverse().compose(self.parent_placement(index)?);
         if let NodeKind::Transform { frames, .. } = &mut node.kind {
             for frame in frames.iter_mut() {
-                let own = graph::parse_transform(frame, node.id).map_err(|e| EditError::Objects(e.to_string()))?;
+                let own = graph::parse_transform(frame, node.id)?;
                 graph::write_transform(frame, delta.compose(own));
             }
         }
@@ -562,7 +538,7 @@ impl Objects {
         let mut node = self.transform_node(index)?.clone();
         let k = self.shown_keyframe(&mut node)?;
         let NodeKind::Transform { frames, .. } = &node.kind else { unreachable!("checked by shown_keyframe") };
-        let own = graph::parse_transform(&frames[k], node.id).map_err(|e| EditError::Objects(e.to_string()))?;
+        let own = graph::parse_transform(&frames[k], node.id)?;
         Ok(self.objects[index].placement.transform.compose(own.inverse()))
     }
 
@@ -580,7 +556,7 @@ impl Objects {
     /// The change that puts object `index` on layer `layer`.
     pub fn on_layer(&self, index: usize, layer: u32) -> Result<GraphChange, EditError> {
         if !self.graph.as_ref().is_some_and(|g| g.layers.iter().any(|l| l.id == layer)) {
-            return Err(EditError::Objects(format!("there is no layer {layer}")));
+            return Err(ObjectRefusal::NoLayer(layer).into());
         }
         let mut node = self.transform_node(index)?.clone();
         if let NodeKind::Transform { layer: own, .. } = &mut node.kind {
@@ -592,7 +568,7 @@ impl Objects {
     /// The change that sets layer `id`'s attribute `key` (adding the layer
     /// when there is none of that id).
     pub fn layer_with(&self, id: u32, key: &str, value: Option<&str>) -> Result<GraphChange, EditError> {
-        let graph = self.graph.as_ref().ok_or_else(|| EditError::Objects(NO_GRAPH.to_owned()))?;
+        let graph = self.graph.as_ref().ok_or(ObjectRefusal::NoGraph)?;
         let mut layer = graph.layers.iter().find(|l| l.id == id).cloned().unwrap_or(Layer {
             id,
             attributes: graph::Attributes::new(),
@@ -609,16 +585,14 @@ impl Objects {
     /// group: showing the same model (a reference), or `model`. Returns it
     /// and the new transform node's id.
     pub fn duplicated(&self, index: usize, model: Option<usize>) -> Result<(GraphChange, u32), EditError> {
-        let graph = self.graph.as_ref().ok_or_else(|| EditError::Objects(NO_GRAPH.to_owned()))?;
+        let graph = self.graph.as_ref().ok_or(ObjectRefusal::NoGraph)?;
         let own = self.transform_node(index)?;
         let mut group = self.parent_group(own.id)?.clone();
-        let shape = graph
-            .node(self.objects[index].shape_node)
-            .ok_or_else(|| EditError::Objects("its shape is missing".to_owned()))?;
+        let shape = graph.node(self.objects[index].shape_node).ok_or(ObjectRefusal::NoShape)?;
         let next = graph.nodes.iter().map(|n| n.id).max().unwrap_or(0);
         let (transform_id, shape_id) = (next.checked_add(1), next.checked_add(2));
         let (Some(transform_id), Some(shape_id)) = (transform_id, shape_id) else {
-            return Err(EditError::Objects("no node ids are left".to_owned()));
+            return Err(ObjectRefusal::NoNodeIds.into());
         };
         let mut transform = own.clone();
         transform.id = transform_id;
@@ -649,7 +623,7 @@ impl Objects {
     pub fn made_unique(&self, index: usize, model: usize) -> Result<GraphChange, EditError> {
         let (mut change, _) = self.duplicated(index, Some(model))?;
         // Of the duplicate keep the shape; the object's own transform takes it.
-        let shape = change.nodes.pop().ok_or_else(|| EditError::Objects("no shape".to_owned()))?;
+        let shape = change.nodes.pop().ok_or(ObjectRefusal::NoShape)?;
         let mut own = self.transform_node(index)?.clone();
         if let NodeKind::Transform { child, .. } = &mut own.kind {
             *child = shape.id;
@@ -667,21 +641,16 @@ impl Objects {
         all.sort_unstable();
         all.dedup();
         if all.len() != others.len() + 1 || all.iter().any(|&i| i >= self.objects.len()) {
-            return Err(EditError::Objects(format!(
-                "merge needs other objects than the picked one, each once, of the {} there are",
-                self.objects.len()
-            )));
+            return Err(ObjectRefusal::MergeWhich(self.objects.len()).into());
         }
         self.unlocked(&all)?;
         if let Some(&hidden) = all.iter().find(|&&k| self.objects[k].hidden) {
             // Its voxels would show once part of a shown model.
-            return Err(EditError::Objects(format!("object {hidden} is hidden: show it (or its layer) to merge it")));
+            return Err(ObjectRefusal::MergeHidden(hidden).into());
         }
         let voxels: u64 = all.iter().map(|&k| self.models[self.objects[k].placement.model].tree.solid_voxels()).sum();
         if voxels > MERGE_LIMIT {
-            return Err(EditError::Objects(format!(
-                "the objects hold {voxels} voxels; a merge takes at most {MERGE_LIMIT} (one model of 256³)"
-            )));
+            return Err(ObjectRefusal::MergeTooLarge { voxels, limit: MERGE_LIMIT }.into());
         }
         // The new model's octree, before it is built: its sources' pools,
         // twice over for cells their grids cut differently, and the undo copy.
@@ -692,7 +661,7 @@ impl Objects {
         let boxes: Vec<(IVec3, IVec3)> =
             all.iter().filter_map(|&k| self.world_box(k)).map(|(lo, hi)| target.invert_box(lo, hi)).collect();
         let mut tree = match boxes.into_iter().reduce(|a, b| (a.0.min(b.0), a.1.max(b.1))) {
-            Some((lo, hi)) => Octree::empty_for(lo, hi).map_err(|e| EditError::Objects(e.to_string()))?,
+            Some((lo, hi)) => Octree::empty_for(lo, hi)?,
             None => Octree::default(),
         };
         // In walk order, so the later wins where two overlap, as drawn.
@@ -714,7 +683,7 @@ impl Objects {
     /// one cell to store, the change that adds its shape and transform, and
     /// the new transform's id.
     pub fn created(&self, name: &str) -> Result<(Model, GraphChange, u32), EditError> {
-        let graph = self.graph.as_ref().ok_or_else(|| EditError::Objects(NO_GRAPH.to_owned()))?;
+        let graph = self.graph.as_ref().ok_or(ObjectRefusal::NoGraph)?;
         // The top group: the one under the root transform (node 0), where
         // the walk starts. The first group in file order may be one no walk
         // reaches (issue 48, item 12), and an object there is in no scene.
@@ -722,13 +691,11 @@ impl Objects {
             Some(NodeKind::Transform { child, .. }) => graph.node(*child),
             _ => None,
         };
-        let mut group = top
-            .filter(|n| matches!(n.kind, NodeKind::Group { .. }))
-            .cloned()
-            .ok_or_else(|| EditError::Objects("the scene graph has no top group to put an object in".to_owned()))?;
+        let mut group =
+            top.filter(|n| matches!(n.kind, NodeKind::Group { .. })).cloned().ok_or(ObjectRefusal::NoTopGroup)?;
         let next = graph.nodes.iter().map(|n| n.id).max().unwrap_or(0);
         let ids = next.checked_add(1).zip(next.checked_add(2));
-        let (transform_id, shape_id) = ids.ok_or_else(|| EditError::Objects("no node ids are left".to_owned()))?;
+        let (transform_id, shape_id) = ids.ok_or(ObjectRefusal::NoNodeIds)?;
         let layer = self.layer_for_new().unwrap_or(u32::MAX);
         let attributes = [("_name".to_owned(), name.to_owned())].into();
         let transform = Node {
@@ -789,12 +756,12 @@ impl Objects {
 
     /// The group that holds transform `id`.
     fn parent_group(&self, id: u32) -> Result<&Node, EditError> {
-        let graph = self.graph.as_ref().ok_or_else(|| EditError::Objects(NO_GRAPH.to_owned()))?;
+        let graph = self.graph.as_ref().ok_or(ObjectRefusal::NoGraph)?;
         graph
             .nodes
             .iter()
             .find(|n| matches!(&n.kind, NodeKind::Group { children } if children.contains(&id)))
-            .ok_or_else(|| EditError::Objects("the object is not in a group (it is the whole scene)".to_owned()))
+            .ok_or(ObjectRefusal::NotInGroup.into())
     }
 
     /// The index of the object placed by transform node `id`.
@@ -822,7 +789,7 @@ impl Objects {
     /// Makes layer `id` the one new objects go on.
     pub fn set_new_layer(&mut self, id: u32) -> Result<(), EditError> {
         if !self.layer_list().iter().any(|l| l.id == id) {
-            return Err(EditError::Objects(format!("the scene has no layer {id}")));
+            return Err(ObjectRefusal::NoLayer(id).into());
         }
         self.new_layer = Some(id);
         Ok(())
