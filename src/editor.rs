@@ -113,7 +113,12 @@ impl Editor {
     /// edit changes nothing).
     pub fn run(&mut self, command: &Line) -> Result<Outcome, EditorError> {
         let tools = self.tools;
+        if command.ends_stroke() {
+            self.history.end_stroke();
+        }
         let changed = match command {
+            Line::Stroke(true) => self.set(|e| e.history.begin_stroke()),
+            Line::Stroke(false) => self.set(|e| e.history.end_stroke()),
             Line::New | Line::Demo(_) => {
                 self.set_scene(built_scene(command).unwrap_or_default());
                 return Ok(Outcome::Replaced);

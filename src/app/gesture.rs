@@ -38,18 +38,17 @@ pub(super) enum SelectDrag {
 }
 
 /// An open mouse stroke: its tool, the face (normal and layer) it started
-/// on, the last brush centre applied, and whether the line being run is
-/// the stroke's own (a step of it, not a key action that ends it).
+/// on, and the last brush centre applied.
 pub(super) struct Stroke {
     pub tool: Tool,
     pub plane: Option<(IVec3, i32)>,
     pub last_center: Option<IVec3>,
-    pub applying: bool,
 }
 
 impl Gesture {
-    /// Whether the gesture groups edits into one undo step (a stroke, a
-    /// held palette control).
+    /// Whether the gesture's edits are one undo step (between the `stroke
+    /// begin` and `stroke end` it runs): a brush stroke, a held palette
+    /// control, an object drag.
     pub fn groups_edits(&self) -> bool {
         matches!(self, Gesture::Stroke(_) | Gesture::Palette | Gesture::ObjectDrag { .. })
     }

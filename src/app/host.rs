@@ -26,28 +26,29 @@ impl App {
         self.run_script_line(Path::new("."), line)
     }
 
-    /// Runs one line (paths relative to `base`) and follows it up. A key
-    /// action during a drag ends the drag's undo step first: the history
-    /// and the recording count steps alike.
+    /// Runs one line (paths relative to `base`) and follows it up. A line
+    /// that ends a stroke (a key action during a drag) ends the drag too:
+    /// the editor has closed its undo step, and the recording and the
+    /// journal count steps by the same rule (`Line::ends_stroke`).
     pub(super) fn run_script_line(&mut self, base: &Path, line: &Line) -> Result<StepResult, StepError> {
-        let gesture = self.continues_gesture(line);
-        if !gesture {
-            self.close_strokes();
+        if line.ends_stroke() && self.gesture.groups_edits() {
+            self.gesture = super::gesture::Gesture::Idle;
         }
         let result = step(self, base, line)?;
         if let StepResult::Ran(Ran { line, outcome, selection, picked }) = &result {
+            let in_stroke = self.doc.editor.history.stroke_open();
             if let Some(picked) = picked {
-                self.followed_up(picked, &Outcome::State, *selection, gesture);
+                self.followed_up(picked, &Outcome::State, *selection, in_stroke);
             }
-            self.followed_up(line, outcome, *selection, gesture);
+            self.followed_up(line, outcome, *selection, in_stroke);
         }
         Ok(result)
     }
 
     /// Follows up an editor line: an edit goes to the GPU, the recording
     /// and the journal; a new scene starts its journal as Open does.
-    /// `gesture`: the line is a step of the stroke or palette control under way.
-    fn followed_up(&mut self, line: &Line, outcome: &Outcome, selection: Option<Region>, gesture: bool) {
+    /// `in_stroke`: the line is an edit of the stroke under way.
+    fn followed_up(&mut self, line: &Line, outcome: &Outcome, selection: Option<Region>, in_stroke: bool) {
         if matches!(outcome, Outcome::Replaced) {
             return self.scene_replaced(line.clone(), None);
         }
@@ -56,7 +57,7 @@ impl App {
             self.open_journal(selection);
         }
         let (tools, camera) = (self.doc.editor.tools, self.state.camera);
-        let ran = |r: &mut Recorder| r.ran(line, &tools, &camera, gesture);
+        let ran = |r: &mut Recorder| r.ran(line, &tools, &camera);
         match (outcome, line) {
             // Undo and redo: the journal gets them as lines only if it holds the steps.
             (Outcome::Changed, Line::Undo(n) | Line::Redo(n)) => {
@@ -71,7 +72,7 @@ impl App {
                 self.after_change("paste", |_| Ok(()));
             }
             // A step of a mouse stroke or a palette control prints `edit: …`.
-            (Outcome::Changed, _) if gesture => self.after_change("edit", ran),
+            (Outcome::Changed, _) if in_stroke => self.after_change("edit", ran),
             (Outcome::Changed, _) => {
                 // The line's command word names it in the printed line (`fill: N bytes written`).
                 self.after_change(line.word(), ran);

@@ -155,12 +155,20 @@ impl App {
             .map(|i| Line::Object(octovox::script::ObjectLine::Pick(octovox::script::ObjectRef::Index(i))));
         let selection = selection.into_iter().chain(picked);
         let (lines, stamp) = (&self.doc.journal_start.lines, &self.doc.journal_start.stamp);
+        // A journal that starts within a stroke (its first edit is one)
+        // begins the stroke too, so that recovery makes the same steps.
+        let stroke = self.doc.editor.history.stroke_open();
+        let (tools, camera) = (self.doc.editor.tools, self.state.camera);
         let started = Recorder::journal(&path, &header).and_then(|mut journal| {
             let write = |journal: &mut Recorder| -> std::io::Result<()> {
                 if let Some(stamp) = stamp {
                     journal.note(&stamp.note())?;
                 }
-                lines.iter().cloned().chain(selection.clone()).try_for_each(|line| journal.scene(line))
+                lines.iter().cloned().chain(selection.clone()).try_for_each(|line| journal.scene(line))?;
+                if stroke {
+                    journal.ran(&Line::Stroke(true), &tools, &camera)?;
+                }
+                Ok(())
             };
             if let Err(err) = write(&mut journal) {
                 // No journal that holds only part of its start is left behind.

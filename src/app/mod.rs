@@ -676,8 +676,7 @@ impl App {
             lines.push(octovox::script::Line::Material(index, material));
         }
         if !matches!(self.gesture, Gesture::Palette) {
-            self.doc.editor.history.begin_stroke();
-            self.gesture = Gesture::Palette;
+            self.begin_stroke(Gesture::Palette);
         }
         for line in &lines {
             if let Err(err) = self.run_line(line) {
@@ -690,17 +689,25 @@ impl App {
         }
     }
 
-    /// Closes the open undo step of a mouse drag or a held palette control,
-    /// in the history and the recording alike.
-    pub(super) fn close_strokes(&mut self) {
-        if self.gesture.groups_edits() {
-            self.gesture = Gesture::Idle;
-            self.doc.editor.history.end_stroke();
+    /// Starts a gesture whose edits are one undo step: `stroke begin`.
+    pub(super) fn begin_stroke(&mut self, gesture: Gesture) {
+        if let Err(err) = self.run_line(&octovox::script::Line::Stroke(true)) {
+            return self.ui.error(format!("stroke refused: {err}"));
         }
-        self.record(|r| {
-            r.end_step();
-            Ok(())
-        });
+        self.gesture = gesture;
+    }
+
+    /// Ends the gesture of a mouse drag or a held palette control: `stroke
+    /// end`, which closes its undo step in the history, the recording and
+    /// the journal alike.
+    pub(super) fn close_strokes(&mut self) {
+        if !self.gesture.groups_edits() {
+            return;
+        }
+        self.gesture = Gesture::Idle;
+        if let Err(err) = self.run_line(&octovox::script::Line::Stroke(false)) {
+            self.ui.error(format!("stroke refused: {err}"));
+        }
     }
 
     fn pointer_edit(&mut self, phase: StrokePhase, tool: Tool, x: f64, y: f64) {
@@ -712,8 +719,7 @@ impl App {
         }
         match phase {
             StrokePhase::Begin => {
-                self.doc.editor.history.begin_stroke();
-                self.gesture = Gesture::Stroke(Stroke { tool, plane: None, last_center: None, applying: false });
+                self.begin_stroke(Gesture::Stroke(Stroke { tool, plane: None, last_center: None }));
                 self.stroke_step(x, y);
             }
             StrokePhase::Move => self.stroke_step(x, y),
@@ -762,12 +768,10 @@ impl App {
         // of the stroke.
         let first = stroke.last_center.is_none();
         let line = octovox::script::edit_command(stroke.tool, center);
-        self.with_stroke(|s| s.applying = true);
         let picked = self.doc.editor.object_line_at(pick.voxel).filter(|_| first);
         let ran = picked
             .map_or(Ok(()), |picked| self.run_line(&picked).map(|_| ()))
             .and_then(|()| self.run_line(&line).map(|_| ()));
-        self.with_stroke(|s| s.applying = false);
         match ran {
             Ok(_) => self.with_stroke(|stroke| {
                 stroke.plane.get_or_insert(layer);
@@ -780,20 +784,6 @@ impl App {
     fn with_stroke(&mut self, f: impl FnOnce(&mut Stroke)) {
         if let Some(stroke) = self.gesture.stroke_mut() {
             f(stroke);
-        }
-    }
-
-    /// Whether `line` is a step of the gesture under way (a mouse stroke,
-    /// a held palette control) rather than an action that ends it.
-    fn continues_gesture(&self, line: &octovox::script::Line) -> bool {
-        use octovox::script::Line;
-        match line {
-            Line::Place(_) | Line::Remove(_) | Line::Paint(_) | Line::Object(octovox::script::ObjectLine::Pick(_)) => {
-                self.gesture.stroke().is_some_and(|s| s.applying)
-            }
-            Line::Rgb(..) | Line::Material(..) => matches!(self.gesture, Gesture::Palette),
-            Line::Object(octovox::script::ObjectLine::Move(_)) => matches!(self.gesture, Gesture::ObjectDrag { .. }),
-            _ => false,
         }
     }
 }

@@ -129,8 +129,7 @@ impl App {
                     None => {}
                 }
                 if phase == StrokePhase::Begin {
-                    self.doc.editor.history.begin_stroke();
-                    self.gesture = Gesture::ObjectDrag { at: pick.voxel, start: (x, y), moved: IVec3::ZERO };
+                    self.begin_stroke(Gesture::ObjectDrag { at: pick.voxel, start: (x, y), moved: IVec3::ZERO });
                 }
             }
             StrokePhase::Move => self.drag_object(x, y),

@@ -21,11 +21,16 @@ pub struct Recorder {
     color: Option<u8>,
     /// Mirror planes the script has in force.
     mirror: Mirror,
-    /// Edits of each undo step still undoable / redoable (a stroke is one
-    /// step in the window but one line per edit in the script).
-    done: Vec<u32>,
-    undone: Vec<u32>,
-    open_stroke: u32,
+    /// Undo steps written and still undoable / redoable: an edit outside
+    /// a stroke is one, a stroke with edits is one.
+    done: u32,
+    undone: u32,
+    /// The edits of the open stroke, if one is open. Its `stroke begin` is
+    /// written before its first edit (a stroke without edits, a click on
+    /// nothing, leaves no lines), its `stroke end` when it ends: at its own
+    /// line or at one that ends it (`Line::ends_stroke`, the rule the
+    /// editor groups edits by).
+    stroke: Option<u32>,
 }
 
 impl Recorder {
@@ -84,9 +89,9 @@ impl Recorder {
             brush: None,
             color: None,
             mirror: Mirror::default(),
-            done: Vec::new(),
-            undone: Vec::new(),
-            open_stroke: 0,
+            done: 0,
+            undone: 0,
+            stroke: None,
         }
     }
 
@@ -111,21 +116,26 @@ impl Recorder {
 
     /// The scene was replaced: `load PATH` (absolute), or `demo`/`new`.
     pub fn scene(&mut self, command: Line) -> std::io::Result<()> {
-        self.done.clear();
-        self.undone.clear();
-        self.open_stroke = 0;
+        (self.done, self.undone, self.stroke) = (0, 0, None);
         self.command(&command)
     }
 
     /// A line the editor ran (`octovox::editor::Editor::run`) with `tools`
     /// in force: edit lines after the state they depend on where it
-    /// changed, each one undo step or, `in_stroke`, one edit of the open
-    /// step (a mouse drag, a held palette control); `select` and `copy` as
-    /// they are. Brush, colour and mirror lines are written before the next
-    /// edit that uses them; expectations and file lines are not part of a
-    /// recording.
-    pub fn ran(&mut self, command: &Line, tools: &Tools, camera: &Camera, in_stroke: bool) -> std::io::Result<()> {
+    /// changed, each one undo step or one edit of the open stroke;
+    /// `stroke`, `select` and `copy` lines as they are. Brush, colour and
+    /// mirror lines are written before the next edit that uses them;
+    /// expectations and file lines are not part of a recording.
+    pub fn ran(&mut self, command: &Line, tools: &Tools, camera: &Camera) -> std::io::Result<()> {
+        if command.ends_stroke() {
+            self.end_stroke()?;
+        }
         let color = match command {
+            Line::Stroke(begin) => {
+                self.end_stroke()?;
+                self.stroke = begin.then_some(0);
+                return Ok(());
+            }
             Line::Place(_) | Line::Paint(_) | Line::Segment(..) | Line::Fill(_) => Some(tools.color),
             Line::Remove(_)
             | Line::Extrude(..)
@@ -173,15 +183,22 @@ impl Recorder {
             // A load runs as the `palette set` it became; a save is a file line.
             | Line::Palette(PaletteLine::Load(_) | PaletteLine::Save(_)) => return Ok(()),
         };
-        if !in_stroke {
-            self.end_step();
-        }
         self.edit_state(camera, tools.brush, color, &tools.mirror)?;
-        self.undone.clear();
-        self.open_stroke += 1;
-        self.command(command)?;
-        if !in_stroke {
-            self.end_step();
+        self.undone = 0;
+        match self.stroke {
+            Some(0) => self.command(&Line::Stroke(true))?,
+            Some(_) => {}
+            None => self.done += 1,
+        }
+        self.stroke = self.stroke.map(|edits| edits + 1);
+        self.command(command)
+    }
+
+    /// Ends the open stroke: one step and a `stroke end` if it has edits.
+    fn end_stroke(&mut self) -> std::io::Result<()> {
+        if self.stroke.take().is_some_and(|edits| edits > 0) {
+            self.done += 1;
+            self.command(&Line::Stroke(false))?;
         }
         Ok(())
     }
@@ -232,42 +249,32 @@ impl Recorder {
     /// Whether an `undo` would be written: a step made since this recorder
     /// started is left to undo.
     pub fn can_undo(&self) -> bool {
-        !self.done.is_empty() || self.open_stroke > 0
+        self.done > 0 || self.stroke.is_some_and(|edits| edits > 0)
     }
 
     /// Whether a `redo` would be written.
     pub fn can_redo(&self) -> bool {
-        !self.undone.is_empty()
+        self.undone > 0
     }
 
-    /// Ends an undo step (a click or a whole drag).
-    pub fn end_step(&mut self) {
-        if self.open_stroke > 0 {
-            self.done.push(self.open_stroke);
-            self.open_stroke = 0;
-        }
-    }
-
+    /// `undo 1`, where a step is left to undo (an undo ends the stroke).
     pub fn undo(&mut self) -> std::io::Result<()> {
-        self.end_step();
-        match self.done.pop() {
-            Some(n) => {
-                self.undone.push(n);
-                self.command(&Line::Undo(n))
-            }
-            None => Ok(()),
+        self.end_stroke()?;
+        if self.done == 0 {
+            return Ok(());
         }
+        (self.done, self.undone) = (self.done - 1, self.undone + 1);
+        self.command(&Line::Undo(1))
     }
 
+    /// `redo 1`, where a step is left to redo.
     pub fn redo(&mut self) -> std::io::Result<()> {
-        self.end_step();
-        match self.undone.pop() {
-            Some(n) => {
-                self.done.push(n);
-                self.command(&Line::Redo(n))
-            }
-            None => Ok(()),
+        self.end_stroke()?;
+        if self.undone == 0 {
+            return Ok(());
         }
+        (self.done, self.undone) = (self.done + 1, self.undone - 1);
+        self.command(&Line::Redo(1))
     }
 }
 
@@ -298,12 +305,79 @@ mod tests {
         let text = ["object 2", "object hide", "layer 1 hide", "object move 1 0 0", "rotate y", "flip x"];
         let script = crate::script::parse_script(&path, &text.join("\n")).unwrap();
         for line in &script.lines {
-            recorder.ran(&line.command, &Tools::default(), &Camera::default(), false).unwrap();
+            recorder.ran(&line.command, &Tools::default(), &Camera::default()).unwrap();
         }
         drop(recorder);
         let written = std::fs::read_to_string(&path).unwrap();
         let kept: Vec<&str> = written.lines().filter(|l| text.contains(l)).collect();
         assert_eq!(kept, text, "{written}");
+    }
+
+    /// Issue 46: a stroke was one undo step in the window but one line per
+    /// edit in the recording, so a recording replayed into other undo
+    /// steps. The window's lines (as the mouse makes them: `stroke begin`,
+    /// its edits, `stroke end`; a click on nothing; a key line inside a
+    /// stroke, which ends it) run through an editor and the recorder; the
+    /// recording, replayed through a fresh editor, has the same steps, and
+    /// undoing them one by one shows the same voxels at every step.
+    #[test]
+    fn a_recording_replays_into_the_undo_steps_the_window_made() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("r.ovr");
+        let mut recorder = Recorder::create(&path).unwrap();
+        let mut window = crate::editor::Editor::default();
+        let lines = [
+            "new",
+            "stroke begin",
+            "place 0 0 0",
+            "place 1 0 0",
+            "place 2 0 0",
+            "stroke end",
+            "stroke begin",
+            "stroke end",
+            "stroke begin",
+            "place 0 1 0",
+            "stroke end",
+            "stroke begin",
+            "place 5 0 0",
+            "brush sphere 1",
+            "place 8 0 0",
+            "stroke begin",
+            "rgb 3 10 20 30",
+            "rgb 3 11 20 30",
+            "stroke end",
+            "undo 1",
+            "stroke begin",
+            "remove 0 0 0",
+            "remove 1 0 0",
+        ];
+        let script = crate::script::parse_script(&path, &lines.join("\n")).unwrap();
+        for line in &script.lines {
+            window.run(&line.command).unwrap();
+            let ran = if line.command == Line::New {
+                recorder.scene(Line::New)
+            } else {
+                recorder.ran(&line.command, &window.tools, &Camera::default())
+            };
+            ran.unwrap();
+        }
+        drop(recorder);
+        let recorded = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(recorded.matches("stroke begin").count(), 5, "the empty stroke leaves no lines:\n{recorded}");
+        let mut replayed = crate::editor::Editor::default();
+        for line in crate::script::parse_script(&path, &recorded).unwrap().lines {
+            replayed.run(&line.command).unwrap();
+        }
+        assert_eq!(replayed.history.steps(), window.history.steps(), "{recorded}");
+        assert_eq!(window.history.steps(), (5, 0));
+        for _ in 0..5 {
+            assert_eq!(replayed.scene.voxels(), window.scene.voxels(), "{recorded}");
+            assert_eq!(replayed.scene.palette.color(3), window.scene.palette.color(3));
+            window.run(&Line::Undo(1)).unwrap();
+            replayed.run(&Line::Undo(1)).unwrap();
+        }
+        assert_eq!(replayed.scene.voxels(), window.scene.voxels());
+        assert_eq!((window.history.steps(), replayed.history.steps()), ((0, 5), (0, 5)));
     }
 
     /// Issue 24, item 6: a journal whose first line could not be written

@@ -35,6 +35,10 @@ pub enum Line {
     /// direction only); `perspective` (None) goes back to the field of view.
     Projection(Option<f32>),
     Brush(Brush),
+    /// `stroke begin` (true), `stroke end` (false): the edits between are
+    /// one undo step, as a mouse drag or a held palette control makes them.
+    /// A line that [`Line::ends_stroke`] ends an open one first.
+    Stroke(bool),
     /// `ground on|off`: whether a `click` (and the mouse) that hits no voxel
     /// lands on the ground, the plane y = 0 (on after `new`, or any scene
     /// that starts empty).
@@ -117,6 +121,37 @@ pub enum Line {
 }
 
 impl Line {
+    /// Whether the line ends an open stroke before it runs: every line but
+    /// the edits a stroke is made of (`place`, `remove`, `paint`, `object
+    /// N` and `object move` of a drag, `rgb` and `material` of a held
+    /// palette control), the view (`camera`, `viewport`, `ortho`) and the
+    /// checks, which change nothing. The editor, the window's recorder and
+    /// the crash journal go by this one rule, so a recording replays into
+    /// the undo steps the window made.
+    pub fn ends_stroke(&self) -> bool {
+        !matches!(
+            self,
+            Line::Place(_)
+                | Line::Remove(_)
+                | Line::Paint(_)
+                | Line::Rgb(..)
+                | Line::Material(..)
+                | Line::Object(ObjectLine::Pick(_) | ObjectLine::Move(_))
+                | Line::Stroke(_)
+                | Line::Camera { .. }
+                | Line::Viewport(..)
+                | Line::Projection(_)
+                | Line::ExpectVoxel(..)
+                | Line::ExpectCount(_)
+                | Line::ExpectWritten(_)
+                | Line::ExpectImage(..)
+                | Line::ExpectEffects(_)
+                | Line::ExpectPalette(..)
+                | Line::ExpectObjects(_)
+                | Line::ExpectModels(_)
+        )
+    }
+
     /// The command word the line starts with (`place`, `object`,
     /// `expect`, …): what the window's messages name a line by.
     pub fn word(&self) -> &'static str {
@@ -129,6 +164,7 @@ impl Line {
             Line::Projection(Some(_)) => "ortho",
             Line::Projection(None) => "perspective",
             Line::Brush(_) => "brush",
+            Line::Stroke(_) => "stroke",
             Line::Ground(_) => "ground",
             Line::Color(_) => "color",
             Line::Place(_) => "place",

@@ -357,6 +357,14 @@ fn parse_command(c: &mut Cursor) -> Result<Line, Fail> {
         "perspective" => Line::Projection(None),
         "viewport" => Line::Viewport(c.int_in("width", 1..=8192)? as u32, c.int_in("height", 1..=8192)? as u32),
         "brush" => Line::Brush(parse_brush(c)?),
+        "stroke" => {
+            let t = c.word("begin or end")?;
+            Line::Stroke(match t.text.as_str() {
+                "begin" => true,
+                "end" => false,
+                other => return Err((t.column, format!("expected begin or end, found '{other}'"))),
+            })
+        }
         "ground" => {
             let t = c.word("on or off")?;
             Line::Ground(match t.text.as_str() {
@@ -717,7 +725,7 @@ mod tests {
                     extrude 1 2 3 0 -1 0 -2\nobject 3\nobject \"tree 4/top\"\nobject hide\nobject show\nlayer 2 hide\n\
                     ortho 42.5\nperspective\nground off\nground on\nlayer 0 show\nexpect objects 19\nexpect models 15\nobject new \"a b\"\nobject move 1 -2 3\nobject rotate z\n\
                     object duplicate\nobject duplicate reference\nobject unique\nobject delete\nobject rename top\n\
-                    object layer 3\nlayer 4 \"roof tiles\"\nlayer 4 color 10 200 255\nlayer 2 active\nobject merge 3 \"tree 4/top\" 7\nobject before 2\nobject after \"a b\"\nobject lock\nobject unlock\n";
+                    object layer 3\nlayer 4 \"roof tiles\"\nlayer 4 color 10 200 255\nlayer 2 active\nobject merge 3 \"tree 4/top\" 7\nobject before 2\nobject after \"a b\"\nobject lock\nobject unlock\nstroke begin\nstroke end\n";
         let script = parse_script(Path::new("t.ovr"), text).unwrap();
         let printed: String = script.lines.iter().map(|l| format!("{}\n", l.command)).collect();
         let again = parse_script(Path::new("t.ovr"), &printed).unwrap();
@@ -725,7 +733,7 @@ mod tests {
             script.lines.iter().map(|l| &l.command).collect::<Vec<_>>(),
             again.lines.iter().map(|l| &l.command).collect::<Vec<_>>()
         );
-        assert_eq!(script.lines.len(), 77);
+        assert_eq!(script.lines.len(), 79);
         // Each line's word is the one it is printed with.
         for line in &script.lines {
             assert_eq!(line.command.to_string().split(' ').next(), Some(line.command.word()), "{}", line.command);

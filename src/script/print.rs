@@ -27,6 +27,7 @@ impl fmt::Display for Line {
             Line::Viewport(w, h) => write!(f, "viewport {w} {h}"),
             Line::Projection(Some(height)) => write!(f, "ortho {height}"),
             Line::Projection(None) => write!(f, "perspective"),
+            Line::Stroke(begin) => write!(f, "stroke {}", if *begin { "begin" } else { "end" }),
             Line::Ground(on) => write!(f, "ground {}", if *on { "on" } else { "off" }),
             Line::Brush(Brush::Voxel) => write!(f, "brush voxel"),
             Line::Brush(Brush::Sphere(r)) => write!(f, "brush sphere {r}"),

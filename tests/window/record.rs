@@ -15,6 +15,63 @@ fn wait_exit(app: &mut KillOnDrop) {
     assert!(status.success(), "octovox exited with {status}");
 }
 
+/// Issue 46: a drag is one undo step in the window, and its recording
+/// wrote one line per edit with nothing grouping them, so `undo 1` after a
+/// replayed recording took one voxel of the stroke away, not the stroke.
+/// A stroke along the torus' top and a click are recorded with the real
+/// mouse; the recording, with two `undo 1` lines after it, replays to the
+/// original voxel count (and, after the first, to the count after the
+/// stroke).
+#[test]
+fn a_recorded_stroke_replays_into_one_undo_step() {
+    let (dir, file, original, camera) = torus_document();
+    let hi = original.solid_bounds().unwrap().1;
+    let (x, y, top, _) = stable_pixel(original.drawn(), &camera, |v, n| n == glam::IVec3::Y && v.y == hi.y);
+    let mut stroked = original.drawn().clone();
+    stroked.apply_brush(&octovox::scene::Shape::Voxel(top + glam::IVec3::Y), octovox::scene::Op::Place(1)).unwrap();
+    let (ex, ey) = same_layer_pixel(&stroked, &camera, (x, y), top, glam::IVec3::Y);
+    let (cx, cy, _, _) = stable_pixel(original.drawn(), &camera, |v, n| n == glam::IVec3::Z && v.y < hi.y - 4);
+
+    let untouched = std::fs::read(&file).unwrap();
+    let (_xvfb, display) = start_xvfb();
+    let script = dir.path().join("stroke.ovr");
+    let args = document_args(&file, &camera, &["--record", &script.display().to_string()]);
+    let (mut app, mut lines, window) = open_ready(&display, dir.path(), &args);
+    xdotool(&display, &["key", "t"]);
+    xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y.to_string()]);
+    std::thread::sleep(Duration::from_millis(300));
+    xdotool(&display, &["mousedown", "1"]);
+    for step in 1..=8 {
+        let sx = x as i64 + (ex as i64 - x as i64) * step / 8;
+        let sy = y as i64 + (ey as i64 - y as i64) * step / 8;
+        xdotool(&display, &["mousemove", "--window", &window, &sx.to_string(), &sy.to_string()]);
+        std::thread::sleep(Duration::from_millis(60));
+    }
+    xdotool(&display, &["mouseup", "1"]);
+    click(&display, &window, &mut lines, cx, cy);
+    save(&display, &mut lines, &file);
+    xdotool(&display, &["key", "ctrl+q"]);
+    wait_exit(&mut app);
+
+    let saved = octovox::io::load_scene(&file, 0).unwrap().solid_voxels();
+    let stroke = saved - 1 - original.solid_voxels();
+    assert!(stroke >= 2, "the drag placed {stroke} voxels");
+    // The recording loads the document as it was before the session.
+    std::fs::write(&file, &untouched).unwrap();
+    let recorded = std::fs::read_to_string(&script).unwrap();
+    eprintln!("recorded:\n{recorded}");
+    let checks = format!(
+        "expect count {saved}\nundo 1\nexpect count {}\nundo 1\nexpect count {}\n",
+        saved - 1,
+        original.solid_voxels()
+    );
+    std::fs::write(&script, format!("{recorded}{checks}")).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_octovox")).args(["replay", "--cpu"]).arg(&script).output().unwrap();
+    let report = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{report}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(report.contains("replay: 3 passed, 0 failed"), "{report}");
+}
+
 #[test]
 fn recorded_window_session_replays_to_the_same_voxels() {
     let (dir, file, original, camera) = torus_document();
