@@ -146,7 +146,7 @@ impl App {
                 objects: self.doc.editor.scene.pickable_objects(),
                 ground: self.doc.editor.ground,
             };
-            let (state, ui_state, tools) = (&mut self.state, &mut self.ui, &mut self.doc.editor.tools);
+            let (state, ui_state, tools) = (&mut self.state, &mut self.ui, &self.doc.editor.tools);
             let pick = self.hover.pick;
             ctx.run_ui(raw_input, |ui| {
                 commands = ui::show(ui, state, tools, ui_state, &info);

@@ -208,7 +208,7 @@ fn rgba(palette: &Palette, index: u8) -> Color32 {
 pub fn show(
     ui: &mut egui::Ui,
     state: &mut EditorState,
-    tools: &mut Tools,
+    tools: &Tools,
     ui_state: &mut UiState,
     info: &Info,
 ) -> Vec<AppCommand> {
@@ -220,7 +220,7 @@ pub fn show(
     egui::Panel::left("tools").resizable(false).exact_size(PANEL_WIDTH).show(ui, |ui| {
         egui::ScrollArea::vertical().show(ui, |ui| {
             tool_panel(ui, state, tools, &mut out);
-            mirror(ui, tools);
+            mirror(ui, tools, &mut out);
             ground(ui, state, info.ground, &mut out);
             ui.separator();
             palette(ui, tools, info.palette, &mut out);
@@ -315,23 +315,30 @@ fn ground(ui: &mut egui::Ui, state: &mut EditorState, on: bool, out: &mut Vec<Ap
     });
 }
 
-/// Mirror planes: a checkbox and the plane's coordinate per axis.
-fn mirror(ui: &mut egui::Ui, tools: &mut Tools) {
+/// Mirror planes: a checkbox and the plane's coordinate per axis. A change
+/// runs as `mirror` lines: `mirror off`, then the planes on.
+fn mirror(ui: &mut egui::Ui, tools: &Tools, out: &mut Vec<AppCommand>) {
+    use octovox::script::Line;
+    let mut mirror = tools.mirror;
     ui.horizontal(|ui| {
         ui.label("Mirror");
         for (axis, name) in ["x", "y", "z"].into_iter().enumerate() {
-            let mut on = tools.mirror.planes[axis].is_some();
-            let mut c = tools.mirror.plane(axis).unwrap_or(0.0);
+            let mut on = mirror.planes[axis].is_some();
+            let mut c = mirror.plane(axis).unwrap_or(0.0);
             ui.checkbox(&mut on, name);
             if on {
                 ui.add(egui::DragValue::new(&mut c).speed(0.5).fixed_decimals(1));
             }
-            tools.mirror.set(axis, on.then_some(c));
+            mirror.set(axis, on.then_some(c));
         }
     });
+    if mirror != tools.mirror {
+        let planes = (0..3).filter_map(|axis| mirror.plane(axis).map(|c| Line::Mirror(Some((axis, c)))));
+        out.push(AppCommand::Lines(std::iter::once(Line::Mirror(None)).chain(planes).collect()));
+    }
 }
 
-fn tool_panel(ui: &mut egui::Ui, state: &mut EditorState, tools: &mut Tools, commands: &mut Vec<AppCommand>) {
+fn tool_panel(ui: &mut egui::Ui, state: &mut EditorState, tools: &Tools, commands: &mut Vec<AppCommand>) {
     ui.heading("Tool");
     ui.horizontal(|ui| {
         for tool in Tool::ALL {
@@ -356,18 +363,20 @@ fn tool_panel(ui: &mut egui::Ui, state: &mut EditorState, tools: &mut Tools, com
             commands.push(AppCommand::ToggleObject);
         }
     });
+    // A change runs as a `brush` line.
+    let mut brush = tools.brush;
     ui.label("Brush");
     ui.horizontal(|ui| {
         for (kind, label) in [(BrushKind::Voxel, "Voxel"), (BrushKind::Sphere, "Sphere"), (BrushKind::Box, "Box")] {
             if ui.selectable_label(BrushKind::of(tools.brush) == kind, label).clicked() {
-                tools.brush = state.brush_of(kind);
+                brush = state.brush_of(kind);
             }
         }
     });
     // One row whatever the brush, so nothing below it moves: the slider
     // shows the brush in force (a script may have set it) and remembers its
     // size for the next switch; a voxel has none.
-    match &mut tools.brush {
+    match &mut brush {
         Brush::Voxel => {
             ui.add_enabled(false, egui::Slider::new(&mut 1, 1..=1).text("size"));
         }
@@ -390,9 +399,12 @@ fn tool_panel(ui: &mut egui::Ui, state: &mut EditorState, tools: &mut Tools, com
         }
     }
     ui.small("left: apply · Ctrl+drag a face: extrude · right-drag: orbit · right-click: erase (Attach) · middle: pan · wheel: zoom · WASDQE + right: fly · F: frame");
+    if brush != tools.brush {
+        commands.push(AppCommand::Lines(vec![octovox::script::Line::Brush(brush)]));
+    }
 }
 
-fn palette(ui: &mut egui::Ui, tools: &mut Tools, palette: &Palette, out: &mut Vec<AppCommand>) {
+fn palette(ui: &mut egui::Ui, tools: &Tools, palette: &Palette, out: &mut Vec<AppCommand>) {
     use octovox::script::{Line, PaletteLine};
     ui.heading("Palette");
     ui.horizontal(|ui| {
@@ -437,7 +449,7 @@ fn palette(ui: &mut egui::Ui, tools: &mut Tools, palette: &Palette, out: &mut Ve
     if response.clicked()
         && let Some(index) = response.interact_pointer_pos().and_then(index_at).filter(|i| *i != 0)
     {
-        tools.color = index;
+        out.push(AppCommand::Lines(vec![Line::Color(index)]));
     }
     if let Some(index) = response.hover_pos().and_then(index_at) {
         response.on_hover_text(format!("{index}"));

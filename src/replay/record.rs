@@ -155,19 +155,22 @@ impl Recorder {
             Line::Select(_) | Line::Copy => return self.command(command),
             Line::Undo(n) => return (0..*n).try_for_each(|_| self.undo()),
             Line::Redo(n) => return (0..*n).try_for_each(|_| self.redo()),
-            // Tool state is written before the edit that uses it; scene,
-            // camera, file and expectation lines are not part of a recording.
+            // Tools as they change (the panels and keys run these lines);
+            // again before an edit where the script's differ (after an
+            // eyedropper pick, or where a journal goes on).
+            Line::Brush(brush) => return self.set_brush(*brush),
+            Line::Color(color) => return self.set_color(*color),
+            Line::Mirror(_) => return self.set_mirror(&tools.mirror),
+            // Scene, camera, file and expectation lines are not part of a
+            // recording (the camera is written before the edit that uses it).
             Line::Load(_)
             | Line::New
             | Line::Demo(_)
             | Line::Camera { .. }
             | Line::Projection(_)
             | Line::Viewport(..)
-            | Line::Brush(_)
             // Clicks are recorded as the edits they became: the ground is not needed.
             | Line::Ground(_)
-            | Line::Color(_)
-            | Line::Mirror(_)
             | Line::Pick(_)
             | Line::Click { .. }
             | Line::Save(_)
@@ -218,17 +221,26 @@ impl Recorder {
                 self.command(&Line::Projection(camera.ortho))?;
             }
         }
-        if self.brush != Some(brush) {
-            self.brush = Some(brush);
-            self.command(&Line::Brush(brush))?;
+        self.set_brush(brush)?;
+        color.map_or(Ok(()), |color| self.set_color(color))
+    }
+
+    /// Writes `brush` where the script's brush is another.
+    fn set_brush(&mut self, brush: Brush) -> std::io::Result<()> {
+        if self.brush == Some(brush) {
+            return Ok(());
         }
-        if let Some(color) = color
-            && self.color != Some(color)
-        {
-            self.color = Some(color);
-            self.command(&Line::Color(color))?;
+        self.brush = Some(brush);
+        self.command(&Line::Brush(brush))
+    }
+
+    /// Writes `color` where the script's colour is another.
+    fn set_color(&mut self, color: u8) -> std::io::Result<()> {
+        if self.color == Some(color) {
+            return Ok(());
         }
-        Ok(())
+        self.color = Some(color);
+        self.command(&Line::Color(color))
     }
 
     /// Writes `mirror` lines when the planes in force changed.
@@ -378,6 +390,31 @@ mod tests {
         }
         assert_eq!(replayed.scene.voxels(), window.scene.voxels());
         assert_eq!((window.history.steps(), replayed.history.steps()), ((0, 5), (0, 5)));
+    }
+
+    /// Issue 46: the panels wrote brush, colour and mirror into the tools
+    /// and the recorder rebuilt lines by diffing them before each edit. The
+    /// panels now run lines, and the recorder writes each as it runs
+    /// (once where it changes nothing in the script).
+    #[test]
+    fn tool_lines_are_recorded_as_they_run() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("t.ovr");
+        let mut recorder = Recorder::create(&path).unwrap();
+        let mut editor = crate::editor::Editor::default();
+        let text = "brush sphere 3\nbrush sphere 3\ncolor 7\nmirror off\nmirror x 4.5\nbrush sphere 4\nplace 1 2 3\n";
+        for line in crate::script::parse_script(&path, text).unwrap().lines {
+            editor.run(&line.command).unwrap();
+            recorder.ran(&line.command, &editor.tools, &Camera::default()).unwrap();
+        }
+        drop(recorder);
+        let written = std::fs::read_to_string(&path).unwrap();
+        let lines: Vec<&str> = written.lines().filter(|l| !l.starts_with('#') && !l.starts_with("camera")).collect();
+        assert_eq!(
+            lines,
+            ["brush sphere 3", "color 7", "mirror off", "mirror x 4.5", "brush sphere 4", "perspective", "place 1 2 3"],
+            "{written}"
+        );
     }
 
     /// Issue 24, item 6: a journal whose first line could not be written
