@@ -149,8 +149,11 @@ pub fn accumulate(
     mut each: impl FnMut(&PathFrame),
 ) -> Result<Accumulated, crate::gpu::GpuError> {
     let (mut ms, mut last) = (0.0, None);
+    // Toward a target, every sample's frame measures the noise it is checked by.
+    let mut options = crate::gpu::PathOptions::default();
+    options.wants.estimate_noise = target.is_some();
     for sample in 0..cap {
-        let frame = renderer.render_path(view, sample == 0)?;
+        let frame = renderer.render_path_with(view, sample == 0, options)?;
         ms += frame.ms;
         each(&frame);
         last = Some(frame);

@@ -7,7 +7,8 @@ use std::time::{Duration, Instant};
 
 use winit::event_loop::ActiveEventLoop;
 
-use octovox::gpu::{FrameInput, PathView, Submitted};
+use octovox::gpu::schedule::Wants;
+use octovox::gpu::{FrameInput, PathOptions, PathView, Submitted};
 use octovox::settings::{PathSettings, RenderSettings, Shading, TraceMode, View};
 use octovox::trace::grid::DenseGrid;
 
@@ -222,18 +223,17 @@ impl App {
         // (not the brush's reach, which follows the pointer: every move
         // would start the accumulation over).
         let tinted = selection.filter(|_| state.mode == Mode::Select).map(|r| (r.min, r.max));
-        gfx.renderer.path_highlight = tinted;
-        gfx.renderer.ground = self.doc.editor.ground.then(|| state.ground_grid());
+        let grid = self.doc.editor.ground.then(|| state.ground_grid());
+        let wants = Wants { denoise: state.denoise, estimate_noise: true, sample_target: state.sample_target.max(1) };
+        let options = PathOptions { highlight: tinted, grid, wants };
         let revision = self.doc.editor.revision();
         let scene_changed = self.frames.path_drawn != Some(revision);
-        let restarts = wants_path && gfx.renderer.path_restarts(&view, scene_changed);
+        let restarts = wants_path && gfx.renderer.path_restarts(&view, scene_changed, &options);
         let path = wants_path && (!restarts || self.frames.preview_before_path);
         self.frames.preview_before_path = wants_path && !path;
         let input = if path {
             self.frames.path_drawn = Some(revision);
-            gfx.renderer.sample_target = self.state.sample_target.max(1);
-            (gfx.renderer.denoise, gfx.renderer.estimate_noise) = (self.state.denoise, true);
-            FrameInput::Path { view, scene_changed }
+            FrameInput::Path { view, scene_changed, options }
         } else {
             // Select mode tints the selected voxels; the brush's modes what it would touch.
             let highlight = match self.state.mode {
@@ -245,7 +245,7 @@ impl App {
                     .map(|pick| self.state.preview_box(&self.doc.editor.tools, &pick, self.gesture.line_start())),
             };
             let settings = RenderSettings { ground: plane, ..state.settings };
-            FrameInput::preview(scene, &state.camera, trace_size, &settings, highlight)
+            FrameInput::preview(scene, &state.camera, trace_size, &settings, highlight, grid)
         };
         if let Err(err) = gfx.renderer.encode(&mut encoder, &input) {
             log::error!("trace failed: {err}");
@@ -308,7 +308,7 @@ impl App {
         }
         // Once the view is final: the samples done and, with Denoise on,
         // their filter (which runs a stage a frame after the last sample).
-        let done = frame.samples >= gfx.renderer.sample_target && !gfx.renderer.denoise_pending();
+        let done = frame.samples >= self.state.sample_target.max(1) && !gfx.renderer.denoise_pending();
         if done && !self.frames.path_reported {
             let effects = frame.effects.names().join(" ");
             report!("path: {} samples, effects [{effects}]", frame.samples);

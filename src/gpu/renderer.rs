@@ -5,9 +5,9 @@
 use glam::IVec3;
 
 use super::context::validated;
-use super::denoise_pass::STAGES;
 use super::path_pass::PathKey;
 use super::scene_buffers::UploadStats;
+use super::schedule::{FilterFrame, FilterSchedule, Wants};
 use super::timer::PassTimer;
 use super::{
     DenoisePass, FrameUniforms, GpuContext, GpuError, GroundGrid, Kernel, PathPass, PathUniforms, SceneBuffers,
@@ -57,7 +57,32 @@ pub enum FrameInput<'a> {
         view: PathView<'a>,
         /// The voxels or the palette changed since the accumulation began.
         scene_changed: bool,
+        /// What the frame shows over the samples, and wants of them.
+        options: PathOptions,
     },
+}
+
+/// What a path-traced frame is asked for beyond its view: the tint and the
+/// grid it draws (a change starts the accumulation over, as each sample
+/// counts them) and what it wants of the accumulation (target, filter,
+/// noise). Headless renders take the default: no tint or grid, unbounded,
+/// unfiltered (they call [`Renderer::denoise_now`] once at the end).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathOptions {
+    /// The world box of voxels tinted (the window's selection, as the
+    /// preview tints it).
+    pub highlight: Option<(IVec3, IVec3)>,
+    /// The ground grid drawn with the voxels (the window's, in a scene
+    /// with its ground on).
+    pub grid: Option<GroundGrid>,
+    pub wants: Wants,
+}
+
+impl Default for PathOptions {
+    fn default() -> PathOptions {
+        let wants = Wants { denoise: false, estimate_noise: false, sample_target: u32::MAX };
+        PathOptions { highlight: None, grid: None, wants }
+    }
 }
 
 /// A frame of a trace kernel.
@@ -73,6 +98,8 @@ pub struct Preview<'a> {
     pub kernel: Kernel,
     /// The world height of the ground plane, if one is drawn.
     pub ground: Option<i32>,
+    /// The ground grid drawn with the voxels.
+    pub grid: Option<GroundGrid>,
 }
 
 impl<'a> FrameInput<'a> {
@@ -83,9 +110,10 @@ impl<'a> FrameInput<'a> {
         size: (u32, u32),
         settings: &RenderSettings,
         highlight: Option<(IVec3, IVec3)>,
+        grid: Option<GroundGrid>,
     ) -> FrameInput<'a> {
         let (view, lod, kernel, ground) = (settings.view, settings.lod, Kernel::from(settings), settings.ground);
-        FrameInput::Trace(Preview { scene, camera, size, view, lod, highlight, kernel, ground })
+        FrameInput::Trace(Preview { scene, camera, size, view, lod, highlight, kernel, ground, grid })
     }
 }
 
@@ -119,11 +147,11 @@ pub struct PathView<'a> {
     pub settings: &'a PathSettings,
 }
 
-/// The key of `view`'s accumulation; `highlight` is the world box it
-/// tints, `ground` the grid it draws.
-fn path_key(view: &PathView, highlight: Option<(IVec3, IVec3)>, ground: Option<GroundGrid>) -> PathKey {
+/// The key of `view`'s accumulation with the tint and grid of `options`.
+fn path_key(view: &PathView, options: &PathOptions) -> PathKey {
     let PathView { scene, camera, size, settings } = *view;
     let basis = camera.basis(size.0.max(1), size.1.max(1), scene.origin());
+    let (highlight, ground) = (options.highlight, options.grid);
     PathKey { basis, settings: *settings, effects: effects_for(scene, settings), highlight, ground }
 }
 
@@ -147,34 +175,15 @@ pub struct Renderer {
     /// other without input, and queued ahead they made the first frame of a
     /// moving camera wait for several of them.
     pub wait_for_frames: bool,
-    /// The accumulation stops growing at this many samples (the window's
-    /// resting view); headless renders leave it unbounded.
-    pub sample_target: u32,
-    /// Whether path-traced frames show the accumulation denoised (the
-    /// window: filtered after samples 1, 2, 4, 8, … and the
-    /// `sample_target`th, a stage a frame);
-    /// headless renders call [`Renderer::denoise_now`] once instead.
-    pub denoise: bool,
-    /// The world box of voxels path-traced frames tint (the window's
-    /// selection, as the preview tints it); a change starts the
-    /// accumulation over, since each sample counts its tinted first hits.
-    pub path_highlight: Option<(IVec3, IVec3)>,
-    /// The ground grid drawn with the voxels (the window's, in a scene
-    /// with its ground on), in preview and path-traced frames; a change
-    /// starts a path-traced accumulation over.
-    pub ground: Option<GroundGrid>,
-    /// Whether each path-traced sample measures the image's noise in its
-    /// own frame (the window, which shows it after every sample; denoised
-    /// frames always do). Without it [`Renderer::noise_estimate`] measures
-    /// when asked.
-    pub estimate_noise: bool,
+    /// What the last path-traced frame wanted of the accumulation
+    /// ([`PathOptions::wants`]): whether the filter is still pending and
+    /// what the output shows follow from it between frames.
+    wants: Wants,
     /// The sample count the last noise measurement saw.
     noise_of: Option<u32>,
-    /// The samples of the current accumulation the denoised output shows.
-    denoised_of: Option<u32>,
-    /// A filter under way, one stage a frame (the window's): the next
-    /// stage and the samples it filters.
-    filtering: Option<(usize, u32)>,
+    /// The denoiser's filter over the current accumulation, a stage a
+    /// frame (the window's): see [`FilterSchedule`].
+    filter: FilterSchedule,
     /// Whether frames write the per-pixel hit records that
     /// [`Renderer::read_hits`] returns; off by default, as they cost time.
     pub hit_records: bool,
@@ -203,15 +212,10 @@ impl Renderer {
             denoiser,
             timer,
             shown: Shown::Trace,
-            denoise: false,
-            path_highlight: None,
-            ground: None,
-            estimate_noise: false,
+            wants: PathOptions::default().wants,
             noise_of: None,
-            denoised_of: None,
-            filtering: None,
+            filter: FilterSchedule::default(),
             path_bands: 1,
-            sample_target: u32::MAX,
             wait_for_frames: true,
             hit_records: false,
             records_written: false,
@@ -275,7 +279,7 @@ impl Renderer {
         settings: &RenderSettings,
         highlight: Option<(IVec3, IVec3)>,
     ) -> Result<f64, GpuError> {
-        Ok(self.render_frame(&FrameInput::preview(scene, camera, size, settings, highlight))?.ms)
+        Ok(self.render_frame(&FrameInput::preview(scene, camera, size, settings, highlight, None))?.ms)
     }
 
     /// A frame of the floor kernel (everything but the traversal, see
@@ -293,6 +297,7 @@ impl Renderer {
             highlight: None,
             kernel: Kernel::Floor,
             ground: None,
+            grid: None,
         };
         let input = FrameInput::Trace(floor);
         Ok(self.render_frame(&input)?.ms)
@@ -307,14 +312,31 @@ impl Renderer {
     /// # Errors
     /// As [`Renderer::render`].
     pub fn render_path(&mut self, view: &PathView, scene_changed: bool) -> Result<PathFrame, GpuError> {
-        let submitted = self.render_frame(&FrameInput::Path { view: *view, scene_changed })?;
+        self.render_path_with(view, scene_changed, PathOptions::default())
+    }
+
+    /// [`Renderer::render_path`] with `options` (a tint, a grid, a target,
+    /// the filter).
+    ///
+    /// # Errors
+    /// As [`Renderer::render`].
+    pub fn render_path_with(
+        &mut self,
+        view: &PathView,
+        scene_changed: bool,
+        options: PathOptions,
+    ) -> Result<PathFrame, GpuError> {
+        let submitted = self.render_frame(&FrameInput::Path { view: *view, scene_changed, options })?;
         submitted.path.ok_or_else(|| GpuError::Readback("a path frame reported no sample".into()))
     }
 
     /// One frame on its own encoder, submitted at once (headless renders;
     /// the window records its blit and panels after [`Renderer::encode`] in
     /// the same encoder and then calls [`Renderer::submit`]).
-    fn render_frame(&mut self, input: &FrameInput) -> Result<Submitted, GpuError> {
+    ///
+    /// # Errors
+    /// As [`Renderer::render`].
+    pub fn render_frame(&mut self, input: &FrameInput) -> Result<Submitted, GpuError> {
         let mut encoder =
             self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         self.encode(&mut encoder, input)?;
@@ -338,9 +360,9 @@ impl Renderer {
                 encoder.pop_debug_group();
                 traced.map(|()| Recorded::Trace)
             }
-            FrameInput::Path { view, scene_changed } => {
+            FrameInput::Path { view, scene_changed, options } => {
                 encoder.push_debug_group("path");
-                let traced = self.encode_path(encoder, &view, scene_changed);
+                let traced = self.encode_path(encoder, &view, scene_changed, &options);
                 encoder.pop_debug_group();
                 traced
             }
@@ -350,7 +372,7 @@ impl Renderer {
     }
 
     fn encode_trace(&mut self, encoder: &mut wgpu::CommandEncoder, preview: &Preview) -> Result<(), GpuError> {
-        let Preview { scene, camera, size, view, lod, highlight, kernel, ground } = *preview;
+        let Preview { scene, camera, size, view, lod, highlight, kernel, ground, grid } = *preview;
         // A scene drawn as instances runs the kernels with the instance walk.
         let instances = self.buffers.instance_nodes.is_some();
         let tree = scene.drawn();
@@ -361,7 +383,7 @@ impl Renderer {
         let uniforms = FrameUniforms {
             hit_records: u32::from(self.hit_records),
             ..FrameUniforms::new(&basis, tree, &self.buffers, view, highlight, Footprint::of_pixels(&basis, lod))
-                .with_ground(self.ground, tree.origin())
+                .with_ground(grid, tree.origin())
                 .with_plane(ground, tree.origin())
         };
         self.records_written = self.hit_records;
@@ -379,15 +401,17 @@ impl Renderer {
         encoder: &mut wgpu::CommandEncoder,
         view: &PathView,
         scene_changed: bool,
+        options: &PathOptions,
     ) -> Result<Recorded, GpuError> {
         let PathView { scene, size, settings, .. } = *view;
+        self.wants = options.wants;
         let gpu = &self.gpu;
         let resized = self.path.resize(gpu, &self.buffers, size)?;
         if resized {
             self.denoiser.bind(gpu, &self.path);
         }
         let mut acc = self.path.accumulation;
-        let key = path_key(view, self.path_highlight, self.ground);
+        let key = path_key(view, options);
         let effects = key.effects;
         // The materials and lights go up again when the scene or the effect set changed.
         let send_scene = scene_changed || resized || acc.key.is_none_or(|k| k.effects != effects);
@@ -400,23 +424,16 @@ impl Renderer {
             acc.samples = 0;
             acc.key = Some(key);
             acc.band.0 = 0;
-            (self.denoised_of, self.filtering, self.noise_of) = (None, None, None);
+            (self.filter, self.noise_of) = (FilterSchedule::default(), None);
         }
         if acc.band.0 == 0 {
             acc.band = (0, self.path_bands.clamp(1, size.1.max(1)));
             acc.band_ms = 0.0;
         }
         self.path.accumulation = acc;
-        if acc.samples >= self.sample_target && self.shown != Shown::Trace {
-            // The last sample's filter, if the one under way when it came
-            // was of an earlier one.
-            let behind = self.filtering.is_none() && self.denoised_of != Some(acc.samples);
-            if self.denoise && behind {
-                self.denoiser.encode_stages(gpu, encoder, &Frame::of(&key.basis), 0..1, true);
-                self.filtering = Some((1, acc.samples));
-            } else {
-                self.advance_filter(encoder, &key);
-            }
+        if acc.samples >= self.wants.sample_target && self.shown != Shown::Trace {
+            let filter = self.filter.at_rest(acc.samples, self.wants);
+            self.encode_filter(encoder, &key, filter);
             self.shown = self.accumulation_shown();
             let (lights, samples) = (acc.lights, acc.samples);
             return Ok(Recorded::Nothing(PathFrame {
@@ -457,47 +474,33 @@ impl Renderer {
         // shown: the trace output is (the window traces the preview first).
         // What this band completes is shown by the frame that records it.
         let completes = band + 1 == bands;
-        let prepared = completes && (self.denoise || self.estimate_noise);
-        let mut started = false;
-        if prepared {
-            // A filter starts after samples 1, 2, 4, 8, … and the last, and
-            // runs a stage a frame: on a slow adapter the whole filter costs
-            // about a sample (docs/bench/denoise.md), and a frame that must
-            // show a moved camera waits for one stage, as for one band.
-            let done = acc.samples + 1;
-            started =
-                self.denoise && self.filtering.is_none() && (done.is_power_of_two() || done >= self.sample_target);
-            self.denoiser.encode_stages(&self.gpu, encoder, &Frame::of(&key.basis), 0..1, started);
-            if started {
-                self.filtering = Some((1, done));
-            }
-        }
-        if !started {
-            self.advance_filter(encoder, &key);
-        }
+        let filter = self.filter.band(completes, acc.samples + u32::from(completes), self.wants);
+        let prepared = filter.prepare.is_some();
+        self.encode_filter(encoder, &key, filter);
         self.shown = if acc.samples + u32::from(completes) > 0 { self.accumulation_shown() } else { Shown::Trace };
         Ok(Recorded::Path { kernel, effects, prepared })
     }
 
-    /// Records the next stage of the filter under way, if any.
-    fn advance_filter(&mut self, encoder: &mut wgpu::CommandEncoder, key: &PathKey) {
-        let Some((stage, samples)) = self.filtering else { return };
-        self.denoiser.encode_stages(&self.gpu, encoder, &Frame::of(&key.basis), stage..stage + 1, true);
-        self.filtering = Some((stage + 1, samples));
-        if stage + 1 == STAGES {
-            (self.filtering, self.denoised_of) = (None, Some(samples));
+    /// Records the denoiser's dispatches the schedule chose for a frame.
+    fn encode_filter(&mut self, encoder: &mut wgpu::CommandEncoder, key: &PathKey, filter: FilterFrame) {
+        let frame = Frame::of(&key.basis);
+        if let Some(starts) = filter.prepare {
+            self.denoiser.encode_stages(&self.gpu, encoder, &frame, 0..1, starts);
+        }
+        if let Some(stage) = filter.stage {
+            self.denoiser.encode_stages(&self.gpu, encoder, &frame, stage..stage + 1, true);
         }
     }
 
     /// Whether the window should keep drawing for the filter: one is under
     /// way, or the last sample's has not run.
     pub fn denoise_pending(&self) -> bool {
-        self.denoise && (self.filtering.is_some() || self.denoised_of != Some(self.path.accumulation.samples))
+        self.filter.pending(self.path.accumulation.samples, self.wants)
     }
 
     /// How the accumulation is shown: denoised when asked and done.
     fn accumulation_shown(&self) -> Shown {
-        if self.denoise && self.denoised_of.is_some() { Shown::Denoised } else { Shown::Path }
+        if self.filter.shows_denoised(self.wants) { Shown::Denoised } else { Shown::Path }
     }
 
     /// Denoises the accumulation as it stands and shows it; returns the
@@ -521,7 +524,7 @@ impl Renderer {
             self.gpu.wait()
         })?;
         let ms = start.elapsed().as_secs_f64() * 1e3;
-        (self.denoised_of, self.filtering) = (Some(acc.samples), None);
+        self.filter.filtered_now(acc.samples);
         (self.noise_of, self.shown) = (Some(acc.samples), Shown::Denoised);
         Ok(ms)
     }
@@ -609,9 +612,9 @@ impl Renderer {
     /// the accumulation over. The window then traces the preview first: it
     /// is shown until the new accumulation's first sample, which may come
     /// in bands, is complete.
-    pub fn path_restarts(&self, view: &PathView, scene_changed: bool) -> bool {
+    pub fn path_restarts(&self, view: &PathView, scene_changed: bool, options: &PathOptions) -> bool {
         let resized = self.path.size() != (view.size.0.max(1), view.size.1.max(1));
-        self.path.accumulation.starts_over(&path_key(view, self.path_highlight, self.ground), resized, scene_changed)
+        self.path.accumulation.starts_over(&path_key(view, options), resized, scene_changed)
     }
 
     /// Compiles the path kernel a scene needs with `settings` now, so that the

@@ -17,7 +17,6 @@ use crate::path_trace::{build, look, material_scene, palette};
 fn renderer_for(scene: &mut Scene) -> Renderer {
     let mut renderer = Renderer::headless().expect("a GPU adapter (lavapipe on CI)");
     renderer.sync(scene);
-    renderer.estimate_noise = true;
     renderer
 }
 

@@ -9,7 +9,7 @@ use crate::common;
 
 use glam::{DVec3, IVec3, Vec3};
 use octovox::camera::Camera;
-use octovox::gpu::{PathView, Renderer};
+use octovox::gpu::{FrameInput, PathOptions, PathView, Renderer};
 use octovox::scene::{Material, MaterialKind, Octree, Op, Palette, Scene, Shape};
 use octovox::settings::{PathSettings, Sky};
 use octovox::trace::path::{CpuRender, render_cpu};
@@ -405,12 +405,15 @@ fn a_sample_split_in_bands_equals_a_whole_one() {
     renderer.sync(&mut scene);
     // The window traces the preview first when an accumulation would start over.
     let view = PathView { scene: &scene, camera: &camera, size, settings: &settings };
-    assert!(renderer.path_restarts(&view, false), "nothing accumulated yet");
+    assert!(renderer.path_restarts(&view, false, &PathOptions::default()), "nothing accumulated yet");
     renderer.render_path(&view, true).unwrap();
-    assert!(!renderer.path_restarts(&view, false), "the same accumulation goes on");
-    assert!(renderer.path_restarts(&view, true), "the scene changed");
+    assert!(!renderer.path_restarts(&view, false, &PathOptions::default()), "the same accumulation goes on");
+    assert!(renderer.path_restarts(&view, true, &PathOptions::default()), "the scene changed");
     let moved = look(DVec3::new(3.5, 8.0, 14.0), DVec3::new(0.0, 1.0, 0.0));
-    assert!(renderer.path_restarts(&PathView { camera: &moved, ..view }, false), "the camera moved");
+    assert!(
+        renderer.path_restarts(&PathView { camera: &moved, ..view }, false, &PathOptions::default()),
+        "the camera moved"
+    );
     for bands in [4, 37, 100] {
         renderer.path_bands = bands;
         let used = bands.min(size.1);
@@ -485,19 +488,19 @@ fn the_selection_is_tinted_in_path_traced_frames() {
     let mut renderer = Renderer::headless().expect("a GPU adapter (lavapipe on CI)");
     renderer.sync(&mut scene);
     let view = PathView { scene: &scene, camera: &camera, size, settings: &settings };
-    let render = |renderer: &mut Renderer| {
+    let render = |renderer: &mut Renderer, options: PathOptions| {
         for sample in 0..4 {
-            renderer.render_path(&view, sample == 0).unwrap();
+            renderer.render_path_with(&view, sample == 0, options).unwrap();
         }
         let raw = renderer.read_image().unwrap();
         renderer.denoise_now().unwrap();
         (raw, renderer.read_image().unwrap())
     };
-    let (plain, plain_denoised) = render(&mut renderer);
+    let (plain, plain_denoised) = render(&mut renderer, PathOptions::default());
     let selected = (IVec3::ZERO, IVec3::new(3, 7, 7));
-    renderer.path_highlight = Some(selected);
-    assert!(renderer.path_restarts(&view, false), "a new selection starts the accumulation over");
-    let (tinted, tinted_denoised) = render(&mut renderer);
+    let options = PathOptions { highlight: Some(selected), ..PathOptions::default() };
+    assert!(renderer.path_restarts(&view, false, &options), "a new selection starts the accumulation over");
+    let (tinted, tinted_denoised) = render(&mut renderer, options);
 
     // Each pixel's first hit through its centre, and whether its
     // neighbours' agree about being selected (edges mix their samples).
@@ -565,13 +568,12 @@ fn the_ground_grid_is_hidden_by_the_voxels_in_front_of_it() {
         lod: 0.0,
         ground: None,
     };
-    let preview = |renderer: &mut Renderer| {
-        renderer.render(&scene, &camera, size, &settings, None).unwrap();
+    let preview = |renderer: &mut Renderer, grid| {
+        renderer.render_frame(&FrameInput::preview(&scene, &camera, size, &settings, None, grid)).unwrap();
         renderer.read_image().unwrap()
     };
-    let plain = preview(&mut renderer);
-    renderer.ground = Some(grid);
-    let gridded = preview(&mut renderer);
+    let plain = preview(&mut renderer, None);
+    let gridded = preview(&mut renderer, Some(grid));
     let lines = changed(&plain, &gridded);
     let over_column = lines.iter().filter(|&&i| on_column(i)).count();
     println!("preview: {} grid pixels, {over_column} of them on the column", lines.len());
@@ -580,17 +582,16 @@ fn the_ground_grid_is_hidden_by_the_voxels_in_front_of_it() {
 
     let path_settings = PathSettings::default();
     let view = PathView { scene: &scene, camera: &camera, size, settings: &path_settings };
-    let path = |renderer: &mut Renderer| {
+    let path = |renderer: &mut Renderer, grid| {
         for sample in 0..2 {
-            renderer.render_path(&view, sample == 0).unwrap();
+            renderer.render_path_with(&view, sample == 0, PathOptions { grid, ..PathOptions::default() }).unwrap();
         }
         renderer.read_image().unwrap()
     };
-    renderer.ground = None;
-    let plain = path(&mut renderer);
-    renderer.ground = Some(grid);
-    assert!(renderer.path_restarts(&view, false), "the grid starts the accumulation over");
-    let gridded = path(&mut renderer);
+    let plain = path(&mut renderer, None);
+    let gridded_options = PathOptions { grid: Some(grid), ..PathOptions::default() };
+    assert!(renderer.path_restarts(&view, false, &gridded_options), "the grid starts the accumulation over");
+    let gridded = path(&mut renderer, Some(grid));
     let lines = changed(&plain, &gridded);
     // A pixel on the column's edge mixes samples that miss it.
     let inside = |i: usize| {
