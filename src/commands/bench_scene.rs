@@ -18,7 +18,7 @@ use octovox::scene::objects::{Model, Objects};
 use octovox::scene::transform::Rotation;
 use octovox::scene::{Instancing, Octree, Palette, Scene};
 use octovox::script::{Line, ObjectLine, ObjectRef};
-use octovox::settings::{PathSettings, RenderSettings, TraceMode, View};
+use octovox::settings::{PathSettings, RenderSettings};
 
 use super::bench::{header, median};
 
@@ -209,14 +209,7 @@ pub fn bench_scene(quick: bool) -> anyhow::Result<(String, String)> {
     let (mut forest_renderer, mut merged_renderer) = (renderer()?, renderer()?);
     let (lo, hi) = merged.solid_bounds().context("an empty forest")?;
     let camera = Camera::framing(lo, hi, 50.0);
-    let settings = RenderSettings {
-        mode: TraceMode::Svo,
-        view: View::Shaded,
-        shadows: false,
-        render_scale: 1.0,
-        lod: 0.0,
-        ground: None,
-    };
+    let settings = RenderSettings { shadows: false, ..RenderSettings::default() };
     let (mut forest_frames, mut merged_frames) = (Vec::new(), Vec::new());
     for round in 0..=frames {
         let pairs = [

@@ -141,15 +141,12 @@ impl Line {
                 | Line::Camera { .. }
                 | Line::Viewport(..)
                 | Line::Projection(_)
-                | Line::ExpectVoxel(..)
-                | Line::ExpectCount(_)
-                | Line::ExpectWritten(_)
-                | Line::ExpectImage(..)
-                | Line::ExpectEffects(_)
-                | Line::ExpectPalette(..)
-                | Line::ExpectObjects(_)
-                | Line::ExpectModels(_)
-        )
+        ) && !self.is_check()
+    }
+
+    /// Whether the line is a check (`expect …`), which changes nothing.
+    pub fn is_check(&self) -> bool {
+        self.word() == "expect"
     }
 
     /// The command word the line starts with (`place`, `object`,

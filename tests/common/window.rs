@@ -277,6 +277,24 @@ pub fn resting_shot(display: &str, window: &str, dir: &Path, name: &str) -> imag
 }
 
 /// Clicks window pixel (x, y) with the left button and waits for the edit.
+/// A left drag from `from` to `to` with the real mouse: press, eight
+/// moves 60 ms apart along the straight line, release.
+pub fn drag(display: &str, window: &str, from: (u32, u32), to: (u32, u32)) {
+    let at = |p: (i64, i64)| [p.0.to_string(), p.1.to_string()];
+    let (x, y) = (i64::from(from.0), i64::from(from.1));
+    let (ex, ey) = (i64::from(to.0), i64::from(to.1));
+    let [sx, sy] = at((x, y));
+    xdotool(display, &["mousemove", "--window", window, &sx, &sy]);
+    std::thread::sleep(Duration::from_millis(300));
+    xdotool(display, &["mousedown", "1"]);
+    for step in 1..=8 {
+        let [px, py] = at((x + (ex - x) * step / 8, y + (ey - y) * step / 8));
+        xdotool(display, &["mousemove", "--window", window, &px, &py]);
+        std::thread::sleep(Duration::from_millis(60));
+    }
+    xdotool(display, &["mouseup", "1"]);
+}
+
 pub fn click(display: &str, window: &str, lines: &mut Lines, x: u32, y: u32) -> u64 {
     xdotool(display, &["mousemove", "--window", window, &x.to_string(), &y.to_string()]);
     // Let a frame show the hover highlight first (not needed for the edit).

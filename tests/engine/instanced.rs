@@ -11,7 +11,7 @@ use octovox::camera::Camera;
 use octovox::editor::Editor;
 use octovox::gpu::Renderer;
 use octovox::scene::{Instancing, Scene};
-use octovox::settings::{RenderSettings, TraceMode, View};
+use octovox::settings::RenderSettings;
 use octovox::trace::instanced::Traced;
 use octovox::trace::render::{Tracer, trace_image};
 use octovox::trace::{Footprint, Hit, Ray};
@@ -64,20 +64,7 @@ fn overlapping_scene(dir: &std::path::Path) -> Scene {
             models: vec![ShapeModel { model_id: k % 2, attributes: dict(&[]) }],
         });
     }
-    let data = DotVoxData {
-        version: 200,
-        index_map: Vec::new(),
-        models: vec![lopsided(10), lopsided(40)],
-        palette: dot_vox::DEFAULT_PALETTE.to_vec(),
-        materials: Vec::new(),
-        scenes,
-        layers: vec![dot_vox::Layer { attributes: dict(&[("_name", "0".into())]) }],
-    };
-    let path = dir.join("pieces.vox");
-    let mut bytes = Vec::new();
-    data.write_vox(&mut bytes).unwrap();
-    std::fs::write(&path, bytes).unwrap();
-    let mut scene = octovox::io::load_scene(&path, 0).unwrap();
+    let mut scene = written(&dir.join("pieces.vox"), vec![lopsided(10), lopsided(40)], scenes);
     assert_eq!(scene.objects().map(|o| o.list().len()), Some(count as usize));
     // So many overlapping pieces compose into less than twice the models'
     // bytes, which `Instancing::Auto` would draw composed.
@@ -118,14 +105,7 @@ fn rays(scene: &Scene, camera: &Camera, size: (u32, u32)) -> Vec<Ray> {
 }
 
 fn gpu_hits(renderer: &mut Renderer, scene: &Scene, camera: &Camera, size: (u32, u32)) -> Vec<Hit> {
-    let settings = RenderSettings {
-        mode: TraceMode::Svo,
-        view: View::Shaded,
-        shadows: true,
-        render_scale: 1.0,
-        lod: 0.0,
-        ground: None,
-    };
+    let settings = RenderSettings::default();
     renderer.render(scene, camera, size, &settings, None).unwrap();
     renderer.read_hits().unwrap()
 }
@@ -260,18 +240,23 @@ fn spread_scene(dir: &std::path::Path) -> Scene {
             models: vec![ShapeModel { model_id: 0, attributes: dict(&[]) }],
         });
     }
+    written(&dir.join("spread.vox"), vec![lopsided(10)], scenes)
+}
+
+/// `models` placed by `scenes` (one layer), written by dot_vox to `path`
+/// and loaded.
+fn written(path: &std::path::Path, models: Vec<Model>, scenes: Vec<SceneNode>) -> Scene {
     let data = DotVoxData {
         version: 200,
         index_map: Vec::new(),
-        models: vec![lopsided(10)],
+        models,
         palette: dot_vox::DEFAULT_PALETTE.to_vec(),
         materials: Vec::new(),
         scenes,
         layers: vec![dot_vox::Layer { attributes: dict(&[("_name", "0".into())]) }],
     };
-    let path = dir.join("spread.vox");
     let mut bytes = Vec::new();
     data.write_vox(&mut bytes).unwrap();
-    std::fs::write(&path, bytes).unwrap();
-    octovox::io::load_scene(&path, 0).unwrap()
+    std::fs::write(path, bytes).unwrap();
+    octovox::io::load_scene(path, 0).unwrap()
 }

@@ -14,7 +14,7 @@ use num_traits::ToPrimitive;
 use octovox::camera::Camera;
 use octovox::gpu::Renderer;
 use octovox::scene::{Octree, Op, Shape};
-use octovox::settings::{RenderSettings, TraceMode, View};
+use octovox::settings::RenderSettings;
 use octovox::trace::{Hit, Ray, svo};
 
 /// splitmix64: a fixed, portable sequence, so every run tests the same rays.
@@ -280,14 +280,7 @@ fn a_tree_two_to_the_twenty_wide() {
 /// Each pixel's GPU hit (SVO, no shadows) against the reference for that
 /// pixel's ray as the CPU computes it.
 fn gpu_tally(renderer: &mut Renderer, scene: &octovox::scene::Scene, camera: &Camera, size: (u32, u32)) -> Tally {
-    let settings = RenderSettings {
-        mode: TraceMode::Svo,
-        view: View::Shaded,
-        shadows: false,
-        render_scale: 1.0,
-        lod: 0.0,
-        ground: None,
-    };
+    let settings = RenderSettings { shadows: false, ..RenderSettings::default() };
     renderer.render(scene, camera, size, &settings, None).unwrap();
     let tree = scene.drawn();
     let basis = camera.basis(size.0, size.1, tree.origin());

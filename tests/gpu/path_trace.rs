@@ -543,7 +543,7 @@ fn the_selection_is_tinted_in_path_traced_frames() {
 /// the ground before any voxel, in the preview and in path-traced frames.
 #[test]
 fn the_ground_grid_is_hidden_by_the_voxels_in_front_of_it() {
-    use octovox::settings::{RenderSettings, TraceMode, View};
+    use octovox::settings::RenderSettings;
     let column = Shape::Box { min: IVec3::ZERO, max: IVec3::new(3, 9, 3) };
     let mut scene = Scene::new(palette(), build(&[(column, Op::Place(WHITE))]));
     let camera = look(DVec3::new(14.0, 10.0, 18.0), DVec3::new(1.0, 3.0, 1.0));
@@ -560,14 +560,7 @@ fn the_ground_grid_is_hidden_by_the_voxels_in_front_of_it() {
         a.pixels().zip(b.pixels()).enumerate().filter(|(_, (p, q))| p != q).map(|(i, _)| i).collect()
     };
 
-    let settings = RenderSettings {
-        mode: TraceMode::Svo,
-        view: View::Shaded,
-        shadows: false,
-        render_scale: 1.0,
-        lod: 0.0,
-        ground: None,
-    };
+    let settings = RenderSettings { shadows: false, ..RenderSettings::default() };
     let preview = |renderer: &mut Renderer, grid| {
         renderer.render_frame(&FrameInput::preview(&scene, &camera, size, &settings, None, grid)).unwrap();
         renderer.read_image().unwrap()

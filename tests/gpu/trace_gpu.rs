@@ -248,14 +248,7 @@ fn teapot_picture_and_iteration_counts() {
     let mut renderer = renderer_for(&mut scene);
     let (lo, hi) = scene.solid_bounds().unwrap();
     let camera = Camera::framing(lo, hi, 50.0);
-    let settings = RenderSettings {
-        mode: TraceMode::Svo,
-        view: View::Shaded,
-        shadows: true,
-        render_scale: 1.0,
-        lod: 0.0,
-        ground: None,
-    };
+    let settings = RenderSettings::default();
     renderer.render(&scene, &camera, (200, 150), &settings, None).unwrap();
     let image = renderer.read_image().unwrap();
     let distinct: std::collections::HashSet<[u8; 4]> = image.pixels().map(|p| p.0).collect();

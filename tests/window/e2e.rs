@@ -124,15 +124,7 @@ fn click_attach_save_erase_save_in_a_real_window() {
     let (ex, ey) = same_layer_pixel(&stroked, &camera, (x, y), top_voxel, IVec3::Y);
     eprintln!("stroke from ({x}, {y}) to ({ex}, {ey})");
     xdotool(&display, &["key", "t"]);
-    xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y.to_string()]);
-    xdotool(&display, &["mousedown", "1"]);
-    for step in 1..=8 {
-        let sx = x as i64 + (ex as i64 - x as i64) * step / 8;
-        let sy = y as i64 + (ey as i64 - y as i64) * step / 8;
-        xdotool(&display, &["mousemove", "--window", &window, &sx.to_string(), &sy.to_string()]);
-        std::thread::sleep(Duration::from_millis(60));
-    }
-    xdotool(&display, &["mouseup", "1"]);
+    drag(&display, &window, (x, y), (ex, ey));
     let before = lines.seen.len();
     xdotool(&display, &["key", "ctrl+z"]);
     let undo = lines.wait_for("undo:", Duration::from_secs(30));

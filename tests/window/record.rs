@@ -38,16 +38,7 @@ fn a_recorded_stroke_replays_into_one_undo_step() {
     let args = document_args(&file, &camera, &["--record", &script.display().to_string()]);
     let (mut app, mut lines, window) = open_ready(&display, dir.path(), &args);
     xdotool(&display, &["key", "t"]);
-    xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y.to_string()]);
-    std::thread::sleep(Duration::from_millis(300));
-    xdotool(&display, &["mousedown", "1"]);
-    for step in 1..=8 {
-        let sx = x as i64 + (ex as i64 - x as i64) * step / 8;
-        let sy = y as i64 + (ey as i64 - y as i64) * step / 8;
-        xdotool(&display, &["mousemove", "--window", &window, &sx.to_string(), &sy.to_string()]);
-        std::thread::sleep(Duration::from_millis(60));
-    }
-    xdotool(&display, &["mouseup", "1"]);
+    drag(&display, &window, (x, y), (ex, ey));
     click(&display, &window, &mut lines, cx, cy);
     save(&display, &mut lines, &file);
     xdotool(&display, &["key", "ctrl+q"]);
