@@ -342,11 +342,6 @@ impl NodePool {
     pub fn live_bytes(&self) -> u64 {
         self.nodes.live() as u64 * NODE_BYTES + self.bricks.live() as u64 * BRICK_BYTES
     }
-
-    /// Bytes of every allocated slot, free ones included (what the GPU holds).
-    pub fn allocated_bytes(&self) -> u64 {
-        self.nodes.len() as u64 * NODE_BYTES + self.bricks.len() as u64 * BRICK_BYTES
-    }
 }
 
 #[cfg(test)]

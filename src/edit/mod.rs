@@ -143,11 +143,6 @@ impl Edit {
             Edit::Palette { .. } | Edit::PopModel => 0,
         })
     }
-
-    /// Whether applying it changes the palette (which then goes to the GPU).
-    pub fn changes_palette(&self) -> bool {
-        matches!(self, Edit::Palette { .. })
-    }
 }
 
 /// One undo step: a single edit or a whole mouse stroke.

@@ -190,14 +190,6 @@ impl SceneGraph {
         self.nodes.get(id as usize).filter(|n| n.id == id).or_else(|| self.nodes.iter().find(|n| n.id == id))
     }
 
-    pub fn node_mut(&mut self, id: u32) -> Option<&mut Node> {
-        let at = match self.nodes.get(id as usize) {
-            Some(n) if n.id == id => Some(id as usize),
-            _ => self.nodes.iter().position(|n| n.id == id),
-        };
-        at.map(|i| &mut self.nodes[i])
-    }
-
     /// Number of group nodes.
     pub fn group_count(&self) -> usize {
         self.nodes.iter().filter(|n| matches!(n.kind, NodeKind::Group { .. })).count()

@@ -86,13 +86,6 @@ impl Hit {
         Hit { iterations, gave_up: iterations >= bound, ..Hit::default() }
     }
 
-    /// Packs normal, value and iterations the way the shader's hit record
-    /// does; the iteration field's largest value, 0xffff, marks a give-up.
-    pub fn pack_info(&self) -> u32 {
-        let iterations = if self.gave_up { GAVE_UP_RECORD } else { self.iterations.min(GAVE_UP_RECORD - 1) };
-        u32::from(self.value) | normal_code(self.normal) << 8 | self.cell_level.min(31) << 11 | iterations << 16
-    }
-
     /// Inverse of the shader's hit record `[x, y, z, info]`.
     pub fn from_record(record: [u32; 4]) -> Hit {
         let info = record[3];

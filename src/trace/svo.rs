@@ -25,13 +25,6 @@ pub fn trace(tree: &Octree, ray: &Ray) -> Hit {
     walk(tree, ray, 0, Footprint::EXACT).hit
 }
 
-/// The first solid cell along `ray` under a level-of-detail footprint: a
-/// node cell below it is hit as a solid cell of its summary's palette index
-/// (`cell_level` then says how big). With [`Footprint::EXACT`], [`trace`].
-pub fn trace_lod(tree: &Octree, ray: &Ray, footprint: Footprint) -> Hit {
-    walk(tree, ray, 0, footprint).hit
-}
-
 /// Where a ray leaves its medium: the first voxel whose value differs from
 /// the medium's, and the ray's t on entering it. Inside glass the medium is
 /// the glass's palette index, and the voxel found may be empty (value 0).
