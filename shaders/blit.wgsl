@@ -2,8 +2,8 @@
 // whole target: the trace output (possibly smaller, render-scaled), or a
 // layer of the target's size over it. Used by src/gpu/blit_pass.rs.
 
-@group(0) @binding(0) var source: texture_2d<f32>;
-@group(0) @binding(1) var source_sampler: sampler;
+@group(0) @binding(BINDING_SOURCE) var source: texture_2d<f32>;
+@group(0) @binding(BINDING_SOURCE_SAMPLER) var source_sampler: sampler;
 
 struct VertexOut {
     @builtin(position) position: vec4<f32>,

@@ -55,7 +55,7 @@ struct FrameUniforms {
 }
 
 // Read-only storage, not uniform: see `constants_entry` in src/gpu/trace_pass.rs.
-@group(0) @binding(0) var<storage, read> frame_constants: FrameUniforms;
+@group(0) @binding(BINDING_FRAME_CONSTANTS) var<storage, read> frame_constants: FrameUniforms;
 // The invocation's copy of the frame constants, read once by `load_constants`
 // at the start of every entry point. CPU-emulated GPUs (lavapipe of Mesa 22)
 // read a storage buffer lane by lane, even where every lane reads the same
@@ -66,15 +66,15 @@ fn load_constants() {
     u = frame_constants;
 }
 // Nodes (NODE_WORDS words each) and then bricks (2 words each) of the node pool.
-@group(0) @binding(1) var<storage, read> pool: array<u32>;
+@group(0) @binding(BINDING_POOL) var<storage, read> pool: array<u32>;
 // The instance tree's nodes, then the instance records (src/scene/instances.rs),
 // read four words at a time: each load site costs a scalar loop over the
 // lanes on CPU-emulated GPUs.
-@group(0) @binding(2) var<storage, read> instances: array<vec4<u32>>;
-@group(0) @binding(3) var<storage, read> palette: array<u32>;
-@group(0) @binding(4) var<storage, read> grid: array<u32>;
-@group(0) @binding(5) var out_color: texture_storage_2d<rgba8unorm, write>;
-@group(0) @binding(6) var<storage, read_write> hit_records: array<vec4<u32>>;
+@group(0) @binding(BINDING_INSTANCES) var<storage, read> instances: array<vec4<u32>>;
+@group(0) @binding(BINDING_PALETTE) var<storage, read> palette: array<u32>;
+@group(0) @binding(BINDING_GRID) var<storage, read> grid: array<u32>;
+@group(0) @binding(BINDING_OUT_COLOR) var out_color: texture_storage_2d<rgba8unorm, write>;
+@group(0) @binding(BINDING_HIT_RECORDS) var<storage, read_write> hit_records: array<vec4<u32>>;
 
 // Sun shadows are compiled in only when the scene and settings ask for them.
 override SHADOWS: bool = true;

@@ -25,18 +25,18 @@ struct DenoiseUniforms {
     light: u32,
 }
 
-@group(0) @binding(0) var<storage, read> constants: DenoiseUniforms;
+@group(0) @binding(BINDING_DENOISE_CONSTANTS) var<storage, read> constants: DenoiseUniforms;
 var<private> du: DenoiseUniforms;
 // Three vec4 per pixel (shaders/path.wgsl): sum and count, sum of
 // squares, sum of the first hits' albedo.
-@group(0) @binding(1) var<storage, read> accum: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read> guides: array<vec4<u32>>;
+@group(0) @binding(BINDING_ACCUM) var<storage, read> accum: array<vec4<f32>>;
+@group(0) @binding(BINDING_GUIDES) var<storage, read> guides: array<vec4<u32>>;
 // Demodulated light and the variance of its luminance, per pixel.
-@group(0) @binding(3) var<storage, read> light_in: array<vec4<f32>>;
-@group(0) @binding(4) var<storage, read_write> light_out: array<vec4<f32>>;
-@group(0) @binding(5) var out_color: texture_storage_2d<rgba8unorm, write>;
+@group(0) @binding(BINDING_LIGHT_IN) var<storage, read> light_in: array<vec4<f32>>;
+@group(0) @binding(BINDING_LIGHT_OUT) var<storage, read_write> light_out: array<vec4<f32>>;
+@group(0) @binding(BINDING_OUT_COLOR) var out_color: texture_storage_2d<rgba8unorm, write>;
 // One sum of displayed variance per `prepare` workgroup.
-@group(0) @binding(6) var<storage, read_write> partials: array<f32>;
+@group(0) @binding(BINDING_PARTIALS) var<storage, read_write> partials: array<f32>;
 
 fn code_of(i: u32) -> u32 {
     return guides[i].w;

@@ -56,18 +56,18 @@ struct Emitter {
     _pad1: u32,
 }
 
-@group(0) @binding(8) var<storage, read> path_constants: PathUniforms;
+@group(0) @binding(BINDING_PATH_CONSTANTS) var<storage, read> path_constants: PathUniforms;
 // Read once per invocation, like `u` (common.wgsl, `load_constants`).
 var<private> pu: PathUniforms;
-@group(0) @binding(9) var<storage, read> materials: array<Material>;
-@group(0) @binding(10) var<storage, read> emitters: array<Emitter>;
+@group(0) @binding(BINDING_MATERIALS) var<storage, read> materials: array<Material>;
+@group(0) @binding(BINDING_EMITTERS) var<storage, read> emitters: array<Emitter>;
 // Three vec4 per pixel: the sum of the samples and their count, the sum of
 // their squares (the denoiser's variance and the noise estimate), and the
 // sum of their first hits' `demodulation_albedo`.
-@group(0) @binding(11) var<storage, read_write> accum: array<vec4<f32>>;
+@group(0) @binding(BINDING_ACCUM) var<storage, read_write> accum: array<vec4<f32>>;
 // The denoiser's guide per pixel (twin of `Guide` in src/trace/denoise.rs):
 // the point where the centre ray enters a face, as bits, then the code.
-@group(0) @binding(12) var<storage, read_write> guides: array<vec4<u32>>;
+@group(0) @binding(BINDING_GUIDES) var<storage, read_write> guides: array<vec4<u32>>;
 
 // The first hit's `demodulation_albedo` of the path being traced.
 var<private> first_albedo: vec3<f32>;

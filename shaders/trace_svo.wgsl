@@ -8,7 +8,7 @@
 // sides of a divergent branch run anyway, and the bookkeeping of branches
 // costs more than the selects.
 
-@group(0) @binding(7) var<storage, read_write> beam_distance: array<f32>;
+@group(0) @binding(BINDING_BEAM_DISTANCE) var<storage, read_write> beam_distance: array<f32>;
 // The tiles the beam prepass found something in; `main` runs on these only
 // (an indirect dispatch), after the floor kernel has drawn every pixel as
 // sky. CPU-emulated GPUs run a branch that any lane takes on every lane,
@@ -19,11 +19,11 @@ struct TracedTiles {
     // x | y << 16 of each tile, in no particular order.
     list: array<u32>,
 }
-@group(0) @binding(12) var<storage, read_write> traced: TracedTiles;
+@group(0) @binding(BINDING_TRACED) var<storage, read_write> traced: TracedTiles;
 // The indirect dispatch arguments of `main`, written by `tile_dispatch`; in a
 // group of its own, since a dispatch may not read its own arguments buffer
 // as storage.
-@group(1) @binding(0) var<storage, read_write> dispatch_args: array<u32, 3>;
+@group(1) @binding(BINDING_DISPATCH_ARGS) var<storage, read_write> dispatch_args: array<u32, 3>;
 
 // Side of the square tile of pixels that shares one beam: set from
 // `BEAM_TILE` in src/gpu/trace_pass.rs, which also sizes the beam buffer.

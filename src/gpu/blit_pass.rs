@@ -5,6 +5,7 @@
 //! target's size with premultiplied alpha, over what the target holds (the
 //! window's panels, kept across frames).
 
+use super::bindings;
 use super::{GpuContext, GpuError};
 
 /// How the blit meets what the target already holds.
@@ -33,7 +34,7 @@ impl BlitPass {
             label: Some("blit bind group layout"),
             entries: &[
                 wgpu::BindGroupLayoutEntry {
-                    binding: 0,
+                    binding: bindings::SOURCE,
                     visibility: wgpu::ShaderStages::FRAGMENT,
                     ty: wgpu::BindingType::Texture {
                         sample_type: wgpu::TextureSampleType::Float { filterable: true },
@@ -43,7 +44,7 @@ impl BlitPass {
                     count: None,
                 },
                 wgpu::BindGroupLayoutEntry {
-                    binding: 1,
+                    binding: bindings::SOURCE_SAMPLER,
                     visibility: wgpu::ShaderStages::FRAGMENT,
                     ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                     count: None,
@@ -102,8 +103,14 @@ impl BlitPass {
             label: Some("blit bind group"),
             layout: &self.layout,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(source) },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::Sampler(&self.sampler) },
+                wgpu::BindGroupEntry {
+                    binding: bindings::SOURCE,
+                    resource: wgpu::BindingResource::TextureView(source),
+                },
+                wgpu::BindGroupEntry {
+                    binding: bindings::SOURCE_SAMPLER,
+                    resource: wgpu::BindingResource::Sampler(&self.sampler),
+                },
             ],
         }));
     }

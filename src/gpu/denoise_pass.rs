@@ -3,6 +3,7 @@
 //! one compute pass, and the noise estimate `prepare` leaves behind. The
 //! filter itself is explained in `crate::trace::denoise`, its CPU twin.
 
+use super::bindings;
 use super::context::compute_pipeline;
 use super::layout::{
     DenoiseUniforms, buffer_entry, buffer_resource, constants_buffer, constants_entry, output_entry, output_texture,
@@ -62,13 +63,13 @@ impl DenoisePass {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("denoise bind group layout"),
             entries: &[
-                constants_entry(0, std::mem::size_of::<DenoiseUniforms>()),
-                buffer_entry(1, true),
-                buffer_entry(2, true),
-                buffer_entry(3, true),
-                buffer_entry(4, false),
-                output_entry(5),
-                buffer_entry(6, false),
+                constants_entry(bindings::DENOISE_CONSTANTS, std::mem::size_of::<DenoiseUniforms>()),
+                buffer_entry(bindings::ACCUM, true),
+                buffer_entry(bindings::GUIDES, true),
+                buffer_entry(bindings::LIGHT_IN, true),
+                buffer_entry(bindings::LIGHT_OUT, false),
+                output_entry(bindings::OUT_COLOR),
+                buffer_entry(bindings::PARTIALS, false),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -117,13 +118,16 @@ impl DenoisePass {
                     label: Some("denoise bind group"),
                     layout: &self.layout,
                     entries: &[
-                        buffer_resource(0, &constants),
-                        buffer_resource(1, accum),
-                        buffer_resource(2, guides),
-                        buffer_resource(3, &light[1 - out]),
-                        buffer_resource(4, &light[out]),
-                        wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&view) },
-                        buffer_resource(6, &partials),
+                        buffer_resource(bindings::DENOISE_CONSTANTS, &constants),
+                        buffer_resource(bindings::ACCUM, accum),
+                        buffer_resource(bindings::GUIDES, guides),
+                        buffer_resource(bindings::LIGHT_IN, &light[1 - out]),
+                        buffer_resource(bindings::LIGHT_OUT, &light[out]),
+                        wgpu::BindGroupEntry {
+                            binding: bindings::OUT_COLOR,
+                            resource: wgpu::BindingResource::TextureView(&view),
+                        },
+                        buffer_resource(bindings::PARTIALS, &partials),
                     ],
                 });
                 Stage { constants, bind_group }

@@ -1,6 +1,7 @@
 //! Everything that talks to wgpu: device setup, the scene's GPU buffers, the
 //! trace pass, timing and readback. The engine modules never import this.
 
+pub mod bindings;
 pub mod blit_pass;
 pub mod context;
 pub mod denoise_pass;

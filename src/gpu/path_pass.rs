@@ -10,6 +10,7 @@
 //! instance walk, and a scene that gains an effect runs the kernel with
 //! every effect (the same image) until its own is compiled.
 
+use super::bindings;
 use std::collections::HashMap;
 use std::sync::mpsc;
 
@@ -160,16 +161,19 @@ fn make_bind_group(
         label: Some("path bind group"),
         layout,
         entries: &[
-            buffer_resource(0, parts.frame),
-            buffer_resource(1, &buffers.pool_buf),
-            buffer_resource(2, &buffers.instances_buf),
-            buffer_resource(3, &buffers.palette_buf),
-            wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&target.view) },
-            buffer_resource(8, parts.path),
-            buffer_resource(9, parts.materials),
-            buffer_resource(10, parts.emitters),
-            buffer_resource(11, &target.accum),
-            buffer_resource(12, &target.guides),
+            buffer_resource(bindings::FRAME_CONSTANTS, parts.frame),
+            buffer_resource(bindings::POOL, &buffers.pool_buf),
+            buffer_resource(bindings::INSTANCES, &buffers.instances_buf),
+            buffer_resource(bindings::PALETTE, &buffers.palette_buf),
+            wgpu::BindGroupEntry {
+                binding: bindings::OUT_COLOR,
+                resource: wgpu::BindingResource::TextureView(&target.view),
+            },
+            buffer_resource(bindings::PATH_CONSTANTS, parts.path),
+            buffer_resource(bindings::MATERIALS, parts.materials),
+            buffer_resource(bindings::EMITTERS, parts.emitters),
+            buffer_resource(bindings::ACCUM, &target.accum),
+            buffer_resource(bindings::GUIDES, &target.guides),
         ],
     })
 }
@@ -189,16 +193,16 @@ impl PathPass {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("path bind group layout"),
             entries: &[
-                constants_entry(0, std::mem::size_of::<FrameUniforms>()),
-                buffer_entry(1, true),
-                buffer_entry(2, true),
-                buffer_entry(3, true),
-                output_entry(5),
-                constants_entry(8, std::mem::size_of::<PathUniforms>()),
-                buffer_entry(9, true),
-                buffer_entry(10, true),
-                buffer_entry(11, false),
-                buffer_entry(12, false),
+                constants_entry(bindings::FRAME_CONSTANTS, std::mem::size_of::<FrameUniforms>()),
+                buffer_entry(bindings::POOL, true),
+                buffer_entry(bindings::INSTANCES, true),
+                buffer_entry(bindings::PALETTE, true),
+                output_entry(bindings::OUT_COLOR),
+                constants_entry(bindings::PATH_CONSTANTS, std::mem::size_of::<PathUniforms>()),
+                buffer_entry(bindings::MATERIALS, true),
+                buffer_entry(bindings::EMITTERS, true),
+                buffer_entry(bindings::ACCUM, false),
+                buffer_entry(bindings::GUIDES, false),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

@@ -64,6 +64,9 @@ pub fn shared_constants() -> String {
     line("LUMINANCE", "vec3<f32>", vec3(denoise::LUMINANCE.to_array()));
     line("KERNEL_CENTRE", "f32", format!("{:?}", denoise::KERNEL_CENTRE));
     line("KERNEL_SIDE", "f32", format!("{:?}", denoise::KERNEL_SIDE));
+    for (_, name, binding) in super::bindings::ALL {
+        line(&format!("BINDING_{name}"), "u32", format!("{binding}u"));
+    }
     for view in View::ALL {
         line(view.wgsl_name(), "u32", format!("{}u", view.code()));
     }

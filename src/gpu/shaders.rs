@@ -54,8 +54,7 @@ impl Module {
             Module::Floor => with_prelude(&[COMMON, FLOOR]),
             Module::Path => with_prelude(&[COMMON, SVO, INSTANCES, PATH]),
             Module::Denoise => with_prelude(&[DENOISE]),
-            // The blit samples a texture: it shares nothing with the others.
-            Module::Blit => BLIT.to_owned(),
+            Module::Blit => with_prelude(&[BLIT]),
         }
     }
 }
@@ -185,27 +184,24 @@ mod tests {
         }
     }
 
-    /// Every module parses, and none binds two variables to one slot (the
-    /// path module concatenates trace_svo.wgsl and path.wgsl: a binding one
-    /// uses and the other reuses would collide the day an entry point
-    /// used both).
+    /// Issue 46, item 4: the path module concatenated trace_svo.wgsl
+    /// (binding 12: `traced`) and path.wgsl (binding 12: `guides`), and
+    /// binding numbers were literals on both sides. Every bound variable of
+    /// every module now has the number `bindings::ALL` gives its name (the
+    /// passes bind by the same constants), and no module binds two
+    /// variables to one slot.
     #[test]
-    fn no_module_binds_two_variables_to_one_slot() {
+    fn every_bound_variable_has_its_number_from_the_one_table() {
+        use crate::gpu::bindings::ALL;
         for module in Module::ALL {
             let parsed = naga::front::wgsl::parse_str(&module.source()).unwrap_or_else(|e| panic!("{module:?}: {e}"));
             let mut seen = std::collections::HashMap::new();
             for (_, var) in parsed.global_variables.iter() {
-                if let Some(binding) = &var.binding {
-                    let name = var.name.clone().unwrap_or_default();
-                    if let Some(other) = seen.insert((binding.group, binding.binding), name.clone()) {
-                        // Known: path.wgsl's `guides` and trace_svo.wgsl's
-                        // `traced` share binding 12; no entry point uses both.
-                        let pair = [other.as_str(), name.as_str()];
-                        assert!(
-                            pair.contains(&"guides") && pair.contains(&"traced"),
-                            "{module:?}: {pair:?} share {binding:?}"
-                        );
-                    }
+                let (Some(binding), Some(name)) = (&var.binding, &var.name) else { continue };
+                let number = ALL.iter().find(|(variable, ..)| variable == name).map(|(.., number)| *number);
+                assert_eq!(number, Some(binding.binding), "{module:?}: `{name}` is bound at {binding:?}");
+                if let Some(other) = seen.insert((binding.group, binding.binding), name.clone()) {
+                    panic!("{module:?}: `{other}` and `{name}` share {binding:?}");
                 }
             }
         }

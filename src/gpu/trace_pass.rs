@@ -1,6 +1,7 @@
 //! The ray tracing compute pass: one thread per pixel walks the SVO (or the
 //! dense grid) and writes a colour texture plus a hit record per pixel.
 
+use super::bindings;
 use std::collections::HashMap;
 
 use super::context::compute_pipeline;
@@ -90,20 +91,20 @@ impl TracePass {
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("trace bind group layout"),
             entries: &[
-                constants_entry(0, std::mem::size_of::<FrameUniforms>()),
-                buffer_entry(1, true),
-                buffer_entry(2, true),
-                buffer_entry(3, true),
-                buffer_entry(4, true),
-                output_entry(5),
-                buffer_entry(6, false),
-                buffer_entry(7, false),
-                buffer_entry(12, false),
+                constants_entry(bindings::FRAME_CONSTANTS, std::mem::size_of::<FrameUniforms>()),
+                buffer_entry(bindings::POOL, true),
+                buffer_entry(bindings::INSTANCES, true),
+                buffer_entry(bindings::PALETTE, true),
+                buffer_entry(bindings::GRID, true),
+                output_entry(bindings::OUT_COLOR),
+                buffer_entry(bindings::HIT_RECORDS, false),
+                buffer_entry(bindings::BEAM_DISTANCE, false),
+                buffer_entry(bindings::TRACED, false),
             ],
         });
         let args_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("dispatch arguments layout"),
-            entries: &[buffer_entry(0, false)],
+            entries: &[buffer_entry(bindings::DISPATCH_ARGS, false)],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("trace pipeline layout"),
@@ -194,7 +195,10 @@ impl TracePass {
         device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("dispatch arguments"),
             layout,
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: target.dispatch_args.as_entire_binding() }],
+            entries: &[wgpu::BindGroupEntry {
+                binding: bindings::DISPATCH_ARGS,
+                resource: target.dispatch_args.as_entire_binding(),
+            }],
         })
     }
 
@@ -209,15 +213,24 @@ impl TracePass {
             label: Some("trace bind group"),
             layout,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: uniform_buf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: buffers.pool_buf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: buffers.instances_buf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: buffers.palette_buf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: buffers.grid_buf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&target.view) },
-                wgpu::BindGroupEntry { binding: 6, resource: target.hits_buf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 7, resource: target.beam_buf.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 12, resource: target.traced_tiles.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: bindings::FRAME_CONSTANTS, resource: uniform_buf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: bindings::POOL, resource: buffers.pool_buf.as_entire_binding() },
+                wgpu::BindGroupEntry {
+                    binding: bindings::INSTANCES,
+                    resource: buffers.instances_buf.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry { binding: bindings::PALETTE, resource: buffers.palette_buf.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: bindings::GRID, resource: buffers.grid_buf.as_entire_binding() },
+                wgpu::BindGroupEntry {
+                    binding: bindings::OUT_COLOR,
+                    resource: wgpu::BindingResource::TextureView(&target.view),
+                },
+                wgpu::BindGroupEntry { binding: bindings::HIT_RECORDS, resource: target.hits_buf.as_entire_binding() },
+                wgpu::BindGroupEntry {
+                    binding: bindings::BEAM_DISTANCE,
+                    resource: target.beam_buf.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry { binding: bindings::TRACED, resource: target.traced_tiles.as_entire_binding() },
             ],
         })
     }
