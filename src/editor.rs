@@ -80,9 +80,6 @@ pub struct Editor {
     /// Clicks that hit no voxel land on the ground, the plane y = 0
     /// (`ground on|off`; on for a scene that starts empty).
     pub ground: bool,
-    /// Counts the changes of the voxels and the palette, new scenes
-    /// included: a frame drawn from revision r is up to date while it is r.
-    revision: u64,
 }
 
 impl Editor {
@@ -96,13 +93,6 @@ impl Editor {
         self.history.clear();
         self.selection = None;
         self.ground = self.scene.solid_voxels() == 0 && self.scene.objects().is_none();
-        self.revision += 1;
-    }
-
-    /// The revision of the voxels and the palette (see `Editor::revision`'s
-    /// field): it changes with every edit, undo, redo and new scene.
-    pub fn revision(&self) -> u64 {
-        self.revision
     }
 
     pub fn clipboard(&self) -> Option<&Block> {
@@ -445,7 +435,6 @@ impl Editor {
     fn commit(&mut self, edits: Vec<Edit>) -> Result<bool, EditError> {
         let any = !edits.is_empty();
         self.history.apply_group(&mut self.scene, edits)?;
-        self.revision += u64::from(any);
         Ok(any)
     }
 
@@ -459,8 +448,6 @@ impl Editor {
         if usize::try_from(n).map_or(true, |n| n > available) {
             return Err(EditorError::TooFewSteps { what, available, wanted: n });
         }
-        // Counted first: a step that fails halfway has changed cells too.
-        self.revision += 1;
         for _ in 0..n {
             let scene = &mut self.scene;
             if undo { self.history.undo(scene) } else { self.history.redo(scene) }?;

@@ -115,7 +115,7 @@ pub fn render_setting(
             if mode == TraceMode::Grid {
                 let grid = crate::trace::grid::DenseGrid::from_octree(scene.drawn())
                     .map_err(|e| crate::gpu::GpuError::TooLarge(e.to_string()))?;
-                renderer.set_grid(&grid)?;
+                renderer.set_grid(&grid, scene.revision())?;
             }
             // The first frame compiles nothing but warms caches; time the second.
             renderer.render(scene, camera, traced, &settings, None)?;

@@ -1,7 +1,7 @@
 //! The frame clock: when the window is ready, when the last frame was
 //! drawn and the next is due, the render scale while the camera moves,
-//! `--bench-frames` and `--frame-stats`, and what the next frame must
-//! redo because something changed since it was last drawn.
+//! `--bench-frames` and `--frame-stats`. (What a frame must redo because
+//! the scene changed, the renderer knows from the scene's revision.)
 
 use std::cell::Cell;
 use std::time::Instant;
@@ -36,12 +36,6 @@ pub(super) struct FrameClock {
     /// Whether the stdout line `path: N samples` was written for the view
     /// shown: its samples done and, with Denoise on, filtered.
     pub path_reported: bool,
-    /// The editor's revision (`Editor::revision`) the dense grid of grid
-    /// mode was built from, and the one the path tracer's accumulation
-    /// holds: a frame redoes what is older than the scene. `None`: nothing
-    /// known to be up to date (the renderer was used for something else).
-    pub grid_drawn: Option<u64>,
-    pub path_drawn: Option<u64>,
 }
 
 impl FrameClock {
@@ -57,8 +51,6 @@ impl FrameClock {
             moving_frames: args.frame_stats.then(motion::MovingFrames::default),
             preview_before_path: false,
             path_reported: false,
-            grid_drawn: None,
-            path_drawn: None,
         }
     }
 }

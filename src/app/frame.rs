@@ -226,14 +226,11 @@ impl App {
         let grid = self.doc.editor.ground.then(|| state.ground_grid());
         let wants = Wants { denoise: state.denoise, estimate_noise: true, sample_target: state.sample_target.max(1) };
         let options = PathOptions { highlight: tinted, grid, wants };
-        let revision = self.doc.editor.revision();
-        let scene_changed = self.frames.path_drawn != Some(revision);
-        let restarts = wants_path && gfx.renderer.path_restarts(&view, scene_changed, &options);
+        let restarts = wants_path && gfx.renderer.path_restarts(&view, false, &options);
         let path = wants_path && (!restarts || self.frames.preview_before_path);
         self.frames.preview_before_path = wants_path && !path;
         let input = if path {
-            self.frames.path_drawn = Some(revision);
-            FrameInput::Path { view, scene_changed, options }
+            FrameInput::Path { view, restart: false, options }
         } else {
             // Select mode tints the selected voxels; the brush's modes what it would touch.
             let highlight = match self.state.mode {
@@ -344,23 +341,18 @@ impl App {
 
     /// Rebuilds and uploads the dense grid while grid mode is on and the voxels changed.
     fn sync_grid(&mut self) {
-        let revision = self.doc.editor.revision();
-        if self.state.settings.mode != TraceMode::Grid || self.frames.grid_drawn == Some(revision) {
+        let Some(gfx) = &mut self.gfx else { return };
+        let revision = self.doc.editor.scene.revision();
+        if self.state.settings.mode != TraceMode::Grid || gfx.renderer.grid_of() == Some(revision) {
             return;
         }
-        let Some(gfx) = &mut self.gfx else { return };
-        match DenseGrid::from_octree(self.doc.editor.scene.drawn()) {
-            Ok(grid) => match gfx.renderer.set_grid(&grid) {
-                Ok(()) => self.frames.grid_drawn = Some(revision),
-                Err(err) => {
-                    self.state.settings.mode = TraceMode::Svo;
-                    self.ui.error(format!("{err}; back to SVO"));
-                }
-            },
-            Err(err) => {
-                self.state.settings.mode = TraceMode::Svo;
-                self.ui.error(format!("{err}; back to SVO"));
-            }
+        let sent = match DenseGrid::from_octree(self.doc.editor.scene.drawn()) {
+            Ok(grid) => gfx.renderer.set_grid(&grid, revision).map_err(|err| err.to_string()),
+            Err(err) => Err(err.to_string()),
+        };
+        if let Err(err) = sent {
+            self.state.settings.mode = TraceMode::Svo;
+            self.ui.error(format!("{err}; back to SVO"));
         }
     }
 }

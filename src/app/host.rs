@@ -106,8 +106,6 @@ impl App {
         let image = gfx.renderer.read_image()?;
         octovox::io::png::save_png(&image, path, WriteOptions::default())?;
         report!("screenshot: {}", path.display());
-        // The window's next frame traces its own view again.
-        self.frames.path_drawn = None;
         self.request_redraw();
         Ok(image)
     }

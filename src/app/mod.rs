@@ -657,8 +657,6 @@ impl App {
             }
             Err(err) => self.ui.error(format!("cannot measure the presets: {err}")),
         }
-        // The measurement traced other frames: the accumulation starts over.
-        self.frames.path_drawn = None;
         self.request_redraw();
     }
 

@@ -136,6 +136,8 @@ pub fn measure(
     renderer.wait_for_frames = true;
     let result = measure_all(renderer, scene, camera, window);
     renderer.wait_for_frames = wait;
+    // Its accumulations are not the window's: the window's starts over.
+    renderer.forget_path();
     result
 }
 

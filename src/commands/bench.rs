@@ -337,7 +337,7 @@ pub(super) fn bench_render(quick: bool, lod: f32) -> anyhow::Result<(String, Str
         let mut scene = Scene::new(Palette::default(), build(&source(model)?)?);
         let grid = DenseGrid::from_octree(scene.drawn())?;
         renderer.sync(&mut scene);
-        renderer.set_grid(&grid)?;
+        renderer.set_grid(&grid, scene.revision())?;
         let (lo, hi) = scene.solid_bounds().context("empty model")?;
         let camera = Camera::framing(lo, hi, 50.0);
         // Shared machines are noisy: enough frames for a steady median.

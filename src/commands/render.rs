@@ -140,7 +140,7 @@ fn preview(
     log::info!("rendering on {}", renderer.gpu.adapter_name);
     renderer.sync(scene);
     if let Some(grid) = &grid {
-        renderer.set_grid(grid)?;
+        renderer.set_grid(grid, scene.revision())?;
     }
     let ms = renderer.render(scene, camera, size, &settings, None)?;
     log::info!("frame took {ms:.2} ms");

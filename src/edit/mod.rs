@@ -117,6 +117,7 @@ impl Edit {
                 let palette = &mut scene.palette;
                 let old_color = std::mem::replace(&mut palette.colors[i], *color);
                 let old_material = std::mem::replace(&mut palette.materials[i], (**material).clone());
+                scene.touch();
                 Ok(Edit::Palette { index: *index, color: old_color, material: Box::new(old_material) })
             }
         }

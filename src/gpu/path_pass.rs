@@ -110,10 +110,12 @@ pub struct PathKey {
     pub basis: RayBasis,
     pub settings: PathSettings,
     pub effects: Effects,
-    /// The world box of voxels tinted (`Renderer::path_highlight`).
+    /// The world box of voxels tinted (`PathOptions::highlight`).
     pub highlight: Option<(glam::IVec3, glam::IVec3)>,
-    /// The ground grid drawn (`Renderer::ground`), in world voxels.
+    /// The ground grid drawn (`PathOptions::grid`), in world voxels.
     pub ground: Option<super::layout::GroundGrid>,
+    /// The scene's revision (`Scene::revision`): an edit starts over.
+    pub revision: u64,
 }
 
 /// The path tracer's accumulation: its key, the samples so far, the lights
@@ -137,8 +139,8 @@ impl Default for Accumulation {
 impl Accumulation {
     /// Whether an accumulation of `key` starts over: the scene or the size
     /// changed, or the key (camera, settings, effects) differs.
-    pub fn starts_over(&self, key: &PathKey, resized: bool, scene_changed: bool) -> bool {
-        scene_changed || resized || self.key != Some(*key)
+    pub fn starts_over(&self, key: &PathKey, resized: bool, restart: bool) -> bool {
+        restart || resized || self.key != Some(*key)
     }
 }
 

@@ -55,8 +55,9 @@ pub enum FrameInput<'a> {
     Trace(Preview<'a>),
     Path {
         view: PathView<'a>,
-        /// The voxels or the palette changed since the accumulation began.
-        scene_changed: bool,
+        /// Start the accumulation over even where its key is the same (a
+        /// change to the scene shows in its revision, which the key holds).
+        restart: bool,
         /// What the frame shows over the samples, and wants of them.
         options: PathOptions,
     },
@@ -152,7 +153,8 @@ fn path_key(view: &PathView, options: &PathOptions) -> PathKey {
     let PathView { scene, camera, size, settings } = *view;
     let basis = camera.basis(size.0.max(1), size.1.max(1), scene.origin());
     let (highlight, ground) = (options.highlight, options.grid);
-    PathKey { basis, settings: *settings, effects: effects_for(scene, settings), highlight, ground }
+    let (effects, revision) = (effects_for(scene, settings), scene.revision());
+    PathKey { basis, settings: *settings, effects, highlight, ground, revision }
 }
 
 pub struct Renderer {
@@ -194,6 +196,8 @@ pub struct Renderer {
     pool_error: Option<crate::gpu_pool::PoolTooLarge>,
     /// What the frame being recorded holds, until it is submitted.
     recorded: Option<Recorded>,
+    /// The scene revision the dense grid was made from.
+    grid_of: Option<u64>,
 }
 
 impl Renderer {
@@ -221,6 +225,7 @@ impl Renderer {
             records_written: false,
             pool_error: None,
             recorded: None,
+            grid_of: None,
         })
     }
 
@@ -255,14 +260,22 @@ impl Renderer {
         }
     }
 
-    /// Uploads the dense grid the grid tracer walks.
+    /// Uploads the dense grid the grid tracer walks, made from the scene
+    /// of `revision`.
     ///
     /// # Errors
     /// [`GpuError::TooLarge`] when the grid is larger than a binding may be.
-    pub fn set_grid(&mut self, grid: &DenseGrid) -> Result<(), GpuError> {
+    pub fn set_grid(&mut self, grid: &DenseGrid, revision: u64) -> Result<(), GpuError> {
         self.gpu.check_binding("the dense grid", grid.data.len() as u64)?;
         self.buffers.upload_grid(&self.gpu.device, &self.gpu.queue, grid);
+        self.grid_of = Some(revision);
         Ok(())
+    }
+
+    /// The revision of the scene the dense grid was made from (see
+    /// [`Renderer::set_grid`]), if one was sent.
+    pub fn grid_of(&self) -> Option<u64> {
+        self.grid_of
     }
 
     /// Traces one frame and waits for it; returns the pass's milliseconds.
@@ -305,14 +318,14 @@ impl Renderer {
 
     /// Adds one path-traced sample per pixel to the accumulation and shows
     /// the mean. The accumulation restarts when the camera, the size, the
-    /// settings or the effect set change, and when `scene_changed` says the
+    /// settings or the effect set change, and when `restart` says the
     /// voxels or the palette did (the materials and lights are then sent
     /// again).
     ///
     /// # Errors
     /// As [`Renderer::render`].
-    pub fn render_path(&mut self, view: &PathView, scene_changed: bool) -> Result<PathFrame, GpuError> {
-        self.render_path_with(view, scene_changed, PathOptions::default())
+    pub fn render_path(&mut self, view: &PathView, restart: bool) -> Result<PathFrame, GpuError> {
+        self.render_path_with(view, restart, PathOptions::default())
     }
 
     /// [`Renderer::render_path`] with `options` (a tint, a grid, a target,
@@ -323,10 +336,10 @@ impl Renderer {
     pub fn render_path_with(
         &mut self,
         view: &PathView,
-        scene_changed: bool,
+        restart: bool,
         options: PathOptions,
     ) -> Result<PathFrame, GpuError> {
-        let submitted = self.render_frame(&FrameInput::Path { view: *view, scene_changed, options })?;
+        let submitted = self.render_frame(&FrameInput::Path { view: *view, restart, options })?;
         submitted.path.ok_or_else(|| GpuError::Readback("a path frame reported no sample".into()))
     }
 
@@ -360,9 +373,9 @@ impl Renderer {
                 encoder.pop_debug_group();
                 traced.map(|()| Recorded::Trace)
             }
-            FrameInput::Path { view, scene_changed, options } => {
+            FrameInput::Path { view, restart, options } => {
                 encoder.push_debug_group("path");
-                let traced = self.encode_path(encoder, &view, scene_changed, &options);
+                let traced = self.encode_path(encoder, &view, restart, &options);
                 encoder.pop_debug_group();
                 traced
             }
@@ -400,7 +413,7 @@ impl Renderer {
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         view: &PathView,
-        scene_changed: bool,
+        restart: bool,
         options: &PathOptions,
     ) -> Result<Recorded, GpuError> {
         let PathView { scene, size, settings, .. } = *view;
@@ -414,13 +427,14 @@ impl Renderer {
         let key = path_key(view, options);
         let effects = key.effects;
         // The materials and lights go up again when the scene or the effect set changed.
-        let send_scene = scene_changed || resized || acc.key.is_none_or(|k| k.effects != effects);
+        let send_scene =
+            restart || resized || acc.key.is_none_or(|k| k.effects != effects || k.revision != key.revision);
         if send_scene {
             let lights = if effects.emit { lights::emitters(scene.drawn(), &scene.palette) } else { Vec::new() };
             self.path.upload_scene(gpu, &self.buffers, &material_table(&scene.palette), &lights);
             acc.lights = lights.len();
         }
-        if acc.starts_over(&key, resized, scene_changed) {
+        if acc.starts_over(&key, resized, restart) {
             acc.samples = 0;
             acc.key = Some(key);
             acc.band.0 = 0;
@@ -608,13 +622,18 @@ impl Renderer {
         PathFrame { ms: acc.band_ms, samples: acc.samples, effects, kernel, lights: acc.lights, added }
     }
 
+    /// Drops the accumulation: the next path-traced frame starts over.
+    pub fn forget_path(&mut self) {
+        self.path.accumulation.key = None;
+    }
+
     /// Whether [`Renderer::render_path`] with these arguments would start
     /// the accumulation over. The window then traces the preview first: it
     /// is shown until the new accumulation's first sample, which may come
     /// in bands, is complete.
-    pub fn path_restarts(&self, view: &PathView, scene_changed: bool, options: &PathOptions) -> bool {
+    pub fn path_restarts(&self, view: &PathView, restart: bool, options: &PathOptions) -> bool {
         let resized = self.path.size() != (view.size.0.max(1), view.size.1.max(1));
-        self.path.accumulation.starts_over(&path_key(view, options), resized, scene_changed)
+        self.path.accumulation.starts_over(&path_key(view, options), resized, restart)
     }
 
     /// Compiles the path kernel a scene needs with `settings` now, so that the

@@ -184,41 +184,56 @@ impl Scene {
         if self.objects.is_some() {
             return Err(ObjectRefusal::NothingToEdit.into());
         }
-        self.tree.apply_brush(shape, op)
+        let patch = self.tree.apply_brush(shape, op);
+        self.touched(patch)
     }
 
     /// Puts back the one model's cells from an undo patch.
     pub fn apply_patch(&mut self, patch: &Patch) -> Result<Patch, EditError> {
-        self.tree.apply_patch(patch)
+        let undo = self.tree.apply_patch(patch);
+        self.touched(undo)
     }
 
     /// Applies a world brush to object `index`'s model (every placement of
     /// it shows the change); returns the model and its undo patch.
     pub fn apply_in_object(&mut self, index: usize, shape: &Shape, op: Op) -> Result<(usize, Patch), EditError> {
         let (objects, tree) = self.objects_and_drawn_mut()?;
-        objects.apply_brush(tree, index, shape, op)
+        let applied = objects.apply_brush(tree, index, shape, op);
+        self.touched(applied)
     }
 
     /// Puts back model `model`'s cells from an undo patch.
     pub fn apply_model_patch(&mut self, model: usize, patch: &Patch) -> Result<Patch, EditError> {
         let (objects, tree) = self.objects_and_drawn_mut()?;
-        objects.apply_patch(tree, model, patch)
+        let undo = objects.apply_patch(tree, model, patch);
+        self.touched(undo)
     }
 
     /// Changes the scene graph; returns the change that undoes it.
     pub fn apply_graph_change(&mut self, change: &GraphChange) -> Result<GraphChange, EditError> {
         let (objects, tree) = self.objects_and_drawn_mut()?;
-        objects.apply_change(tree, change)
+        let undo = objects.apply_change(tree, change);
+        self.touched(undo)
     }
 
     /// Stores a model that nothing places yet.
     pub fn push_model(&mut self, model: Model) -> Result<usize, EditError> {
-        Ok(self.objects_and_drawn_mut()?.0.push_model(model))
+        let index = self.objects_and_drawn_mut()?.0.push_model(model);
+        self.touched(Ok(index))
     }
 
     /// Takes the last model out, unless it is placed.
     pub fn pop_model(&mut self) -> Result<Model, EditError> {
-        self.objects_and_drawn_mut()?.0.pop_model()
+        let model = self.objects_and_drawn_mut()?.0.pop_model();
+        self.touched(model)
+    }
+
+    /// `result`, after a new revision where it is a change made.
+    fn touched<T>(&mut self, result: Result<T, EditError>) -> Result<T, EditError> {
+        if result.is_ok() {
+            self.touch();
+        }
+        result
     }
 
     /// The objects and the drawn tree, for a change to the objects that

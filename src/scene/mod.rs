@@ -64,7 +64,7 @@ pub fn grow_bounds(bounds: Option<(IVec3, IVec3)>, p: IVec3) -> (IVec3, IVec3) {
 /// or a scene of objects. The octree that is drawn is kept behind methods:
 /// callers ask the scene for voxels, bounds and uploads, and edits go
 /// through it, so what is drawn can change shape without touching them.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct Scene {
     pub palette: Palette,
     /// What is drawn: the one model, or the visible objects composed.
@@ -76,6 +76,23 @@ pub struct Scene {
     gpu: instances::GpuCopy,
     /// When a scene of objects is drawn as instances.
     instancing: Instancing,
+    /// Names the scene's content: every change to the voxels, the objects
+    /// or the palette takes a number no scene had before, so two scenes of
+    /// one revision draw alike (a renderer keeps what it made of one).
+    revision: u64,
+}
+
+impl Default for Scene {
+    /// An empty scene of the default palette, of a revision of its own.
+    fn default() -> Scene {
+        Scene::new(Palette::default(), Octree::default())
+    }
+}
+
+/// A revision no scene has had.
+fn fresh_revision() -> u64 {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+    NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }
 
 /// When a scene of objects is drawn as instances of its models rather than
@@ -109,14 +126,15 @@ fn draws_instances(objects: &objects::Objects, composed: &Octree) -> bool {
 impl Scene {
     /// A scene of one model.
     pub fn new(palette: Palette, tree: Octree) -> Scene {
-        Scene { palette, tree, objects: None, gpu: instances::GpuCopy::default(), instancing: Instancing::Auto }
+        let (gpu, instancing, revision) = (instances::GpuCopy::default(), Instancing::Auto, fresh_revision());
+        Scene { palette, tree, objects: None, gpu, instancing, revision }
     }
 
     /// A scene of objects whose visible ones `tree` draws, composed (what a
     /// loader that stores the composed tree reads back).
     pub fn with_objects(palette: Palette, tree: Octree, objects: objects::Objects) -> Scene {
-        let gpu = instances::GpuCopy::default();
-        Scene { palette, tree, objects: Some(Box::new(objects)), gpu, instancing: Instancing::Auto }
+        let (gpu, instancing, revision) = (instances::GpuCopy::default(), Instancing::Auto, fresh_revision());
+        Scene { palette, tree, objects: Some(Box::new(objects)), gpu, instancing, revision }
     }
 
     /// A scene of objects, its drawn tree composed from them.
@@ -155,6 +173,17 @@ impl Scene {
             Instancing::Auto => draws_instances(o, &self.tree),
             Instancing::References => o.has_references(),
         })
+    }
+
+    /// The revision of the scene's content (see the field): it changes with
+    /// every edit, undo and redo.
+    pub fn revision(&self) -> u64 {
+        self.revision
+    }
+
+    /// Gives the scene a new revision: its content changed.
+    pub fn touch(&mut self) {
+        self.revision = fresh_revision();
     }
 
     /// Sets when the scene is drawn as instances (the GPU copy follows at

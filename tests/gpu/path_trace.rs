@@ -388,6 +388,37 @@ fn a_new_effect_set_is_compiled_off_the_frame_path() {
     assert_eq!(frame.kernel, frame.effects);
 }
 
+/// Issue 46: the window kept the revision its accumulation was made from
+/// and told the renderer when the scene changed. The scene's revision is in
+/// the accumulation's key: an edit (or an undo, or a palette change) starts
+/// it over without the caller saying so; a frame of the same scene goes on.
+#[test]
+fn an_edit_starts_the_accumulation_over_by_the_scenes_revision() {
+    let mut editor = octovox::editor::Editor::default();
+    editor.set_scene(material_scene());
+    let camera = look(DVec3::new(18.0, 14.0, 26.0), DVec3::new(0.0, 3.0, 0.0));
+    let (size, settings, none) =
+        ((24, 18), PathSettings { bounces: 1, ..PathSettings::default() }, PathOptions::default());
+    let mut renderer = Renderer::headless().expect("a GPU adapter (lavapipe on CI)");
+    let lines = ["place 0 13 0", "undo 1", "rgb 2 1 2 3"];
+    renderer.sync(&mut editor.scene);
+    for line in lines {
+        let view = PathView { scene: &editor.scene, camera: &camera, size, settings: &settings };
+        let first = renderer.render_path(&view, false).unwrap().samples;
+        let frame = renderer.render_path(&view, false).unwrap();
+        assert_eq!(frame.samples, first + 1, "the same scene goes on accumulating");
+        assert!(!renderer.path_restarts(&view, false, &none));
+        let before = editor.scene.revision();
+        let script = octovox::script::parse_script(std::path::Path::new("t.ovr"), line).unwrap();
+        editor.run(&script.lines[0].command).unwrap();
+        assert_ne!(editor.scene.revision(), before, "`{line}` gives the scene a new revision");
+        renderer.sync(&mut editor.scene);
+        let view = PathView { scene: &editor.scene, camera: &camera, size, settings: &settings };
+        assert!(renderer.path_restarts(&view, false, &none), "`{line}` starts the accumulation over");
+        assert_eq!(renderer.render_path(&view, false).unwrap().samples, 1, "after `{line}`");
+    }
+}
+
 #[test]
 fn a_sample_split_in_bands_equals_a_whole_one() {
     // The window spreads a slow sample over frames (`Renderer::path_bands`):

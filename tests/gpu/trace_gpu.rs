@@ -21,7 +21,7 @@ fn renderer_for(scene: &mut Scene) -> Renderer {
     renderer.hit_records = true;
     renderer.sync(scene);
     if let Ok(grid) = DenseGrid::from_octree(scene.drawn()) {
-        renderer.set_grid(&grid).unwrap();
+        renderer.set_grid(&grid, scene.revision()).unwrap();
     }
     renderer
 }
@@ -303,7 +303,7 @@ fn frame_times_stay_plausible_after_path_traced_frames() {
     let camera = octovox::scene::showroom::interior_camera();
     let mut renderer = Renderer::headless().unwrap();
     renderer.sync(&mut scene);
-    renderer.set_grid(&DenseGrid::from_octree(scene.drawn()).unwrap()).unwrap();
+    renderer.set_grid(&DenseGrid::from_octree(scene.drawn()).unwrap(), scene.revision()).unwrap();
     let settings = RenderSettings { mode: TraceMode::Grid, ..RenderSettings::default() };
     let size = (480, 270);
     renderer.render(&scene, &camera, size, &settings, None).unwrap();
