@@ -169,3 +169,23 @@ pub enum AppCommand {
     RecoverJournal(PathBuf, octovox::journal::Checks),
     DiscardJournal(PathBuf),
 }
+
+impl AppCommand {
+    /// Whether the command edits the scene: refused while a file loads
+    /// (the scene it would edit is about to be replaced).
+    pub fn edits_scene(&self) -> bool {
+        matches!(
+            self,
+            AppCommand::PointerEdit { .. }
+                | AppCommand::ExtrudeDrag { .. }
+                | AppCommand::EditPalette { .. }
+                | AppCommand::Cut
+                | AppCommand::DeleteSelection
+                | AppCommand::PasteAtCursor
+                | AppCommand::Nudge(_)
+                | AppCommand::Turn { .. }
+                | AppCommand::Undo
+                | AppCommand::Redo
+        )
+    }
+}

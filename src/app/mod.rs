@@ -314,45 +314,31 @@ impl App {
     /// Carries out one command. Panels, keys, the mouse and played replay
     /// scripts all end up here.
     fn execute(&mut self, command: AppCommand, event_loop: &ActiveEventLoop) {
-        let busy_loading = self.doc.loading.is_some();
+        if command.edits_scene() && self.doc.loading.is_some() {
+            return self.ui.info("still loading…");
+        }
         match command {
-            AppCommand::PointerEdit { phase, tool, x, y } if !busy_loading => self.pointer_edit(phase, tool, x, y),
-            AppCommand::ExtrudeDrag { phase, x, y } if !busy_loading => self.extrude_drag(phase, x, y),
-            AppCommand::EditPalette { edit, dragging } if !busy_loading => self.palette_edit(edit, dragging),
-            AppCommand::Cut if !busy_loading => self.act(octovox::script::Line::Cut, "cut"),
+            AppCommand::PointerEdit { phase, tool, x, y } => self.pointer_edit(phase, tool, x, y),
+            AppCommand::ExtrudeDrag { phase, x, y } => self.extrude_drag(phase, x, y),
+            AppCommand::EditPalette { edit, dragging } => self.palette_edit(edit, dragging),
+            AppCommand::Cut => self.act(octovox::script::Line::Cut, "cut"),
             // Object mode: Delete and X/Y/Z act on the picked object.
-            AppCommand::DeleteSelection if !busy_loading && self.state.mode == Mode::Object => {
+            AppCommand::DeleteSelection if self.state.mode == Mode::Object => {
                 self.act(octovox::script::Line::Object(octovox::script::ObjectLine::Delete), "object")
             }
-            AppCommand::Turn { axis, flip: false } if !busy_loading && self.state.mode == Mode::Object => {
+            AppCommand::Turn { axis, flip: false } if self.state.mode == Mode::Object => {
                 self.act(octovox::script::Line::Object(octovox::script::ObjectLine::Rotate(axis)), "object")
             }
             AppCommand::Turn { flip: true, .. } if self.state.mode == Mode::Object => {
                 self.ui.info("an object turns (X, Y, Z) but does not flip");
             }
-            AppCommand::DeleteSelection if !busy_loading => self.act(octovox::script::Line::Delete, "delete"),
-            AppCommand::PasteAtCursor if !busy_loading => self.paste_at_cursor(),
-            AppCommand::Nudge(nudge) if !busy_loading => self.nudge(nudge),
-            AppCommand::Turn { axis, flip: false } if !busy_loading => {
-                self.act(octovox::script::Line::Rotate(axis), "rotate")
-            }
-            AppCommand::Turn { axis, flip: true } if !busy_loading => {
-                self.act(octovox::script::Line::Flip(axis), "flip")
-            }
-            AppCommand::Undo if !busy_loading => self.undo_redo(true),
-            AppCommand::Redo if !busy_loading => self.undo_redo(false),
-            AppCommand::PointerEdit { .. }
-            | AppCommand::Cut
-            | AppCommand::DeleteSelection
-            | AppCommand::PasteAtCursor
-            | AppCommand::Nudge(_)
-            | AppCommand::Turn { .. }
-            | AppCommand::ExtrudeDrag { .. }
-            | AppCommand::EditPalette { .. }
-            | AppCommand::Undo
-            | AppCommand::Redo => {
-                self.ui.info("still loading…");
-            }
+            AppCommand::DeleteSelection => self.act(octovox::script::Line::Delete, "delete"),
+            AppCommand::PasteAtCursor => self.paste_at_cursor(),
+            AppCommand::Nudge(nudge) => self.nudge(nudge),
+            AppCommand::Turn { axis, flip: false } => self.act(octovox::script::Line::Rotate(axis), "rotate"),
+            AppCommand::Turn { axis, flip: true } => self.act(octovox::script::Line::Flip(axis), "flip"),
+            AppCommand::Undo => self.undo_redo(true),
+            AppCommand::Redo => self.undo_redo(false),
             AppCommand::ApplyPreset(i) => {
                 if let Some(preset) = presets::PRESETS.get(i) {
                     preset.apply(&mut self.state);
