@@ -45,6 +45,47 @@ pub(super) struct Stroke {
     pub last_center: Option<IVec3>,
 }
 
+/// A step a stroke takes: the line it runs, the face layer it is on, and
+/// whether it is the stroke's first (which picks the object it hits).
+#[derive(Debug, PartialEq)]
+pub(super) struct StrokeStep {
+    pub line: octovox::script::Line,
+    pub layer: (IVec3, i32),
+    pub center: IVec3,
+    pub first: bool,
+}
+
+impl Stroke {
+    /// The step the pointer over `pick` makes, with a brush of `reach`:
+    /// none where the brush would land where the last step did, or (Attach
+    /// and Erase) off the face the stroke started on by more than the
+    /// reach (the cells a stroke reveals or creates would otherwise be
+    /// picked next, and it would dig or pile up toward the camera), or
+    /// where Attach has no face (the camera inside a voxel).
+    pub fn step_at(&self, pick: &Pick, reach: i32) -> Option<StrokeStep> {
+        if self.tool == Tool::Attach && pick.normal == IVec3::ZERO {
+            return None;
+        }
+        let layer = (pick.normal, pick.voxel.dot(pick.normal));
+        let off_layer = |(normal, depth): (IVec3, i32)| normal != layer.0 || (layer.1 - depth).abs() > reach;
+        if self.tool != Tool::Paint && self.plane.is_some_and(off_layer) {
+            return None;
+        }
+        let center = octovox::edit::brush::click_target(self.tool, pick.voxel, pick.normal);
+        if self.last_center == Some(center) {
+            return None;
+        }
+        let line = octovox::script::edit_command(self.tool, center);
+        Some(StrokeStep { line, layer, center, first: self.last_center.is_none() })
+    }
+
+    /// The stroke after `step` ran.
+    pub fn stepped(&mut self, step: &StrokeStep) {
+        self.plane.get_or_insert(step.layer);
+        self.last_center = Some(step.center);
+    }
+}
+
 impl Gesture {
     /// Whether the gesture's edits are one undo step (between the `stroke
     /// begin` and `stroke end` it runs): a brush stroke, a held palette
@@ -81,5 +122,99 @@ impl Gesture {
             Gesture::Select { preview, .. } => *preview,
             _ => None,
         }
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)] // in tests a panic is the failure report
+mod tests {
+    use glam::IVec3;
+    use octovox::camera::Camera;
+    use octovox::editor::Editor;
+    use octovox::replay::Recorder;
+    use octovox::scene::{Octree, Op, Palette, Scene, Shape};
+    use octovox::script::Line;
+
+    use super::{Stroke, Tool};
+    use crate::app::state::Pick;
+
+    /// A 8 × 1 × 8 floor of colour 1 at y = 0.
+    fn floor() -> Editor {
+        let mut tree = Octree::default();
+        tree.apply_brush(&Shape::Box { min: IVec3::ZERO, max: IVec3::new(7, 0, 7) }, Op::Place(1)).unwrap();
+        let mut editor = Editor::default();
+        editor.set_scene(Scene::new(Palette::default(), tree));
+        editor
+    }
+
+    /// A stroke of `tool` over `picks`, as the window runs it: `stroke
+    /// begin`, a step's line wherever the stroke takes one, `stroke end`;
+    /// each line through the editor and the recorder (a journal writes the
+    /// same). Returns the recorded lines.
+    fn stroke(editor: &mut Editor, tool: Tool, picks: &[Pick]) -> Vec<String> {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("journal.ovr");
+        let mut recorder = Recorder::create(&path).unwrap();
+        let mut run = |editor: &mut Editor, line: &Line| {
+            editor.run(line).unwrap();
+            recorder.ran(line, &editor.tools, &Camera::default()).unwrap();
+        };
+        run(editor, &Line::Stroke(true));
+        let mut open = Stroke { tool, plane: None, last_center: None };
+        for pick in picks {
+            if let Some(step) = open.step_at(pick, editor.tools.brush.reach()) {
+                run(editor, &step.line);
+                open.stepped(&step);
+            }
+        }
+        run(editor, &Line::Stroke(false));
+        drop(recorder);
+        let text = std::fs::read_to_string(&path).unwrap();
+        text.lines()
+            .filter(|l| !l.starts_with('#') && !l.starts_with("camera") && *l != "perspective")
+            .map(String::from)
+            .collect()
+    }
+
+    fn top(x: i32, z: i32) -> Pick {
+        Pick { voxel: IVec3::new(x, 0, z), normal: IVec3::Y, value: 1 }
+    }
+
+    /// Issue 46: gestures were tested only through Xvfb. An Attach drag
+    /// along the floor: a voxel on each new cell of the floor's top (the
+    /// pointer resting on one cell adds nothing; the top of a voxel the
+    /// stroke just placed is off its layer and adds nothing), one undo
+    /// step, and the lines a journal gets.
+    #[test]
+    fn an_attach_stroke_places_along_its_face_in_one_undo_step() {
+        let mut editor = floor();
+        let placed_top = Pick { voxel: IVec3::new(1, 1, 2), normal: IVec3::Y, value: 1 };
+        let picks = [top(1, 2), top(1, 2), placed_top, top(2, 2), top(3, 2)];
+        let lines = stroke(&mut editor, Tool::Attach, &picks);
+        assert_eq!(
+            lines,
+            ["brush voxel", "color 1", "stroke begin", "place 1 1 2", "place 2 1 2", "place 3 1 2", "stroke end"]
+        );
+        assert_eq!(editor.history.steps(), (1, 0), "one undo step");
+        assert_eq!(editor.scene.solid_voxels(), 64 + 3);
+        editor.run(&Line::Undo(1)).unwrap();
+        assert_eq!(editor.scene.solid_voxels(), 64, "one undo takes the stroke away");
+    }
+
+    /// An Erase drag digs one layer, and a Paint drag follows the pointer
+    /// to any face; a stroke that edits nothing leaves no step and no lines.
+    #[test]
+    fn erase_stays_on_its_layer_paint_goes_anywhere_and_an_empty_stroke_is_nothing() {
+        let mut editor = floor();
+        let below = Pick { voxel: IVec3::new(2, -1, 2), normal: IVec3::Y, value: 1 };
+        let lines = stroke(&mut editor, Tool::Erase, &[top(1, 1), below, top(2, 1)]);
+        assert_eq!(lines, ["brush voxel", "stroke begin", "remove 1 0 1", "remove 2 0 1", "stroke end"]);
+        let side = Pick { voxel: IVec3::new(7, 0, 5), normal: IVec3::X, value: 1 };
+        let lines = stroke(&mut editor, Tool::Paint, &[top(4, 4), side]);
+        assert_eq!(lines, ["brush voxel", "color 1", "stroke begin", "paint 4 0 4", "paint 7 0 5", "stroke end"]);
+        assert_eq!(editor.history.steps(), (2, 0));
+        let inside = Pick { voxel: IVec3::new(3, 0, 3), normal: IVec3::ZERO, value: 1 };
+        assert!(stroke(&mut editor, Tool::Attach, &[inside]).is_empty(), "no face to attach to");
+        assert_eq!(editor.history.steps(), (2, 0), "an empty stroke leaves no step");
     }
 }

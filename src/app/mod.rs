@@ -729,38 +729,17 @@ impl App {
                 return;
             }
         };
-        if stroke.tool == Tool::Attach && pick.normal == IVec3::ZERO {
-            return; // the camera is inside a voxel: no face to attach to
-        }
-        let layer = (pick.normal, pick.voxel.dot(pick.normal));
-        // Attach and Erase strokes stay on the face they started on, within
-        // the brush's reach of its layer: the cells they reveal or create
-        // would otherwise be picked next and the stroke would dig or pile up
-        // toward the camera.
-        let reach = self.doc.editor.tools.brush.reach();
-        let off_layer = |(normal, depth): (IVec3, i32)| normal != layer.0 || (layer.1 - depth).abs() > reach;
-        if stroke.tool != Tool::Paint && stroke.plane.is_some_and(off_layer) {
-            return;
-        }
-        let center = octovox::edit::brush::click_target(stroke.tool, pick.voxel, pick.normal);
-        if stroke.last_center == Some(center) {
-            return;
-        }
+        let Some(step) = stroke.step_at(&pick, self.doc.editor.tools.brush.reach()) else { return };
         // The stroke's first step picks the object it hits (it edits that
         // one to the end); each step is the script line a click there is:
         // the same path as every line, recorded and journaled as one edit
         // of the stroke.
-        let first = stroke.last_center.is_none();
-        let line = octovox::script::edit_command(stroke.tool, center);
-        let picked = self.doc.editor.object_line_at(pick.voxel).filter(|_| first);
+        let picked = self.doc.editor.object_line_at(pick.voxel).filter(|_| step.first);
         let ran = picked
             .map_or(Ok(()), |picked| self.run_line(&picked).map(|_| ()))
-            .and_then(|()| self.run_line(&line).map(|_| ()));
+            .and_then(|()| self.run_line(&step.line).map(|_| ()));
         match ran {
-            Ok(_) => self.with_stroke(|stroke| {
-                stroke.plane.get_or_insert(layer);
-                stroke.last_center = Some(center);
-            }),
+            Ok(_) => self.with_stroke(|stroke| stroke.stepped(&step)),
             Err(err) => self.ui.error(format!("edit refused: {err}")),
         }
     }
