@@ -22,6 +22,7 @@ mod clock;
 mod command;
 mod dialog_kind;
 mod document;
+mod drag;
 mod egui_layers;
 mod file_dialog;
 mod files;
@@ -615,15 +616,17 @@ impl App {
     }
 
     /// The whole voxel steps along `normal` that a drag from window pixel
-    /// `start` to `end` covers, as the step from the (tree-local) point
-    /// `face` is drawn on screen: extrudes and selection handles.
+    /// `start` to `end` covers at the (tree-local) point `face`
+    /// ([`drag::screen_steps`] through the window's camera): extrudes and
+    /// selection handles.
     fn screen_steps(&self, face: glam::Vec3, normal: IVec3, start: (f64, f64), end: (f64, f64)) -> Option<i32> {
+        drag::screen_steps(&self.view_basis(), face, normal, start, end)
+    }
+
+    /// The camera's rays over the whole window, tree-local.
+    pub(super) fn view_basis(&self) -> octovox::camera::RayBasis {
         let (w, h) = self.window_size();
-        let basis = self.state.camera.basis(w, h, self.doc.editor.scene.origin());
-        let (a, b) = (basis.project(face)?, basis.project(face + normal.as_vec3())?);
-        let step = glam::DVec2::new(f64::from(b.0 - a.0), f64::from(b.1 - a.1));
-        let drag = glam::DVec2::new(end.0 - start.0, end.1 - start.1);
-        Some((drag.dot(step) / step.length_squared().max(1e-6)).round() as i32)
+        self.state.camera.basis(w, h, self.doc.editor.scene.origin())
     }
 
     /// Measures the quality presets from the current camera (a second or

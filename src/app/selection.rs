@@ -67,14 +67,7 @@ impl App {
                 let (lo, hi) = box_corners(&region, self.doc.editor.scene.origin());
                 let face = (lo + hi) * 0.5 + normal.as_vec3() * (hi - lo) * 0.5;
                 let steps = self.screen_steps(face, normal, start, (x, y))?;
-                // The face moves along its normal; the box never turns inside out.
-                let (mut min, mut max) = (region.min, region.max);
-                if normal.element_sum() > 0 {
-                    max = (max + normal * steps).max(min);
-                } else {
-                    min = (min + normal * steps).min(max);
-                }
-                Region::new(min, max).ok()
+                super::drag::moved_face(&region, normal, steps)
             }
         }
     }
@@ -158,20 +151,7 @@ impl App {
     /// of those two axes there. (A move can grow the tree and move its
     /// origin, hence world coordinates until here.)
     fn ground_steps(&self, at: IVec3, start: (f64, f64), end: (f64, f64)) -> Option<IVec3> {
-        let (w, h) = self.window_size();
-        let origin = self.doc.editor.scene.origin();
-        let basis = self.state.camera.basis(w, h, origin);
-        let at = (at - origin).as_vec3() + Vec3::splat(0.5);
-        let screen = |p: Vec3| basis.project(p).map(|(x, y)| glam::DVec2::new(f64::from(x), f64::from(y)));
-        let origin = screen(at)?;
-        let (sx, sz) = (screen(at + Vec3::X)? - origin, screen(at + Vec3::Z)? - origin);
-        let det = sx.perp_dot(sz);
-        if det.abs() < 1e-3 {
-            return None; // the ground is seen edge-on
-        }
-        let drag = glam::DVec2::new(end.0 - start.0, end.1 - start.1);
-        let (a, b) = (drag.perp_dot(sz) / det, sx.perp_dot(drag) / det);
-        Some(IVec3::new(a.round() as i32, 0, b.round() as i32))
+        super::drag::ground_steps(&self.view_basis(), at - self.doc.editor.scene.origin(), start, end)
     }
 }
 
