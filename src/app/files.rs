@@ -194,6 +194,9 @@ impl App {
     /// Saves atomically; reports the outcome in the UI and on stdout. A
     /// read-only file is not replaced: the user is asked first.
     pub(super) fn save_document(&mut self, path: &Path, options: WriteOptions) -> bool {
+        // A save ends the drag under way: the file holds whole undo steps,
+        // and a journal started after it never begins inside one.
+        self.close_strokes();
         if !options.overwrite_read_only && octovox::io::atomic::is_read_only(path) {
             report!("asking: {} is read-only", path.display());
             self.ui.replace = Some(ui::Replace { path: path.to_path_buf(), read_only: true });

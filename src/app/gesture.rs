@@ -156,8 +156,8 @@ mod tests {
         let path = dir.path().join("journal.ovr");
         let mut recorder = Recorder::create(&path).unwrap();
         let mut run = |editor: &mut Editor, line: &Line| {
-            editor.run(line).unwrap();
-            recorder.ran(line, &editor.tools, &Camera::default()).unwrap();
+            let changed = editor.run(line).unwrap() == octovox::editor::Outcome::Changed;
+            recorder.ran(line, &editor.tools, &Camera::default(), changed).unwrap();
         };
         run(editor, &Line::Stroke(true));
         let mut open = Stroke { tool, plane: None, last_center: None };

@@ -31,8 +31,10 @@ impl App {
     /// the editor has closed its undo step, and the recording and the
     /// journal count steps by the same rule (`Line::ends_stroke`).
     pub(super) fn run_script_line(&mut self, base: &Path, line: &Line) -> Result<StepResult, StepError> {
-        if line.ends_stroke() && self.gesture.groups_edits() {
-            self.gesture = super::gesture::Gesture::Idle;
+        // Ended by its own line first, so that the recording and the journal
+        // close it even where `line` is then refused.
+        if line.ends_stroke() && self.doc.editor.history.stroke_open() {
+            self.end_stroke();
         }
         let result = step(self, base, line)?;
         if let StepResult::Ran(Ran { line, outcome, selection, picked }) = &result {
@@ -57,7 +59,8 @@ impl App {
             self.open_journal(selection);
         }
         let (tools, camera) = (self.doc.editor.tools, self.state.camera);
-        let ran = |r: &mut Recorder| r.ran(line, &tools, &camera);
+        let changed = matches!(outcome, Outcome::Changed);
+        let ran = |r: &mut Recorder| r.ran(line, &tools, &camera, changed);
         match (outcome, line) {
             // Undo and redo: the journal gets them as lines only if it holds the steps.
             (Outcome::Changed, Line::Undo(n) | Line::Redo(n)) => {

@@ -155,8 +155,9 @@ impl App {
             .map(|i| Line::Object(octovox::script::ObjectLine::Pick(octovox::script::ObjectRef::Index(i))));
         let selection = selection.into_iter().chain(picked);
         let (lines, stamp) = (&self.doc.journal_start.lines, &self.doc.journal_start.stamp);
-        // A journal that starts within a stroke (its first edit is one)
-        // begins the stroke too, so that recovery makes the same steps.
+        // A journal that starts within a stroke (its first change is one of
+        // the stroke's: a save ends strokes, so its earlier edits are in no
+        // file) begins the stroke too, so that recovery makes the same steps.
         let stroke = self.doc.editor.history.stroke_open();
         let (tools, camera) = (self.doc.editor.tools, self.state.camera);
         let started = Recorder::journal(&path, &header).and_then(|mut journal| {
@@ -166,7 +167,7 @@ impl App {
                 }
                 lines.iter().cloned().chain(selection.clone()).try_for_each(|line| journal.scene(line))?;
                 if stroke {
-                    journal.ran(&Line::Stroke(true), &tools, &camera)?;
+                    journal.ran(&Line::Stroke(true), &tools, &camera, false)?;
                 }
                 Ok(())
             };

@@ -688,10 +688,16 @@ impl App {
     /// end`, which closes its undo step in the history, the recording and
     /// the journal alike.
     pub(super) fn close_strokes(&mut self) {
-        if !self.gesture.groups_edits() {
-            return;
+        if self.gesture.groups_edits() {
+            self.end_stroke();
         }
-        self.gesture = Gesture::Idle;
+    }
+
+    /// Runs `stroke end`; the drag that made the stroke is over.
+    pub(super) fn end_stroke(&mut self) {
+        if self.gesture.groups_edits() {
+            self.gesture = Gesture::Idle;
+        }
         if let Err(err) = self.run_line(&octovox::script::Line::Stroke(false)) {
             self.ui.error(format!("stroke refused: {err}"));
         }

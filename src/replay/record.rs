@@ -122,11 +122,11 @@ impl Recorder {
 
     /// A line the editor ran (`octovox::editor::Editor::run`) with `tools`
     /// in force: edit lines after the state they depend on where it
-    /// changed, each one undo step or one edit of the open stroke;
-    /// `stroke`, `select` and `copy` lines as they are. Brush, colour and
-    /// mirror lines are written before the next edit that uses them;
-    /// expectations and file lines are not part of a recording.
-    pub fn ran(&mut self, command: &Line, tools: &Tools, camera: &Camera) -> std::io::Result<()> {
+    /// changed, each one undo step or one edit of the open stroke (an edit
+    /// that `changed` nothing makes no step and is not written); `stroke`,
+    /// `select` and `copy` lines as they are; tool lines as they change
+    /// the tools. Expectations and file lines are not part of a recording.
+    pub fn ran(&mut self, command: &Line, tools: &Tools, camera: &Camera, changed: bool) -> std::io::Result<()> {
         if command.ends_stroke() {
             self.end_stroke()?;
         }
@@ -186,6 +186,9 @@ impl Recorder {
             // A load runs as the `palette set` it became; a save is a file line.
             | Line::Palette(PaletteLine::Load(_) | PaletteLine::Save(_)) => return Ok(()),
         };
+        if !changed {
+            return Ok(());
+        }
         self.edit_state(camera, tools.brush, color, &tools.mirror)?;
         self.undone = 0;
         match self.stroke {
@@ -317,7 +320,7 @@ mod tests {
         let text = ["object 2", "object hide", "layer 1 hide", "object move 1 0 0", "rotate y", "flip x"];
         let script = crate::script::parse_script(&path, &text.join("\n")).unwrap();
         for line in &script.lines {
-            recorder.ran(&line.command, &Tools::default(), &Camera::default()).unwrap();
+            recorder.ran(&line.command, &Tools::default(), &Camera::default(), true).unwrap();
         }
         drop(recorder);
         let written = std::fs::read_to_string(&path).unwrap();
@@ -365,11 +368,11 @@ mod tests {
         ];
         let script = crate::script::parse_script(&path, &lines.join("\n")).unwrap();
         for line in &script.lines {
-            window.run(&line.command).unwrap();
+            let changed = window.run(&line.command).unwrap() == crate::editor::Outcome::Changed;
             let ran = if line.command == Line::New {
                 recorder.scene(Line::New)
             } else {
-                recorder.ran(&line.command, &window.tools, &Camera::default())
+                recorder.ran(&line.command, &window.tools, &Camera::default(), changed)
             };
             ran.unwrap();
         }
@@ -404,8 +407,8 @@ mod tests {
         let mut editor = crate::editor::Editor::default();
         let text = "brush sphere 3\nbrush sphere 3\ncolor 7\nmirror off\nmirror x 4.5\nbrush sphere 4\nplace 1 2 3\n";
         for line in crate::script::parse_script(&path, text).unwrap().lines {
-            editor.run(&line.command).unwrap();
-            recorder.ran(&line.command, &editor.tools, &Camera::default()).unwrap();
+            let changed = editor.run(&line.command).unwrap() == crate::editor::Outcome::Changed;
+            recorder.ran(&line.command, &editor.tools, &Camera::default(), changed).unwrap();
         }
         drop(recorder);
         let written = std::fs::read_to_string(&path).unwrap();
@@ -415,6 +418,28 @@ mod tests {
             ["brush sphere 3", "color 7", "mirror off", "mirror x 4.5", "brush sphere 4", "perspective", "place 1 2 3"],
             "{written}"
         );
+    }
+
+    /// An edit that changes nothing (`palette set` of the colours there
+    /// are) makes no undo step in the editor, and the recorder writes none:
+    /// a journal counted one and could `undo` past what the window could.
+    #[test]
+    fn an_edit_that_changes_nothing_is_not_recorded() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("n.ovr");
+        let mut recorder = Recorder::create(&path).unwrap();
+        let mut editor = crate::editor::Editor::default();
+        for text in ["palette set 3 010203", "palette set 3 010203"] {
+            let line = crate::script::parse_script(&path, text).unwrap().lines.remove(0).command;
+            let changed = editor.run(&line).unwrap() == crate::editor::Outcome::Changed;
+            recorder.ran(&line, &editor.tools, &Camera::default(), changed).unwrap();
+        }
+        assert_eq!(editor.history.steps(), (1, 0));
+        recorder.undo().unwrap();
+        assert!(!recorder.can_undo(), "the recorder counts the editor's one step");
+        drop(recorder);
+        let written = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(written.matches("palette set").count(), 1, "{written}");
     }
 
     /// Issue 24, item 6: a journal whose first line could not be written

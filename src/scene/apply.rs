@@ -228,11 +228,11 @@ impl Scene {
         self.touched(model)
     }
 
-    /// `result`, after a new revision where it is a change made.
+    /// `result`, after a new revision: a change made, or a refusal that
+    /// may have changed cells before it came (a patch that cannot grow the
+    /// root, a model that cannot be composed again).
     fn touched<T>(&mut self, result: Result<T, EditError>) -> Result<T, EditError> {
-        if result.is_ok() {
-            self.touch();
-        }
+        self.touch();
         result
     }
 

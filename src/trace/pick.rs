@@ -19,10 +19,11 @@ pub fn pick(scene: &Scene, camera: &Camera, size: (u32, u32), x: u32, y: u32) ->
     Ok(hit.is_hit().then(|| Hit { voxel: hit.voxel + scene.origin(), ..hit }))
 }
 
-/// [`pick`], and where it finds no voxel and `ground` is on, the ground:
-/// the cell under the plane y = 0 where the pixel's ray, coming down from
-/// above it, crosses it (value 0, normal +y: Attach places on (x, 0, z)).
-/// The ground of an empty scene is what a first click builds on.
+/// [`pick`], and where `ground` is on and the ray comes down through the
+/// plane y = 0 before it meets a voxel (none, or one below the plane, which
+/// the drawn ground hides), the ground: the cell under the plane where the
+/// ray crosses it (value 0, normal +y: Attach places on (x, 0, z)). The
+/// ground of an empty scene is what a first click builds on.
 pub fn pick_with_ground(
     scene: &Scene,
     camera: &Camera,
@@ -31,6 +32,7 @@ pub fn pick_with_ground(
     ground: bool,
 ) -> Result<Option<Hit>, GaveUp> {
     match pick(scene, camera, size, x, y)? {
+        Some(hit) if ground && hit.voxel.y < 0 => Ok(ground_pick(camera, size, x, y).or(Some(hit))),
         Some(hit) => Ok(Some(hit)),
         None if ground => Ok(ground_pick(camera, size, x, y)),
         None => Ok(None),

@@ -86,3 +86,20 @@ fn the_ground_under_a_model_is_dark_where_the_model_hides_the_sun() {
     let sky = render_scene_cpu(&scene, None, &camera, size, &RenderSettings::default());
     assert_ne!(sky, image);
 }
+
+/// A click goes where the picture shows: with the ground on (drawn at
+/// y = 0), a voxel below the plane is hidden by it, and the pixel over it
+/// picks the ground, not the voxel (the review of issue 47's ground found
+/// clicks acting on hidden voxels).
+#[test]
+fn a_click_on_the_drawn_ground_picks_the_ground_not_a_voxel_under_it() {
+    let mut tree = Octree::default();
+    tree.apply_brush(&Shape::Box { min: IVec3::new(-20, -6, -20), max: IVec3::new(20, -3, 20) }, Op::Place(1)).unwrap();
+    let scene = Scene::new(Palette::default(), tree);
+    let camera = Camera { eye: DVec3::new(3.0, 30.0, 40.0), target: DVec3::ZERO, fov_y_deg: 50.0, ortho: None };
+    let (size, centre) = ((64, 48), (32, 24));
+    let hidden = octovox::trace::pick::pick_with_ground(&scene, &camera, size, centre, false).unwrap().unwrap();
+    assert!(hidden.value == 1 && hidden.voxel.y == -3, "{hidden:?}");
+    let shown = octovox::trace::pick::pick_with_ground(&scene, &camera, size, centre, true).unwrap().unwrap();
+    assert_eq!((shown.value, shown.voxel.y, shown.normal), (0, -1, IVec3::Y), "{shown:?}");
+}

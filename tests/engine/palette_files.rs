@@ -120,7 +120,8 @@ fn a_recording_of_a_load_needs_no_file() {
     for line in &script.lines {
         if let octovox::replay::StepResult::Ran(ran) = runner.step(dir.path(), line).unwrap() {
             let tools = runner.editor.tools;
-            recorder.ran(&ran.line, &tools, &octovox::camera::Camera::default()).unwrap();
+            let changed = ran.outcome == octovox::editor::Outcome::Changed;
+            recorder.ran(&ran.line, &tools, &octovox::camera::Camera::default(), changed).unwrap();
         }
     }
     // A file that fails to read changes nothing.

@@ -13,7 +13,9 @@ use octovox::settings::{PathSettings, RenderSettings};
 use octovox::trace::path::render_cpu;
 use octovox::trace::render::render_scene_cpu;
 
-use crate::path_trace::{WHITE, build, instanced_material_scene, look, material_scene, mean, palette, render_gpu};
+use crate::path_trace::{
+    WHITE, build, instanced_material_scene, look, material, material_scene, mean, palette, render_gpu,
+};
 
 /// A slab held up by a leg, and the ground under the leg's foot.
 fn table() -> (Scene, i32) {
@@ -83,4 +85,24 @@ fn gpu_and_cpu_path_trace_the_ground_alike() {
         println!("CPU mean {mc}, GPU mean {mg}, {differing} of {} pixels differ by more than 0.02", cpu.len());
         assert!(differing * 20 <= cpu.len(), "{differing} of {} pixels differ by more than 0.02", cpu.len());
     }
+}
+
+/// Glass resting on the ground: a path inside it that comes down to the
+/// plane bounces off the ground on both tracers (the CPU's took the ground
+/// for the glass's far side and let the sky in under it).
+#[test]
+fn glass_resting_on_the_ground_is_path_traced_alike_on_gpu_and_cpu() {
+    let mut palette = palette();
+    palette.materials[6] = material(octovox::scene::MaterialKind::Glass, &[("_ri", "1.5"), ("_trans", "1")]);
+    let tree = build(&[(Shape::Box { min: IVec3::new(-4, 0, -4), max: IVec3::new(4, 5, 4) }, Op::Place(6))]);
+    let mut scene = Scene::new(palette, tree);
+    let camera = look(DVec3::new(-14.0, 12.0, 18.0), DVec3::new(0.0, 1.0, 0.0));
+    let settings = PathSettings { bounces: 3, seed: 2, ground: Some(0), ..PathSettings::default() };
+    let (size, spp) = ((40, 30), 8);
+    let cpu = render_cpu(&scene, &camera, size, &settings, spp).pixels;
+    let (gpu, effects) = render_gpu(&mut scene, &camera, size, &settings, spp);
+    assert!(effects.glass, "{effects:?}");
+    let (mc, mg) = (mean(&cpu), mean(&gpu));
+    println!("CPU mean {mc}, GPU mean {mg}");
+    assert!((mc - mg).abs().max_element() < 0.01, "CPU mean {mc}, GPU mean {mg}");
 }

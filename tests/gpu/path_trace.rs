@@ -28,7 +28,7 @@ pub(crate) fn palette() -> Palette {
     palette
 }
 
-fn material(kind: MaterialKind, params: &[(&str, &str)]) -> Material {
+pub(crate) fn material(kind: MaterialKind, params: &[(&str, &str)]) -> Material {
     let mut m = Material::new(kind);
     for (k, v) in params {
         m.params.insert((*k).into(), (*v).into());

@@ -200,7 +200,10 @@ impl PathScene<'_> {
             let glass = |index: u8| self.materials[usize::from(index)].kind == MATERIAL_GLASS;
             let dir;
             // Leaving glass (into empty space or other glass), or entering it.
-            let leaving = self.effects.glass && medium != 0 && (value == 0 || glass(value));
+            // (The ground is no interface: a ray in glass that lands on it,
+            // under glass resting there, bounces off it as the GPU's does.)
+            let on_ground = surface == GROUND_SURFACE;
+            let leaving = self.effects.glass && medium != 0 && !on_ground && (value == 0 || glass(value));
             if !leaving && self.effects.emit && material.kind == MATERIAL_EMIT {
                 if !lights_counted {
                     radiance += beta * self.albedo[surface] * material.emission;
