@@ -201,6 +201,27 @@ mod tests {
         assert_eq!(editor.scene.solid_voxels(), 64, "one undo takes the stroke away");
     }
 
+    /// A line drag is one `line` from the cell in front of the pressed face
+    /// to the one in front of the released face (one undo step); a box
+    /// select is one `select` from the pressed cell to the released one (on
+    /// the ground, the cell on it).
+    #[test]
+    fn a_line_drag_and_a_box_select_are_one_line_each() {
+        let mut editor = floor();
+        let (press, release) = (top(1, 1), top(6, 1));
+        let line = Line::Segment(press.in_front(), release.in_front());
+        assert_eq!(line.to_string(), "line 1 1 1 6 1 1");
+        editor.run(&line).unwrap();
+        assert_eq!((editor.scene.solid_voxels(), editor.history.steps()), (64 + 6, (1, 0)));
+        let ground = Pick { voxel: IVec3::new(9, -1, 9), normal: IVec3::Y, value: 0 };
+        let select = Line::Select(Some((press.cell(), ground.cell())));
+        assert_eq!(select.to_string(), "select 1 0 1 9 0 9");
+        editor.run(&select).unwrap();
+        let region = editor.selection.unwrap();
+        assert_eq!((region.min, region.max), (IVec3::new(1, 0, 1), IVec3::new(9, 0, 9)));
+        assert_eq!(editor.history.steps(), (1, 0), "a selection is no undo step");
+    }
+
     /// An Erase drag digs one layer, and a Paint drag follows the pointer
     /// to any face; a stroke that edits nothing leaves no step and no lines.
     #[test]

@@ -553,7 +553,7 @@ impl App {
     /// release the end; the brush is placed along the line as one step.
     fn line_edit(&mut self, phase: StrokePhase, x: f64, y: f64) {
         let target = match self.pick_or_ground(x, y) {
-            Ok(Some(pick)) => Some(pick.voxel + pick.normal),
+            Ok(Some(pick)) => Some(pick.in_front()),
             Ok(None) => None,
             Err(gave_up) => {
                 self.ui.error(gave_up.to_string());

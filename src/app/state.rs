@@ -29,6 +29,12 @@ impl Pick {
     pub fn cell(&self) -> IVec3 {
         if self.value == 0 { self.voxel + self.normal } else { self.voxel }
     }
+
+    /// The cell in front of the picked face: where a line drag starts or
+    /// ends.
+    pub fn in_front(&self) -> IVec3 {
+        self.voxel + self.normal
+    }
 }
 
 /// The brush shapes the panel offers; switching shapes keeps each one's
