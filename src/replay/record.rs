@@ -9,7 +9,7 @@ use crate::camera::Camera;
 use crate::edit::brush::Brush;
 use crate::edit::mirror::Mirror;
 use crate::editor::Tools;
-use crate::script::{Line, ObjectLine, PaletteLine};
+use crate::script::{Kind, Line};
 
 /// Writes script lines as the user works. Lines are flushed as they are
 /// written, so a crash loses nothing that was recorded.
@@ -130,61 +130,37 @@ impl Recorder {
         if command.ends_stroke() {
             self.end_stroke()?;
         }
-        let color = match command {
-            Line::Stroke(begin) => {
+        let color = match command.kind() {
+            Kind::Edit { color } => color.then_some(tools.color),
+            Kind::Stroke => {
                 self.end_stroke()?;
-                self.stroke = begin.then_some(0);
+                self.stroke = (*command == Line::Stroke(true)).then_some(0);
                 return Ok(());
             }
-            Line::Place(_) | Line::Paint(_) | Line::Segment(..) | Line::Fill(_) => Some(tools.color),
-            Line::Remove(_)
-            | Line::Extrude(..)
-            | Line::Cut
-            | Line::Delete
-            | Line::Paste(_)
-            | Line::Move(_)
-            | Line::Rotate(_)
-            | Line::Flip(_)
-            | Line::Rgb(..)
-            | Line::Material(..)
-            | Line::Layer(..)
-            | Line::Palette(PaletteLine::Set { .. } | PaletteLine::Preset(_)) => None,
-            // Picking an object is tool state every later edit depends on.
-            Line::Object(ObjectLine::Pick(_)) => return self.command(command),
-            Line::Object(_) => None,
-            Line::Select(_) | Line::Copy => return self.command(command),
-            Line::Undo(n) => return (0..*n).try_for_each(|_| self.undo()),
-            Line::Redo(n) => return (0..*n).try_for_each(|_| self.redo()),
             // Tools as they change (the panels and keys run these lines);
             // again before an edit where the script's differ (after an
             // eyedropper pick, or where a journal goes on).
-            Line::Brush(brush) => return self.set_brush(*brush),
-            Line::Color(color) => return self.set_color(*color),
-            Line::Mirror(_) => return self.set_mirror(&tools.mirror),
-            // Scene, camera, file and expectation lines are not part of a
-            // recording (the camera is written before the edit that uses it).
-            Line::Load(_)
-            | Line::New
-            | Line::Demo(_)
-            | Line::Camera { .. }
-            | Line::Projection(_)
-            | Line::Viewport(..)
-            // Clicks are recorded as the edits they became: the ground is not needed.
-            | Line::Ground(_)
-            | Line::Pick(_)
-            | Line::Click { .. }
-            | Line::Save(_)
-            | Line::Render(_)
-            | Line::ExpectVoxel(..)
-            | Line::ExpectCount(_)
-            | Line::ExpectWritten(_)
-            | Line::ExpectImage(..)
-            | Line::ExpectEffects(_)
-            | Line::ExpectObjects(_)
-            | Line::ExpectModels(_)
-            | Line::ExpectPalette(..)
-            // A load runs as the `palette set` it became; a save is a file line.
-            | Line::Palette(PaletteLine::Load(_) | PaletteLine::Save(_)) => return Ok(()),
+            Kind::Tool => {
+                return match command {
+                    Line::Brush(brush) => self.set_brush(*brush),
+                    Line::Color(color) => self.set_color(*color),
+                    _ => self.set_mirror(&tools.mirror),
+                };
+            }
+            // Picking an object, selecting and copying: state later edits
+            // depend on.
+            Kind::State => return self.command(command),
+            Kind::History => {
+                return match *command {
+                    Line::Undo(n) => (0..n).try_for_each(|_| self.undo()),
+                    Line::Redo(n) => (0..n).try_for_each(|_| self.redo()),
+                    _ => Ok(()),
+                };
+            }
+            // Scenes are written by `Recorder::scene`; the camera before the
+            // edit that uses it; a click as the edit it became; files and
+            // checks are not part of a recording.
+            Kind::Scene | Kind::View | Kind::Host | Kind::Check => return Ok(()),
         };
         if !changed {
             return Ok(());

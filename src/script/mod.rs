@@ -121,15 +121,68 @@ pub enum Line {
 }
 
 impl Line {
+    /// What kind of line it is: the one place the editor's grouping, the
+    /// recorder and the journal read it from.
+    pub fn kind(&self) -> Kind {
+        match self {
+            Line::Place(_) | Line::Paint(_) | Line::Segment(..) | Line::Fill(_) => Kind::Edit { color: true },
+            Line::Remove(_)
+            | Line::Extrude(..)
+            | Line::Cut
+            | Line::Delete
+            | Line::Paste(_)
+            | Line::Move(_)
+            | Line::Rotate(_)
+            | Line::Flip(_)
+            | Line::Rgb(..)
+            | Line::Material(..)
+            | Line::Layer(..)
+            | Line::Object(
+                ObjectLine::New(_)
+                | ObjectLine::Move(_)
+                | ObjectLine::Rotate(_)
+                | ObjectLine::Duplicate { .. }
+                | ObjectLine::Unique
+                | ObjectLine::Regroup(..)
+                | ObjectLine::Merge(_)
+                | ObjectLine::Delete
+                | ObjectLine::Hide(_)
+                | ObjectLine::Lock(_)
+                | ObjectLine::Rename(_)
+                | ObjectLine::Layer(_),
+            )
+            | Line::Palette(PaletteLine::Set { .. } | PaletteLine::Preset(_)) => Kind::Edit { color: false },
+            Line::Stroke(_) => Kind::Stroke,
+            Line::Brush(_) | Line::Color(_) | Line::Mirror(_) => Kind::Tool,
+            Line::Object(ObjectLine::Pick(_)) | Line::Select(_) | Line::Copy => Kind::State,
+            Line::Undo(_) | Line::Redo(_) => Kind::History,
+            Line::Load(_) | Line::New | Line::Demo(_) => Kind::Scene,
+            Line::Camera { .. } | Line::Viewport(..) | Line::Projection(_) => Kind::View,
+            Line::Ground(_)
+            | Line::Pick(_)
+            | Line::Click { .. }
+            | Line::Save(_)
+            | Line::Render(_)
+            | Line::Palette(PaletteLine::Load(_) | PaletteLine::Save(_)) => Kind::Host,
+            Line::ExpectVoxel(..)
+            | Line::ExpectCount(_)
+            | Line::ExpectWritten(_)
+            | Line::ExpectImage(..)
+            | Line::ExpectEffects(_)
+            | Line::ExpectPalette(..)
+            | Line::ExpectObjects(_)
+            | Line::ExpectModels(_) => Kind::Check,
+        }
+    }
+
     /// Whether the line ends an open stroke before it runs: every line but
     /// the edits a stroke is made of (`place`, `remove`, `paint`, `object
     /// N` and `object move` of a drag, `rgb` and `material` of a held
-    /// palette control), the view (`camera`, `viewport`, `ortho`) and the
-    /// checks, which change nothing. The editor, the window's recorder and
-    /// the crash journal go by this one rule, so a recording replays into
-    /// the undo steps the window made.
+    /// palette control), the view and the checks, which change nothing.
+    /// The editor, the window's recorder and the crash journal go by this
+    /// one rule, so a recording replays into the undo steps the window made.
     pub fn ends_stroke(&self) -> bool {
-        !matches!(
+        let of_a_stroke = matches!(
             self,
             Line::Place(_)
                 | Line::Remove(_)
@@ -137,16 +190,13 @@ impl Line {
                 | Line::Rgb(..)
                 | Line::Material(..)
                 | Line::Object(ObjectLine::Pick(_) | ObjectLine::Move(_))
-                | Line::Stroke(_)
-                | Line::Camera { .. }
-                | Line::Viewport(..)
-                | Line::Projection(_)
-        ) && !self.is_check()
+        );
+        !of_a_stroke && !matches!(self.kind(), Kind::Stroke | Kind::View | Kind::Check)
     }
 
     /// Whether the line is a check (`expect …`), which changes nothing.
     pub fn is_check(&self) -> bool {
-        self.word() == "expect"
+        self.kind() == Kind::Check
     }
 
     /// The command word the line starts with (`place`, `object`,
@@ -200,6 +250,32 @@ impl Line {
             Line::Palette(_) => "palette",
         }
     }
+}
+
+/// What kind of line a [`Line`] is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// A change to the scene: one undo step, or one edit of the open
+    /// stroke; `color`: it uses the current colour.
+    Edit { color: bool },
+    /// `stroke begin`, `stroke end`.
+    Stroke,
+    /// The tools: brush, colour, mirror planes.
+    Tool,
+    /// The editor's other state: the picked object, the selection, the
+    /// clipboard.
+    State,
+    /// `undo`, `redo`.
+    History,
+    /// A new scene: `load`, `new`, `demo`.
+    Scene,
+    /// The view: camera, viewport, projection.
+    View,
+    /// The host's: files written or read, the ground, the eyedropper, a
+    /// click (which becomes an edit line).
+    Host,
+    /// A check (`expect …`).
+    Check,
 }
 
 /// What an `object` line does.

@@ -737,6 +737,8 @@ mod tests {
         // Each line's word is the one it is printed with.
         for line in &script.lines {
             assert_eq!(line.command.to_string().split(' ').next(), Some(line.command.word()), "{}", line.command);
+            // The checks are exactly the `expect` lines.
+            assert_eq!(line.command.is_check(), line.command.word() == "expect", "{}", line.command);
         }
     }
 
