@@ -546,7 +546,7 @@ impl Renderer {
     /// The remaining noise of the accumulation, estimated from its samples
     /// (`crate::trace::denoise::noise_estimate`): `None` below two samples.
     /// Measured now (the denoiser's `prepare`, without the light) unless the
-    /// last sample's frame did ([`Renderer::estimate_noise`]).
+    /// last sample's frame did (`Wants::estimate_noise` of its options).
     ///
     /// # Errors
     /// A failed measurement or readback.

@@ -98,8 +98,9 @@ pub fn shadow_ray(hit: &Hit) -> Option<Ray> {
     Some(Ray::new(origin, Vec3::from(SUN_DIR)))
 }
 
-/// The hit voxel's depth along the view axis: the camera ray's t there, near
-/// enough, from integers alone so the GPU (`hit_depth` in WGSL) agrees.
+/// A shaded cell's depth along the view axis (the hit voxel's, or the ground
+/// cell's): the camera ray's t there, near enough, from integers alone so
+/// the GPU (`main` in `shaders/trace_svo.wgsl`) agrees.
 pub fn cell_depth(cell: IVec3, basis: &RayBasis) -> f32 {
     (cell.as_vec3() + Vec3::splat(0.5) - basis.eye).dot(basis.forward)
 }
