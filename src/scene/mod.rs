@@ -163,7 +163,7 @@ impl Scene {
     /// The objects when the scene is drawn as instances of its models: a
     /// scene where some model is placed more than once (a reference), and
     /// where that saves at least half of what its objects composed take
-    /// ([`draws_instances`]). Then each model is stored once on the GPU
+    /// (`draws_instances`, [`INSTANCE_SAVING`]). Then each model is stored once on the GPU
     /// too, and a move writes one record. Any other scene of objects (a big
     /// model saved in 256³ blocks, or a few small references) is drawn as
     /// its objects composed into one octree: CPU-emulated GPUs trace one
