@@ -125,6 +125,24 @@ impl Gesture {
     }
 }
 
+/// The lines a palette control's change runs: `rgb` and `material`, for
+/// the parts of entry `index` that differ from `palette`'s.
+pub(super) fn palette_lines(
+    palette: &octovox::scene::Palette,
+    edit: octovox::edit::Edit,
+) -> Vec<octovox::script::Line> {
+    use octovox::script::Line;
+    let octovox::edit::Edit::Palette { index, color: [r, g, b, _], material } = edit else { return Vec::new() };
+    let mut lines = Vec::new();
+    if palette.color(index)[..3] != [r, g, b] {
+        lines.push(Line::Rgb(index, [r, g, b]));
+    }
+    if *palette.material(index) != *material {
+        lines.push(Line::Material(index, material));
+    }
+    lines
+}
+
 #[cfg(test)]
 #[allow(clippy::unwrap_used)] // in tests a panic is the failure report
 mod tests {
@@ -199,6 +217,42 @@ mod tests {
         assert_eq!(editor.scene.solid_voxels(), 64 + 3);
         editor.run(&Line::Undo(1)).unwrap();
         assert_eq!(editor.scene.solid_voxels(), 64, "one undo takes the stroke away");
+    }
+
+    /// A held palette control: each change runs the `rgb` or `material`
+    /// line of what differs, inside one stroke: one undo step, and the
+    /// journal's lines say so.
+    #[test]
+    fn a_held_palette_control_is_one_undo_step() {
+        use octovox::edit::Edit;
+        use octovox::scene::{Material, MaterialKind};
+        let mut editor = floor();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("journal.ovr");
+        let mut recorder = Recorder::create(&path).unwrap();
+        let mut run = |editor: &mut Editor, line: &Line| {
+            let changed = editor.run(line).unwrap() == octovox::editor::Outcome::Changed;
+            recorder.ran(line, &editor.tools, &Camera::default(), changed).unwrap();
+        };
+        let diffuse = Box::new(editor.scene.palette.material(5).clone());
+        let metal = Box::new(Material::new(MaterialKind::Metal));
+        let drag = [([10, 0, 0, 255], diffuse.clone()), ([20, 0, 0, 255], diffuse.clone()), ([20, 0, 0, 255], metal)];
+        run(&mut editor, &Line::Stroke(true));
+        for (color, material) in drag {
+            let lines = super::palette_lines(&editor.scene.palette, Edit::Palette { index: 5, color, material });
+            assert_eq!(lines.len(), 1, "only the part that changed: {lines:?}");
+            lines.iter().for_each(|line| run(&mut editor, line));
+        }
+        run(&mut editor, &Line::Stroke(false));
+        drop(recorder);
+        let written = std::fs::read_to_string(&path).unwrap();
+        // The state an edit depends on comes first (camera, projection, brush).
+        let lines: Vec<&str> = written.lines().skip_while(|l| *l != "stroke begin").collect();
+        assert_eq!(lines, ["stroke begin", "rgb 5 10 0 0", "rgb 5 20 0 0", "material 5 metal", "stroke end"]);
+        assert_eq!(editor.history.steps(), (1, 0));
+        assert_eq!(editor.scene.palette.color(5)[..3], [20, 0, 0]);
+        editor.run(&Line::Undo(1)).unwrap();
+        assert_eq!(*editor.scene.palette.material(5), *diffuse, "one undo puts the entry back");
     }
 
     /// A line drag is one `line` from the cell in front of the pressed face

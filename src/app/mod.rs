@@ -653,15 +653,7 @@ impl App {
     /// parts that changed); changes while a control is held form one undo
     /// step, and so do the two lines of one change.
     fn palette_edit(&mut self, edit: Edit, dragging: bool) {
-        let Edit::Palette { index, color: [r, g, b, _], material } = edit else { return };
-        let palette = &self.doc.editor.scene.palette;
-        let mut lines = Vec::new();
-        if palette.color(index)[..3] != [r, g, b] {
-            lines.push(octovox::script::Line::Rgb(index, [r, g, b]));
-        }
-        if *palette.material(index) != *material {
-            lines.push(octovox::script::Line::Material(index, material));
-        }
+        let lines = gesture::palette_lines(&self.doc.editor.scene.palette, edit);
         if !matches!(self.gesture, Gesture::Palette) {
             self.begin_stroke(Gesture::Palette);
         }
