@@ -255,6 +255,33 @@ mod tests {
         assert_eq!(*editor.scene.palette.material(5), *diffuse, "one undo puts the entry back");
     }
 
+    /// An object drag (object mode): the press picks the object (`object
+    /// N`), the drag's whole-voxel moves over the ground are `object move`
+    /// lines inside one stroke, one undo step, as the journal writes them.
+    #[test]
+    fn an_object_drag_is_one_undo_step() {
+        let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/vox/format/test_groups.vox");
+        let mut editor = Editor::default();
+        editor.set_scene(octovox::io::load_scene(&file, 0).unwrap());
+        let before = editor.scene.voxels();
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("journal.ovr");
+        let mut recorder = Recorder::create(&path).unwrap();
+        let script = "object 3\nstroke begin\nobject move 1 0 0\nobject move 0 0 -2\nobject move 2 0 0\nstroke end\n";
+        for line in octovox::script::parse_script(&path, script).unwrap().lines {
+            let changed = editor.run(&line.command).unwrap() == octovox::editor::Outcome::Changed;
+            recorder.ran(&line.command, &editor.tools, &Camera::default(), changed).unwrap();
+        }
+        drop(recorder);
+        let written = std::fs::read_to_string(&path).unwrap();
+        let lines: Vec<&str> = written.lines().filter(|l| l.starts_with("object") || l.starts_with("stroke")).collect();
+        assert_eq!(lines, script.lines().collect::<Vec<_>>(), "{written}");
+        assert_eq!(editor.history.steps(), (1, 0), "the drag is one undo step");
+        assert_ne!(editor.scene.voxels(), before, "the object moved");
+        editor.run(&Line::Undo(1)).unwrap();
+        assert_eq!(editor.scene.voxels(), before, "one undo puts it back");
+    }
+
     /// A line drag is one `line` from the cell in front of the pressed face
     /// to the one in front of the released face (one undo step); a box
     /// select is one `select` from the pressed cell to the released one (on
