@@ -188,7 +188,7 @@ impl App {
         mut full: egui::FullOutput,
         overlays: Overlays,
     ) -> Option<Option<capture::WindowCopy>> {
-        let (trace_size, selection) = (self.trace_size(), self.shown_selection());
+        let (trace_size, selection, modal) = (self.trace_size(), self.shown_selection(), self.modal_open());
         let gfx = self.gfx.as_mut()?;
         let tessellate_started = Instant::now();
         let panels = ctx.tessellate(full.shapes, full.pixels_per_point);
@@ -224,7 +224,11 @@ impl App {
         // would start the accumulation over).
         let tinted = selection.filter(|_| state.mode == Mode::Select).map(|r| (r.min, r.max));
         let grid = self.doc.editor.ground.then(|| state.ground_grid());
-        let wants = Wants { denoise: state.denoise, estimate_noise: true, sample_target: state.sample_target.max(1) };
+        // A dialog over the view holds the accumulation where it is: its
+        // frames stay cheap, and the dialog answers at once.
+        let held = modal.then_some(gfx.renderer.path.accumulation.samples);
+        let sample_target = held.unwrap_or(state.sample_target).max(1);
+        let wants = Wants { denoise: state.denoise, estimate_noise: true, sample_target };
         let options = PathOptions { highlight: tinted, grid, wants };
         let restarts = wants_path && gfx.renderer.path_restarts(&view, false, &options);
         let path = wants_path && (!restarts || self.frames.preview_before_path);
@@ -318,7 +322,8 @@ impl App {
     /// for when egui asks to be drawn again).
     fn schedule_repaint(&mut self, repaint_delay: Option<Duration>) {
         let filtering = self.gfx.as_ref().is_some_and(|gfx| gfx.renderer.denoise_pending());
-        let accumulating = self.readouts.stats.path.is_some_and(|p| p.samples < self.state.sample_target || filtering);
+        let accumulating = !self.modal_open()
+            && self.readouts.stats.path.is_some_and(|p| p.samples < self.state.sample_target || filtering);
         let animating = accumulating
             || self.frames.preview_before_path
             || self.doc.loading.is_some()
@@ -354,6 +359,13 @@ impl App {
             self.state.settings.mode = TraceMode::Svo;
             self.ui.error(format!("{err}; back to SVO"));
         }
+    }
+}
+
+impl App {
+    /// Whether a dialog of the window or the desktop waits for an answer.
+    fn modal_open(&self) -> bool {
+        self.ui.modal_open() || self.doc.file_dialog.is_some()
     }
 }
 

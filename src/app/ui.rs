@@ -166,6 +166,11 @@ pub struct Replace {
 }
 
 impl UiState {
+    /// Whether a dialog or prompt waits for an answer over the view.
+    pub fn modal_open(&self) -> bool {
+        self.dialog.is_some() || self.prompt_open || self.replace.is_some() || self.recover.is_some()
+    }
+
     pub fn error(&mut self, text: impl Into<String>) {
         let text = text.into();
         log::warn!("{text}");

@@ -82,3 +82,29 @@ fn new_then_a_click_on_the_ground_places_a_voxel_at_y_0() {
     let placed = octovox::io::load_scene(&file, 0).unwrap();
     assert_eq!(placed.voxels().into_iter().map(|(p, _)| p).collect::<Vec<_>>(), vec![ground + IVec3::Y]);
 }
+
+/// A dialog over the view holds the path tracer's accumulation where it is:
+/// while the file browser is open no sample is added (on a loaded machine
+/// the samples of a view on the ground made the browser miss the keys
+/// typed into it), and once it is closed the accumulation goes on.
+#[test]
+fn a_dialog_holds_the_accumulation_and_closing_it_resumes() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_xvfb, display) = start_xvfb();
+    let args = ["--size".to_owned(), format!("{WIDTH}x{HEIGHT}")];
+    let (_app, mut lines, window) = open_ready(&display, dir.path(), &args);
+    lines.wait_for("noise:", Duration::from_secs(60));
+    xdotool(&display, &["windowfocus", "--sync", &window]);
+    xdotool(&display, &["key", "ctrl+shift+s"]);
+    lines.wait_for("file dialog: browser", Duration::from_secs(30));
+    // A sample already under way may still complete.
+    std::thread::sleep(Duration::from_secs(1));
+    let held_from = lines.seen.len();
+    assert!(
+        lines.try_wait_for("noise:", Duration::from_secs(4)).is_none(),
+        "samples went on: {:?}",
+        &lines.seen[held_from..]
+    );
+    xdotool(&display, &["key", "Escape"]);
+    lines.wait_for("noise:", Duration::from_secs(60));
+}
