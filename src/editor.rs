@@ -95,6 +95,12 @@ impl Editor {
         self.ground = self.scene.solid_voxels() == 0 && self.scene.objects().is_none();
     }
 
+    /// The world height of the ground plane drawn under the scene: y = 0
+    /// where clicks build on the ground, none where they do not.
+    pub fn ground_plane(&self) -> Option<i32> {
+        self.ground.then_some(0)
+    }
+
     pub fn clipboard(&self) -> Option<&Block> {
         self.clipboard.as_ref()
     }

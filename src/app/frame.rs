@@ -216,7 +216,7 @@ impl App {
         let (scene, state) = (&self.doc.editor.scene, &self.state);
         // Where clicks build on the ground, the ground plane is drawn, and
         // takes the voxels' shadows.
-        let plane = self.doc.editor.ground.then_some(0);
+        let plane = self.doc.editor.ground_plane();
         let path_settings = PathSettings { ground: plane, ..state.path_settings };
         let view = PathView { scene, camera: &state.camera, size: trace_size, settings: &path_settings };
         // Select mode tints the selected voxels in path-traced frames too
@@ -344,6 +344,11 @@ impl App {
         }
     }
 
+    /// Whether a dialog of the window or the desktop waits for an answer.
+    fn modal_open(&self) -> bool {
+        self.ui.modal_open() || self.doc.file_dialog.is_some()
+    }
+
     /// Rebuilds and uploads the dense grid while grid mode is on and the voxels changed.
     fn sync_grid(&mut self) {
         let Some(gfx) = &mut self.gfx else { return };
@@ -359,13 +364,6 @@ impl App {
             self.state.settings.mode = TraceMode::Svo;
             self.ui.error(format!("{err}; back to SVO"));
         }
-    }
-}
-
-impl App {
-    /// Whether a dialog of the window or the desktop waits for an answer.
-    fn modal_open(&self) -> bool {
-        self.ui.modal_open() || self.doc.file_dialog.is_some()
     }
 }
 

@@ -165,29 +165,48 @@ mod tests {
         editor
     }
 
-    /// A stroke of `tool` over `picks`, as the window runs it: `stroke
-    /// begin`, a step's line wherever the stroke takes one, `stroke end`;
-    /// each line through the editor and the recorder (a journal writes the
-    /// same). Returns the recorded lines.
-    fn stroke(editor: &mut Editor, tool: Tool, picks: &[Pick]) -> Vec<String> {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("journal.ovr");
-        let mut recorder = Recorder::create(&path).unwrap();
-        let mut run = |editor: &mut Editor, line: &Line| {
+    /// Lines run as the window runs them: through the editor, then the
+    /// recorder (the crash journal writes the same).
+    struct Journaled {
+        recorder: Recorder,
+        path: std::path::PathBuf,
+        _dir: tempfile::TempDir,
+    }
+
+    impl Journaled {
+        fn new() -> Journaled {
+            let dir = tempfile::tempdir().unwrap();
+            let path = dir.path().join("journal.ovr");
+            Journaled { recorder: Recorder::create(&path).unwrap(), path, _dir: dir }
+        }
+
+        fn run(&mut self, editor: &mut Editor, line: &Line) {
             let changed = editor.run(line).unwrap() == octovox::editor::Outcome::Changed;
-            recorder.ran(line, &editor.tools, &Camera::default(), changed).unwrap();
-        };
-        run(editor, &Line::Stroke(true));
+            self.recorder.ran(line, &editor.tools, &Camera::default(), changed).unwrap();
+        }
+
+        /// What the recorder wrote.
+        fn written(self) -> String {
+            drop(self.recorder);
+            std::fs::read_to_string(&self.path).unwrap()
+        }
+    }
+
+    /// A stroke of `tool` over `picks`, as the window runs it: `stroke
+    /// begin`, a step's line wherever the stroke takes one, `stroke end`.
+    /// Returns the recorded lines.
+    fn stroke(editor: &mut Editor, tool: Tool, picks: &[Pick]) -> Vec<String> {
+        let mut journal = Journaled::new();
+        journal.run(editor, &Line::Stroke(true));
         let mut open = Stroke { tool, plane: None, last_center: None };
         for pick in picks {
             if let Some(step) = open.step_at(pick, editor.tools.brush.reach()) {
-                run(editor, &step.line);
+                journal.run(editor, &step.line);
                 open.stepped(&step);
             }
         }
-        run(editor, &Line::Stroke(false));
-        drop(recorder);
-        let text = std::fs::read_to_string(&path).unwrap();
+        journal.run(editor, &Line::Stroke(false));
+        let text = journal.written();
         text.lines()
             .filter(|l| !l.starts_with('#') && !l.starts_with("camera") && *l != "perspective")
             .map(String::from)
@@ -227,25 +246,18 @@ mod tests {
         use octovox::edit::Edit;
         use octovox::scene::{Material, MaterialKind};
         let mut editor = floor();
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("journal.ovr");
-        let mut recorder = Recorder::create(&path).unwrap();
-        let mut run = |editor: &mut Editor, line: &Line| {
-            let changed = editor.run(line).unwrap() == octovox::editor::Outcome::Changed;
-            recorder.ran(line, &editor.tools, &Camera::default(), changed).unwrap();
-        };
+        let mut journal = Journaled::new();
         let diffuse = Box::new(editor.scene.palette.material(5).clone());
         let metal = Box::new(Material::new(MaterialKind::Metal));
         let drag = [([10, 0, 0, 255], diffuse.clone()), ([20, 0, 0, 255], diffuse.clone()), ([20, 0, 0, 255], metal)];
-        run(&mut editor, &Line::Stroke(true));
+        journal.run(&mut editor, &Line::Stroke(true));
         for (color, material) in drag {
             let lines = super::palette_lines(&editor.scene.palette, Edit::Palette { index: 5, color, material });
             assert_eq!(lines.len(), 1, "only the part that changed: {lines:?}");
-            lines.iter().for_each(|line| run(&mut editor, line));
+            lines.iter().for_each(|line| journal.run(&mut editor, line));
         }
-        run(&mut editor, &Line::Stroke(false));
-        drop(recorder);
-        let written = std::fs::read_to_string(&path).unwrap();
+        journal.run(&mut editor, &Line::Stroke(false));
+        let written = journal.written();
         // The state an edit depends on comes first (camera, projection, brush).
         let lines: Vec<&str> = written.lines().skip_while(|l| *l != "stroke begin").collect();
         assert_eq!(lines, ["stroke begin", "rgb 5 10 0 0", "rgb 5 20 0 0", "material 5 metal", "stroke end"]);
@@ -264,16 +276,12 @@ mod tests {
         let mut editor = Editor::default();
         editor.set_scene(octovox::io::load_scene(&file, 0).unwrap());
         let before = editor.scene.voxels();
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("journal.ovr");
-        let mut recorder = Recorder::create(&path).unwrap();
+        let mut journal = Journaled::new();
         let script = "object 3\nstroke begin\nobject move 1 0 0\nobject move 0 0 -2\nobject move 2 0 0\nstroke end\n";
-        for line in octovox::script::parse_script(&path, script).unwrap().lines {
-            let changed = editor.run(&line.command).unwrap() == octovox::editor::Outcome::Changed;
-            recorder.ran(&line.command, &editor.tools, &Camera::default(), changed).unwrap();
+        for line in octovox::script::parse_script(std::path::Path::new("drag.ovr"), script).unwrap().lines {
+            journal.run(&mut editor, &line.command);
         }
-        drop(recorder);
-        let written = std::fs::read_to_string(&path).unwrap();
+        let written = journal.written();
         let lines: Vec<&str> = written.lines().filter(|l| l.starts_with("object") || l.starts_with("stroke")).collect();
         assert_eq!(lines, script.lines().collect::<Vec<_>>(), "{written}");
         assert_eq!(editor.history.steps(), (1, 0), "the drag is one undo step");

@@ -104,7 +104,7 @@ impl App {
         self.check_write(path, OutputKind::Image)?;
         let gfx = self.gfx.as_mut().ok_or(HostError::NoGpuYet)?;
         let viewport = self.doc.player.as_ref().map_or(octovox::replay::DEFAULT_VIEWPORT, |p| p.viewport);
-        let settings = RenderSettings { ground: self.doc.editor.ground.then_some(0), ..RenderSettings::default() };
+        let settings = RenderSettings { ground: self.doc.editor.ground_plane(), ..RenderSettings::default() };
         gfx.renderer.render(&self.doc.editor.scene, &self.state.camera, viewport, &settings, None)?;
         let image = gfx.renderer.read_image()?;
         octovox::io::png::save_png(&image, path, WriteOptions::default())?;

@@ -73,9 +73,8 @@ const PATH_SCENE: &str = "vox/format/test_groups.vox";
 /// alternating after one warm-up sample each (which compiles the kernel).
 fn path_row(quick: bool) -> anyhow::Result<PathRow> {
     let (width, height, samples) = if quick { (320, 180, 2) } else { (1280, 720, 6) };
-    let file = super::bench::assets().join(PATH_SCENE);
-    let mut scene = octovox::io::load_scene(&file, 0)?;
-    let mut instances = octovox::io::load_scene(&file, 0)?;
+    let mut scene = octovox::io::load_scene(&super::bench::assets().join(PATH_SCENE), 0)?;
+    let mut instances = scene.clone();
     instances.set_instancing(Instancing::References);
     let mut merged = Scene::new(scene.palette.clone(), scene.drawn().clone());
     let (lo, hi) = merged.solid_bounds().context("an empty scene")?;

@@ -151,7 +151,7 @@ impl Runner {
 
     fn render_image(&mut self) -> Result<image::RgbaImage, HostError> {
         // The ground plane where the window draws one (`ground on`).
-        let settings = RenderSettings { ground: self.editor.ground.then_some(0), ..self.settings };
+        let settings = RenderSettings { ground: self.editor.ground_plane(), ..self.settings };
         match &mut self.mode {
             RunnerMode::Gpu(renderer) => {
                 renderer.render(&self.editor.scene, &self.camera, self.viewport, &settings, None)?;

@@ -31,28 +31,20 @@ pub fn pick_with_ground(
     (x, y): (u32, u32),
     ground: bool,
 ) -> Result<Option<Hit>, GaveUp> {
-    match pick(scene, camera, size, x, y)? {
-        Some(hit) if ground && hit.voxel.y < 0 => Ok(ground_pick(camera, size, x, y).or(Some(hit))),
-        Some(hit) => Ok(Some(hit)),
-        None if ground => Ok(ground_pick(camera, size, x, y)),
-        None => Ok(None),
+    let hit = pick(scene, camera, size, x, y)?;
+    if !ground {
+        return Ok(hit);
     }
-}
-
-/// The ground cell under pixel (x, y), if its ray comes down through y = 0.
-fn ground_pick(camera: &Camera, size: (u32, u32), x: u32, y: u32) -> Option<Hit> {
+    // The rule the drawn ground follows (`ground::landing`), in world cells.
     let (origin, dir) = camera.basis(size.0, size.1, glam::IVec3::ZERO).ray(x, y);
-    let (origin, dir) = (origin.as_dvec3(), dir.as_dvec3());
-    if origin.y <= 0.0 || dir.y >= 0.0 {
-        return None;
-    }
-    let at = origin + dir * (-origin.y / dir.y);
-    let limit = f64::from(crate::scene::octree::WORLD_LIMIT - 1);
-    if !(at.x.abs() < limit && at.z.abs() < limit) {
-        return None;
-    }
-    let voxel = glam::IVec3::new(at.x.floor() as i32, -1, at.z.floor() as i32);
-    Some(Hit { value: 0, voxel, normal: glam::IVec3::Y, ..Hit::default() })
+    let landing = super::ground::landing(&Ray::new(origin, dir), 0, hit.map(|h| h.voxel));
+    let cells = -(crate::scene::octree::WORLD_LIMIT - 1)..crate::scene::octree::WORLD_LIMIT - 1;
+    Ok(match landing {
+        Some(land) if cells.contains(&land.cell.x) && cells.contains(&land.cell.z) => {
+            Some(Hit { value: 0, voxel: land.cell, normal: glam::IVec3::Y, ..Hit::default() })
+        }
+        _ => hit,
+    })
 }
 
 /// A pick whose ray ran out of iterations: what lies under the pixel is

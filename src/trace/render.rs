@@ -43,7 +43,8 @@ pub fn trace_image(tracer: &Tracer, basis: &RayBasis, footprint: Footprint) -> V
 
 /// Colours hit records into RGBA8 pixels. `shadow` says, per pixel, whether
 /// the sun is blocked (all false when shadows are off); `grounds`, where the
-/// pixel's ray lands on the ground instead (empty without a ground).
+/// pixel's ray lands on the ground instead (empty without a ground, which
+/// only the shaded view draws).
 pub fn shade_image(
     hits: &[Hit],
     grounds: &[Option<Landing>],
@@ -60,7 +61,7 @@ pub fn shade_image(
             let dir = basis.ray(x, y).1;
             let in_shadow = shadow.get(i).copied().unwrap_or(false);
             match grounds.get(i) {
-                Some(Some(_)) if view == View::Shaded => display_rgba(ground::shaded(in_shadow)),
+                Some(Some(_)) => display_rgba(ground::shaded(in_shadow)),
                 _ => shade(hit, dir, palette, view, in_shadow),
             }
         })
@@ -81,21 +82,18 @@ pub fn ground_landings(hits: &[Hit], basis: &RayBasis, y: i32) -> Vec<Option<Lan
         .collect()
 }
 
-/// The ray toward the sun from the ground cell a ray landed on: from the
-/// centre of the empty cell above it, as from a voxel's top face.
-pub fn ground_shadow_ray(landing: &Landing) -> Ray {
-    Ray::new((landing.cell + IVec3::Y).as_vec3() + Vec3::splat(0.5), Vec3::from(SUN_DIR))
-}
-
 /// The ray toward the sun from a hit: it starts at the centre of the empty
 /// voxel in front of the entered face, so it never starts inside the surface
 /// (shadows are per face, which suits voxels). Mirrors `shadow_origin` in WGSL.
 pub fn shadow_ray(hit: &Hit) -> Option<Ray> {
-    if !hit.is_hit() || hit.normal == IVec3::ZERO {
-        return None;
-    }
-    let origin = (hit.voxel + hit.normal).as_vec3() + Vec3::splat(0.5);
-    Some(Ray::new(origin, Vec3::from(SUN_DIR)))
+    (hit.is_hit() && hit.normal != IVec3::ZERO).then(|| sun_ray_from(hit.voxel + hit.normal))
+}
+
+/// The ray toward the sun from the centre of the empty `cell` in front of a
+/// lit face (a voxel's, or the ground's top face, whose cell is the one
+/// above the landing's).
+fn sun_ray_from(cell: IVec3) -> Ray {
+    Ray::new(cell.as_vec3() + Vec3::splat(0.5), Vec3::from(SUN_DIR))
 }
 
 /// A shaded cell's depth along the view axis (the hit voxel's, or the ground
@@ -193,7 +191,7 @@ pub fn render_scene_cpu(
             .into_par_iter()
             .map(|i| {
                 let ray = match grounds.get(i) {
-                    Some(Some(landing)) => Some((ground_shadow_ray(landing), landing.cell)),
+                    Some(Some(landing)) => Some((sun_ray_from(landing.cell + IVec3::Y), landing.cell)),
                     _ => shadow_ray(&hits[i]).map(|ray| (ray, hits[i].voxel)),
                 };
                 ray.is_some_and(|(ray, cell)| tracer.trace(&ray, footprint.at(cell_depth(cell, &basis))).is_hit())

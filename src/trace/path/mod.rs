@@ -143,15 +143,16 @@ impl PathScene<'_> {
         ground::landing(ray, self.ground?, found).filter(|_| !c.hit.gave_up)
     }
 
-    /// The surface a ray meets: where, its normal, the voxel value (0 for
-    /// the ground) and the entry of the material and albedo tables; `None`
-    /// when it meets nothing or starts inside a solid voxel.
-    fn surface(&self, ray: &Ray, c: &Crossing) -> Option<(Vec3, Vec3, u8, usize)> {
+    /// The surface a ray meets: where, its normal, and its entry of the
+    /// material and albedo tables (the voxel's value, or [`GROUND_SURFACE`],
+    /// as the GPU's hit has it); `None` when it meets nothing or starts
+    /// inside a solid voxel.
+    fn surface(&self, ray: &Ray, c: &Crossing) -> Option<(Vec3, Vec3, usize)> {
         if let Some(land) = self.landing(ray, c) {
-            return Some((land.point(ray), Vec3::Y, 0, GROUND_SURFACE));
+            return Some((land.point(ray), Vec3::Y, GROUND_SURFACE));
         }
         (c.found && c.hit.normal != IVec3::ZERO)
-            .then(|| (surface_point(ray, c), c.hit.normal.as_vec3(), c.hit.value, usize::from(c.hit.value)))
+            .then(|| (surface_point(ray, c), c.hit.normal.as_vec3(), usize::from(c.hit.value)))
     }
 
     /// The denoiser's guide of pixel (x, y): the first hit of its centre
@@ -161,7 +162,7 @@ impl PathScene<'_> {
         let ray = Ray::new(origin, dir);
         let c = self.cross(&ray, 0, None);
         match self.surface(&ray, &c) {
-            Some((p, n, _, surface)) if !self.left_to_samples(self.materials[surface].kind) => {
+            Some((p, n, surface)) if !self.left_to_samples(self.materials[surface].kind) => {
                 Guide::filtered(p, normal_code(n.as_ivec3()))
             }
             _ => Guide::LEFT,
@@ -184,7 +185,7 @@ impl PathScene<'_> {
             if c.hit.gave_up {
                 return radiance + beta * GAVE_UP_COLOR;
             }
-            let Some((p, n, value, surface)) = self.surface(&ray, &c) else {
+            let Some((p, n, surface)) = self.surface(&ray, &c) else {
                 if c.found {
                     // The ray started inside a solid voxel: nothing to see.
                     return radiance;
@@ -197,13 +198,10 @@ impl PathScene<'_> {
                 *first_albedo = self.demodulation_albedo(surface);
                 first = false;
             }
-            let glass = |index: u8| self.materials[usize::from(index)].kind == MATERIAL_GLASS;
+            let glass = |index: usize| self.materials[index].kind == MATERIAL_GLASS;
             let dir;
             // Leaving glass (into empty space or other glass), or entering it.
-            // (The ground is no interface: a ray in glass that lands on it,
-            // under glass resting there, bounces off it as the GPU's does.)
-            let on_ground = surface == GROUND_SURFACE;
-            let leaving = self.effects.glass && medium != 0 && !on_ground && (value == 0 || glass(value));
+            let leaving = self.effects.glass && medium != 0 && (surface == 0 || glass(surface));
             if !leaving && self.effects.emit && material.kind == MATERIAL_EMIT {
                 if !lights_counted {
                     radiance += beta * self.albedo[surface] * material.emission;
@@ -214,7 +212,8 @@ impl PathScene<'_> {
                 || (self.effects.glass && material.kind == MATERIAL_GLASS && rng.uniform() < material.transparency)
             {
                 transmissions += 1;
-                let Some((next, to)) = self.interface(d, n, medium, value, rng) else { return radiance };
+                // A glass face is a voxel's (the ground is none): its value.
+                let Some((next, to)) = self.interface(d, n, medium, c.hit.value, rng) else { return radiance };
                 // Into other glass (or out of it): the instance of the face crossed.
                 if to.0 != medium {
                     inside = c.instance;
