@@ -13,7 +13,7 @@ use crate::edit::{Edit, History};
 use crate::scene::objects::Objects;
 use crate::scene::transform::CellMap;
 use crate::scene::{EditError, Op, Palette, Scene};
-use crate::script::{Line, ObjectLine, ObjectRef, PaletteLine};
+use crate::script::{AnimLine, Line, ObjectLine, ObjectRef, PaletteLine};
 use crate::settings::PathSettings;
 
 /// Why a line could not run. A refused line changes nothing.
@@ -221,6 +221,22 @@ impl Editor {
                 let got = self.scene.objects().map_or(1, |o| o.list().len());
                 return Ok(checked(got == *want, format!("{want} objects"), got));
             }
+            Line::Frame(frame) => self.show_frame(*frame)?,
+            Line::Anim(line) => {
+                let objects = self.animated()?;
+                let mut animation = objects.graph.as_ref().map(|g| g.animation).unwrap_or_default();
+                match *line {
+                    AnimLine::Range(first, last) => animation.range = Some((first, last)),
+                    AnimLine::Fps(fps) => animation.fps = Some(fps),
+                    AnimLine::Loop(on) => animation.looping = Some(on),
+                }
+                let change = objects.with_animation(animation)?;
+                self.commit(vec![Edit::Graph(Box::new(change))])?
+            }
+            Line::ExpectFrame(want) => {
+                let got = self.scene.objects().map_or(0, |o| o.frame);
+                return Ok(checked(got == *want as usize, format!("frame {want}"), got));
+            }
             Line::ExpectModels(want) => {
                 let got = self.scene.objects().map_or(1, |o| o.models.len());
                 return Ok(checked(got == *want, format!("{want} models"), got));
@@ -299,6 +315,34 @@ impl Editor {
         })
     }
 
+    /// Shows frame `frame`; whether the picture changed.
+    fn show_frame(&mut self, frame: u32) -> Result<bool, EditorError> {
+        let objects = self.animated()?;
+        let frame = frame as usize;
+        if objects.frame == frame {
+            return Ok(false);
+        }
+        if objects.graph.is_none() && frame >= objects.models.len() {
+            return Err(EditorError::Object(format!(
+                "frame {frame}: this file of animation frames has {} (0 to {})",
+                objects.models.len(),
+                objects.models.len() - 1
+            )));
+        }
+        self.scene.set_frame(frame)?;
+        Ok(true)
+    }
+
+    /// The objects of a scene that has time, or why `frame` and `anim`
+    /// lines mean nothing in it.
+    fn animated(&self) -> Result<&Objects, EditorError> {
+        self.scene.objects().ok_or_else(|| {
+            EditorError::Object(
+                "the scene is one model, which has no animation: `frame` and `anim` need a scene of objects".to_owned(),
+            )
+        })
+    }
+
     /// The object the `object …` lines change.
     fn picked_object(&self) -> Result<usize, EditorError> {
         self.objects()?.selected.ok_or_else(|| {
@@ -351,6 +395,8 @@ impl Editor {
                 (graph(objects.with_attribute(index, "_lock", locked.then_some("1"))?), Picks::Same)
             }
             ObjectLine::Layer(layer) => (graph(objects.on_layer(index, *layer)?), Picks::Same),
+            ObjectLine::Key(ease) => (graph(objects.keyed(index, *ease)?), Picks::Same),
+            ObjectLine::Unkey => (graph(objects.unkeyed(index)?), Picks::Same),
             ObjectLine::Delete => (graph(objects.deleted(index)?), Picks::None),
             ObjectLine::Duplicate { reference: true } => {
                 let (change, id) = objects.duplicated(index, None)?;

@@ -169,7 +169,7 @@ fn forest(count: u32) -> anyhow::Result<Scene> {
         });
     }
     let layer = octovox::scene::graph::Layer { id: 0, attributes: attributes(), reserved: u32::MAX };
-    let graph = SceneGraph { nodes, layers: vec![layer] };
+    let graph = SceneGraph { nodes, layers: vec![layer], ..SceneGraph::default() };
     let objects = Objects::new(Some(graph), vec![tree_model()], Vec::new(), 0, usize::MAX)?;
     Ok(Scene::compose(Palette::default(), objects)?)
 }

@@ -133,6 +133,10 @@ pub enum ObjectRefusal {
     NotInGroup,
     #[error("no node ids are left")]
     NoNodeIds,
+    #[error("object {index} has no key at frame {frame}")]
+    NoKey { index: usize, frame: u32 },
+    #[error("that is object {0}'s only key: an object keeps at least one")]
+    LastKey(usize),
 }
 
 /// Peak bytes an edit takes per surface voxel of its shape: bricks and
@@ -214,6 +218,13 @@ impl Scene {
         let (objects, tree) = self.objects_and_drawn_mut()?;
         let undo = objects.apply_change(tree, change);
         self.touched(undo)
+    }
+
+    /// Shows frame `frame` of a scene of objects: its keys sampled there.
+    pub fn set_frame(&mut self, frame: usize) -> Result<(), EditError> {
+        let (objects, tree) = self.objects_and_drawn_mut()?;
+        let shown = objects.set_frame(tree, frame);
+        self.touched(shown)
     }
 
     /// Stores a model that nothing places yet.

@@ -29,6 +29,8 @@ pub type Attributes = BTreeMap<String, String>;
 pub struct SceneGraph {
     pub nodes: Vec<Node>,
     pub layers: Vec<Layer>,
+    /// The playback settings of the file's META chunk.
+    pub animation: super::anim::Animation,
 }
 
 /// One nTRN, nGRP or nSHP chunk.
@@ -110,6 +112,9 @@ pub enum GraphError {
     /// A missing node, a model id out of range, a malformed transform.
     #[error("scene graph: {0}")]
     Bad(String),
+    /// A frame past the last a key can name (`_f` is 32 bits).
+    #[error("frame {0} is past the last frame a key can name (4294967295)")]
+    FrameTooLate(usize),
     /// The placed models hold more voxels than the caller allows.
     #[error("the scene holds more than {limit} voxels (at least {found})")]
     TooManyVoxels { limit: usize, found: usize },
@@ -173,7 +178,7 @@ impl SceneGraph {
             index_of: index_nodes(&self.nodes)?,
             hidden_layers: self.layers.iter().filter(|l| l.hidden()).map(|l| l.id).collect(),
             model_voxels,
-            frame,
+            frame: u32::try_from(frame).map_err(|_| GraphError::FrameTooLate(frame))?,
             voxel_limit,
             on_path: vec![false; self.nodes.len()],
             stack: vec![Step::Enter { id: 0, parent: None, context: Context::ROOT }],
@@ -237,7 +242,7 @@ struct Walk<'a> {
     index_of: HashMap<u32, usize>,
     hidden_layers: Vec<u32>,
     model_voxels: &'a [usize],
-    frame: usize,
+    frame: u32,
     voxel_limit: usize,
     /// Nodes on the path from the root to the node being visited.
     on_path: Vec<bool>,
@@ -341,7 +346,7 @@ impl<'a> Walk<'a> {
                     self.stack.push(Step::Enter { id: child, parent: Some(id), context });
                 }
             }
-            NodeKind::Shape { models } => self.place_shape(id, models, context)?,
+            NodeKind::Shape { models } => self.place_shape(node, models, context)?,
         }
         Ok(())
     }
@@ -359,10 +364,7 @@ impl<'a> Walk<'a> {
         layer: u32,
         context: Context,
     ) -> Result<Context, GraphError> {
-        let local = match pick_keyframe(frames.iter(), self.frame, node.id)? {
-            Some(k) => parse_transform(&frames[k], node.id)?,
-            None => Transform::IDENTITY,
-        };
+        let local = super::anim::sample_transform(frames, &node.attributes, self.frame, node.id)?;
         let layer = (layer != u32::MAX).then_some(layer);
         let name = match node.name() {
             Some(_) => {
@@ -385,8 +387,9 @@ impl<'a> Walk<'a> {
         })
     }
 
-    fn place_shape(&mut self, id: u32, models: &[(u32, Attributes)], context: Context) -> Result<(), GraphError> {
-        let Some(k) = pick_keyframe(models.iter().map(|m| &m.1), self.frame, id)? else { return Ok(()) };
+    fn place_shape(&mut self, node: &Node, models: &[(u32, Attributes)], context: Context) -> Result<(), GraphError> {
+        let id = node.id;
+        let Some(k) = super::anim::sample_model(models, &node.attributes, self.frame, id)? else { return Ok(()) };
         let model = usize::try_from(models[k].0).unwrap_or(usize::MAX);
         let count = self.model_voxels.get(model).copied().ok_or_else(|| {
             GraphError::Bad(format!(
@@ -430,33 +433,6 @@ fn index_nodes(nodes: &[Node]) -> Result<HashMap<u32, usize>, GraphError> {
         }
     }
     Ok(index_of)
-}
-
-/// Index of the keyframe shown at `frame`: the last one whose `_f` is at
-/// most `frame` (a missing `_f` counts as 0), else the first; `None` when
-/// there are none. MagicaVoxel interpolates translations between keyframes;
-/// octovox snaps to the earlier one.
-pub fn pick_keyframe<'a>(
-    keyframes: impl Iterator<Item = &'a Attributes>,
-    frame: usize,
-    node: u32,
-) -> Result<Option<usize>, GraphError> {
-    let mut best: Option<(usize, usize)> = None;
-    let mut any = false;
-    for (k, attributes) in keyframes.enumerate() {
-        any = true;
-        let at = match attributes.get("_f") {
-            None => 0,
-            Some(text) => text
-                .trim()
-                .parse::<usize>()
-                .map_err(|_| GraphError::Bad(format!("node {node} has a malformed frame index _f={text:?}")))?,
-        };
-        if at <= frame && best.is_none_or(|(best_at, _)| at > best_at) {
-            best = Some((at, k));
-        }
-    }
-    Ok(best.map(|(_, k)| k).or(any.then_some(0)))
 }
 
 /// Parses a keyframe's `_r` rotation byte and `_t` translation.
@@ -536,6 +512,7 @@ mod tests {
                 transform(6, 5, 0, ""),
             ],
             layers: vec![hidden_layer],
+            ..SceneGraph::default()
         };
         let walked = graph.walk(&[10], 0, 100).unwrap();
         let seen: Vec<(String, bool, Option<u32>)> =
@@ -554,7 +531,7 @@ mod tests {
         let depth = 100_000u32;
         let mut nodes: Vec<Node> = (0..depth).map(|i| transform(i, i + 1, u32::MAX, "n")).collect();
         nodes.push(shape(depth, 0));
-        let graph = SceneGraph { nodes, layers: vec![] };
+        let graph = SceneGraph { nodes, layers: vec![], ..SceneGraph::default() };
         let walked = graph.walk(&[1], 0, 10).unwrap();
         assert_eq!(walked.objects.len(), 1);
         assert_eq!(path_of(&graph, &walked.names, walked.objects[0].name).len(), 2 * depth as usize - 1);

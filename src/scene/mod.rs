@@ -1,5 +1,6 @@
 //! The scene model: palette, materials and the voxels themselves.
 
+pub mod anim;
 pub mod apply;
 pub mod build;
 pub mod counts;

@@ -13,6 +13,7 @@ use std::collections::HashMap;
 
 use glam::IVec3;
 
+use super::anim;
 use super::graph::{
     self, GraphError, Layer, NameEntry, Node, NodeKind, Object, OutlineRow, SceneGraph, Walked, path_of,
 };
@@ -367,9 +368,25 @@ impl Objects {
         let graph = self.graph.as_mut().ok_or(ObjectRefusal::NoGraph)?;
         let saved = graph.clone();
         let inverse = change.apply(graph);
+        self.compose_rewalk(tree, |objects| objects.graph = Some(saved))?;
+        Ok(inverse)
+    }
+
+    /// Shows frame `frame`: every key is sampled there, and the cells of
+    /// every object that moved, came, went or shows another model are
+    /// composed again. A frame the walk refuses changes nothing.
+    pub fn set_frame(&mut self, tree: &mut Octree, frame: usize) -> Result<(), EditError> {
+        let shown = std::mem::replace(&mut self.frame, frame);
+        self.compose_rewalk(tree, |objects| objects.frame = shown)
+    }
+
+    /// After a change to the graph or the frame: walks again and composes
+    /// the cells of every object drawn differently. Where the walk or the
+    /// tree refuses, `undo` takes the change back and the scene is as it was.
+    fn compose_rewalk(&mut self, tree: &mut Octree, undo: impl FnOnce(&mut Objects)) -> Result<(), EditError> {
         let before = self.drawn();
         if let Err(err) = self.walk(usize::MAX) {
-            self.graph = Some(saved);
+            undo(self);
             self.walk(usize::MAX)?;
             return Err(err.into());
         }
@@ -391,9 +408,9 @@ impl Objects {
         for (done, &region) in regions.iter().enumerate() {
             if let Err(err) = self.recompose(tree, region) {
                 // A region the tree cannot hold (a move past the world's
-                // width): the graph goes back, and so do the cells already
+                // width): the change goes back, and so do the cells already
                 // composed from it. A refused change leaves the scene as it was.
-                self.graph = Some(saved);
+                undo(self);
                 self.walk(usize::MAX)?;
                 for &region in &regions[..done] {
                     self.recompose(tree, region)?;
@@ -401,7 +418,24 @@ impl Objects {
                 return Err(err);
             }
         }
-        Ok(inverse)
+        Ok(())
+    }
+
+    /// The frame shown, as keys name frames.
+    fn key_frame(&self) -> Result<u32, EditError> {
+        u32::try_from(self.frame).map_err(|_| GraphError::FrameTooLate(self.frame).into())
+    }
+
+    /// The frames the document plays: its own range, else from the first
+    /// key to the last, else every model of a file of animation frames.
+    pub fn frame_range(&self) -> (u32, u32) {
+        let last_model = u32::try_from(self.models.len().saturating_sub(1)).unwrap_or(u32::MAX);
+        match &self.graph {
+            None => (0, last_model),
+            Some(graph) => {
+                graph.animation.range.or_else(|| super::anim::keyed_range(graph).ok().flatten()).unwrap_or((0, 0))
+            }
+        }
     }
 
     /// (model, cell map) of every visible object.
@@ -434,17 +468,77 @@ impl Objects {
         object.transform_node.and_then(|id| graph.node(id)).ok_or(ObjectRefusal::NoTransform(index).into())
     }
 
-    /// The index of the keyframe of `node` shown now (the one a move or a
-    /// turn changes), adding one to a node without any.
-    fn shown_keyframe(&self, node: &mut Node) -> Result<usize, EditError> {
+    /// The index of the key of `node` a move or a turn changes: the one at
+    /// the frame shown; for a node that moves and has none there, a new key
+    /// there holding what the frame shows (a move in an animation keys the
+    /// frame, as MagicaVoxel's does); for a node that does not move, its
+    /// one key, so the object moves at every frame.
+    fn key_to_change(&self, node: &mut Node) -> Result<usize, EditError> {
+        let frame = self.key_frame()?;
         let NodeKind::Transform { frames, .. } = &mut node.kind else {
             return Err(ObjectRefusal::NotATransform(node.id).into());
         };
         if frames.is_empty() {
             frames.push(graph::Attributes::new());
         }
-        let shown = graph::pick_keyframe(frames.iter(), self.frame, node.id)?;
-        Ok(shown.unwrap_or(0))
+        if let Some(k) = anim::key_at(frames, frame, node.id)? {
+            return Ok(k);
+        }
+        if !anim::is_animated(frames, node.id)? {
+            return Ok(anim::keys_in_time(frames.iter(), node.id)?[0].1);
+        }
+        let shown = anim::sample_transform(frames, &node.attributes, frame, node.id)?;
+        Ok(insert_key(frames, frame, shown, node.id)?)
+    }
+
+    /// What object `index`'s own transform node places it by at the frame shown.
+    fn own_transform(&self, node: &Node) -> Result<Transform, EditError> {
+        let NodeKind::Transform { frames, .. } = &node.kind else {
+            return Err(ObjectRefusal::NotATransform(node.id).into());
+        };
+        Ok(anim::sample_transform(frames, &node.attributes, self.key_frame()?, node.id)?)
+    }
+
+    /// The change that keys object `index`'s transform at the frame shown
+    /// with what it shows there, the way to the next key eased by `ease`
+    /// (`object key`); a key already there takes the easing.
+    pub fn keyed(&self, index: usize, ease: anim::Ease) -> Result<GraphChange, EditError> {
+        self.unlocked(&[index])?;
+        let frame = self.key_frame()?;
+        let mut node = self.transform_node(index)?.clone();
+        let shown = self.own_transform(&node)?;
+        let NodeKind::Transform { frames, .. } = &mut node.kind else { unreachable!("checked by own_transform") };
+        let k = match anim::key_at(frames, frame, node.id)? {
+            Some(k) => k,
+            None => insert_key(frames, frame, shown, node.id)?,
+        };
+        // A key that had no frame (a still object's) is now at frame 0.
+        frames[k].insert("_f".to_owned(), frame.to_string());
+        ease.write(&mut frames[k]);
+        Ok(GraphChange { nodes: vec![node], ..GraphChange::default() })
+    }
+
+    /// The change that takes object `index`'s key at the frame shown out
+    /// (`object unkey`); the object then shows what its other keys give.
+    pub fn unkeyed(&self, index: usize) -> Result<GraphChange, EditError> {
+        self.unlocked(&[index])?;
+        let frame = self.key_frame()?;
+        let mut node = self.transform_node(index)?.clone();
+        let NodeKind::Transform { frames, .. } = &mut node.kind else {
+            return Err(ObjectRefusal::NotATransform(node.id).into());
+        };
+        let k = anim::key_at(frames, frame, node.id)?.ok_or(ObjectRefusal::NoKey { index, frame })?;
+        if frames.len() == 1 {
+            return Err(ObjectRefusal::LastKey(index).into());
+        }
+        frames.remove(k);
+        Ok(GraphChange { nodes: vec![node], ..GraphChange::default() })
+    }
+
+    /// The change that sets the document's playback settings.
+    pub fn with_animation(&self, animation: anim::Animation) -> Result<GraphChange, EditError> {
+        self.graph.as_ref().ok_or(ObjectRefusal::NoGraph)?;
+        Ok(GraphChange { animation: Some(animation), ..GraphChange::default() })
     }
 
     /// The change that moves object `index` by `by` world voxels.
@@ -486,9 +580,9 @@ impl Objects {
     ) -> Result<GraphChange, EditError> {
         self.unlocked(&[index])?;
         let mut node = self.transform_node(index)?.clone();
-        let k = self.shown_keyframe(&mut node)?;
-        let NodeKind::Transform { frames, .. } = &mut node.kind else { unreachable!("checked by shown_keyframe") };
-        let own = graph::parse_transform(&frames[k], node.id)?;
+        let own = self.own_transform(&node)?;
+        let k = self.key_to_change(&mut node)?;
+        let NodeKind::Transform { frames, .. } = &mut node.kind else { unreachable!("checked by key_to_change") };
         // The whole transform is parent · own, so the parent's rotation is whole · own⁻¹.
         let parent = self.objects[index].placement.transform.rotation.times(own.rotation.inverse());
         graph::write_transform(&mut frames[k], f(own, parent));
@@ -535,10 +629,7 @@ impl Objects {
     /// Where object `index`'s group places it: its whole transform at the
     /// shown frame without its own.
     fn parent_placement(&self, index: usize) -> Result<Transform, EditError> {
-        let mut node = self.transform_node(index)?.clone();
-        let k = self.shown_keyframe(&mut node)?;
-        let NodeKind::Transform { frames, .. } = &node.kind else { unreachable!("checked by shown_keyframe") };
-        let own = graph::parse_transform(&frames[k], node.id)?;
+        let own = self.own_transform(self.transform_node(index)?)?;
         Ok(self.objects[index].placement.transform.compose(own.inverse()))
     }
 
@@ -815,6 +906,8 @@ pub struct GraphChange {
     pub layers: Vec<Layer>,
     pub remove: Vec<u32>,
     pub remove_layers: Vec<u32>,
+    /// The document's playback settings to put in.
+    pub animation: Option<anim::Animation>,
 }
 
 /// Bytes a changed node or layer takes while a change is applied: it, the
@@ -832,6 +925,9 @@ impl GraphChange {
     /// Applies it to `graph`; returns the change that undoes it.
     fn apply(&self, graph: &mut SceneGraph) -> GraphChange {
         let mut inverse = GraphChange::default();
+        if let Some(animation) = self.animation {
+            inverse.animation = Some(std::mem::replace(&mut graph.animation, animation));
+        }
         for id in &self.remove {
             if let Some(at) = graph.nodes.iter().position(|n| n.id == *id) {
                 inverse.nodes.push(graph.nodes.remove(at));
@@ -905,6 +1001,29 @@ fn copy_cells(from: &Octree, (lo, hi): (IVec3, IVec3), to: &mut Octree, map: imp
         }
     });
     to.insert_voxels(&batch);
+}
+
+/// Adds a key at `frame` holding `transform` among `keys`, before the
+/// first key of a later frame (keys stay in the order of their frames, as
+/// MagicaVoxel writes them); returns its index.
+fn insert_key(
+    keys: &mut Vec<graph::Attributes>,
+    frame: u32,
+    transform: Transform,
+    node: u32,
+) -> Result<usize, GraphError> {
+    let mut key = graph::Attributes::new();
+    key.insert("_f".to_owned(), frame.to_string());
+    graph::write_transform(&mut key, transform);
+    let mut at = keys.len();
+    for (k, other) in keys.iter().enumerate() {
+        if anim::key_frame(other, node)? > frame {
+            at = k;
+            break;
+        }
+    }
+    keys.insert(at, key);
+    Ok(at)
 }
 
 /// Min corners of the boxes of at most [`COMPOSE_BOX`] a side that tile `lo..=hi`.

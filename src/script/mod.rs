@@ -12,6 +12,7 @@ use std::path::PathBuf;
 use glam::{DVec3, IVec3};
 
 use crate::edit::brush::{Brush, Tool};
+use crate::scene::anim::Ease;
 
 pub use parse::{MAX_SCRIPT_BYTES, ScriptError, load_script, parse_script, split_words};
 pub use print::quoted;
@@ -118,6 +119,12 @@ pub enum Line {
     ExpectObjects(usize),
     /// `expect models N`: the scene stores N models (each once).
     ExpectModels(usize),
+    /// `frame N`: show frame N of the animation (every key sampled there).
+    Frame(u32),
+    /// `anim range A B`, `anim fps N`, `anim loop on|off`.
+    Anim(AnimLine),
+    /// `expect frame N`: frame N is shown.
+    ExpectFrame(u32),
 }
 
 impl Line {
@@ -149,12 +156,15 @@ impl Line {
                 | ObjectLine::Hide(_)
                 | ObjectLine::Lock(_)
                 | ObjectLine::Rename(_)
-                | ObjectLine::Layer(_),
+                | ObjectLine::Layer(_)
+                | ObjectLine::Key(_)
+                | ObjectLine::Unkey,
             )
+            | Line::Anim(_)
             | Line::Palette(PaletteLine::Set { .. } | PaletteLine::Preset(_)) => Kind::Edit { color: false },
             Line::Stroke(_) => Kind::Stroke,
             Line::Brush(_) | Line::Color(_) | Line::Mirror(_) => Kind::Tool,
-            Line::Object(ObjectLine::Pick(_)) | Line::Select(_) | Line::Copy => Kind::State,
+            Line::Object(ObjectLine::Pick(_)) | Line::Select(_) | Line::Copy | Line::Frame(_) => Kind::State,
             Line::Undo(_) | Line::Redo(_) => Kind::History,
             Line::Load(_) | Line::New | Line::Demo(_) => Kind::Scene,
             Line::Camera { .. } | Line::Viewport(..) | Line::Projection(_) => Kind::View,
@@ -171,7 +181,8 @@ impl Line {
             | Line::ExpectEffects(_)
             | Line::ExpectPalette(..)
             | Line::ExpectObjects(_)
-            | Line::ExpectModels(_) => Kind::Check,
+            | Line::ExpectModels(_)
+            | Line::ExpectFrame(_) => Kind::Check,
         }
     }
 
@@ -229,7 +240,10 @@ impl Line {
             | Line::ExpectEffects(_)
             | Line::ExpectPalette(..)
             | Line::ExpectObjects(_)
-            | Line::ExpectModels(_) => "expect",
+            | Line::ExpectModels(_)
+            | Line::ExpectFrame(_) => "expect",
+            Line::Frame(_) => "frame",
+            Line::Anim(_) => "anim",
             Line::Segment(..) => "line",
             Line::Mirror(_) => "mirror",
             Line::Fill(_) => "fill",
@@ -310,6 +324,22 @@ pub enum ObjectLine {
     Rename(String),
     /// `object layer N`.
     Layer(u32),
+    /// `object key [step|linear|smooth]`: key the transform at the frame
+    /// shown with what it shows, eased that way to the next key.
+    Key(Ease),
+    /// `object unkey`: take the key at the frame shown out.
+    Unkey,
+}
+
+/// What an `anim` line sets (each an undoable edit of the document).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AnimLine {
+    /// `anim range A B`: the frames played, A to B.
+    Range(u32, u32),
+    /// `anim fps N`.
+    Fps(u32),
+    /// `anim loop on|off`: whether playing starts again at the range's start.
+    Loop(bool),
 }
 
 /// What a `palette` line does.

@@ -5,9 +5,10 @@ use std::path::{Path, PathBuf};
 
 use glam::{DVec3, IVec3};
 
-use super::{LayerLine, Line, NumberedLine, ObjectLine, ObjectRef, PaletteLine, Script};
+use super::{AnimLine, LayerLine, Line, NumberedLine, ObjectLine, ObjectRef, PaletteLine, Script};
 use crate::camera::{FOV_RANGE_DEG, check_fov};
 use crate::edit::brush::{Brush, Tool};
+use crate::scene::anim::{Ease, MAX_FPS};
 use crate::scene::demo::BuiltIn;
 use crate::scene::shape::MAX_BRUSH_EXTENT;
 use clap::ValueEnum as _;
@@ -55,6 +56,8 @@ pub(super) const NAME_KEYWORDS: &[&str] = &[
     "layer",
     "color",
     "active",
+    "key",
+    "unkey",
 ];
 
 /// Reads the tokens of one line, left to right, with errors that point at
@@ -444,6 +447,8 @@ fn parse_command(c: &mut Cursor) -> Result<Line, Fail> {
         "render" => Line::Render(c.path()?),
         "expect" => parse_expect(c)?,
         "object" => Line::Object(parse_object(c)?),
+        "frame" => Line::Frame(c.int_in("a frame", 0..=i64::from(u32::MAX))? as u32),
+        "anim" => Line::Anim(parse_anim(c)?),
         "layer" => {
             let id = c.int_in("layer id", 0..=i64::from(u32::MAX - 1))? as u32;
             let what = c.word("hide, show, color, active or a name")?;
@@ -496,7 +501,35 @@ fn parse_object(c: &mut Cursor) -> Result<ObjectLine, Fail> {
         "delete" => ObjectLine::Delete,
         "rename" => ObjectLine::Rename(c.word("a name")?.text),
         "layer" => ObjectLine::Layer(c.int_in("layer id", 0..=i64::from(u32::MAX - 1))? as u32),
+        "key" => ObjectLine::Key(match c.optional() {
+            None => Ease::Linear,
+            Some(word) => Ease::from_name(&word.text)
+                .ok_or((word.column, format!("expected step, linear or smooth, found '{}'", word.text)))?,
+        }),
+        "unkey" => ObjectLine::Unkey,
         _ => ObjectLine::Pick(object_ref(word)?),
+    })
+}
+
+/// `anim range A B`, `anim fps N`, `anim loop on|off`.
+fn parse_anim(c: &mut Cursor) -> Result<AnimLine, Fail> {
+    let what = c.word("range, fps or loop")?;
+    Ok(match what.text.as_str() {
+        "range" => {
+            let first = c.int_in("the first frame", 0..=i64::from(u32::MAX))? as u32;
+            let last = c.int_in("the last frame", i64::from(first)..=i64::from(u32::MAX))? as u32;
+            AnimLine::Range(first, last)
+        }
+        "fps" => AnimLine::Fps(c.int_in("frames a second", 1..=i64::from(MAX_FPS))? as u32),
+        "loop" => {
+            let word = c.word("on or off")?;
+            AnimLine::Loop(match word.text.as_str() {
+                "on" => true,
+                "off" => false,
+                other => return Err((word.column, format!("expected on or off, found '{other}'"))),
+            })
+        }
+        other => return Err((what.column, format!("expected range, fps or loop, found '{other}'"))),
     })
 }
 
@@ -565,7 +598,7 @@ fn parse_brush(c: &mut Cursor) -> Result<Brush, Fail> {
 }
 
 fn parse_expect(c: &mut Cursor) -> Result<Line, Fail> {
-    let what = c.word("voxel, count, written, image, effects, palette, objects or models")?;
+    let what = c.word("voxel, count, written, image, effects, palette, objects, models or frame")?;
     Ok(match what.text.as_str() {
         "voxel" => {
             let p = c.position()?;
@@ -599,10 +632,13 @@ fn parse_expect(c: &mut Cursor) -> Result<Line, Fail> {
         }
         "objects" => Line::ExpectObjects(c.number("an object count")?),
         "models" => Line::ExpectModels(c.number("a model count")?),
+        "frame" => Line::ExpectFrame(c.int_in("a frame", 0..=i64::from(u32::MAX))? as u32),
         other => {
             return Err((
                 what.column,
-                format!("expected voxel, count, written, image, effects, palette, objects or models, found '{other}'"),
+                format!(
+                    "expected voxel, count, written, image, effects, palette, objects, models or frame, found '{other}'"
+                ),
             ));
         }
     })
@@ -700,6 +736,13 @@ mod tests {
         );
         assert_eq!(errors("expect written < 3"), vec!["expected '<=', found '<' at build.ovr:1:16"]);
         assert_eq!(errors("new extra"), vec!["unexpected 'extra' after the command at build.ovr:1:5"]);
+        assert_eq!(errors("anim range 5 2"), vec!["the last frame 2 is outside 5..=4294967295 at build.ovr:1:14"]);
+        assert_eq!(errors("frame -1"), vec!["a frame -1 is outside 0..=4294967295 at build.ovr:1:7"]);
+        assert_eq!(
+            errors("object key bouncy"),
+            vec!["expected step, linear or smooth, found 'bouncy' at build.ovr:1:12"]
+        );
+        assert_eq!(errors("anim fps 0"), vec!["frames a second 0 is outside 1..=240 at build.ovr:1:10"]);
         assert_eq!(errors("click 3 4 smash"), vec!["expected attach, erase or paint, found 'smash' at build.ovr:1:11"]);
         assert_eq!(errors("select 0 0 0 5000 0 0"), vec!["a selection is at most 4096 voxels wide at build.ovr:1:1"]);
         assert_eq!(errors("paste 1 2"), vec!["missing Z at build.ovr:1:10"]);
@@ -725,7 +768,8 @@ mod tests {
                     extrude 1 2 3 0 -1 0 -2\nobject 3\nobject \"tree 4/top\"\nobject hide\nobject show\nlayer 2 hide\n\
                     ortho 42.5\nperspective\nground off\nground on\nlayer 0 show\nexpect objects 19\nexpect models 15\nobject new \"a b\"\nobject move 1 -2 3\nobject rotate z\n\
                     object duplicate\nobject duplicate reference\nobject unique\nobject delete\nobject rename top\n\
-                    object layer 3\nlayer 4 \"roof tiles\"\nlayer 4 color 10 200 255\nlayer 2 active\nobject merge 3 \"tree 4/top\" 7\nobject before 2\nobject after \"a b\"\nobject lock\nobject unlock\nstroke begin\nstroke end\n";
+                    object layer 3\nlayer 4 \"roof tiles\"\nlayer 4 color 10 200 255\nlayer 2 active\nobject merge 3 \"tree 4/top\" 7\nobject before 2\nobject after \"a b\"\nobject lock\nobject unlock\nstroke begin\nstroke end\n\
+                    frame 12\nanim range 0 30\nanim fps 24\nanim loop off\nexpect frame 12\nobject key smooth\nobject key\nobject unkey\n";
         let script = parse_script(Path::new("t.ovr"), text).unwrap();
         let printed: String = script.lines.iter().map(|l| format!("{}\n", l.command)).collect();
         let again = parse_script(Path::new("t.ovr"), &printed).unwrap();
@@ -733,7 +777,7 @@ mod tests {
             script.lines.iter().map(|l| &l.command).collect::<Vec<_>>(),
             again.lines.iter().map(|l| &l.command).collect::<Vec<_>>()
         );
-        assert_eq!(script.lines.len(), 79);
+        assert_eq!(script.lines.len(), 87);
         // Each line's word is the one it is printed with.
         for line in &script.lines {
             assert_eq!(line.command.to_string().split(' ').next(), Some(line.command.word()), "{}", line.command);

@@ -5,7 +5,7 @@ use std::fmt;
 
 use glam::IVec3;
 
-use super::{LayerLine, Line, ObjectLine, ObjectRef, PaletteLine};
+use super::{AnimLine, LayerLine, Line, ObjectLine, ObjectRef, PaletteLine};
 use crate::edit::brush::Brush;
 
 /// Writes a command back as a script line (what `--record` produces).
@@ -103,6 +103,13 @@ impl fmt::Display for Line {
                 write!(f, "object rename {}", quoted_name(name))
             }
             Line::Object(ObjectLine::Layer(id)) => write!(f, "object layer {id}"),
+            Line::Object(ObjectLine::Key(ease)) => write!(f, "object key {}", ease.name()),
+            Line::Object(ObjectLine::Unkey) => write!(f, "object unkey"),
+            Line::Frame(n) => write!(f, "frame {n}"),
+            Line::Anim(AnimLine::Range(a, b)) => write!(f, "anim range {a} {b}"),
+            Line::Anim(AnimLine::Fps(n)) => write!(f, "anim fps {n}"),
+            Line::Anim(AnimLine::Loop(on)) => write!(f, "anim loop {}", if *on { "on" } else { "off" }),
+            Line::ExpectFrame(n) => write!(f, "expect frame {n}"),
             Line::Layer(id, LayerLine::Hide(true)) => write!(f, "layer {id} hide"),
             Line::Layer(id, LayerLine::Hide(false)) => write!(f, "layer {id} show"),
             Line::Layer(id, LayerLine::Name(name)) => write!(f, "layer {id} {}", quoted_name(name)),

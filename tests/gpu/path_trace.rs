@@ -670,7 +670,14 @@ pub(crate) fn instanced_material_scene() -> Scene {
         nodes.push(Node { id: id + 1, attributes: Attributes::new(), kind: shape });
     }
     let layers = vec![Layer { id: 0, attributes: Attributes::new(), reserved: u32::MAX }];
-    let objects = Objects::new(Some(SceneGraph { nodes, layers }), vec![model], Vec::new(), 0, usize::MAX).unwrap();
+    let objects = Objects::new(
+        Some(SceneGraph { nodes, layers, ..SceneGraph::default() }),
+        vec![model],
+        Vec::new(),
+        0,
+        usize::MAX,
+    )
+    .unwrap();
     let mut scene = Scene::compose(single.palette.clone(), objects).unwrap();
     scene.set_instancing(octovox::scene::Instancing::References);
     assert!(scene.instanced().is_some());

@@ -147,3 +147,11 @@ pub(super) fn le_u32(bytes: &[u8], at: usize) -> Option<u32> {
 pub(super) fn widen(n: u32) -> usize {
     usize::try_from(n).unwrap_or(usize::MAX)
 }
+
+/// The dictionary a kept chunk's content starts with (META's whole
+/// content), or `None` where it holds none.
+pub(super) fn content_dict(id: [u8; 4], content: &[u8]) -> Option<Attributes> {
+    let chunk =
+        Chunk { id, offset: 0, content_start: 0, content_end: content.len(), children_bytes: 0, end: content.len() };
+    Cursor::new(content, &chunk).dict("settings").ok()
+}

@@ -94,6 +94,7 @@ impl From<crate::scene::graph::GraphError> for VoxError {
         match e {
             GraphError::Cycle(node) => VoxError::SceneCycle(node),
             GraphError::Bad(problem) => VoxError::BadSceneGraph(problem),
+            late @ GraphError::FrameTooLate(_) => VoxError::BadSceneGraph(late.to_string()),
             GraphError::TooManyVoxels { limit, found } => VoxError::TooManyVoxels { limit, found },
             GraphError::OverBudget(over) => VoxError::OverBudget(over),
         }

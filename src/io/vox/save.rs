@@ -6,10 +6,11 @@ use std::path::Path;
 
 use glam::IVec3;
 
-use super::stored;
 use super::validate::MAX_MODEL_EDGE;
 use super::{MAX_FILE_BYTES, MAX_VOXELS, VoxError};
+use super::{chunk, stored};
 use crate::io::atomic::{WriteOptions, write_atomically};
+use crate::scene::anim::Animation;
 use crate::scene::graph::{Attributes, Node, NodeKind, SceneGraph};
 use crate::scene::objects::Objects;
 use crate::scene::{Material, Octree, Palette, Voxel};
@@ -372,8 +373,15 @@ pub fn encode_objects(palette: &Palette, objects: &Objects) -> Result<Vec<u8>, V
         write_dict(&mut chunk, material.iter().map(|(k, v)| (k.as_str(), v.as_str())));
         push_chunk(&mut children, b"MATL", &chunk, 0);
     }
+    let animation = objects.graph.as_ref().map(|g| g.animation).unwrap_or_default();
     for kept in &objects.kept {
-        push_chunk(&mut children, &kept.id, &kept.content, 0);
+        match kept.id {
+            META => push_chunk(&mut children, &META, &meta_content(Some(&kept.content), animation), 0),
+            id => push_chunk(&mut children, &id, &kept.content, 0),
+        }
+    }
+    if animation != Animation::default() && !objects.kept.iter().any(|k| k.id == META) {
+        push_chunk(&mut children, &META, &meta_content(None, animation), 0);
     }
     let total = 8 + CHUNK_HEADER_BYTES + children.len() as u64;
     if total > MAX_FILE_BYTES {
@@ -386,6 +394,23 @@ pub fn encode_objects(palette: &Palette, objects: &Objects) -> Result<Vec<u8>, V
     push_chunk(&mut out, b"MAIN", &[], u32::try_from(children.len()).unwrap_or(u32::MAX));
     out.extend_from_slice(&children);
     Ok(out)
+}
+
+const META: [u8; 4] = *b"META";
+
+/// A META chunk's content holding `animation`: the one read, as read, where
+/// it says the same; else its dictionary with the settings written in.
+fn meta_content(read: Option<&[u8]>, animation: Animation) -> Vec<u8> {
+    let mut meta = read.and_then(|content| chunk::content_dict(META, content)).unwrap_or_default();
+    if let Some(content) = read
+        && Animation::from_meta(&meta).0 == animation
+    {
+        return content.to_vec();
+    }
+    animation.write_meta(&mut meta);
+    let mut content = Vec::new();
+    write_attributes(&mut content, &meta);
+    content
 }
 
 /// A scene whose placements octovox would refuse to load is not written:

@@ -15,6 +15,7 @@ use std::collections::BTreeMap;
 
 use super::VoxError;
 use super::chunk::{Chunk, Cursor, le_u32, read_chunk_header, widen};
+use crate::scene::anim::Animation;
 use crate::scene::graph::{Layer, Node, NodeKind, SceneGraph};
 use crate::scene::objects::KeptChunk;
 use crate::scene::{Material, MaterialKind};
@@ -134,7 +135,21 @@ fn check_chunk(bytes: &[u8], chunk: &Chunk, size: &mut Option<[u32; 3]>, layout:
         b"LAYR" => layout.graph.layers.push(read_layer(&mut cursor)?),
         // PACK only counts the models that follow; the saver writes none.
         b"PACK" | b"RGBA" => {}
-        // IMAP, rOBJ, rCAM, NOTE, META and unknown chunks are kept as read.
+        // Kept as read too; octovox reads its playback settings.
+        b"META" => {
+            match cursor.dict("settings") {
+                Ok(meta) => {
+                    let (animation, warnings) = Animation::from_meta(&meta);
+                    layout.graph.animation = animation;
+                    layout.warnings.extend(warnings);
+                }
+                Err(e) => layout.warnings.push(format!("{e}: its playback settings are ignored")),
+            }
+            layout
+                .kept
+                .push(KeptChunk { id: *b"META", content: bytes[chunk.content_start..chunk.content_end].to_vec() });
+        }
+        // IMAP, rOBJ, rCAM, NOTE and unknown chunks are kept as read.
         id => layout.kept.push(KeptChunk { id: *id, content: bytes[chunk.content_start..chunk.content_end].to_vec() }),
     }
     Ok(())
