@@ -343,7 +343,8 @@ mod tests {
         assert_eq!([5, 6, 7, 8, 9, 4, 3, 0].map(|f| looped(5, 8, f)), [5, 6, 7, 8, 5, 8, 7, 8]);
         assert_eq!(looped(0, 0, u32::MAX), 0);
         assert_eq!(looped(0, u32::MAX, u32::MAX), u32::MAX);
-        assert_eq!(looped(1 << 31, u32::MAX, 0), u32::MAX - ((1 << 31) - 1) % (1 << 31));
+        // One whole period (2^31 frames) before the first key shows the first.
+        assert_eq!(looped(1 << 31, u32::MAX, 0), 1 << 31);
     }
 
     #[test]

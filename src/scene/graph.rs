@@ -195,6 +195,30 @@ impl SceneGraph {
         self.nodes.get(id as usize).filter(|n| n.id == id).or_else(|| self.nodes.iter().find(|n| n.id == id))
     }
 
+    /// Reads every key of every node (frame, translation, turn, easing),
+    /// so that a key no frame shows yet is refused when the file is read,
+    /// not when a frame first shows it.
+    pub fn check_keys(&self) -> Result<(), GraphError> {
+        for node in &self.nodes {
+            match &node.kind {
+                NodeKind::Transform { frames, .. } => {
+                    for key in frames {
+                        super::anim::key_frame(key, node.id)?;
+                        parse_transform(key, node.id)?;
+                        super::anim::Ease::of(key, node.id)?;
+                    }
+                }
+                NodeKind::Shape { models } => {
+                    for (_, key) in models {
+                        super::anim::key_frame(key, node.id)?;
+                    }
+                }
+                NodeKind::Group { .. } => {}
+            }
+        }
+        Ok(())
+    }
+
     /// Number of group nodes.
     pub fn group_count(&self) -> usize {
         self.nodes.iter().filter(|n| matches!(n.kind, NodeKind::Group { .. })).count()

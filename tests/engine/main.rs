@@ -8,6 +8,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod animation;
 mod bench_cli;
 mod budgets;
 mod export;

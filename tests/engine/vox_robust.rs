@@ -146,7 +146,9 @@ fn voxels_past_the_coordinate_limit_are_refused_at_load() {
     assert_eq!(placed_at("16777215 0 -16777215").unwrap().voxels[0].0.to_array(), [16777215, -16777215, -0]);
 }
 
-/// `--frame` picks the last keyframe at or before it (no interpolation).
+/// `--frame` samples the keys as MagicaVoxel and `ogt_vox` do: linear
+/// between keys, rounded toward zero (before issue 49 it snapped to the
+/// earlier key: 0 at frame 4 and 10 at frame 7).
 #[test]
 fn keyframes_follow_the_requested_frame() {
     let mut chunks = one_voxel_model();
@@ -157,7 +159,7 @@ fn keyframes_follow_the_requested_frame() {
     ));
     chunks.push(shape(1, 0));
     let bytes = vox_file(&chunks);
-    for (frame, x) in [(0, 0), (4, 0), (5, 10), (7, 10), (8, 20), (100, 20)] {
+    for (frame, x) in [(0, 0), (4, 8), (5, 10), (7, 16), (8, 20), (100, 20)] {
         let model = load_vox(&bytes, frame).expect("animated scene");
         assert_eq!(model.voxels[0].0.x, x, "frame {frame}");
     }

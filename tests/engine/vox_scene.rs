@@ -32,7 +32,7 @@ fn asset_files() -> Vec<PathBuf> {
 }
 
 /// The children of MAIN as (id, content), read byte by byte.
-fn raw_chunks(bytes: &[u8]) -> Vec<([u8; 4], Vec<u8>)> {
+pub(crate) fn raw_chunks(bytes: &[u8]) -> Vec<([u8; 4], Vec<u8>)> {
     let word = |at: usize| u32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as usize;
     let mut out = Vec::new();
     let mut at = 8 + 12;
@@ -46,7 +46,7 @@ fn raw_chunks(bytes: &[u8]) -> Vec<([u8; 4], Vec<u8>)> {
 }
 
 /// The chunks a saver must keep as they are.
-fn kept_chunks(bytes: &[u8]) -> Vec<([u8; 4], Vec<u8>)> {
+pub(crate) fn kept_chunks(bytes: &[u8]) -> Vec<([u8; 4], Vec<u8>)> {
     let read = [*b"SIZE", *b"XYZI", *b"nTRN", *b"nGRP", *b"nSHP", *b"LAYR", *b"RGBA", *b"MATL", *b"MATT", *b"PACK"];
     raw_chunks(bytes).into_iter().filter(|(id, _)| !read.contains(id)).collect()
 }
@@ -70,16 +70,16 @@ fn assert_same_scene(name: &str, before: &[u8], after: &[u8]) {
 }
 
 /// Runs script lines on the editor; the first refused one's error.
-fn run(editor: &mut Editor, text: &str) -> Result<(), octovox::editor::EditorError> {
+pub(crate) fn run(editor: &mut Editor, text: &str) -> Result<(), octovox::editor::EditorError> {
     let script = octovox::script::parse_script(std::path::Path::new("t.ovr"), text).unwrap();
     script.lines.iter().try_for_each(|l| editor.run(&l.command).map(|_| ()))
 }
 
-fn load(bytes: &[u8]) -> Scene {
+pub(crate) fn load(bytes: &[u8]) -> Scene {
     load_vox_scene(bytes, 0).unwrap().0
 }
 
-fn saved(scene: &Scene) -> Vec<u8> {
+pub(crate) fn saved(scene: &Scene) -> Vec<u8> {
     encode_objects(&scene.palette, scene.objects().expect("a scene of objects")).unwrap()
 }
 
@@ -176,7 +176,7 @@ fn the_animation_keeps_its_keys_layers_cameras_and_settings() {
 }
 
 /// A cube-ish model with a marked corner, so that rotations show.
-fn model(size: u32, color: u8) -> Model {
+pub(crate) fn model(size: u32, color: u8) -> Model {
     let mut voxels = Vec::new();
     for x in 0..size as u8 {
         for y in 0..size as u8 {
@@ -187,7 +187,7 @@ fn model(size: u32, color: u8) -> Model {
     Model { size: Size { x: size, y: size, z: 2 }, voxels }
 }
 
-fn dict(pairs: &[(&str, String)]) -> dot_vox::Dict {
+pub(crate) fn dict(pairs: &[(&str, String)]) -> dot_vox::Dict {
     pairs.iter().map(|(k, v)| ((*k).to_owned(), v.clone())).collect()
 }
 
@@ -260,7 +260,7 @@ pub(crate) fn written_scene(count: usize) -> Vec<u8> {
 }
 
 /// Appends chunks to MAIN and fixes its children size.
-fn append_chunks(bytes: &mut Vec<u8>, chunks: &[([u8; 4], Vec<u8>)]) {
+pub(crate) fn append_chunks(bytes: &mut Vec<u8>, chunks: &[([u8; 4], Vec<u8>)]) {
     for (id, content) in chunks {
         bytes.extend_from_slice(id);
         bytes.extend_from_slice(&(content.len() as u32).to_le_bytes());

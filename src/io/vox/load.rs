@@ -152,6 +152,7 @@ fn parse(bytes: &[u8], frame: usize) -> Result<Parsed, VoxError> {
     let objects = if data.scenes.is_empty() {
         frame_objects(data.models.len(), frame)?
     } else {
+        layout.graph.check_keys()?;
         layout.graph.objects(&layout.model_voxels, frame, MAX_VOXELS)?
     };
     let empty = layout.zero_index_voxels.iter().copied().collect();
