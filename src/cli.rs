@@ -216,8 +216,24 @@ pub struct RenderArgs {
     /// Leave the model in the sky, with no ground under it.
     #[arg(long, overrides_with = "ground")]
     pub no_ground: bool,
+    /// The animation frame shown (every key sampled there); with
+    /// --turntable, the frame the scene stands at.
     #[arg(long, default_value_t = 0)]
     pub frame: usize,
+    /// Render the animation's frames A to B (both included) into OUTPUT, a
+    /// name with `%d` or `%0Nd` for the frame's number
+    /// (`out/walk_%04d.png`), or one looping `.gif`.
+    #[arg(long, value_parser = parse_frames, value_name = "A..B")]
+    pub frames: Option<(u32, u32)>,
+    /// Render N frames of the camera orbiting its target once, the scene
+    /// standing still (--frames picks some of them, from 0..N-1).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000), value_name = "N")]
+    pub turntable: Option<u32>,
+    /// Render only shard K's share of the frames, of N shards (0 ≤ K < N):
+    /// consecutive frames, the same whichever machine renders them, so a
+    /// cluster's job array spreads an animation (docs/animation.md).
+    #[arg(long, value_parser = parse_shard, value_name = "K/N")]
+    pub shard: Option<(u32, u32)>,
     /// Replace OUTPUT even if it is the input or an existing .vox/.obj/.ovr.
     #[arg(long)]
     pub force: bool,
@@ -234,6 +250,40 @@ pub struct RenderArgs {
     /// denoise_ms, noise_estimate, adapter, lights.
     #[arg(long)]
     pub stats: bool,
+}
+
+impl RenderArgs {
+    /// Whether it renders frames of an animation or a turntable, not one image.
+    pub fn animates(&self) -> bool {
+        self.frames.is_some() || self.turntable.is_some() || self.shard.is_some()
+    }
+}
+
+/// Parses `A..B`, frames A to B, both included.
+pub fn parse_frames(s: &str) -> Result<(u32, u32), String> {
+    let (a, b) = s.split_once("..").ok_or_else(|| format!("'{s}' is not A..B (frames A to B, e.g. 0..47)"))?;
+    let parse = |v: &str| {
+        v.trim().parse::<u32>().map_err(|_| format!("'{s}': '{v}' is not a frame number (0 to {})", u32::MAX))
+    };
+    let (a, b) = (parse(a)?, parse(b.trim_start_matches('='))?);
+    if a > b {
+        return Err(format!("'{s}': the first frame {a} is after the last {b}"));
+    }
+    Ok((a, b))
+}
+
+/// Parses `K/N`: shard K of N, 0 ≤ K < N.
+pub fn parse_shard(s: &str) -> Result<(u32, u32), String> {
+    let (k, n) = s.split_once('/').ok_or_else(|| format!("'{s}' is not K/N (shard K of N, e.g. 0/4)"))?;
+    let parse = |v: &str| v.trim().parse::<u32>().map_err(|_| format!("'{s}': '{v}' is not a whole number"));
+    let (k, n) = (parse(k)?, parse(n)?);
+    if n == 0 {
+        return Err(format!("'{s}': N, the number of shards, is at least 1"));
+    }
+    if k >= n {
+        return Err(format!("'{s}': the shards of {n} are numbered 0 to {}", n - 1));
+    }
+    Ok((k, n))
 }
 
 /// The path tracer's knobs on the command line.

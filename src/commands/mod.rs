@@ -23,6 +23,7 @@ mod progress_bar;
 mod quality_plot;
 mod recover;
 pub mod render;
+mod render_frames;
 mod replay;
 
 use std::process::ExitCode;

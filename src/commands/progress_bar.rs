@@ -17,6 +17,16 @@ pub fn bar(what: &str, total: u64) -> ProgressBar {
     bar
 }
 
+/// A bar over the `total` frames of a render, with the time left.
+pub fn frames_bar(total: u64) -> ProgressBar {
+    let bar = ProgressBar::new(total);
+    bar.set_style(
+        ProgressStyle::with_template("rendering [{bar:30}] {pos}/{len} frames, {eta} left")
+            .unwrap_or(ProgressStyle::default_bar()),
+    );
+    bar
+}
+
 /// Runs `work` with a progress it reports to, showing a bar named `what`.
 pub fn with_bar<T: Send>(what: &str, work: impl FnOnce(&Progress) -> T + Send) -> T {
     let progress = Progress::default();

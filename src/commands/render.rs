@@ -41,8 +41,30 @@ pub fn open_scene(file: Option<&std::path::Path>, frame: usize, demo: Option<Bui
 }
 
 pub fn run(args: &RenderArgs) -> anyhow::Result<ExitCode> {
+    check_args(args)?;
+    if args.animates() {
+        return super::render_frames::run(args);
+    }
     let inputs: Vec<&std::path::Path> = args.file.iter().map(|p| p.as_path()).collect();
     check_output(&args.output, OutputKind::Image, &inputs, args.force)?;
+    let mut scene = open_scene(args.file.as_deref(), args.frame, args.demo)?;
+    let camera = Camera { ortho: args.ortho, ..camera_or_filling(args.camera, args.fov, &scene, args.size) };
+    let ground = ground_height(&scene, args);
+    let mut device = Device::new(args)?;
+    let (image, stats) =
+        render_frame(&mut device, &mut scene, &camera, args, Shot { ground, number: frame_number(args.frame) })?;
+    save_png(&image, &args.output, WriteOptions::forced(args.force))?;
+    if args.stats {
+        say!("{}", serde_json::to_string(&stats)?)?;
+    } else {
+        say!("wrote {} ({}x{})", args.output.display(), args.size.0, args.size.1)?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Refuses flags that do not go together, and a picture larger than the
+/// memory budget, before anything is loaded.
+fn check_args(args: &RenderArgs) -> anyhow::Result<()> {
     let traced_path = args.path.traced();
     if traced_path && (args.mode != TraceMode::Svo || args.view != View::Shaded) {
         anyhow::bail!("the path tracer (--spp) walks the SVO and shades: it takes neither --mode grid nor --view");
@@ -70,34 +92,71 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<ExitCode> {
         (false, false) => GPU_BYTES_PER_PIXEL,
     };
     octovox::budget::check(|| format!("a {}x{} render", args.size.0, args.size.1), pixels * per_pixel)?;
-    let mut scene = open_scene(args.file.as_deref(), args.frame, args.demo)?;
-    let camera = Camera { ortho: args.ortho, ..camera_or_filling(args.camera, args.fov, &scene, args.size) };
-    let traced = octovox::settings::scaled_size(args.size, args.render_scale);
-    let (image, stats) = if traced_path {
-        path_traced(&mut scene, &camera, args, traced)?
-    } else {
-        preview(&mut scene, &camera, args, traced)?
-    };
-    let image = octovox::io::png::upscale(image, args.size);
-    save_png(&image, &args.output, WriteOptions::forced(args.force))?;
-    if args.stats {
-        say!("{}", serde_json::to_string(&stats)?)?;
-    } else {
-        say!("wrote {} ({}x{})", args.output.display(), args.size.0, args.size.1)?;
+    Ok(())
+}
+
+/// Where a render's frames are drawn: one GPU renderer for every frame,
+/// or the CPU reference.
+pub(super) enum Device {
+    Gpu(Box<Renderer>),
+    Cpu,
+}
+
+impl Device {
+    pub(super) fn new(args: &RenderArgs) -> anyhow::Result<Device> {
+        if args.cpu {
+            return Ok(Device::Cpu);
+        }
+        let renderer = Renderer::headless().context("no GPU for rendering (try --cpu)")?;
+        log::info!("rendering on {}", renderer.gpu.adapter_name);
+        Ok(Device::Gpu(Box::new(renderer)))
     }
-    Ok(ExitCode::SUCCESS)
+}
+
+/// What differs between the frames of one render: the ground's height
+/// (fixed for an animation, so it does not jump) and the frame's number,
+/// which picks the path tracer's samples: a frame is the same bytes
+/// whichever process renders it.
+#[derive(Clone, Copy)]
+pub(super) struct Shot {
+    pub ground: Option<i32>,
+    pub number: u32,
+}
+
+/// One picture of `scene`: the preview or the path tracer, at the render
+/// scale, scaled up to `--size`.
+pub(super) fn render_frame(
+    device: &mut Device,
+    scene: &mut Scene,
+    camera: &Camera,
+    args: &RenderArgs,
+    frame: Shot,
+) -> anyhow::Result<(image::RgbaImage, Stats)> {
+    let traced = octovox::settings::scaled_size(args.size, args.render_scale);
+    let (image, stats) = if args.path.traced() {
+        path_traced(device, scene, camera, args, traced, frame)?
+    } else {
+        preview(device, scene, camera, args, traced, frame.ground)?
+    };
+    Ok((octovox::io::png::upscale(image, args.size), stats))
+}
+
+/// A frame's number as the path tracer's seeds take it (a frame past
+/// 2^32 is refused when the scene is walked there).
+pub(super) fn frame_number(frame: usize) -> u32 {
+    u32::try_from(frame).unwrap_or(u32::MAX)
 }
 
 /// The world height of the ground plane (`--ground`, the default; none with
 /// `--no-ground`): under the lowest voxel, or at 0 in an empty scene.
-fn ground_height(scene: &Scene, args: &RenderArgs) -> Option<i32> {
+pub(super) fn ground_height(scene: &Scene, args: &RenderArgs) -> Option<i32> {
     let lowest = scene.solid_bounds().map_or(0, |(lo, _)| lo.y);
     (!args.no_ground).then_some(lowest)
 }
 
 /// What `--stats` prints.
 #[derive(serde::Serialize, Default)]
-struct Stats {
+pub(super) struct Stats {
     effects: Vec<&'static str>,
     /// The samples taken (with `--target-error`, until the estimate met it).
     spp: u32,
@@ -113,10 +172,12 @@ struct Stats {
 
 /// Today's deterministic shading (colour, Lambert, shadow), one frame.
 fn preview(
+    device: &mut Device,
     scene: &mut Scene,
     camera: &Camera,
     args: &RenderArgs,
     size: (u32, u32),
+    ground: Option<i32>,
 ) -> anyhow::Result<(image::RgbaImage, Stats)> {
     let settings = RenderSettings {
         mode: args.mode,
@@ -124,20 +185,18 @@ fn preview(
         shadows: !args.no_shadows,
         render_scale: 1.0,
         lod: args.lod,
-        ground: ground_height(scene, args),
+        ground,
     };
     let grid = match args.mode {
         TraceMode::Grid => Some(DenseGrid::from_octree(scene.drawn())?),
         TraceMode::Svo => None,
     };
     let stats = |ms, adapter| Stats { ms_per_sample: ms, adapter, ..Stats::default() };
-    if args.cpu {
+    let Device::Gpu(renderer) = device else {
         let start = Instant::now();
         let image = render_scene_cpu(scene, grid.as_ref(), camera, size, &settings);
         return Ok((image, stats(start.elapsed().as_secs_f64() * 1e3, "cpu".into())));
-    }
-    let mut renderer = Renderer::headless().context("no GPU for rendering (try --cpu)")?;
-    log::info!("rendering on {}", renderer.gpu.adapter_name);
+    };
     renderer.sync(scene);
     if let Some(grid) = &grid {
         renderer.set_grid(grid, scene.revision())?;
@@ -151,25 +210,32 @@ fn preview(
 /// until the noise estimate is below `--target-error`; denoised with
 /// `--denoise`.
 fn path_traced(
+    device: &mut Device,
     scene: &mut Scene,
     camera: &Camera,
     args: &RenderArgs,
     size: (u32, u32),
+    frame: Shot,
 ) -> anyhow::Result<(image::RgbaImage, Stats)> {
-    let settings = PathSettings { ground: ground_height(scene, args), ..args.path.settings() };
-    if args.cpu {
+    // The frame's own sequence of samples (seed 0, frame 0: today's still images).
+    let seed = (u64::from(args.path.seed) + u64::from(frame.number)) % u64::from(octovox::settings::SEEDS);
+    let settings = PathSettings { ground: frame.ground, seed: seed as u32, ..args.path.settings() };
+    let Device::Gpu(renderer) = device else {
         return path_traced_cpu(scene, camera, &settings, args, size);
-    }
-    let mut renderer = Renderer::headless().context("no GPU for rendering (try --cpu)")?;
-    log::info!("path tracing on {}", renderer.gpu.adapter_name);
+    };
     renderer.sync(scene);
     let (cap, target) = (args.path.samples(), args.path.target_error);
     let view = PathView { scene, camera, size, settings: &settings };
-    let bar = super::progress_bar::bar("path tracing", u64::from(cap));
-    let Accumulated { last: frame, ms: total_ms } = accumulate(&mut renderer, &view, cap, target, |_| bar.inc(1))?;
+    // One bar at a time: a render of many frames draws its own.
+    let bar = if args.animates() {
+        indicatif::ProgressBar::hidden()
+    } else {
+        super::progress_bar::bar("path tracing", u64::from(cap))
+    };
+    let Accumulated { last: frame, ms: total_ms } = accumulate(renderer, &view, cap, target, |_| bar.inc(1))?;
     bar.finish_and_clear();
     let noise = renderer.noise_estimate()?;
-    let (image, denoise_ms) = finished_image(&mut renderer, &args.path, size)?;
+    let (image, denoise_ms) = finished_image(renderer, &args.path, size)?;
     let stats = Stats {
         effects: frame.effects.names(),
         spp: frame.samples,

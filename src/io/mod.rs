@@ -3,6 +3,7 @@
 
 pub mod atomic;
 pub mod export;
+pub mod gif;
 mod guard;
 pub mod input;
 pub mod mesh;

@@ -10,6 +10,8 @@ use std::path::{Path, PathBuf};
 pub enum OutputKind {
     /// A rendered image: `.png`.
     Image,
+    /// A rendered animation in one file: `.gif`.
+    Animation,
     /// A scene: `.vox` or `.ovx`.
     Scene,
     /// A replay script (`--record`): any name, `.ovr` by convention.
@@ -27,6 +29,7 @@ impl OutputKind {
     fn extensions(self) -> &'static [&'static str] {
         match self {
             OutputKind::Image => &["png"],
+            OutputKind::Animation => &["gif"],
             OutputKind::Scene => &["vox", "ovx"],
             OutputKind::Script => &[],
             OutputKind::Mesh => &["obj", "ply", "glb"],

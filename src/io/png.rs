@@ -20,9 +20,19 @@ pub enum PngError {
 /// ([`crate::io::atomic`]): the folder must exist, links are followed,
 /// devices refused, new files get the usual permissions (umask applied).
 pub fn save_png(image: &image::RgbaImage, path: &Path, options: WriteOptions) -> Result<(), PngError> {
+    save_encoded(path, options, |out| image.write_to(out, image::ImageFormat::Png))
+}
+
+/// Writes what `encode` writes into a buffered file, atomically, with
+/// errors that name the file (PNG and GIF alike).
+pub(crate) fn save_encoded(
+    path: &Path,
+    options: WriteOptions,
+    encode: impl FnOnce(&mut std::io::BufWriter<&mut std::fs::File>) -> Result<(), image::ImageError>,
+) -> Result<(), PngError> {
     let result = crate::io::atomic::write_atomically(path, options, |file| {
         let mut out = std::io::BufWriter::new(file);
-        image.write_to(&mut out, image::ImageFormat::Png).map_err(EncodeOrIo::Encode)?;
+        encode(&mut out).map_err(EncodeOrIo::Encode)?;
         out.flush().map_err(EncodeOrIo::Io)
     });
     result.map_err(|e| match e {

@@ -197,6 +197,11 @@ impl Objects {
         Some(self.maps[index].apply_box(lo, hi))
     }
 
+    /// The world box of every shown object's voxels; `None` when none has any.
+    pub fn bounds(&self) -> Option<(IVec3, IVec3)> {
+        self.visible().filter_map(|i| self.world_box(i)).reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
+    }
+
     /// The world box of object `index`'s model's root cube: it holds every
     /// voxel the object may show, and takes no walk of the model.
     fn reach(&self, index: usize) -> (IVec3, IVec3) {
@@ -419,6 +424,16 @@ impl Objects {
             }
         }
         Ok(())
+    }
+
+    /// A copy of the objects walked at frame `frame`: what a frame of a
+    /// rendered animation composes from, the same whatever frame was shown
+    /// before (so a frame is the same whichever process renders it).
+    pub fn at_frame(&self, frame: usize) -> Result<Objects, ObjectsError> {
+        let mut objects = self.clone();
+        objects.frame = frame;
+        objects.walk(usize::MAX)?;
+        Ok(objects)
     }
 
     /// The frame shown, as keys name frames.
