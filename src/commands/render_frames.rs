@@ -194,7 +194,7 @@ fn orbit(camera: &Camera, k: u32, n: u32) -> Camera {
 fn scene_at(loaded: &Scene, frame: u32) -> anyhow::Result<Scene> {
     let objects = loaded.objects().context("the scene has no objects")?;
     let walked = objects.at_frame(frame as usize).with_context(|| format!("frame {frame}"))?;
-    Ok(Scene::compose(loaded.palette.clone(), walked).with_context(|| format!("frame {frame}"))?)
+    Scene::compose(loaded.palette.clone(), walked).with_context(|| format!("frame {frame}"))
 }
 
 /// Where the frames go.

@@ -11,6 +11,7 @@ mod common;
 mod animation;
 mod bench_cli;
 mod budgets;
+mod cluster;
 mod export;
 mod export_scene;
 mod fuzz_corpus;
