@@ -6,6 +6,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod animation;
 mod denoise;
 mod ground;
 mod path_trace;
