@@ -88,7 +88,8 @@ pub enum CliCommand {
         /// One line per object: index, name path, model, layer, hidden, world box.
         #[arg(long)]
         objects: bool,
-        /// Animation frame to read (files with several models and no scene graph).
+        /// The animation frame to read (every key sampled there; in a file of
+        /// several models and no scene graph, the model shown).
         #[arg(long, default_value_t = 0)]
         frame: usize,
     },

@@ -101,6 +101,17 @@ struct Summary {
     palette_entries: usize,
     /// Kind → number of used palette entries of that kind.
     materials: BTreeMap<MaterialKind, usize>,
+    /// A scene of objects' time: the frame shown, the frames it plays, how
+    /// fast, whether playing loops.
+    animation: Option<Animation>,
+}
+
+/// What `info` says of a scene's time.
+struct Animation {
+    frame: usize,
+    range: (u32, u32),
+    fps: u32,
+    looping: bool,
 }
 
 impl Summary {
@@ -123,6 +134,10 @@ impl Summary {
             bounds: scene.solid_bounds().map(|(lo, hi)| (lo.to_array(), hi.to_array())),
             palette_entries: used.len(),
             materials,
+            animation: objects.map(|o| {
+                let settings = o.graph.as_ref().map(|g| g.animation).unwrap_or_default();
+                Animation { frame: o.frame, range: o.frame_range(), fps: settings.fps(), looping: settings.looping() }
+            }),
         }
     }
 
@@ -152,6 +167,9 @@ impl Summary {
             "max": self.bounds.map(|(_, hi)| hi),
             "palette_entries": self.palette_entries,
             "materials": materials,
+            "animation": self.animation.as_ref().map(|a| serde_json::json!({
+                "frame": a.frame, "range": [a.range.0, a.range.1], "fps": a.fps, "loop": a.looping,
+            })),
         })
     }
 
@@ -173,7 +191,11 @@ impl Summary {
             ("palette entries", self.palette_entries.to_string()),
             ("materials", if materials.is_empty() { "-".to_owned() } else { materials.join(", ") }),
         ];
+        let animation = self.animation.as_ref().map(|a| {
+            let looping = if a.looping { "looping" } else { "once" };
+            ("animation", format!("frame {} of {}..{}, {} a second, {looping}", a.frame, a.range.0, a.range.1, a.fps))
+        });
         let warnings = self.warnings.iter().map(|w| ("warning", w.clone()));
-        rows.into_iter().chain(warnings).map(|(key, value)| format!("{key:<16} {value}\n")).collect()
+        rows.into_iter().chain(animation).chain(warnings).map(|(key, value)| format!("{key:<16} {value}\n")).collect()
     }
 }

@@ -374,3 +374,22 @@ fn an_edit_at_any_frame_edits_the_model_every_frame_shows() {
     // At frame 2 the post is 9 lower, and the new voxel with it.
     assert_eq!(editor.scene.voxel(IVec3::new(x, y + 1 - 9, z)), 5);
 }
+
+/// `info --frame N` reads the scene at frame N and says its time.
+#[test]
+fn info_follows_the_frame_and_says_the_range() {
+    let file = assets().join("anim/animation.vox");
+    let info = |frame: &str| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_octovox"))
+            .args(["info", file.to_str().unwrap(), "--json", "--frame", frame])
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let (at0, at9) = (info("0"), info("9"));
+    assert_eq!(at9["animation"], serde_json::json!({"frame": 9, "range": [0, 30], "fps": 12, "loop": true}));
+    // Key 9 is 43 voxels along MagicaVoxel −x and 60 along +y (world −z) from key 0.
+    let min = |v: &serde_json::Value, axis: usize| v["min"][axis].as_i64().unwrap();
+    assert_eq!((min(&at9, 0) - min(&at0, 0), min(&at9, 2) - min(&at0, 2)), (-43, -60));
+}

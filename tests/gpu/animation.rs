@@ -29,7 +29,7 @@ fn path(p: &Path) -> &str {
 /// The pixels that are not the sky or the ground: where the model is.
 fn model_pixels(image: &image::RgbaImage) -> Vec<(u32, u32)> {
     let sky_or_ground = |p: &image::Rgba<u8>| {
-        let [r, g, b, _] = p.0;
+        let [r, _, b, _] = p.0;
         // The model is blue (animation.vox's colour), the ground grey and the sky bluish grey.
         !(i32::from(b) - i32::from(r) > 40 && b > 120)
     };
