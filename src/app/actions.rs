@@ -46,13 +46,14 @@ const EDIT: Option<&str> = Some("Edit");
 const TOOLS: Option<&str> = Some("Tools");
 const VIEW: Option<&str> = Some("View");
 const OBJECT: Option<&str> = Some("Object");
+const ANIMATION: Option<&str> = Some("Animation");
 
 const fn object(label: &'static str, code: KeyCode, line: ObjectLine) -> Action {
     Action { label, key: code, ctrl: true, shift: false, menu: OBJECT, command: AppCommand::Object(line) }
 }
 
 /// Every keyboard action, in menu order.
-pub static ACTIONS: [Action; 49] = [
+pub static ACTIONS: [Action; 54] = [
     ctrl("New", KeyCode::KeyN, FILE, AppCommand::New),
     ctrl("Open…", KeyCode::KeyO, FILE, AppCommand::AskOpen),
     ctrl("Save", KeyCode::KeyS, FILE, AppCommand::Save),
@@ -93,6 +94,18 @@ pub static ACTIONS: [Action; 49] = [
     object("Turn object about y", KeyCode::KeyR, ObjectLine::Rotate(1)),
     object("Hide object", KeyCode::KeyH, ObjectLine::Hide(true)),
     object("Delete object", KeyCode::Delete, ObjectLine::Delete),
+    key("Play or pause", KeyCode::Space, ANIMATION, AppCommand::TogglePlay),
+    key("Frame before", KeyCode::Comma, ANIMATION, AppCommand::StepFrame(-1)),
+    key("Frame after", KeyCode::Period, ANIMATION, AppCommand::StepFrame(1)),
+    key("Key object at this frame", KeyCode::KeyK, ANIMATION, AppCommand::Key(true)),
+    Action {
+        label: "Take the object's key out",
+        key: KeyCode::KeyK,
+        ctrl: false,
+        shift: true,
+        menu: ANIMATION,
+        command: AppCommand::Key(false),
+    },
     key("Frame model", KeyCode::KeyF, VIEW, AppCommand::FrameModel),
     Action {
         label: "Frame selection",

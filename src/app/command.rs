@@ -97,6 +97,16 @@ pub enum AppCommand {
     /// panel's `object N` and `object hide`, the Layers panel's `layer N
     /// hide`, the palette's `palette preset`, `load` and `save`).
     Lines(Vec<octovox::script::Line>),
+    /// Show frame N while playing or scrubbing: the editor's `frame N`,
+    /// not recorded or journaled (the frame where it stops is a line).
+    ShowFrame(u32),
+    /// Play or pause the animation (Space).
+    TogglePlay,
+    /// Show the frame before (−1) or after (+1), as a `frame N` line.
+    StepFrame(i32),
+    /// Key the object the timeline keys at the frame shown (true: K), or
+    /// take its key there out (false: Shift+K).
+    Key(bool),
     /// Edit ▸ Copy, Cut, Delete, Select none: the `copy`, `cut`, `delete`
     /// and `select off` lines.
     Copy,
@@ -186,6 +196,10 @@ impl AppCommand {
                 | AppCommand::Turn { .. }
                 | AppCommand::Undo
                 | AppCommand::Redo
+                | AppCommand::ShowFrame(_)
+                | AppCommand::TogglePlay
+                | AppCommand::StepFrame(_)
+                | AppCommand::Key(_)
         )
     }
 }

@@ -76,6 +76,8 @@ impl App {
             }
             // A step of a mouse stroke or a palette control prints `edit: …`.
             (Outcome::Changed, _) if in_stroke => self.after_change("edit", ran),
+            // A frame says which (`frame 12: N bytes written`).
+            (Outcome::Changed, Line::Frame(_)) => self.after_change(&line.to_string(), ran),
             (Outcome::Changed, _) => {
                 // The line's command word names it in the printed line (`fill: N bytes written`).
                 self.after_change(line.word(), ran);

@@ -41,6 +41,7 @@ mod script;
 mod selection;
 mod slow_clicks;
 mod state;
+mod timeline;
 mod ui;
 
 use std::path::PathBuf;
@@ -265,6 +266,49 @@ impl App {
         }
     }
 
+    /// Shows frame `frame` while playing or scrubbing: the editor's `frame
+    /// N`, uploaded and drawn, but not recorded or journaled (`timeline`).
+    fn show_frame(&mut self, frame: u32) {
+        match self.doc.editor.run(&octovox::script::Line::Frame(frame)) {
+            Ok(_) => {
+                let upload = self.upload();
+                self.readouts.stats.last_edit_bytes = Some(upload.bytes);
+                self.readouts.stats.last_edit_ranges = upload.ranges;
+                self.request_redraw();
+            }
+            Err(err) => self.ui.error(format!("frame {frame} refused: {err}")),
+        }
+    }
+
+    /// Space, comma, period, K and Shift+K: play or pause, step a frame,
+    /// key or unkey the object the timeline keys.
+    fn timeline_key(&mut self, command: &AppCommand) {
+        let Some(objects) = self.doc.editor.scene.objects() else {
+            return self.ui.info("this scene is one model: it has no animation");
+        };
+        let shown = u32::try_from(objects.frame).unwrap_or(u32::MAX);
+        let lines = match *command {
+            AppCommand::TogglePlay => timeline::toggle(&mut self.ui.playback, shown).into_iter().collect(),
+            AppCommand::StepFrame(by) => vec![octovox::script::Line::Frame(timeline::stepped(objects, shown, by))],
+            AppCommand::Key(on) => {
+                let line = if on {
+                    octovox::script::ObjectLine::Key(self.ui.playback.ease)
+                } else {
+                    octovox::script::ObjectLine::Unkey
+                };
+                match timeline::key_lines(objects, line) {
+                    Some(lines) => lines,
+                    None => return self.ui.info("pick an object to key it"),
+                }
+            }
+            _ => Vec::new(),
+        };
+        for line in lines {
+            let word = line.word();
+            self.act(line, word);
+        }
+    }
+
     /// Whether the scene differs from its file: the history is not at the
     /// state it was saved or loaded at (undoing back to it is no change).
     pub(super) fn unsaved(&self) -> bool {
@@ -359,6 +403,8 @@ impl App {
             },
             AppCommand::SelectNone => self.act(octovox::script::Line::Select(None), "select"),
             AppCommand::Object(line) => self.act(octovox::script::Line::Object(line), "object"),
+            AppCommand::ShowFrame(frame) => self.show_frame(frame),
+            AppCommand::TogglePlay | AppCommand::StepFrame(_) | AppCommand::Key(_) => self.timeline_key(&command),
             AppCommand::Lines(lines) => {
                 for line in lines {
                     let word = line.word();

@@ -150,6 +150,8 @@ pub struct UiState {
     pub recover: Option<(PathBuf, Option<String>)>,
     /// The Outliner's and Layers panel's own state.
     pub outliner: super::outliner::OutlinerState,
+    /// The timeline's: playing, the easing of new keys.
+    pub playback: super::timeline::Playback,
     /// The open scene's edits are not journaled, and why: shown until a
     /// journal starts again.
     pub journal_warning: Option<String>,
@@ -219,6 +221,9 @@ pub fn show(
 ) -> Vec<AppCommand> {
     let mut out = Vec::new();
     egui::Panel::top("menu").show(ui, |ui| menu_bar(ui, info, ui_state, &mut out));
+    if let Some(objects) = info.scene.objects() {
+        super::timeline::show(ui, objects, &mut ui_state.playback, &mut out);
+    }
     if let Some(objects) = info.objects {
         super::outliner::show(ui, objects, &mut ui_state.outliner, &mut out);
     }

@@ -317,7 +317,9 @@ mod tests {
         assert_eq!(parts, [vec![5, 6, 7], vec![8, 9, 10], vec![11, 12, 13], vec![14, 15, 16]]);
         let odd: Vec<usize> = (0..5).map(|k| shard_of(&frames, Some((k, 5))).len()).collect();
         assert_eq!(odd, [2, 2, 3, 2, 3]);
-        assert_eq!(shard_of(&frames[..2], Some((1, 4))), Vec::<u32>::new());
+        // Two frames over four shards: two shards get none.
+        let few: Vec<Vec<u32>> = (0..4).map(|k| shard_of(&frames[..2], Some((k, 4)))).collect();
+        assert_eq!(few, [vec![], vec![5], vec![], vec![6]]);
         assert_eq!(shard_of(&frames, None), frames);
     }
 

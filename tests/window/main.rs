@@ -16,3 +16,4 @@ mod record;
 mod recovery;
 mod select;
 mod stray;
+mod timeline;

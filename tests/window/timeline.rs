@@ -1,0 +1,96 @@
+//! The timeline in the real window (issue 49, item 4): Space plays and
+//! pauses, `.` and `,` step, a click on the bar shows the frame under it,
+//! K keys the object at the frame shown; the saved file holds the key (read
+//! back with `dot_vox`), and the recording replays headless to the same keys.
+#![allow(clippy::unwrap_used)] // in tests a panic is the failure report
+
+use crate::common;
+
+use std::process::Command;
+use std::time::Duration;
+
+use common::window::*;
+use octovox::camera::Camera;
+
+/// The frame the next `frame N` line names: `ran: frame N` where the
+/// frame was shown already, `frame N: B bytes written …` where it changed.
+fn next_frame(lines: &mut Lines) -> u32 {
+    let deadline = std::time::Instant::now() + Duration::from_secs(10);
+    loop {
+        let left = deadline.saturating_duration_since(std::time::Instant::now());
+        let line = lines.rx.recv_timeout(left).unwrap_or_else(|_| panic!("no `frame` line; saw {:?}", lines.seen));
+        lines.seen.push(line.clone());
+        let rest = line.strip_prefix("ran: frame ").or_else(|| line.strip_prefix("frame "));
+        if let Some(number) = rest.and_then(|r| r.split(':').next()).and_then(|n| n.trim().parse().ok()) {
+            return number;
+        }
+    }
+}
+
+/// The `_f` of every key of the file's looping transform, as `dot_vox` reads them.
+fn keys(file: &std::path::Path) -> Vec<u32> {
+    let data = dot_vox::load_bytes(&std::fs::read(file).unwrap()).unwrap();
+    let mut keys: Vec<u32> = data
+        .scenes
+        .iter()
+        .find_map(|node| match node {
+            dot_vox::SceneNode::Transform { attributes, frames, .. } if attributes.contains_key("_loop") => {
+                Some(frames.iter().map(|f| f.attributes.get("_f").map_or(0, |v| v.parse().unwrap())).collect())
+            }
+            _ => None,
+        })
+        .expect("the moving object's transform");
+    keys.sort_unstable();
+    keys
+}
+
+#[test]
+fn the_timeline_plays_steps_scrubs_and_keys() {
+    require_window_tools();
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("anim.vox");
+    common::copy_writable(&common::assets().join("vox/anim/animation.vox"), &file);
+    let untouched = std::fs::read(&file).unwrap();
+    let camera = Camera { eye: glam::DVec3::new(120.0, 110.0, 140.0), ..Camera::default() };
+    let (_xvfb, display) = start_xvfb();
+    let script = dir.path().join("session.ovr");
+    let args = document_args(&file, &camera, &["--record", &script.display().to_string()]);
+    let (mut app, mut lines, window) = open_ready(&display, dir.path(), &args);
+
+    // Play for a while: pausing leaves the frame it reached as a line.
+    xdotool(&display, &["key", "space"]);
+    std::thread::sleep(Duration::from_millis(700));
+    xdotool(&display, &["key", "space"]);
+    let paused = next_frame(&mut lines);
+    assert!(paused > 0, "playing moved on from frame 0");
+    xdotool(&display, &["key", "period"]);
+    assert_eq!(next_frame(&mut lines), (paused + 1) % 31);
+    // A click near the bar's right end shows a frame near the range's end.
+    let bar_y = HEIGHT - 38;
+    xdotool(&display, &["mousemove", "--window", &window, &(WIDTH - 12).to_string(), &bar_y.to_string()]);
+    xdotool(&display, &["click", "1"]);
+    let clicked = next_frame(&mut lines);
+    assert!((27..=30).contains(&clicked), "clicked frame {clicked}");
+    xdotool(&display, &["mousemove", "--window", &window, "400", "300"]);
+    xdotool(&display, &["key", "comma"]);
+    let keyed = next_frame(&mut lines);
+    assert_eq!(keyed, clicked - 1);
+    xdotool(&display, &["key", "k"]);
+    lines.wait_for("object:", Duration::from_secs(10));
+    save(&display, &mut lines, &file);
+    xdotool(&display, &["key", "ctrl+q"]);
+    let status = wait_for_exit(&mut app, Duration::from_secs(30), "quit");
+    assert!(status.success(), "octovox exited with {status}");
+
+    let saved = keys(&file);
+    assert_eq!(saved, [0, 9, keyed, 30], "a key at frame {keyed}");
+    // The recording, on the file as it was, keys the same frame.
+    let recorded = std::fs::read_to_string(&script).unwrap();
+    assert!(recorded.contains(&format!("frame {keyed}\n")) && recorded.contains("object key linear"), "{recorded}");
+    std::fs::write(&file, &untouched).unwrap();
+    let replayed = dir.path().join("replayed.vox");
+    std::fs::write(&script, format!("{recorded}expect frame {keyed}\nsave {}\n", replayed.display())).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_octovox")).args(["replay", "--cpu"]).arg(&script).output().unwrap();
+    assert!(out.status.success(), "{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert_eq!(keys(&replayed), saved);
+}
