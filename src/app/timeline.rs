@@ -252,6 +252,6 @@ mod tests {
         assert_eq!(frame_after(25, 1.0, (0, 30), 12, false), (30, false));
         assert_eq!(frame_after(50, 0.0, (0, 30), 12, true), (30, true), "a frame past the range starts at its end");
         assert_eq!(frame_after(5, 1e12, (5, 5), 240, true), (5, true));
-        assert_eq!(frame_after(0, 1e30, (0, u32::MAX), 240, true).1, true, "no overflow");
+        assert!(frame_after(0, 1e30, (0, u32::MAX), 240, true).1, "no overflow");
     }
 }
