@@ -88,6 +88,26 @@ pub(crate) struct Glb {
     pub triangles: Vec<[usize; 3]>,
     /// Each mesh's triangles (indices into `positions`), in mesh order.
     pub mesh_triangles: Vec<Vec<[usize; 3]>>,
+    pub bin: Vec<u8>,
+}
+
+impl Glb {
+    /// The floats of accessor `index` (tightly packed), component by component.
+    pub fn floats(&self, index: usize) -> Vec<f64> {
+        let accessor = &self.json["accessors"][index];
+        let view = &self.json["bufferViews"][accessor["bufferView"].as_u64().unwrap() as usize];
+        assert_eq!(accessor["componentType"], 5126, "floats");
+        let width = match accessor["type"].as_str().unwrap() {
+            "SCALAR" => 1,
+            "VEC3" => 3,
+            "VEC4" => 4,
+            other => panic!("accessor type {other}"),
+        };
+        let start = (view["byteOffset"].as_u64().unwrap_or(0) + accessor["byteOffset"].as_u64().unwrap_or(0)) as usize;
+        let count = accessor["count"].as_u64().unwrap() as usize * width;
+        let bytes = &self.bin[start..start + 4 * count];
+        bytes.chunks_exact(4).map(|w| f64::from(f32::from_le_bytes(w.try_into().unwrap()))).collect()
+    }
 }
 
 pub(crate) fn read_glb(path: &Path) -> Glb {
@@ -137,7 +157,8 @@ pub(crate) fn read_glb(path: &Path) -> Glb {
         }
         mesh_triangles.push(triangles[first..].to_vec());
     }
-    Glb { json, positions, triangles, mesh_triangles }
+    let bin = bin.to_vec();
+    Glb { json, positions, triangles, mesh_triangles, bin }
 }
 
 /// Runs the Khronos glTF validator (`tests/gltf/validate.js`) on `files`

@@ -18,7 +18,12 @@ fn solid_cells(bytes: &[u8]) -> HashSet<[i64; 3]> {
 
 /// Every triangle lies on a face of a solid cell and faces out of it: the
 /// point a quarter voxel behind its centroid is in a solid cell.
-fn faces_lie_on_solid_cells(label: &str, positions: &[[f64; 3]], triangles: &[[usize; 3]], solid: &HashSet<[i64; 3]>) {
+pub(crate) fn faces_lie_on_solid_cells(
+    label: &str,
+    positions: &[[f64; 3]],
+    triangles: &[[usize; 3]],
+    solid: &HashSet<[i64; 3]>,
+) {
     assert!(!triangles.is_empty(), "{label}: no triangles");
     for t in triangles {
         let [a, b, c] = t.map(|i| positions[i]);
@@ -56,12 +61,12 @@ fn read_obj_objects(path: &Path) -> (Vec<[f64; 3]>, Vec<ObjObject>) {
 
 /// Each node's matrix (column-major, the identity when absent) times its
 /// parents', for the nodes with a mesh: (node name, mesh, world matrix).
-fn placed_meshes(json: &serde_json::Value) -> Vec<(String, usize, [f64; 16])> {
+pub(crate) fn placed_meshes(json: &serde_json::Value) -> Vec<(String, usize, [f64; 16])> {
     let nodes = json["nodes"].as_array().unwrap();
     let matrix = |node: &serde_json::Value| -> [f64; 16] {
         match node["matrix"].as_array() {
             Some(m) => std::array::from_fn(|i| m[i].as_f64().unwrap()),
-            None => std::array::from_fn(|i| if i % 5 == 0 { 1.0 } else { 0.0 }),
+            None => trs_matrix(node),
         }
     };
     let times = |a: &[f64; 16], b: &[f64; 16]| -> [f64; 16] {
@@ -87,7 +92,32 @@ fn placed_meshes(json: &serde_json::Value) -> Vec<(String, usize, [f64; 16])> {
     out
 }
 
-fn apply(m: &[f64; 16], p: [f64; 3]) -> [f64; 3] {
+/// A node's translation, rotation and scale (a moving object's) as the
+/// column-major matrix T · R · S; the identity for a node without them.
+fn trs_matrix(node: &serde_json::Value) -> [f64; 16] {
+    let read = |key: &str, default: &[f64]| -> Vec<f64> {
+        node[key].as_array().map_or(default.to_vec(), |a| a.iter().map(|v| v.as_f64().unwrap()).collect())
+    };
+    let (t, q, s) = (read("translation", &[0.0; 3]), read("rotation", &[0.0, 0.0, 0.0, 1.0]), read("scale", &[1.0; 3]));
+    let (x, y, z, w) = (q[0], q[1], q[2], q[3]);
+    // The rotation matrix of a unit quaternion, row by row.
+    let r = [
+        [1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - z * w), 2.0 * (x * z + y * w)],
+        [2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w)],
+        [2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y)],
+    ];
+    let mut m = [0.0; 16];
+    for column in 0..3 {
+        for row in 0..3 {
+            m[column * 4 + row] = r[row][column] * s[column];
+        }
+        m[12 + column] = t[column];
+    }
+    m[15] = 1.0;
+    m
+}
+
+pub(crate) fn apply(m: &[f64; 16], p: [f64; 3]) -> [f64; 3] {
     std::array::from_fn(|r| m[r] * p[0] + m[4 + r] * p[1] + m[8 + r] * p[2] + m[12 + r])
 }
 

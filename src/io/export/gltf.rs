@@ -11,7 +11,7 @@ use glam::IVec3;
 use serde_json::{Map, Value, json};
 
 use super::VoxelMesh;
-use super::parts::Exported;
+use super::parts::{Exported, Motion};
 use crate::scene::Palette;
 use crate::trace::path::materials::{MATERIAL_EMIT, MATERIAL_GLASS, MATERIAL_METAL, gpu_material};
 
@@ -44,7 +44,8 @@ pub fn glb(exported: &Exported, palette: &Palette, scale: f32) -> Option<Vec<u8>
             meshes.push(json!({"name": named.name, "primitives": primitives}));
         }
     }
-    let (mut nodes, mut roots) = nodes(exported, &gltf_mesh, scale);
+    let (mut nodes, mut roots, moving) = nodes(exported, &gltf_mesh, scale);
+    let animation = buffers.animation(&moving, exported.fps, scale);
     // A scene needs a node (every object hidden): one without a mesh.
     if nodes.is_empty() {
         (nodes, roots) = (vec![json!({"name": "voxels"})], vec![0]);
@@ -59,11 +60,16 @@ pub fn glb(exported: &Exported, palette: &Palette, scale: f32) -> Option<Vec<u8>
     if !meshes.is_empty() {
         root.insert("meshes".into(), Value::Array(meshes));
         root.insert("materials".into(), Value::Array(materials));
+    }
+    if !buffers.accessors.is_empty() {
         root.insert("accessors".into(), Value::Array(buffers.accessors));
         root.insert("bufferViews".into(), Value::Array(buffers.views));
         root.insert("buffers".into(), json!([{"byteLength": buffers.bin.len()}]));
     }
     root.insert("nodes".into(), Value::Array(nodes));
+    if let Some(animation) = animation {
+        root.insert("animations".into(), json!([animation]));
+    }
     if !extensions_used.is_empty() {
         root.insert("extensionsUsed".into(), json!(extensions_used));
     }
@@ -71,9 +77,16 @@ pub fn glb(exported: &Exported, palette: &Palette, scale: f32) -> Option<Vec<u8>
 }
 
 /// The nodes: one per part (with its mesh and, unless it is the identity,
-/// its matrix) under one per group on its path, in the order first met;
-/// and the indices of the scene's root nodes.
-fn nodes(exported: &Exported, gltf_mesh: &[Option<usize>], scale: f32) -> (Vec<Value>, Vec<usize>) {
+/// its matrix; a part that moves has its place at the frame shown as
+/// translation, rotation and scale, which an animation can drive) under
+/// one per group on its path, in the order first met; the indices of the
+/// scene's root nodes; and each moving part's node with its motion.
+fn nodes<'a>(
+    exported: &'a Exported,
+    gltf_mesh: &[Option<usize>],
+    scale: f32,
+) -> (Vec<Value>, Vec<usize>, Vec<(usize, &'a Motion)>) {
+    let mut moving = Vec::new();
     let mut nodes: Vec<Value> = Vec::new();
     let mut roots = Vec::new();
     let mut group_nodes: HashMap<Vec<String>, usize> = HashMap::new();
@@ -97,14 +110,25 @@ fn nodes(exported: &Exported, gltf_mesh: &[Option<usize>], scale: f32) -> (Vec<V
         if let Some(mesh) = gltf_mesh[part.mesh] {
             node["mesh"] = json!(mesh);
         }
-        if let Some(matrix) = part.place.matrix(scale) {
-            node["matrix"] = json!(matrix);
+        match &part.motion {
+            Some(motion) => {
+                let (translation, rotation, scaling) = part.place.trs(scale);
+                node["translation"] = json!(translation);
+                node["rotation"] = json!(rotation);
+                node["scale"] = json!(scaling);
+                moving.push((nodes.len(), motion));
+            }
+            None => {
+                if let Some(matrix) = part.place.matrix(scale) {
+                    node["matrix"] = json!(matrix);
+                }
+            }
         }
         nodes.push(node);
         let node = nodes.len() - 1;
         attach(&mut nodes, &mut roots, parent, node);
     }
-    (nodes, roots)
+    (nodes, roots, moving)
 }
 
 /// Makes node `child` a child of `parent`, or a root of the scene.
@@ -162,11 +186,62 @@ impl Buffers {
     /// Appends `words` (little-endian, as glTF stores numbers) as a buffer
     /// view of its own; returns the view's index.
     fn push_view(&mut self, words: impl Iterator<Item = [u8; 4]>, target: u32) -> usize {
+        let index = self.push_data(words);
+        self.views[index]["target"] = json!(target);
+        index
+    }
+
+    /// The same, for data no vertex stage reads (animation samplers).
+    fn push_data(&mut self, words: impl Iterator<Item = [u8; 4]>) -> usize {
         let offset = self.bin.len();
         self.bin.extend(words.flatten());
         let length = self.bin.len() - offset;
-        self.views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": length, "target": target}));
+        self.views.push(json!({"buffer": 0, "byteOffset": offset, "byteLength": length}));
         self.views.len() - 1
+    }
+
+    /// An accessor of floats, `kind` ("SCALAR", "VEC3", "VEC4") wide each.
+    fn float_accessor(&mut self, values: &[f32], width: usize, kind: &str, bounds: bool) -> usize {
+        let view = self.push_data(values.iter().map(|v| v.to_le_bytes()));
+        let mut accessor =
+            json!({"bufferView": view, "componentType": FLOAT, "count": values.len() / width, "type": kind});
+        if bounds {
+            let lo = values.iter().copied().fold(f32::INFINITY, f32::min);
+            let hi = values.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+            accessor["min"] = json!([lo]);
+            accessor["max"] = json!([hi]);
+        }
+        self.accessors.push(accessor);
+        self.accessors.len() - 1
+    }
+
+    /// One animation driving every moving node: its translation (STEP where
+    /// its keys hold, else LINEAR) and, where they change, its rotation and
+    /// scale (STEP: turns are held between keys); `None` when nothing moves.
+    fn animation(&mut self, moving: &[(usize, &Motion)], fps: u32, scale: f32) -> Option<Value> {
+        let (mut samplers, mut channels) = (Vec::new(), Vec::new());
+        for &(node, motion) in moving {
+            let times: Vec<f32> = motion.samples.iter().map(|(frame, _)| *frame as f32 / fps.max(1) as f32).collect();
+            let input = self.float_accessor(&times, 1, "SCALAR", true);
+            let trs: Vec<_> = motion.samples.iter().map(|(_, place)| place.trs(scale)).collect();
+            let translation: Vec<f32> = trs.iter().flat_map(|t| t.0).collect();
+            let rotation: Vec<f32> = trs.iter().flat_map(|t| t.1).collect();
+            let scaling: Vec<f32> = trs.iter().flat_map(|t| t.2).collect();
+            let step = if motion.step { "STEP" } else { "LINEAR" };
+            let mut channel = |path: &str, values: &[f32], width: usize, kind: &str, interpolation: &str| {
+                let output = self.float_accessor(values, width, kind, false);
+                samplers.push(json!({"input": input, "output": output, "interpolation": interpolation}));
+                channels.push(json!({"sampler": samplers.len() - 1, "target": {"node": node, "path": path}}));
+            };
+            channel("translation", &translation, 3, "VEC3", step);
+            if rotation.chunks(4).any(|q| q != &rotation[..4]) {
+                channel("rotation", &rotation, 4, "VEC4", "STEP");
+            }
+            if scaling.chunks(3).any(|s| s != &scaling[..3]) {
+                channel("scale", &scaling, 3, "VEC3", "STEP");
+            }
+        }
+        (!channels.is_empty()).then(|| json!({"name": "animation", "samplers": samplers, "channels": channels}))
     }
 }
 

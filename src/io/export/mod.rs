@@ -52,6 +52,10 @@ pub enum ExportError {
          (infinite, denormal or zero coordinates); this scene allows --scale {min:e} to {max:e}"
     )]
     Scale { scale: f32, min: f32, max: f32 },
+    #[error("the animation plays {frames} frames; an export samples at most {most}: narrow it with `anim range`")]
+    TooManyFrames { frames: u64, most: u32 },
+    #[error("frame {frame} cannot be placed: {reason}")]
+    Frame { frame: u32, reason: String },
     #[error(transparent)]
     OverBudget(#[from] crate::budget::OverBudget),
 }

@@ -22,6 +22,8 @@ pub struct Exported {
     /// The scene has objects (a file of one model writes exactly what it
     /// always wrote: no object names, no groups).
     pub objects: bool,
+    /// Frames a second of the animation the parts' motions play.
+    pub fps: u32,
 }
 
 pub struct NamedMesh {
@@ -37,7 +39,22 @@ pub struct Part {
     pub name: String,
     pub mesh: usize,
     pub place: Place,
+    /// Where it is at each frame of the document's range, when it moves.
+    pub motion: Option<Motion>,
 }
+
+/// An object's places over the frames of the document's range: at every
+/// frame where its place changes and the frame before, so that a sampler
+/// gives its place at every frame exactly.
+pub struct Motion {
+    /// Frames counted from the range's first, and the place at each.
+    pub samples: Vec<(u32, Place)>,
+    /// Its own keys are all `step` (held until the next), else moving on.
+    pub step: bool,
+}
+
+/// Most frames of an animation an export samples.
+pub const MAX_EXPORT_FRAMES: u32 = 4096;
 
 impl Part {
     /// Its groups and name joined by `/`, as `info --objects` prints them,
@@ -87,6 +104,22 @@ impl Place {
         if self.mirrors() { [a, c, b] } else { [a, b, c] }
     }
 
+    /// The map as translation, rotation (a unit quaternion) and scale, as
+    /// glTF animates them: a map that mirrors is a turn after a mirror of x
+    /// (scale −1 on x).
+    pub fn trs(&self, scale: f32) -> ([f32; 3], [f32; 4], [f32; 3]) {
+        let mut columns = [glam::Vec3::ZERO; 3];
+        let mut translation = [0.0; 3];
+        for (row, (axis, sign, offset)) in self.rows.into_iter().enumerate() {
+            columns[axis][row] = sign as f32;
+            translation[row] = offset as f32 * 0.5 * scale;
+        }
+        let flip = if self.mirrors() { -1.0 } else { 1.0 };
+        columns[0] *= flip;
+        let rotation = glam::Quat::from_mat3(&glam::Mat3::from_cols(columns[0], columns[1], columns[2])).normalize();
+        (translation, rotation.to_array(), [flip, 1.0, 1.0])
+    }
+
     /// The map as a column-major 4×4 matrix on coordinates scaled by
     /// `scale` (glTF's `matrix`); `None` for the identity.
     pub fn matrix(&self, scale: f32) -> Option<[f32; 16]> {
@@ -112,12 +145,14 @@ impl Exported {
         check_scale(scene.drawn(), scale)?;
         let Some(objects) = scene.objects() else {
             let mesh = NamedMesh { name: "voxels".into(), mesh: mesh_within_budget(scene.drawn())? };
-            let part = Part { groups: Vec::new(), name: "voxels".into(), mesh: 0, place: Place::IDENTITY };
-            return Ok(Exported { meshes: vec![mesh], parts: vec![part], objects: false });
+            let part =
+                Part { groups: Vec::new(), name: "voxels".into(), mesh: 0, place: Place::IDENTITY, motion: None };
+            return Ok(Exported { meshes: vec![mesh], parts: vec![part], objects: false, fps: 0 });
         };
         let mut meshes = Vec::new();
         let mut mesh_of_model: HashMap<usize, usize> = HashMap::new();
         let mut parts = Vec::new();
+        let mut motions = motions(objects)?;
         for (index, object) in objects.list().iter().enumerate() {
             if object.hidden {
                 continue;
@@ -134,9 +169,11 @@ impl Exported {
                 }
             };
             let (groups, name) = names(objects, index);
-            parts.push(Part { groups, name, mesh, place: Place::of(&objects.map(index)) });
+            let motion = motions.remove(&index);
+            parts.push(Part { groups, name, mesh, place: Place::of(&objects.map(index)), motion });
         }
-        Ok(Exported { meshes, parts, objects: true })
+        let fps = objects.graph.as_ref().map_or(crate::scene::anim::DEFAULT_FPS, |g| g.animation.fps());
+        Ok(Exported { meshes, parts, objects: true, fps })
     }
 
     /// Palette indices any mesh uses, in order.
@@ -152,6 +189,46 @@ impl Exported {
             (t + mesh.triangles.len(), v + mesh.positions_x2.len(), n + mesh.exposed_faces * 2)
         })
     }
+}
+
+/// The motion of every object that moves over the document's range (see
+/// [`Motion`]), by object index.
+fn motions(objects: &Objects) -> Result<HashMap<usize, Motion>, ExportError> {
+    let (first, last) = objects.frame_range();
+    if first == last || objects.graph.is_none() {
+        return Ok(HashMap::new());
+    }
+    if last - first >= MAX_EXPORT_FRAMES {
+        return Err(ExportError::TooManyFrames { frames: u64::from(last - first) + 1, most: MAX_EXPORT_FRAMES });
+    }
+    let mut places: Vec<Vec<Place>> = vec![Vec::new(); objects.list().len()];
+    for frame in first..=last {
+        let walked =
+            objects.at_frame(frame as usize).map_err(|e| ExportError::Frame { frame, reason: e.to_string() })?;
+        for (index, row) in places.iter_mut().enumerate() {
+            row.push(Place::of(&walked.map(index)));
+        }
+    }
+    let mut motions = HashMap::new();
+    for (index, row) in places.into_iter().enumerate() {
+        if row.windows(2).all(|w| w[0] == w[1]) {
+            continue;
+        }
+        let kept =
+            (0..row.len()).filter(|&k| k == 0 || row[k] != row[k - 1] || row.get(k + 1).is_some_and(|n| *n != row[k]));
+        let samples = kept.map(|k| (k as u32, row[k])).collect();
+        motions.insert(index, Motion { samples, step: own_keys_step(objects, index) });
+    }
+    Ok(motions)
+}
+
+/// Whether every key of object `index`'s own transform is held (`step`).
+fn own_keys_step(objects: &Objects, index: usize) -> bool {
+    use crate::scene::anim::Ease;
+    use crate::scene::graph::NodeKind;
+    let Ok(node) = objects.transform_node(index) else { return false };
+    let NodeKind::Transform { frames, .. } = &node.kind else { return false };
+    !frames.is_empty() && frames.iter().all(|k| Ease::of(k, node.id) == Ok(Ease::Step))
 }
 
 /// Object `index`'s groups and name: its path of named transforms, of which
