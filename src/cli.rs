@@ -390,6 +390,9 @@ pub enum BenchKind {
     Scale,
     /// A forest of 2,000 references of one tree against the merged model.
     Scene,
+    /// Playing a forest of 2,000 moving references against it standing
+    /// still; a turntable as 1, 2 and 4 shards.
+    Anim,
 }
 
 /// Parses "WxH".

@@ -133,8 +133,9 @@ fn tree_model() -> Model {
 }
 
 /// 2,000 placements of one model on a 50 × 40 grid, each turned by one of
-/// the eight rotations that keep z up.
-fn forest(count: u32) -> anyhow::Result<Scene> {
+/// the eight rotations that keep z up; with `moving`, each also keyed to
+/// rise and come back over [`MOVING_FRAMES`] frames, looping (`bench anim`).
+pub(super) fn forest(count: u32, moving: bool) -> anyhow::Result<Scene> {
     let upright: Vec<u8> =
         (0..=127u8).filter(|b| Rotation::from_byte(*b).is_some_and(|r| r.apply([0, 0, 1]) == [0, 0, 1])).collect();
     let attributes = Attributes::new;
@@ -152,15 +153,28 @@ fn forest(count: u32) -> anyhow::Result<Scene> {
     ];
     for k in 0..count {
         let (x, y) = ((k % 50) as i32 * 24, (k / 50) as i32 * 24);
-        let frame: Attributes = [
-            ("_t".to_owned(), format!("{x} {y} 13")),
-            ("_r".to_owned(), upright[k as usize % upright.len()].to_string()),
-        ]
-        .into();
+        let key = |f: u32, z: u32| -> Attributes {
+            [
+                ("_f".to_owned(), f.to_string()),
+                ("_t".to_owned(), format!("{x} {y} {z}")),
+                ("_r".to_owned(), upright[k as usize % upright.len()].to_string()),
+            ]
+            .into()
+        };
+        // Each tree rises its own height (1 to 8 voxels) and comes back.
+        let frames = if moving {
+            vec![key(0, 13), key(MOVING_FRAMES / 2, 14 + k % 8), key(MOVING_FRAMES, 13)]
+        } else {
+            vec![key(0, 13)]
+        };
+        let mut named: Attributes = [("_name".to_owned(), format!("tree {k}"))].into();
+        if moving {
+            named.insert("_loop".to_owned(), "1".to_owned());
+        }
         nodes.push(Node {
             id: 2 + 2 * k,
-            attributes: [("_name".to_owned(), format!("tree {k}"))].into(),
-            kind: NodeKind::Transform { child: 3 + 2 * k, reserved: u32::MAX, layer: 0, frames: vec![frame] },
+            attributes: named,
+            kind: NodeKind::Transform { child: 3 + 2 * k, reserved: u32::MAX, layer: 0, frames },
         });
         nodes.push(Node {
             id: 3 + 2 * k,
@@ -173,6 +187,9 @@ fn forest(count: u32) -> anyhow::Result<Scene> {
     let objects = Objects::new(Some(graph), vec![tree_model()], Vec::new(), 0, usize::MAX)?;
     Ok(Scene::compose(Palette::default(), objects)?)
 }
+
+/// The frames a moving forest's loop takes.
+pub(super) const MOVING_FRAMES: u32 = 48;
 
 /// Median milliseconds of `runs` calls of `f`.
 fn timed(runs: usize, mut f: impl FnMut() -> anyhow::Result<()>) -> anyhow::Result<f64> {
@@ -188,7 +205,7 @@ fn timed(runs: usize, mut f: impl FnMut() -> anyhow::Result<()>) -> anyhow::Resu
 pub fn bench_scene(quick: bool) -> anyhow::Result<(String, String)> {
     let count = if quick { 200 } else { 2000 };
     let (width, height, frames, loads) = if quick { (320, 180, 3, 1) } else { (1280, 720, 9, 3) };
-    let scene = forest(count)?;
+    let scene = forest(count, false)?;
     let objects = scene.objects().context("a scene of objects")?;
     let forest_bytes = encode_objects(&scene.palette, objects)?;
     let merged_bytes = encode_vox(&scene.palette, &scene.voxels())?;

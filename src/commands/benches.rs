@@ -20,6 +20,7 @@ pub fn run(args: &BenchArgs) -> anyhow::Result<ExitCode> {
         BenchKind::Quality => super::bench_quality::bench_quality(args.quick, &args.out)?,
         BenchKind::Scale => super::bench_scale::bench_scale(args.quick)?,
         BenchKind::Scene => super::bench_scene::bench_scene(args.quick)?,
+        BenchKind::Anim => super::bench_anim::bench_anim(args.quick)?,
     };
     say!("{markdown}")?;
     let mut name = format!("{:?}", args.what).to_lowercase();

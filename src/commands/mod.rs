@@ -10,6 +10,7 @@ macro_rules! say {
 }
 
 mod bench;
+mod bench_anim;
 mod bench_effects;
 mod bench_quality;
 mod bench_scale;
