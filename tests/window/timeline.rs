@@ -94,3 +94,50 @@ fn the_timeline_plays_steps_scrubs_and_keys() {
     assert!(out.status.success(), "{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
     assert_eq!(keys(&replayed), saved);
 }
+
+/// Scrubbed to a frame, the window shows what `render --frames k..k` of
+/// the same camera draws (the preview shading, no ground, as the window
+/// opens a file): compared over the part of the view no panel covers.
+#[test]
+fn a_scrubbed_frame_looks_as_render_draws_it() {
+    require_window_tools();
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("anim.vox");
+    common::copy_writable(&common::assets().join("vox/anim/animation.vox"), &file);
+    let camera = Camera {
+        eye: glam::DVec3::new(35.0, 110.0, 100.0),
+        target: glam::DVec3::new(-90.0, 10.0, -20.0),
+        ..Camera::default()
+    };
+    let (_xvfb, display) = start_xvfb();
+    let args = document_args(&file, &camera, &["--shading", "preview"]);
+    let (_app, mut lines, window) = open_ready(&display, dir.path(), &args);
+    xdotool(&display, &["mousemove", "--window", &window, &(WIDTH * 2 / 3).to_string(), &(HEIGHT - 38).to_string()]);
+    xdotool(&display, &["click", "1"]);
+    let frame = next_frame(&mut lines);
+    assert!((5..=25).contains(&frame), "clicked frame {frame}");
+    let shot = resting_shot(&display, &window, dir.path(), "scrubbed");
+    let rendered = dir.path().join("rendered.png");
+    let out = Command::new(env!("CARGO_BIN_EXE_octovox"))
+        .args(["render", file.to_str().unwrap(), "--frames", &format!("{frame}..{frame}"), "--no-ground"])
+        .args(["--size", &format!("{WIDTH}x{HEIGHT}"), &camera_arg(&camera), "-o", rendered.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let rendered = image::open(&rendered).unwrap().to_rgb8();
+    // Clear of the tool panel, the menu, the view gizmo and the timeline.
+    let (mut differing, mut total, mut model) = (0, 0, 0);
+    for y in FREE_Y..HEIGHT - 70 {
+        for x in FREE_X..WIDTH - 130 {
+            let (a, b) = (shot.get_pixel(x, y), rendered.get_pixel(x, y));
+            let most = (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap();
+            differing += usize::from(most > 24);
+            model += usize::from(b[2].saturating_sub(b[0]) > 60);
+            total += 1;
+        }
+    }
+    let share = differing as f64 / total as f64;
+    eprintln!("frame {frame}: {differing} of {total} pixels differ by more than 24 levels; {model} show the model");
+    assert!(model > total / 50, "the model shows in the compared part: {model} of {total} pixels");
+    assert!(share < 0.01, "{differing} of {total} pixels ({:.2} %) differ by more than 24 levels", share * 100.0);
+}
