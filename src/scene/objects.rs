@@ -566,13 +566,13 @@ impl Objects {
         })
     }
 
-    /// The change that turns object `index` a quarter counter-clockwise
-    /// about world axis `axis` (0, 1, 2 = x, y, z), seen from its positive
-    /// end, about the object's pivot.
-    pub fn rotated(&self, index: usize, axis: usize) -> Result<GraphChange, EditError> {
+    /// The change that turns object `index` `quarters` quarters
+    /// counter-clockwise (negative: clockwise) about world axis `axis`
+    /// (0, 1, 2 = x, y, z), seen from its positive end, about its pivot.
+    pub fn rotated(&self, index: usize, axis: usize, quarters: i64) -> Result<GraphChange, EditError> {
         // World x, y, z are MagicaVoxel +x, +z and −y: a turn about world z
         // is three about MagicaVoxel y.
-        let turn = match axis {
+        let quarter = match axis {
             0 => Rotation::quarter_turn(0),
             1 => Rotation::quarter_turn(2),
             _ => {
@@ -580,6 +580,7 @@ impl Objects {
                 back.times(back).times(back)
             }
         };
+        let turn = (0..quarters.rem_euclid(4)).fold(Rotation::IDENTITY, |turn, _| quarter.times(turn));
         self.retransformed(index, |own, parent| Transform {
             rotation: parent.inverse().times(turn).times(parent).times(own.rotation),
             translation: own.translation,

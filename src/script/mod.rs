@@ -158,7 +158,8 @@ impl Line {
                 | ObjectLine::Rename(_)
                 | ObjectLine::Layer(_)
                 | ObjectLine::Key(_)
-                | ObjectLine::Unkey,
+                | ObjectLine::Unkey
+                | ObjectLine::Turn { .. },
             )
             | Line::Anim(_)
             | Line::Palette(PaletteLine::Set { .. } | PaletteLine::Preset(_)) => Kind::Edit { color: false },
@@ -324,6 +325,14 @@ pub enum ObjectLine {
     Rename(String),
     /// `object layer N`.
     Layer(u32),
+    /// `object turn x|y|z DEGREES`: turn counter-clockwise seen from the
+    /// positive axis, about the pivot, by a whole number of quarter turns
+    /// (other angles are refused when the line is read: free turns are not
+    /// done yet).
+    Turn {
+        axis: usize,
+        quarters: i64,
+    },
     /// `object key [step|linear|smooth]`: key the transform at the frame
     /// shown with what it shows, eased that way to the next key.
     Key(Ease),

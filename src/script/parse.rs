@@ -58,6 +58,7 @@ pub(super) const NAME_KEYWORDS: &[&str] = &[
     "active",
     "key",
     "unkey",
+    "turn",
 ];
 
 /// Reads the tokens of one line, left to right, with errors that point at
@@ -496,6 +497,24 @@ fn parse_object(c: &mut Cursor) -> Result<ObjectLine, Fail> {
         "new" => ObjectLine::New(c.word("a name")?.text),
         "move" => ObjectLine::Move(c.position()?),
         "rotate" => ObjectLine::Rotate(c.axis()?),
+        "turn" => {
+            let axis = c.axis()?;
+            let token = c.word("an angle in degrees")?;
+            let degrees = token.text.parse::<f64>().ok().filter(|d| d.is_finite()).ok_or_else(|| {
+                (token.column, format!("expected an angle in degrees (a number), found '{}'", token.text))
+            })?;
+            let quarters = degrees / 90.0;
+            if degrees.abs() > 1e9 || (quarters - quarters.round()).abs() > 1e-9 {
+                return Err((
+                    token.column,
+                    format!(
+                        "object turn by {degrees}°: objects turn by quarter turns only for now (90, 180, -90, …); \
+                         free angles are not done yet"
+                    ),
+                ));
+            }
+            ObjectLine::Turn { axis, quarters: quarters.round() as i64 }
+        }
         "duplicate" => ObjectLine::Duplicate { reference: c.take("reference") },
         "unique" => ObjectLine::Unique,
         "delete" => ObjectLine::Delete,
@@ -743,6 +762,16 @@ mod tests {
             vec!["expected step, linear or smooth, found 'bouncy' at build.ovr:1:12"]
         );
         assert_eq!(errors("anim fps 0"), vec!["frames a second 0 is outside 1..=240 at build.ovr:1:10"]);
+        assert_eq!(
+            errors("object turn y 45"),
+            vec![
+                "object turn by 45°: objects turn by quarter turns only for now (90, 180, -90, …); free angles are not done yet at build.ovr:1:15"
+            ]
+        );
+        assert_eq!(
+            errors("object turn y NaN"),
+            vec!["expected an angle in degrees (a number), found 'NaN' at build.ovr:1:15"]
+        );
         assert_eq!(errors("click 3 4 smash"), vec!["expected attach, erase or paint, found 'smash' at build.ovr:1:11"]);
         assert_eq!(errors("select 0 0 0 5000 0 0"), vec!["a selection is at most 4096 voxels wide at build.ovr:1:1"]);
         assert_eq!(errors("paste 1 2"), vec!["missing Z at build.ovr:1:10"]);
@@ -769,7 +798,8 @@ mod tests {
                     ortho 42.5\nperspective\nground off\nground on\nlayer 0 show\nexpect objects 19\nexpect models 15\nobject new \"a b\"\nobject move 1 -2 3\nobject rotate z\n\
                     object duplicate\nobject duplicate reference\nobject unique\nobject delete\nobject rename top\n\
                     object layer 3\nlayer 4 \"roof tiles\"\nlayer 4 color 10 200 255\nlayer 2 active\nobject merge 3 \"tree 4/top\" 7\nobject before 2\nobject after \"a b\"\nobject lock\nobject unlock\nstroke begin\nstroke end\n\
-                    frame 12\nanim range 0 30\nanim fps 24\nanim loop off\nexpect frame 12\nobject key smooth\nobject key\nobject unkey\n";
+                    frame 12\nanim range 0 30\nanim fps 24\nanim loop off\nexpect frame 12\nobject key smooth\nobject key\nobject unkey\n\
+                    object turn y -90\nobject turn x 450.0\n";
         let script = parse_script(Path::new("t.ovr"), text).unwrap();
         let printed: String = script.lines.iter().map(|l| format!("{}\n", l.command)).collect();
         let again = parse_script(Path::new("t.ovr"), &printed).unwrap();
@@ -777,7 +807,7 @@ mod tests {
             script.lines.iter().map(|l| &l.command).collect::<Vec<_>>(),
             again.lines.iter().map(|l| &l.command).collect::<Vec<_>>()
         );
-        assert_eq!(script.lines.len(), 87);
+        assert_eq!(script.lines.len(), 89);
         // Each line's word is the one it is printed with.
         for line in &script.lines {
             assert_eq!(line.command.to_string().split(' ').next(), Some(line.command.word()), "{}", line.command);

@@ -468,3 +468,26 @@ fn the_glb_export_animates_what_moves_and_passes_the_validator() {
         }
     }
 }
+
+/// `object turn AXIS DEGREES` turns by whole quarter turns as `object
+/// rotate` does (−90 undoes 90, 450 is 90); other angles are refused when
+/// the line is read, the scene unchanged.
+#[test]
+fn object_turn_goes_by_quarter_turns() {
+    let scene = || {
+        let mut editor = Editor::default();
+        editor.set_scene(load(&bytes_of(&cart())));
+        run(&mut editor, "object rider").unwrap();
+        editor
+    };
+    let original = drawn(&scene());
+    let (mut turned, mut rotated, mut round) = (scene(), scene(), scene());
+    run(&mut turned, "object turn z 90").unwrap();
+    run(&mut rotated, "object rotate z").unwrap();
+    run(&mut round, "object turn z 450\nobject turn z -90").unwrap();
+    assert_ne!(drawn(&turned), original);
+    assert!(drawn(&turned) == drawn(&rotated), "a 90° turn is a quarter rotate");
+    assert!(drawn(&round) == original, "450° then −90° is a whole turn");
+    let refused = octovox::script::parse_script(std::path::Path::new("t.ovr"), "object turn y 45").unwrap_err();
+    assert!(format!("{refused:?}").contains("quarter turns only"), "{refused:?}");
+}
