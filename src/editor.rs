@@ -108,6 +108,8 @@ impl Editor {
     /// Carries out one line. `Err` is a line that could not run (a refused
     /// edit changes nothing).
     pub fn run(&mut self, command: &Line) -> Result<Outcome, EditorError> {
+        // Frames played since the last line are composed before it reads the scene.
+        self.scene.catch_up()?;
         let tools = self.tools;
         if command.ends_stroke() {
             self.history.end_stroke();
@@ -221,7 +223,7 @@ impl Editor {
                 let got = self.scene.objects().map_or(1, |o| o.list().len());
                 return Ok(checked(got == *want, format!("{want} objects"), got));
             }
-            Line::Frame(frame) => self.show_frame(*frame)?,
+            Line::Frame(frame) => self.show_frame(*frame, false)?,
             Line::Anim(line) => {
                 let objects = self.animated()?;
                 let mut animation = objects.graph.as_ref().map(|g| g.animation).unwrap_or_default();
@@ -315,8 +317,17 @@ impl Editor {
         })
     }
 
-    /// Shows frame `frame`; whether the picture changed.
-    fn show_frame(&mut self, frame: u32) -> Result<bool, EditorError> {
+    /// Shows frame `frame` while it plays (the window's timeline): as the
+    /// `frame N` line, but a scene drawn as instances composes its octree
+    /// only when the next line runs (`Scene::show_frame`), so a played frame
+    /// writes instance words and nothing else. Whether the picture changed.
+    pub fn play_frame(&mut self, frame: u32) -> Result<bool, EditorError> {
+        self.show_frame(frame, true)
+    }
+
+    /// Shows frame `frame`, composed at once or (`deferred`) as
+    /// [`Editor::play_frame`] does; whether the picture changed.
+    fn show_frame(&mut self, frame: u32, deferred: bool) -> Result<bool, EditorError> {
         let objects = self.animated()?;
         let frame = frame as usize;
         if objects.frame == frame {
@@ -329,7 +340,10 @@ impl Editor {
                 objects.models.len() - 1
             )));
         }
-        self.scene.set_frame(frame)?;
+        match deferred {
+            true => self.scene.show_frame(frame)?,
+            false => self.scene.set_frame(frame)?,
+        }
         Ok(true)
     }
 

@@ -269,7 +269,7 @@ impl App {
     /// Shows frame `frame` while playing or scrubbing: the editor's `frame
     /// N`, uploaded and drawn, but not recorded or journaled (`timeline`).
     fn show_frame(&mut self, frame: u32) {
-        match self.doc.editor.run(&octovox::script::Line::Frame(frame)) {
+        match self.doc.editor.play_frame(frame) {
             Ok(_) => {
                 let upload = self.upload();
                 self.readouts.stats.last_edit_bytes = Some(upload.bytes);

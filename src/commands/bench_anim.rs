@@ -14,7 +14,6 @@ use serde::Serialize;
 use octovox::camera::Camera;
 use octovox::editor::Editor;
 use octovox::gpu::Renderer;
-use octovox::script::Line;
 use octovox::settings::RenderSettings;
 
 use super::bench::{header, median};
@@ -34,8 +33,11 @@ struct AnimRow {
     /// The same frame of the forest standing still: the upload (nothing)
     /// and the preview.
     frame_ms_still: f64,
-    /// Of a playing frame, the `frame N` line alone (walk and compose).
+    /// Of a playing frame, showing it alone (`Editor::play_frame`).
     show_ms: f64,
+    /// Composing the CPU's octree once playing stops halfway through the
+    /// loop, every tree moved (`Scene::catch_up`).
+    catch_up_ms: f64,
     upload_bytes_per_frame: u64,
     instance_bytes: u64,
     turntable: TurntableRow,
@@ -70,7 +72,7 @@ pub fn bench_anim(quick: bool) -> anyhow::Result<(String, String)> {
     let (mut playing_ms, mut still_ms, mut show_ms, mut bytes) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for frame in 1..=rounds {
         let start = Instant::now();
-        playing.run(&Line::Frame(frame))?;
+        playing.play_frame(frame)?;
         show_ms.push(start.elapsed().as_secs_f64() * 1e3);
         bytes.push(playing_renderer.sync(&mut playing.scene).bytes);
         playing_renderer.render(&playing.scene, &camera, (width, height), &settings, None)?;
@@ -80,6 +82,12 @@ pub fn bench_anim(quick: bool) -> anyhow::Result<(String, String)> {
         still_renderer.render(&still, &camera, (width, height), &settings, None)?;
         still_ms.push(start.elapsed().as_secs_f64() * 1e3);
     }
+    // Stopped halfway, where every tree stands furthest from where the
+    // composed octree holds it (the loop's last frame is its first again).
+    playing.play_frame(MOVING_FRAMES / 2)?;
+    let start = Instant::now();
+    playing.scene.catch_up()?;
+    let catch_up_ms = start.elapsed().as_secs_f64() * 1e3;
     let row = AnimRow {
         objects: count as usize,
         adapter: playing_renderer.gpu.adapter_name.clone(),
@@ -90,6 +98,7 @@ pub fn bench_anim(quick: bool) -> anyhow::Result<(String, String)> {
         frame_ms_playing: median(playing_ms),
         frame_ms_still: median(still_ms),
         show_ms: median(show_ms),
+        catch_up_ms,
         upload_bytes_per_frame: bytes.iter().copied().max().unwrap_or(0),
         instance_bytes: octovox::scene::instances::word_bytes(count as usize),
         turntable: turntable(quick)?,
@@ -101,7 +110,7 @@ pub fn bench_anim(quick: bool) -> anyhow::Result<(String, String)> {
 /// process after another (on a cluster the shards run at once: the longest
 /// is what it waits for).
 fn turntable(quick: bool) -> anyhow::Result<TurntableRow> {
-    let (frames, width, height, spp) = if quick { (8, 160, 90, 2) } else { (48, 640, 360, 8) };
+    let (frames, width, height, spp) = if quick { (8, 160, 90, 2) } else { (48, 320, 180, 4) };
     let exe = std::env::current_exe().context("where octovox is")?;
     let dir = tempfile::tempdir()?;
     let pattern = dir.path().join("spin_%02d.png");
@@ -141,9 +150,9 @@ fn report(r: &AnimRow) -> String {
     md += &format!(
         "Adapter: **{}**, {}×{}, SVO preview without shadows. The forest of `bench scene` ({} references of one \
          tree, drawn as **{}**), each tree keyed to rise 1 to 8 voxels and come back over {} frames, looping. A \
-         playing frame is the `frame N` line (the path of the window's timeline: every key sampled, the moved \
-         objects composed again on the CPU), the upload and the preview; a still frame is the same forest without \
-         keys, upload and preview. Median of {} frames, the two alternating after one warm-up each.\n\n",
+         playing frame is the window's (`Editor::play_frame`: every key sampled; a scene drawn as instances \
+         composes its CPU octree, which picking and checks read, only once playing stops), the upload and the \
+         preview; a still frame is the same forest without keys, upload and preview. Median of {} frames, the two alternating after one warm-up each.\n\n",
         r.adapter, r.width, r.height, r.objects, r.drawn_as, MOVING_FRAMES, r.frames
     );
     md += "| measure | playing | still | playing / still | target |\n|---|---|---|---|---|\n";
@@ -153,7 +162,11 @@ fn report(r: &AnimRow) -> String {
         r.frame_ms_still,
         r.frame_ms_playing / r.frame_ms_still.max(1e-9)
     );
-    md += &format!("| of which `frame N` ms | {:.2} | | | |\n", r.show_ms);
+    md += &format!("| of which showing the frame, ms | {:.2} | | | |\n", r.show_ms);
+    md += &format!(
+        "| composing the CPU octree once, after playing stops halfway (every tree moved), ms | {:.1} | | | |\n",
+        r.catch_up_ms
+    );
     md += &format!(
         "| bytes uploaded a frame (most) | {} | 0 | | the instance words: {} |\n\n",
         r.upload_bytes_per_frame, r.instance_bytes

@@ -227,6 +227,28 @@ impl Scene {
         self.touched(shown)
     }
 
+    /// Shows frame `frame` while it plays: composed at once in a scene
+    /// drawn composed; in one drawn as instances (`Scene::instanced`), only
+    /// walked, the composed tree catching up at [`Scene::catch_up`].
+    pub fn show_frame(&mut self, frame: usize) -> Result<(), EditError> {
+        if self.instanced().is_none() {
+            return self.set_frame(frame);
+        }
+        let shown = self.objects_and_drawn_mut()?.0.show_frame(frame);
+        self.touched(shown)
+    }
+
+    /// Composes the cells the frames [`Scene::show_frame`] showed left
+    /// behind: what picking, checks and edits read is the frame shown again.
+    pub fn catch_up(&mut self) -> Result<(), EditError> {
+        if !self.objects().is_some_and(Objects::is_behind) {
+            return Ok(());
+        }
+        let (objects, tree) = self.objects_and_drawn_mut()?;
+        let caught = objects.catch_up(tree);
+        self.touched(caught)
+    }
+
     /// Stores a model that nothing places yet.
     pub fn push_model(&mut self, model: Model) -> Result<usize, EditError> {
         let index = self.objects_and_drawn_mut()?.0.push_model(model);

@@ -84,6 +84,10 @@ pub struct Objects {
     /// The layer `object new` puts objects on (`layer N active`); the
     /// first layer when unset or gone.
     pub new_layer: Option<u32>,
+    /// While frames shown by [`Objects::show_frame`] are not composed: the
+    /// placements the composed tree still holds, until [`Objects::catch_up`]
+    /// composes what differs from them.
+    behind: Option<Vec<(usize, CellMap)>>,
 }
 
 /// Why the objects cannot be placed.
@@ -118,6 +122,7 @@ impl Objects {
             maps: Vec::new(),
             selected: None,
             new_layer: None,
+            behind: None,
         };
         objects.walk(voxel_limit)?;
         Ok(objects)
@@ -312,6 +317,7 @@ impl Objects {
     ) -> Result<(usize, Patch), EditError> {
         let model = self.objects.get(index).ok_or(ObjectRefusal::NoObject(index))?.placement.model;
         self.unlocked(&[index])?;
+        self.catch_up(tree)?;
         // A reference shares the model: an edit through an unlocked
         // placement would change a locked one too (issue 48, item 11).
         if let Some(k) = (0..self.objects.len()).find(|&k| self.objects[k].placement.model == model && self.locked(k)) {
@@ -330,6 +336,7 @@ impl Objects {
     /// Puts back a model's cells from an undo patch; returns the patch that
     /// undoes this.
     pub fn apply_patch(&mut self, tree: &mut Octree, model: usize, patch: &Patch) -> Result<Patch, EditError> {
+        self.catch_up(tree)?;
         let inverse = self.models.get_mut(model).ok_or(ObjectRefusal::NoModel(model))?.tree.apply_patch(patch)?;
         if let Some(bounds) = patch.bounds() {
             self.recompose_model(tree, model, bounds)?;
@@ -385,31 +392,77 @@ impl Objects {
         self.compose_rewalk(tree, |objects| objects.frame = shown)
     }
 
+    /// Shows frame `frame` without composing it: every key sampled there
+    /// and the objects walked, the world boxes of what moved kept until
+    /// [`Objects::catch_up`]. For a scene drawn as instances, which the GPU
+    /// draws from the objects, not from the composed tree: a played frame
+    /// then writes instance words and nothing else, and the composed tree
+    /// (which picking, checks and saving read) catches up when playing
+    /// stops. A frame the walk refuses changes nothing.
+    pub fn show_frame(&mut self, frame: usize) -> Result<(), EditError> {
+        if self.behind.is_none() {
+            self.behind = Some(self.drawn());
+        }
+        let shown = std::mem::replace(&mut self.frame, frame);
+        if let Err(err) = self.walk(usize::MAX) {
+            self.frame = shown;
+            self.walk(usize::MAX)?;
+            return Err(err.into());
+        }
+        Ok(())
+    }
+
+    /// Whether frames shown by [`Objects::show_frame`] are not composed yet.
+    pub fn is_behind(&self) -> bool {
+        self.behind.is_some()
+    }
+
+    /// Composes the cells of what differs between the placements the
+    /// composed tree holds and the frame shown: however many frames were
+    /// played, each moved object's boxes then and now, once.
+    pub fn catch_up(&mut self, tree: &mut Octree) -> Result<(), EditError> {
+        let Some(before) = self.behind.take() else { return Ok(()) };
+        for region in self.changed_regions(&before) {
+            if let Err(err) = self.recompose(tree, region) {
+                // Composing a region again is harmless: the next try redoes them all.
+                self.behind = Some(before);
+                return Err(err);
+            }
+        }
+        Ok(())
+    }
+
+    /// The world boxes of the placements that differ between `before` (a
+    /// walk's [`Objects::drawn`]) and now.
+    fn changed_regions(&self, before: &[(usize, CellMap)]) -> Vec<(IVec3, IVec3)> {
+        let mut counts: HashMap<(usize, CellMap), i64> = HashMap::new();
+        for key in before {
+            *counts.entry(*key).or_default() += 1;
+        }
+        for key in &self.drawn() {
+            *counts.entry(*key).or_default() -= 1;
+        }
+        counts
+            .into_iter()
+            .filter(|&(_, count)| count != 0)
+            .filter_map(|((model, map), _)| {
+                self.models[model].tree.solid_bounds().map(|(lo, hi)| map.apply_box(lo, hi))
+            })
+            .collect()
+    }
+
     /// After a change to the graph or the frame: walks again and composes
     /// the cells of every object drawn differently. Where the walk or the
     /// tree refuses, `undo` takes the change back and the scene is as it was.
     fn compose_rewalk(&mut self, tree: &mut Octree, undo: impl FnOnce(&mut Objects)) -> Result<(), EditError> {
+        self.catch_up(tree)?;
         let before = self.drawn();
         if let Err(err) = self.walk(usize::MAX) {
             undo(self);
             self.walk(usize::MAX)?;
             return Err(err.into());
         }
-        let after = self.drawn();
-        let mut counts: HashMap<(usize, CellMap), i64> = HashMap::new();
-        for key in &before {
-            *counts.entry(*key).or_default() += 1;
-        }
-        for key in &after {
-            *counts.entry(*key).or_default() -= 1;
-        }
-        let regions: Vec<(IVec3, IVec3)> = counts
-            .into_iter()
-            .filter(|&(_, count)| count != 0)
-            .filter_map(|((model, map), _)| {
-                self.models[model].tree.solid_bounds().map(|(lo, hi)| map.apply_box(lo, hi))
-            })
-            .collect();
+        let regions = self.changed_regions(&before);
         for (done, &region) in regions.iter().enumerate() {
             if let Err(err) = self.recompose(tree, region) {
                 // A region the tree cannot hold (a move past the world's
@@ -432,6 +485,8 @@ impl Objects {
     pub fn at_frame(&self, frame: usize) -> Result<Objects, ObjectsError> {
         let mut objects = self.clone();
         objects.frame = frame;
+        // What it composes into is a tree of its own, composed whole.
+        objects.behind = None;
         objects.walk(usize::MAX)?;
         Ok(objects)
     }

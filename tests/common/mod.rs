@@ -4,6 +4,7 @@
 
 pub mod exact;
 pub mod window;
+pub mod written;
 
 use std::path::PathBuf;
 

@@ -14,6 +14,7 @@ use glam::IVec3;
 use octovox::editor::Editor;
 
 use super::vox_scene::{append_chunks, assets, dict, kept_chunks, load, model, raw_chunks, run, saved};
+use crate::common::written::herd;
 
 type Cells = BTreeMap<(i32, i32, i32), u8>;
 /// A transform as the test applies it: rotation matrix, translation.
@@ -490,4 +491,31 @@ fn object_turn_goes_by_quarter_turns() {
     assert!(drawn(&round) == original, "450° then −90° is a whole turn");
     let refused = octovox::script::parse_script(std::path::Path::new("t.ovr"), "object turn y 45").unwrap_err();
     assert!(format!("{refused:?}").contains("quarter turns only"), "{refused:?}");
+}
+
+/// Frames played in a scene drawn as instances leave the CPU's octree
+/// behind (only the instance words go to the GPU); the next line composes
+/// it, and it then holds what an independent composition of the frame puts
+/// there.
+#[test]
+fn played_frames_are_composed_before_the_next_line_reads_the_scene() {
+    let data = herd(200);
+    let mut editor = Editor::default();
+    editor.set_scene(load(&bytes_of(&data)));
+    assert!(editor.scene.instanced().is_some(), "the herd is drawn as instances");
+    for frame in [1, 2, 5, 9, 13] {
+        editor.play_frame(frame).unwrap();
+    }
+    assert!(editor.scene.objects().unwrap().is_behind(), "played frames are not composed yet");
+    run(&mut editor, "expect frame 13").unwrap();
+    assert!(drawn(&editor) == composed(&data, 13), "composed when the next line ran");
+    // A move after playing lands where the frame shows the object.
+    editor.play_frame(7).unwrap();
+    run(&mut editor, "object 4\nobject move 0 5 0").unwrap();
+    let moved = octovox::io::vox::load_vox_scene(&saved(&editor.scene), 7).unwrap().0;
+    let cells = |scene: &octovox::scene::Scene| -> Cells {
+        scene.voxels().into_iter().map(|(p, c)| ((p.x, p.y, p.z), c)).collect()
+    };
+    assert!(cells(&moved) == drawn(&editor), "saved and drawn agree at frame 7");
+    assert!(cells(&moved) != composed(&data, 7), "the move changed the frame");
 }

@@ -12,6 +12,8 @@ use octovox::editor::Editor;
 use octovox::io::vox::{encode_objects, load_vox, load_vox_scene};
 use octovox::scene::Scene;
 
+pub(crate) use crate::common::written::{dict, model};
+
 pub(crate) fn assets() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/vox")
 }
@@ -173,22 +175,6 @@ fn the_animation_keeps_its_keys_layers_cameras_and_settings() {
         _ => false,
     });
     assert!(looped, "_loop 1 kept");
-}
-
-/// A cube-ish model with a marked corner, so that rotations show.
-pub(crate) fn model(size: u32, color: u8) -> Model {
-    let mut voxels = Vec::new();
-    for x in 0..size as u8 {
-        for y in 0..size as u8 {
-            voxels.push(Voxel { x, y, z: 0, i: color });
-        }
-    }
-    voxels.push(Voxel { x: 0, y: 0, z: 1, i: color + 1 });
-    Model { size: Size { x: size, y: size, z: 2 }, voxels }
-}
-
-pub(crate) fn dict(pairs: &[(&str, String)]) -> dot_vox::Dict {
-    pairs.iter().map(|(k, v)| ((*k).to_owned(), v.clone())).collect()
 }
 
 /// A scene the test writes with `dot_vox`: `count` references of three

@@ -168,3 +168,45 @@ fn a_render_of_frames_shows_frames_and_time_left_on_a_terminal() {
     assert!(tty.status.success(), "{said}");
     assert!(said.contains("frames, ") && said.contains(" left"), "{said}");
 }
+
+/// Frames played in a scene drawn as instances send only instance words
+/// (the CPU's octree catches up later), and the GPU draws each exactly as
+/// the scene loaded at that frame: the preview compared pixel for pixel.
+#[test]
+fn played_frames_draw_as_the_frame_loaded_afresh() {
+    use octovox::camera::Camera;
+    use octovox::gpu::Renderer;
+    use octovox::settings::RenderSettings;
+    let mut bytes = Vec::new();
+    crate::common::written::herd(200).write_vox(&mut bytes).unwrap();
+    let mut editor = octovox::editor::Editor::default();
+    editor.set_scene(octovox::io::vox::load_vox_scene(&bytes, 0).unwrap().0);
+    assert!(editor.scene.instanced().is_some());
+    let (lo, hi) = editor.scene.solid_bounds().unwrap();
+    let camera = Camera::framing(lo, hi + glam::IVec3::new(12, 0, 0), 50.0);
+    let settings = RenderSettings::default();
+    let size = (160, 120);
+    let mut renderer = Renderer::headless().unwrap();
+    renderer.sync(&mut editor.scene);
+    for frame in [3u32, 8, 14] {
+        editor.play_frame(frame).unwrap();
+        let written = renderer.sync(&mut editor.scene).bytes;
+        let words = octovox::scene::instances::word_bytes(200);
+        assert!(written > 0 && written < words, "frame {frame}: {written} bytes written, the words are {words}");
+        renderer.render(&editor.scene, &camera, size, &settings, None).unwrap();
+        let played = renderer.read_image().unwrap();
+        let mut fresh = octovox::io::vox::load_vox_scene(&bytes, frame as usize).unwrap().0;
+        let mut other = Renderer::headless().unwrap();
+        other.sync(&mut fresh);
+        other.render(&fresh, &camera, size, &settings, None).unwrap();
+        let loaded = other.read_image().unwrap();
+        let differing = played.pixels().zip(loaded.pixels()).filter(|(a, b)| a != b).count();
+        assert_eq!(differing, 0, "frame {frame}: {differing} pixels differ");
+        assert_ne!(model_pixels_any(&played), 0, "frame {frame}: the herd shows");
+    }
+}
+
+/// Pixels that are neither sky nor ground grey: the herd's colours.
+fn model_pixels_any(image: &image::RgbaImage) -> usize {
+    image.pixels().filter(|p| p[0].abs_diff(p[1]) > 30 || p[1].abs_diff(p[2]) > 30 && p[0] > p[2]).count()
+}
