@@ -44,12 +44,18 @@ fn keys(file: &std::path::Path) -> Vec<u32> {
     keys
 }
 
-#[test]
-fn the_timeline_plays_steps_scrubs_and_keys() {
+/// A writable copy of animation.vox in a new folder.
+fn animation_document() -> (tempfile::TempDir, std::path::PathBuf) {
     require_window_tools();
     let dir = tempfile::tempdir().unwrap();
     let file = dir.path().join("anim.vox");
     common::copy_writable(&common::assets().join("vox/anim/animation.vox"), &file);
+    (dir, file)
+}
+
+#[test]
+fn the_timeline_plays_steps_scrubs_and_keys() {
+    let (dir, file) = animation_document();
     let untouched = std::fs::read(&file).unwrap();
     let camera = Camera { eye: glam::DVec3::new(120.0, 110.0, 140.0), ..Camera::default() };
     let (_xvfb, display) = start_xvfb();
@@ -100,10 +106,7 @@ fn the_timeline_plays_steps_scrubs_and_keys() {
 /// opens a file): compared over the part of the view no panel covers.
 #[test]
 fn a_scrubbed_frame_looks_as_render_draws_it() {
-    require_window_tools();
-    let dir = tempfile::tempdir().unwrap();
-    let file = dir.path().join("anim.vox");
-    common::copy_writable(&common::assets().join("vox/anim/animation.vox"), &file);
+    let (dir, file) = animation_document();
     let camera = Camera {
         eye: glam::DVec3::new(35.0, 110.0, 100.0),
         target: glam::DVec3::new(-90.0, 10.0, -20.0),
