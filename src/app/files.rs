@@ -42,6 +42,8 @@ impl App {
             line => (None, line),
         };
         self.record(|r| r.scene(line.clone()));
+        // A new scene starts still, at the frame it was opened at.
+        self.ui.playback.stop();
         // The old document's edits were saved or discarded before this.
         self.close_journal();
         // The line that makes the scene starts its journal (untitled ones too).

@@ -39,6 +39,12 @@ impl Playback {
         self.playing.is_some()
     }
 
+    /// Stops playing, where it is (a new scene starts still).
+    pub fn stop(&mut self) {
+        self.playing = None;
+        self.scrubbing = None;
+    }
+
     /// Starts playing from `shown`, or stops (the frame it stopped at is
     /// then run as a `frame N` line by [`show`]).
     pub fn toggle(&mut self, shown: u32) {
