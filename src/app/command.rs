@@ -181,6 +181,24 @@ pub enum AppCommand {
 }
 
 impl AppCommand {
+    /// Whether the animation may go on playing while it runs: the view's
+    /// commands and playing's own. Any other stops playing first, at a
+    /// `frame N` line, so that what it does is recorded at its frame and
+    /// reads the frame composed.
+    pub fn keeps_playing(&self) -> bool {
+        matches!(
+            self,
+            AppCommand::ShowFrame(_)
+                | AppCommand::TogglePlay
+                | AppCommand::Orbit { .. }
+                | AppCommand::Pan { .. }
+                | AppCommand::Zoom { .. }
+                | AppCommand::ToggleProjection
+                | AppCommand::ViewFrom(_)
+                | AppCommand::Screenshot
+        )
+    }
+
     /// Whether the command edits the scene: refused while a file loads
     /// (the scene it would edit is about to be replaced).
     pub fn edits_scene(&self) -> bool {

@@ -362,6 +362,9 @@ impl App {
         if command.edits_scene() && self.doc.loading.is_some() {
             return self.ui.info("still loading…");
         }
+        if self.ui.playback.playing() && !command.keeps_playing() {
+            self.timeline_key(&AppCommand::TogglePlay);
+        }
         match command {
             AppCommand::PointerEdit { phase, tool, x, y } => self.pointer_edit(phase, tool, x, y),
             AppCommand::ExtrudeDrag { phase, x, y } => self.extrude_drag(phase, x, y),

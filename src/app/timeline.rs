@@ -187,7 +187,7 @@ fn scrub_bar(
     painter.vline(x_of(at.clamp(first, last)), rect.y_range(), Stroke::new(2.0, Color32::from_rgb(90, 170, 255)));
     let pointed = response.interact_pointer_pos().map(|p| {
         let t = f64::from(((p.x - rect.left()) / rect.width()).clamp(0.0, 1.0));
-        first + (t * span).round() as u32
+        first.saturating_add((t * span).round() as u32).min(last)
     });
     if let Some(frame) = pointed.filter(|_| response.dragged() || response.clicked()) {
         playback.playing = None;

@@ -133,7 +133,8 @@ fn frames_of(args: &RenderArgs) -> anyhow::Result<Vec<u32>> {
 }
 
 /// Shard `k` of `n`'s frames: the `k`-th of `n` runs of consecutive frames,
-/// as even as they can be (the first `len % n` one longer).
+/// from `k·len/n` to `(k+1)·len/n` (rounded down): as even as they can be,
+/// none more than one frame longer than another.
 fn shard_of(frames: &[u32], shard: Option<(u32, u32)>) -> Vec<u32> {
     let Some((k, n)) = shard else { return frames.to_vec() };
     let (len, k, n) = (frames.len() as u64, u64::from(k), u64::from(n));

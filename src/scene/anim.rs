@@ -150,8 +150,8 @@ pub fn sample_transform(
     let s = Ease::of(&keys[from], node)?.shaped(t);
     let mut out = held;
     for axis in 0..3 {
-        // f32 and a cast that rounds toward zero, as ogt_vox computes it;
-        // the translations are i32 in the file, so the casts are exact.
+        // f32 and a cast that rounds toward zero, as ogt_vox computes it
+        // (exact up to 2^24; farther translations round as ogt_vox's do).
         let (a, b) = (held.translation[axis] as f32, toward.translation[axis] as f32);
         out.translation[axis] = i64::from((b * s + a * (1.0 - s)) as i32);
     }
@@ -173,14 +173,12 @@ pub fn sample_model(
     Ok(Some(bracket(&timed, is_set(node_attributes, "_loop"), frame).0))
 }
 
-/// The index of the key at exactly `frame`, if there is one.
+/// The index of the key at exactly `frame`, if there is one: the one a
+/// frame shows where several share it (the last in file order, as
+/// [`keys_in_time`] orders them).
 pub fn key_at(keys: &[Attributes], frame: u32, node: u32) -> Result<Option<usize>, GraphError> {
-    for (k, key) in keys.iter().enumerate() {
-        if key_frame(key, node)? == frame {
-            return Ok(Some(k));
-        }
-    }
-    Ok(None)
+    let timed = keys_in_time(keys.iter(), node)?;
+    Ok(timed.iter().rev().find(|&&(f, _)| f == frame).map(|&(_, k)| k))
 }
 
 /// Whether a transform node moves: keys at more than one frame.
@@ -360,6 +358,17 @@ mod tests {
         assert!(!keys[0].contains_key(EASE_KEY));
         keys[0].insert(EASE_KEY.into(), "bouncy".into());
         assert!(sample_transform(&keys, &Attributes::new(), 3, 4).is_err());
+    }
+
+    /// Two keys at one frame: the frame shows the later in file order, and
+    /// that is the key a move there changes (a review found the first).
+    #[test]
+    fn of_keys_sharing_a_frame_the_shown_one_is_changed() {
+        let keys =
+            [key(0, [0, 0, 0], None), key(5, [1, 0, 0], None), key(5, [2, 0, 0], None), key(10, [3, 0, 0], None)];
+        assert_eq!(at(&keys, false, 5).translation[0], 2);
+        assert_eq!(key_at(&keys, 5, 7).unwrap(), Some(2));
+        assert_eq!(key_at(&keys, 6, 7).unwrap(), None);
     }
 
     /// Keys far apart in time (2^31) and keys out of order.

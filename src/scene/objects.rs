@@ -377,6 +377,7 @@ impl Objects {
     /// Returns the change that undoes it; a change the walk refuses (a
     /// cycle) changes nothing.
     pub fn apply_change(&mut self, tree: &mut Octree, change: &GraphChange) -> Result<GraphChange, EditError> {
+        self.catch_up(tree)?;
         let graph = self.graph.as_mut().ok_or(ObjectRefusal::NoGraph)?;
         let saved = graph.clone();
         let inverse = change.apply(graph);
@@ -388,6 +389,7 @@ impl Objects {
     /// every object that moved, came, went or shows another model are
     /// composed again. A frame the walk refuses changes nothing.
     pub fn set_frame(&mut self, tree: &mut Octree, frame: usize) -> Result<(), EditError> {
+        self.catch_up(tree)?;
         let shown = std::mem::replace(&mut self.frame, frame);
         self.compose_rewalk(tree, |objects| objects.frame = shown)
     }
@@ -397,8 +399,8 @@ impl Objects {
     /// [`Objects::catch_up`]. For a scene drawn as instances, which the GPU
     /// draws from the objects, not from the composed tree: a played frame
     /// then writes instance words and nothing else, and the composed tree
-    /// (which picking, checks and saving read) catches up when playing
-    /// stops. A frame the walk refuses changes nothing.
+    /// (which picking, checks and saving read) catches up before the next
+    /// line or edit (`Editor::run`). A frame the walk refuses changes nothing.
     pub fn show_frame(&mut self, frame: usize) -> Result<(), EditError> {
         if self.behind.is_none() {
             self.behind = Some(self.drawn());
@@ -451,11 +453,11 @@ impl Objects {
             .collect()
     }
 
-    /// After a change to the graph or the frame: walks again and composes
-    /// the cells of every object drawn differently. Where the walk or the
-    /// tree refuses, `undo` takes the change back and the scene is as it was.
+    /// After a change to the graph or the frame (made on a composed tree:
+    /// caught up first): walks again and composes the cells of every object
+    /// drawn differently. Where the walk or the tree refuses, `undo` takes
+    /// the change back and the scene is as it was.
     fn compose_rewalk(&mut self, tree: &mut Octree, undo: impl FnOnce(&mut Objects)) -> Result<(), EditError> {
-        self.catch_up(tree)?;
         let before = self.drawn();
         if let Err(err) = self.walk(usize::MAX) {
             undo(self);
@@ -473,6 +475,9 @@ impl Objects {
                 for &region in &regions[..done] {
                     self.recompose(tree, region)?;
                 }
+                // The failed one too, where its removal ran before the
+                // refusal; where the refusal came first it refuses again.
+                let _ = self.recompose(tree, regions[done]);
                 return Err(err);
             }
         }
@@ -489,6 +494,29 @@ impl Objects {
         objects.behind = None;
         objects.walk(usize::MAX)?;
         Ok(objects)
+    }
+
+    /// Every object's cell map at frame `frame`, in walk order (the graph
+    /// walked there, the models not copied): what an export samples.
+    pub fn maps_at(&self, frame: usize) -> Result<Vec<CellMap>, ObjectsError> {
+        let Some(graph) = &self.graph else {
+            let model = self.models.get(frame).ok_or_else(|| {
+                GraphError::Bad(format!("frame {frame} requested but there are {} models", self.models.len()))
+            })?;
+            let placement = Object::frame(frame).placement;
+            return Ok(vec![placement.cell_map(model.size).ok_or(ObjectsError::OutsideWorld { model: frame })?]);
+        };
+        let voxels: Vec<usize> =
+            self.models.iter().map(|m| usize::try_from(m.tree.solid_voxels()).unwrap_or(usize::MAX)).collect();
+        let walked = graph.walk(&voxels, frame, usize::MAX)?;
+        walked
+            .objects
+            .iter()
+            .map(|o| {
+                let model = o.placement.model;
+                o.placement.cell_map(self.models[model].size).ok_or(ObjectsError::OutsideWorld { model })
+            })
+            .collect()
     }
 
     /// The frame shown, as keys name frames.

@@ -144,3 +144,37 @@ fn a_scrubbed_frame_looks_as_render_draws_it() {
     assert!(model > total / 50, "the model shows in the compared part: {model} of {total} pixels");
     assert!(share < 0.01, "{differing} of {total} pixels ({:.2} %) differ by more than 24 levels", share * 100.0);
 }
+
+/// A key pressed while playing stops playing first, at a `frame N` line,
+/// so the recording keys the frame the key was made at (a review found the
+/// key recorded without its frame: replayed, it keyed frame 0).
+#[test]
+fn a_key_pressed_while_playing_is_recorded_at_its_frame() {
+    let (dir, file) = animation_document();
+    let untouched = std::fs::read(&file).unwrap();
+    let camera = Camera { eye: glam::DVec3::new(120.0, 110.0, 140.0), ..Camera::default() };
+    let (_xvfb, display) = start_xvfb();
+    let script = dir.path().join("session.ovr");
+    let args = document_args(&file, &camera, &["--record", &script.display().to_string()]);
+    let (mut app, mut lines, _window) = open_ready(&display, dir.path(), &args);
+    xdotool(&display, &["key", "space"]);
+    std::thread::sleep(Duration::from_millis(600));
+    xdotool(&display, &["key", "k"]);
+    let stopped = next_frame(&mut lines);
+    assert!(stopped > 0 && stopped != 9 && stopped != 30, "stopped at {stopped}");
+    lines.wait_for("object:", Duration::from_secs(10));
+    save(&display, &mut lines, &file);
+    xdotool(&display, &["key", "ctrl+q"]);
+    let status = wait_for_exit(&mut app, Duration::from_secs(30), "quit");
+    assert!(status.success(), "octovox exited with {status}");
+    let mut want = vec![0, 9, stopped, 30];
+    want.sort_unstable();
+    assert_eq!(keys(&file), want);
+    let recorded = std::fs::read_to_string(&script).unwrap();
+    std::fs::write(&file, &untouched).unwrap();
+    let replayed = dir.path().join("replayed.vox");
+    std::fs::write(&script, format!("{recorded}save {}\n", replayed.display())).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_octovox")).args(["replay", "--cpu"]).arg(&script).output().unwrap();
+    assert!(out.status.success(), "{recorded}{}", String::from_utf8_lossy(&out.stdout));
+    assert_eq!(keys(&replayed), want, "the recording keys the same frame:\n{recorded}");
+}

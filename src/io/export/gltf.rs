@@ -216,8 +216,8 @@ impl Buffers {
     }
 
     /// One animation driving every moving node: its translation (STEP where
-    /// its keys hold, else LINEAR) and, where they change, its rotation and
-    /// scale (STEP: turns are held between keys); `None` when nothing moves.
+    /// its keys hold, else LINEAR), its rotation and its scale (STEP: turns
+    /// are held between keys); `None` when nothing moves.
     fn animation(&mut self, moving: &[(usize, &Motion)], fps: u32, scale: f32) -> Option<Value> {
         let (mut samplers, mut channels) = (Vec::new(), Vec::new());
         for &(node, motion) in moving {
@@ -233,13 +233,11 @@ impl Buffers {
                 samplers.push(json!({"input": input, "output": output, "interpolation": interpolation}));
                 channels.push(json!({"sampler": samplers.len() - 1, "target": {"node": node, "path": path}}));
             };
+            // All three, even where one holds over the range: the node's own
+            // values are those of the frame exported, which may lie outside it.
             channel("translation", &translation, 3, "VEC3", step);
-            if rotation.chunks(4).any(|q| q != &rotation[..4]) {
-                channel("rotation", &rotation, 4, "VEC4", "STEP");
-            }
-            if scaling.chunks(3).any(|s| s != &scaling[..3]) {
-                channel("scale", &scaling, 3, "VEC3", "STEP");
-            }
+            channel("rotation", &rotation, 4, "VEC4", "STEP");
+            channel("scale", &scaling, 3, "VEC3", "STEP");
         }
         (!channels.is_empty()).then(|| json!({"name": "animation", "samplers": samplers, "channels": channels}))
     }

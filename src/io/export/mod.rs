@@ -121,7 +121,8 @@ pub fn check_scale(tree: &crate::scene::Octree, scale: f32) -> Result<(), Export
 /// folder) naming the file.
 pub fn export_mesh(path: &Path, scene: &Scene, scale: f32, options: WriteOptions) -> Result<ExportStats, ExportError> {
     let format = MeshFormat::of(path).ok_or_else(|| ExportError::Format { path: path.to_path_buf() })?;
-    let exported = parts::Exported::of(scene, scale)?;
+    // Only glTF holds motion.
+    let exported = parts::Exported::of(scene, scale, format == MeshFormat::Glb)?;
     // Every file's bytes first, so that nothing is written when one of
     // them cannot be made.
     let mut outputs = Vec::new();

@@ -137,11 +137,13 @@ impl Place {
 }
 
 impl Exported {
-    /// Meshes `scene`: the one drawn octree, or each model an object shows.
+    /// Meshes `scene`: the one drawn octree, or each model an object shows;
+    /// with `animated`, each moving object's motion too.
     ///
     /// # Errors
-    /// A scale that no vertex coordinate survives, the memory budget.
-    pub fn of(scene: &Scene, scale: f32) -> Result<Exported, ExportError> {
+    /// A scale that no vertex coordinate survives, the memory budget, an
+    /// animation longer than [`MAX_EXPORT_FRAMES`].
+    pub fn of(scene: &Scene, scale: f32, animated: bool) -> Result<Exported, ExportError> {
         check_scale(scene.drawn(), scale)?;
         let Some(objects) = scene.objects() else {
             let mesh = NamedMesh { name: "voxels".into(), mesh: mesh_within_budget(scene.drawn())? };
@@ -152,7 +154,7 @@ impl Exported {
         let mut meshes = Vec::new();
         let mut mesh_of_model: HashMap<usize, usize> = HashMap::new();
         let mut parts = Vec::new();
-        let mut motions = motions(objects)?;
+        let mut motions = if animated { motions(objects)? } else { HashMap::new() };
         for (index, object) in objects.list().iter().enumerate() {
             if object.hidden {
                 continue;
@@ -203,10 +205,9 @@ fn motions(objects: &Objects) -> Result<HashMap<usize, Motion>, ExportError> {
     }
     let mut places: Vec<Vec<Place>> = vec![Vec::new(); objects.list().len()];
     for frame in first..=last {
-        let walked =
-            objects.at_frame(frame as usize).map_err(|e| ExportError::Frame { frame, reason: e.to_string() })?;
-        for (index, row) in places.iter_mut().enumerate() {
-            row.push(Place::of(&walked.map(index)));
+        let maps = objects.maps_at(frame as usize).map_err(|e| ExportError::Frame { frame, reason: e.to_string() })?;
+        for (row, map) in places.iter_mut().zip(&maps) {
+            row.push(Place::of(map));
         }
     }
     let mut motions = HashMap::new();

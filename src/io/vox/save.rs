@@ -373,14 +373,19 @@ pub fn encode_objects(palette: &Palette, objects: &Objects) -> Result<Vec<u8>, V
         write_dict(&mut chunk, material.iter().map(|(k, v)| (k.as_str(), v.as_str())));
         push_chunk(&mut children, b"MATL", &chunk, 0);
     }
-    let animation = objects.graph.as_ref().map(|g| g.animation).unwrap_or_default();
+    // A file without a scene graph has no settings of its own: its META goes back as read.
+    let animation = objects.graph.as_ref().map(|g| g.animation);
     for kept in &objects.kept {
-        match kept.id {
-            META => push_chunk(&mut children, &META, &meta_content(Some(&kept.content), animation), 0),
-            id => push_chunk(&mut children, &id, &kept.content, 0),
+        match (kept.id, animation) {
+            (META, Some(animation)) => {
+                push_chunk(&mut children, &META, &meta_content(Some(&kept.content), animation), 0)
+            }
+            (id, _) => push_chunk(&mut children, &id, &kept.content, 0),
         }
     }
-    if animation != Animation::default() && !objects.kept.iter().any(|k| k.id == META) {
+    if let Some(animation) = animation.filter(|a| *a != Animation::default())
+        && !objects.kept.iter().any(|k| k.id == META)
+    {
         push_chunk(&mut children, &META, &meta_content(None, animation), 0);
     }
     let total = 8 + CHUNK_HEADER_BYTES + children.len() as u64;
