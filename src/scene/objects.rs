@@ -572,13 +572,20 @@ impl Objects {
     /// frame, as MagicaVoxel's does); for a node that does not move, its
     /// one key, so the object moves at every frame.
     fn key_to_change(&self, node: &mut Node) -> Result<usize, EditError> {
-        let frame = self.key_frame()?;
         let NodeKind::Transform { frames, .. } = &mut node.kind else {
             return Err(ObjectRefusal::NotATransform(node.id).into());
         };
         if frames.is_empty() {
             frames.push(graph::Attributes::new());
         }
+        // A looping node shows, outside its keys, the frame its loop wraps
+        // to: that frame is keyed (a key outside would lengthen the loop).
+        let timed = anim::keys_in_time(frames.iter(), node.id)?;
+        let (first, last) = (timed[0].0, timed[timed.len() - 1].0);
+        let frame = match self.key_frame()? {
+            frame if graph::is_set(&node.attributes, "_loop") => anim::looped(first, last, frame),
+            frame => frame,
+        };
         if let Some(k) = anim::key_at(frames, frame, node.id)? {
             return Ok(k);
         }

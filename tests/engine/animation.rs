@@ -519,3 +519,24 @@ fn played_frames_are_composed_before_the_next_line_reads_the_scene() {
     assert!(cells(&moved) == drawn(&editor), "saved and drawn agree at frame 7");
     assert!(cells(&moved) != composed(&data, 7), "the move changed the frame");
 }
+
+/// A move at a frame past a looping object's keys keys the frame its loop
+/// shows there, so the loop keeps its length (a review found the key added
+/// past the last, which lengthened the loop of every frame).
+#[test]
+fn a_move_outside_a_loop_keys_the_frame_the_loop_shows() {
+    let data = herd(3);
+    let mut editor = Editor::default();
+    editor.set_scene(load(&bytes_of(&data)));
+    // Cow 0 loops over keys 0, 6 and 20: frame 25 shows frame 4.
+    run(&mut editor, "frame 25\nobject 0\nobject move 0 2 0").unwrap();
+    let frames: Vec<u32> = keys_of(&saved(&editor.scene), "cow 0").iter().map(|k| k.0).collect();
+    assert_eq!(frames, [0, 4, 6, 20]);
+    assert!(drawn(&editor) != composed(&data, 25), "the cow moved");
+    // (The other cows do not loop: only cow 0's place is compared.)
+    let cow = |editor: &Editor| editor.scene.objects().unwrap().world_box(0);
+    run(&mut editor, "frame 4").unwrap();
+    let at4 = cow(&editor);
+    run(&mut editor, "frame 25").unwrap();
+    assert_eq!(cow(&editor), at4, "frame 25 still shows frame 4");
+}
