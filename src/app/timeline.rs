@@ -21,6 +21,8 @@ use octovox::script::{AnimLine, Line, ObjectLine, ObjectRef};
 
 /// Height of the timeline panel in points.
 pub const TIMELINE_HEIGHT: f32 = 56.0;
+/// Width of the frame number's label: `frame 4294967295` fits.
+const FRAME_LABEL_WIDTH: f32 = 110.0;
 
 /// The timeline's own state: playing or not, the easing of new keys, and
 /// values being edited.
@@ -98,7 +100,9 @@ pub fn show(ui: &mut egui::Ui, objects: &Objects, playback: &mut Playback, out: 
             if ui.button(label).on_hover_text("Space").clicked() {
                 out.extend(toggle(playback, shown).map(|line| AppCommand::Lines(vec![line])));
             }
-            ui.label(format!("frame {}", playback.scrubbing.unwrap_or(shown)));
+            // A fixed width: the bar after it does not shift as the digits change.
+            let label = egui::Label::new(format!("frame {}", playback.scrubbing.unwrap_or(shown)));
+            ui.add_sized([FRAME_LABEL_WIDTH, 18.0], label);
             let keyed = keyed_object(objects);
             let keys = keyed.map_or(Vec::new(), |i| key_frames(objects, i));
             scrub_bar(ui, playback, shown, (first, last), &keys, out);
