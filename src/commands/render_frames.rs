@@ -154,8 +154,7 @@ fn motion_bounds(scene: &Scene, frames: &[u32]) -> anyhow::Result<Option<(IVec3,
     let step = frames.len().div_ceil(FRAMED_FRAMES).max(1);
     let mut bounds: Option<(IVec3, IVec3)> = None;
     for &frame in frames.iter().step_by(step).chain(frames.last()) {
-        let walked = objects.at_frame(frame as usize).with_context(|| format!("frame {frame}"))?;
-        if let Some((lo, hi)) = walked.bounds() {
+        if let Some((lo, hi)) = objects.bounds_at(frame as usize).with_context(|| format!("frame {frame}"))? {
             bounds = Some(bounds.map_or((lo, hi), |(a, b)| (a.min(lo), b.max(hi))));
         }
     }

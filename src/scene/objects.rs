@@ -130,21 +130,9 @@ impl Objects {
 
     /// Walks the graph again (after a change to it) and maps every object.
     fn walk(&mut self, voxel_limit: usize) -> Result<(), ObjectsError> {
-        let voxels: Vec<usize> =
-            self.models.iter().map(|m| usize::try_from(m.tree.solid_voxels()).unwrap_or(usize::MAX)).collect();
-        Walked { objects: self.objects, outline: self.outline, names: self.names } = match &self.graph {
-            Some(graph) => graph.walk(&voxels, self.frame, voxel_limit)?,
-            None => self.frame_object()?,
-        };
-        self.maps = Vec::with_capacity(self.objects.len());
-        for object in &self.objects {
-            let model = &self.models[object.placement.model];
-            let map = object
-                .placement
-                .cell_map(model.size)
-                .ok_or(ObjectsError::OutsideWorld { model: object.placement.model })?;
-            self.maps.push(map);
-        }
+        Walked { objects: self.objects, outline: self.outline, names: self.names } =
+            self.walked_at(self.frame, voxel_limit)?;
+        self.maps = self.cell_maps(&self.objects)?;
         for (object, map) in self.objects.iter().zip(&self.maps) {
             if let Some((lo, hi)) = self.models[object.placement.model].tree.solid_bounds() {
                 let (lo, hi) = map.apply_box(lo, hi);
@@ -156,17 +144,29 @@ impl Objects {
         Ok(())
     }
 
-    /// Without a graph: model `frame` as stored.
-    fn frame_object(&self) -> Result<Walked, GraphError> {
-        if self.frame >= self.models.len() {
-            return Err(GraphError::Bad(format!(
-                "frame {} requested but there are {} models",
-                self.frame,
-                self.models.len()
-            )));
+    /// The graph walked at `frame`; without a graph, model `frame` as stored.
+    fn walked_at(&self, frame: usize, voxel_limit: usize) -> Result<Walked, GraphError> {
+        if let Some(graph) = &self.graph {
+            let voxels: Vec<usize> =
+                self.models.iter().map(|m| usize::try_from(m.tree.solid_voxels()).unwrap_or(usize::MAX)).collect();
+            return graph.walk(&voxels, frame, voxel_limit);
+        }
+        if frame >= self.models.len() {
+            return Err(GraphError::Bad(format!("frame {frame} requested but there are {} models", self.models.len())));
         }
         let outline = vec![OutlineRow::Object { index: 0, depth: 0 }];
-        Ok(Walked { objects: vec![Object::frame(self.frame)], outline, names: Vec::new() })
+        Ok(Walked { objects: vec![Object::frame(frame)], outline, names: Vec::new() })
+    }
+
+    /// The cell map of each of `objects` (a walk's).
+    fn cell_maps(&self, objects: &[Object]) -> Result<Vec<CellMap>, ObjectsError> {
+        objects
+            .iter()
+            .map(|o| {
+                let model = o.placement.model;
+                o.placement.cell_map(self.models[model].size).ok_or(ObjectsError::OutsideWorld { model })
+            })
+            .collect()
     }
 
     /// The objects in walk order.
@@ -200,11 +200,6 @@ impl Objects {
     pub fn world_box(&self, index: usize) -> Option<(IVec3, IVec3)> {
         let (lo, hi) = self.models[self.objects[index].placement.model].tree.solid_bounds()?;
         Some(self.maps[index].apply_box(lo, hi))
-    }
-
-    /// The world box of every shown object's voxels; `None` when none has any.
-    pub fn bounds(&self) -> Option<(IVec3, IVec3)> {
-        self.visible().filter_map(|i| self.world_box(i)).reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))
     }
 
     /// The world box of object `index`'s model's root cube: it holds every
@@ -499,24 +494,19 @@ impl Objects {
     /// Every object's cell map at frame `frame`, in walk order (the graph
     /// walked there, the models not copied): what an export samples.
     pub fn maps_at(&self, frame: usize) -> Result<Vec<CellMap>, ObjectsError> {
-        let Some(graph) = &self.graph else {
-            let model = self.models.get(frame).ok_or_else(|| {
-                GraphError::Bad(format!("frame {frame} requested but there are {} models", self.models.len()))
-            })?;
-            let placement = Object::frame(frame).placement;
-            return Ok(vec![placement.cell_map(model.size).ok_or(ObjectsError::OutsideWorld { model: frame })?]);
-        };
-        let voxels: Vec<usize> =
-            self.models.iter().map(|m| usize::try_from(m.tree.solid_voxels()).unwrap_or(usize::MAX)).collect();
-        let walked = graph.walk(&voxels, frame, usize::MAX)?;
-        walked
-            .objects
-            .iter()
-            .map(|o| {
-                let model = o.placement.model;
-                o.placement.cell_map(self.models[model].size).ok_or(ObjectsError::OutsideWorld { model })
-            })
-            .collect()
+        self.cell_maps(&self.walked_at(frame, usize::MAX)?.objects)
+    }
+
+    /// The world box of every shown object's voxels at frame `frame`, the
+    /// models not copied; `None` when none has any.
+    pub fn bounds_at(&self, frame: usize) -> Result<Option<(IVec3, IVec3)>, ObjectsError> {
+        let objects = self.walked_at(frame, usize::MAX)?.objects;
+        let maps = self.cell_maps(&objects)?;
+        let boxes = objects.iter().zip(&maps).filter(|(o, _)| !o.hidden).filter_map(|(o, map)| {
+            let (lo, hi) = self.models[o.placement.model].tree.solid_bounds()?;
+            Some(map.apply_box(lo, hi))
+        });
+        Ok(boxes.reduce(|a, b| (a.0.min(b.0), a.1.max(b.1))))
     }
 
     /// The frame shown, as keys name frames.
