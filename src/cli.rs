@@ -486,11 +486,6 @@ pub fn camera_or_filling(
     /// Past this many cells the box's corners stand for the voxels'.
     const MOST_CELLS: usize = 1 << 18;
     let (None, Some((lo, hi))) = (camera, scene.solid_bounds()) else { return camera_or_framing(camera, fov, scene) };
-    // The corners of the cells `lo..hi` (corner coordinates, `hi` one past).
-    let corners = |lo: glam::IVec3, hi: glam::IVec3| {
-        let (a, b) = (lo.as_dvec3(), hi.as_dvec3());
-        (0..8).map(move |k| DVec3::new([a.x, b.x][k & 1], [a.y, b.y][(k >> 1) & 1], [a.z, b.z][(k >> 2) & 1]))
-    };
     let mut points = Vec::new();
     let mut cells = 0usize;
     scene.drawn().for_each_solid_cell(|min, size, _| {
@@ -503,6 +498,12 @@ pub fn camera_or_filling(
         points = corners(lo, hi + glam::IVec3::ONE).collect();
     }
     Camera::filling(lo, hi, &points, fov, f64::from(width) / f64::from(height.max(1)))
+}
+
+/// The eight corners of the cells `lo..hi` (corner coordinates, `hi` one past).
+pub fn corners(lo: glam::IVec3, hi: glam::IVec3) -> impl Iterator<Item = DVec3> {
+    let (a, b) = (lo.as_dvec3(), hi.as_dvec3());
+    (0..8).map(move |k| DVec3::new([a.x, b.x][k & 1], [a.y, b.y][(k >> 1) & 1], [a.z, b.z][(k >> 2) & 1]))
 }
 
 /// The camera given on the command line, or one framing the scene.

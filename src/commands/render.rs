@@ -49,7 +49,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<ExitCode> {
     check_output(&args.output, OutputKind::Image, &inputs, args.force)?;
     let mut scene = open_scene(args.file.as_deref(), args.frame, args.demo)?;
     let camera = Camera { ortho: args.ortho, ..camera_or_filling(args.camera, args.fov, &scene, args.size) };
-    let ground = ground_height(&scene, args);
+    let ground = ground_height(scene.solid_bounds(), args);
     let mut device = Device::new(args)?;
     let (image, stats) =
         render_frame(&mut device, &mut scene, &camera, args, Shot { ground, number: frame_number(args.frame) })?;
@@ -148,10 +148,10 @@ pub(super) fn frame_number(frame: usize) -> u32 {
 }
 
 /// The world height of the ground plane (`--ground`, the default; none with
-/// `--no-ground`): under the lowest voxel, or at 0 in an empty scene.
-pub(super) fn ground_height(scene: &Scene, args: &RenderArgs) -> Option<i32> {
-    let lowest = scene.solid_bounds().map_or(0, |(lo, _)| lo.y);
-    (!args.no_ground).then_some(lowest)
+/// `--no-ground`): under the lowest voxel of `bounds` (the scene's, or an
+/// animation's whole motion), or at 0 in an empty scene.
+pub(super) fn ground_height(bounds: Option<(glam::IVec3, glam::IVec3)>, args: &RenderArgs) -> Option<i32> {
+    (!args.no_ground).then_some(bounds.map_or(0, |(lo, _)| lo.y))
 }
 
 /// What `--stats` prints.

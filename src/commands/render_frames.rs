@@ -14,7 +14,7 @@ use std::time::Instant;
 use anyhow::Context;
 use glam::{DQuat, DVec3, IVec3};
 
-use super::render::{Device, Shot, Stats, open_scene, render_frame};
+use super::render::{Device, Shot, Stats, ground_height, open_scene, render_frame};
 use crate::cli::{RenderArgs, camera_or_filling};
 use octovox::camera::Camera;
 use octovox::io::atomic::WriteOptions;
@@ -54,7 +54,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<ExitCode> {
         None => motion_bounds(&scene, &frames)?,
     };
     let camera = base_camera(args, &scene, bounds);
-    let ground = (!args.no_ground).then_some(bounds.map_or(0, |(lo, _)| lo.y));
+    let ground = ground_height(bounds, args);
     let mut device = Device::new(args)?;
     let bar = super::progress_bar::frames_bar(ours.len() as u64);
     let mut gif = Vec::new();
@@ -169,10 +169,7 @@ fn base_camera(args: &RenderArgs, scene: &Scene, bounds: Option<(IVec3, IVec3)>)
     let camera = match (args.camera, bounds, args.turntable) {
         (None, Some((lo, hi)), Some(_)) => Camera::framing(lo, hi, args.fov),
         (None, Some((lo, hi)), None) => {
-            let (a, b) = (lo.as_dvec3(), (hi + IVec3::ONE).as_dvec3());
-            let corners: Vec<DVec3> = (0..8)
-                .map(|k| DVec3::new([a.x, b.x][k & 1], [a.y, b.y][(k >> 1) & 1], [a.z, b.z][(k >> 2) & 1]))
-                .collect();
+            let corners: Vec<DVec3> = crate::cli::corners(lo, hi + IVec3::ONE).collect();
             Camera::filling(lo, hi, &corners, args.fov, aspect)
         }
         _ => camera_or_filling(args.camera, args.fov, scene, args.size),
