@@ -53,52 +53,83 @@ fn animation_document() -> (tempfile::TempDir, std::path::PathBuf) {
     (dir, file)
 }
 
+/// A window on animation.vox recording its session, and the file as it was.
+struct Recorded {
+    dir: tempfile::TempDir,
+    file: std::path::PathBuf,
+    untouched: Vec<u8>,
+    script: std::path::PathBuf,
+    _xvfb: KillOnDrop,
+    display: String,
+    app: KillOnDrop,
+    lines: Lines,
+    window: String,
+}
+
+impl Recorded {
+    fn start() -> Recorded {
+        let (dir, file) = animation_document();
+        let untouched = std::fs::read(&file).unwrap();
+        let camera = Camera { eye: glam::DVec3::new(120.0, 110.0, 140.0), ..Camera::default() };
+        let (xvfb, display) = start_xvfb();
+        let script = dir.path().join("session.ovr");
+        let args = document_args(&file, &camera, &["--record", &script.display().to_string()]);
+        let (app, lines, window) = open_ready(&display, dir.path(), &args);
+        Recorded { dir, file, untouched, script, _xvfb: xvfb, display, app, lines, window }
+    }
+
+    /// Saves, quits, and replays the recording headless on the file as it
+    /// was, with `checks` after it: the recording, the saved file's keys and
+    /// the replayed file's.
+    fn save_quit_replay(&mut self, checks: &str) -> (String, Vec<u32>, Vec<u32>) {
+        save(&self.display, &mut self.lines, &self.file);
+        xdotool(&self.display, &["key", "ctrl+q"]);
+        let status = wait_for_exit(&mut self.app, Duration::from_secs(30), "quit");
+        assert!(status.success(), "octovox exited with {status}");
+        let saved = keys(&self.file);
+        let recorded = std::fs::read_to_string(&self.script).unwrap();
+        std::fs::write(&self.file, &self.untouched).unwrap();
+        let replayed = self.dir.path().join("replayed.vox");
+        std::fs::write(&self.script, format!("{recorded}{checks}save {}\n", replayed.display())).unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_octovox")).args(["replay", "--cpu"]).arg(&self.script).output();
+        let out = out.unwrap();
+        let said = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+        assert!(out.status.success(), "{recorded}{said}");
+        (recorded, saved, keys(&replayed))
+    }
+}
+
 #[test]
 fn the_timeline_plays_steps_scrubs_and_keys() {
-    let (dir, file) = animation_document();
-    let untouched = std::fs::read(&file).unwrap();
-    let camera = Camera { eye: glam::DVec3::new(120.0, 110.0, 140.0), ..Camera::default() };
-    let (_xvfb, display) = start_xvfb();
-    let script = dir.path().join("session.ovr");
-    let args = document_args(&file, &camera, &["--record", &script.display().to_string()]);
-    let (mut app, mut lines, window) = open_ready(&display, dir.path(), &args);
+    let mut session = Recorded::start();
+    let (display, window) = (session.display.clone(), session.window.clone());
+    let lines = &mut session.lines;
 
     // Play for a while: pausing leaves the frame it reached as a line.
     xdotool(&display, &["key", "space"]);
     std::thread::sleep(Duration::from_millis(700));
     xdotool(&display, &["key", "space"]);
-    let paused = next_frame(&mut lines);
+    let paused = next_frame(lines);
     assert!(paused > 0, "playing moved on from frame 0");
     xdotool(&display, &["key", "period"]);
-    assert_eq!(next_frame(&mut lines), (paused + 1) % 31);
+    assert_eq!(next_frame(lines), (paused + 1) % 31);
     // A click near the bar's right end shows a frame near the range's end.
     let bar_y = HEIGHT - 38;
     xdotool(&display, &["mousemove", "--window", &window, &(WIDTH - 12).to_string(), &bar_y.to_string()]);
     xdotool(&display, &["click", "1"]);
-    let clicked = next_frame(&mut lines);
+    let clicked = next_frame(lines);
     assert!((27..=30).contains(&clicked), "clicked frame {clicked}");
     xdotool(&display, &["mousemove", "--window", &window, "400", "300"]);
     xdotool(&display, &["key", "comma"]);
-    let keyed = next_frame(&mut lines);
+    let keyed = next_frame(lines);
     assert_eq!(keyed, clicked - 1);
     xdotool(&display, &["key", "k"]);
     lines.wait_for("object:", Duration::from_secs(10));
-    save(&display, &mut lines, &file);
-    xdotool(&display, &["key", "ctrl+q"]);
-    let status = wait_for_exit(&mut app, Duration::from_secs(30), "quit");
-    assert!(status.success(), "octovox exited with {status}");
-
-    let saved = keys(&file);
-    assert_eq!(saved, [0, 9, keyed, 30], "a key at frame {keyed}");
     // The recording, on the file as it was, keys the same frame.
-    let recorded = std::fs::read_to_string(&script).unwrap();
+    let (recorded, saved, replayed) = session.save_quit_replay(&format!("expect frame {keyed}\n"));
+    assert_eq!(saved, [0, 9, keyed, 30], "a key at frame {keyed}");
     assert!(recorded.contains(&format!("frame {keyed}\n")) && recorded.contains("object key linear"), "{recorded}");
-    std::fs::write(&file, &untouched).unwrap();
-    let replayed = dir.path().join("replayed.vox");
-    std::fs::write(&script, format!("{recorded}expect frame {keyed}\nsave {}\n", replayed.display())).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_octovox")).args(["replay", "--cpu"]).arg(&script).output().unwrap();
-    assert!(out.status.success(), "{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
-    assert_eq!(keys(&replayed), saved);
+    assert_eq!(replayed, saved);
 }
 
 /// Scrubbed to a frame, the window shows what `render --frames k..k` of
@@ -150,31 +181,18 @@ fn a_scrubbed_frame_looks_as_render_draws_it() {
 /// key recorded without its frame: replayed, it keyed frame 0).
 #[test]
 fn a_key_pressed_while_playing_is_recorded_at_its_frame() {
-    let (dir, file) = animation_document();
-    let untouched = std::fs::read(&file).unwrap();
-    let camera = Camera { eye: glam::DVec3::new(120.0, 110.0, 140.0), ..Camera::default() };
-    let (_xvfb, display) = start_xvfb();
-    let script = dir.path().join("session.ovr");
-    let args = document_args(&file, &camera, &["--record", &script.display().to_string()]);
-    let (mut app, mut lines, _window) = open_ready(&display, dir.path(), &args);
+    let mut session = Recorded::start();
+    let display = session.display.clone();
+    let lines = &mut session.lines;
     xdotool(&display, &["key", "space"]);
     std::thread::sleep(Duration::from_millis(600));
     xdotool(&display, &["key", "k"]);
-    let stopped = next_frame(&mut lines);
+    let stopped = next_frame(lines);
     assert!(stopped > 0 && stopped != 9 && stopped != 30, "stopped at {stopped}");
     lines.wait_for("object:", Duration::from_secs(10));
-    save(&display, &mut lines, &file);
-    xdotool(&display, &["key", "ctrl+q"]);
-    let status = wait_for_exit(&mut app, Duration::from_secs(30), "quit");
-    assert!(status.success(), "octovox exited with {status}");
+    let (recorded, saved, replayed) = session.save_quit_replay("");
     let mut want = vec![0, 9, stopped, 30];
     want.sort_unstable();
-    assert_eq!(keys(&file), want);
-    let recorded = std::fs::read_to_string(&script).unwrap();
-    std::fs::write(&file, &untouched).unwrap();
-    let replayed = dir.path().join("replayed.vox");
-    std::fs::write(&script, format!("{recorded}save {}\n", replayed.display())).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_octovox")).args(["replay", "--cpu"]).arg(&script).output().unwrap();
-    assert!(out.status.success(), "{recorded}{}", String::from_utf8_lossy(&out.stdout));
-    assert_eq!(keys(&replayed), want, "the recording keys the same frame:\n{recorded}");
+    assert_eq!(saved, want);
+    assert_eq!(replayed, want, "the recording keys the same frame:\n{recorded}");
 }
