@@ -7,6 +7,7 @@ use std::time::Instant;
 use anyhow::Context as _;
 use winit::event_loop::ActiveEventLoop;
 
+use octovox::gpu::GpuContext;
 use octovox::gpu::readback::{padded_row_bytes, read_buffer, staging_buffer};
 
 use super::{App, Gfx, SAVES_DIR};
@@ -19,26 +20,26 @@ impl App {
     /// Writes the traced view (and, where the swapchain allows copies, the
     /// whole window with its panels) as PNGs under `saves/`.
     pub(super) fn save_screenshot(&mut self, window_copy: Option<WindowCopy>) {
-        let Some(gfx) = &self.gfx else { return };
+        let Some(renderer) = &self.session.renderer else { return };
         let stamp = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_millis());
         if let Err(err) = std::fs::create_dir_all(SAVES_DIR) {
             log::warn!("cannot create {SAVES_DIR}: {err}");
         }
         let view_path = Path::new(SAVES_DIR).join(format!("octovox-{stamp}.png"));
         let base = view_path.with_extension("");
-        let result = gfx.renderer.read_image().map_err(anyhow::Error::from).and_then(|image| {
+        let result = renderer.read_image().map_err(anyhow::Error::from).and_then(|image| {
             octovox::io::png::save_png(&image, &view_path, Default::default()).map_err(anyhow::Error::from)
         });
         match result {
             Ok(()) => report!("screenshot: {}", view_path.display()),
             Err(err) => {
-                self.ui.error(format!("screenshot failed: {err:#}"));
+                self.session.ui.error(format!("screenshot failed: {err:#}"));
                 return;
             }
         }
         if let Some((buffer, width, height, bgra)) = window_copy {
             let window_path = PathBuf::from(format!("{}-window.png", base.display()));
-            let result = read_buffer(&gfx.renderer.gpu, &buffer).map_err(anyhow::Error::from).and_then(|bytes| {
+            let result = read_buffer(&renderer.gpu, &buffer).map_err(anyhow::Error::from).and_then(|bytes| {
                 let row = (width * 4) as usize;
                 let mut pixels: Vec<u8> =
                     bytes.chunks(padded_row_bytes(width) as usize).flat_map(|r| &r[..row]).copied().collect();
@@ -52,24 +53,25 @@ impl App {
             });
             match result {
                 Ok(()) => report!("screenshot: {}", window_path.display()),
-                Err(err) => self.ui.error(format!("window screenshot failed: {err:#}")),
+                Err(err) => self.session.ui.error(format!("window screenshot failed: {err:#}")),
             }
         }
-        self.ui.info(format!("screenshot saved to {}", view_path.display()));
+        self.session.ui.info(format!("screenshot saved to {}", view_path.display()));
     }
 
     pub(super) fn bench_step(&mut self, event_loop: &ActiveEventLoop) {
         if !self.frames.ready {
             return;
         }
-        let (w, h) = self.trace_size();
-        let clock = self.gfx.as_ref().map_or("", |g| if g.renderer.timed_by_gpu() { "GPU timestamps" } else { "wall" });
+        let (w, h) = self.session.trace_size();
+        let clock =
+            self.session.renderer.as_ref().map_or("", |g| if g.timed_by_gpu() { "GPU timestamps" } else { "wall" });
         let Some(bench) = &mut self.frames.bench else { return };
         match bench.started {
             // The first ready frame warms up; timing starts after it.
             None => bench.started = Some(Instant::now()),
             Some(started) => {
-                bench.trace_ms += self.readouts.stats.trace_ms;
+                bench.trace_ms += self.session.readouts.stats.trace_ms;
                 bench.left -= 1;
                 if bench.left == 0 {
                     let seconds = started.elapsed().as_secs_f64();
@@ -90,10 +92,15 @@ impl App {
 }
 
 /// Copies the swapchain image into a mappable buffer (read after submit).
-pub(super) fn copy_frame(gfx: &Gfx, encoder: &mut wgpu::CommandEncoder, texture: &wgpu::Texture) -> WindowCopy {
+pub(super) fn copy_frame(
+    gfx: &Gfx,
+    gpu: &GpuContext,
+    encoder: &mut wgpu::CommandEncoder,
+    texture: &wgpu::Texture,
+) -> WindowCopy {
     let (width, height) = (texture.width(), texture.height());
     let padded = padded_row_bytes(width);
-    let buffer = staging_buffer(&gfx.renderer.gpu.device, "window screenshot", u64::from(padded) * u64::from(height));
+    let buffer = staging_buffer(&gpu.device, "window screenshot", u64::from(padded) * u64::from(height));
     encoder.copy_texture_to_buffer(
         texture.as_image_copy(),
         wgpu::TexelCopyBufferInfo {

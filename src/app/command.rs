@@ -1,5 +1,5 @@
 //! What the user (or, later, a replay script) asks the app to do. The panels
-//! and the input handler produce these; `App::execute` is the one place that
+//! and the input handler produce these; `Session::execute` is the one place that
 //! carries them out, so a scripted edit and a mouse edit share every step.
 
 use std::path::PathBuf;

@@ -1,6 +1,6 @@
 //! The open document: the engine's editor (scene, history, tools,
-//! selection, clipboard), where its file comes from (a background load, a
-//! file dialog, the recent files), its crash journal, and the scripts
+//! selection, clipboard), where its file comes from (a background load, the
+//! recent files), its crash journal, and the scripts
 //! played on it or recorded from it.
 
 use std::path::PathBuf;
@@ -13,7 +13,7 @@ use octovox::journal::FileStamp;
 use octovox::replay::Recorder;
 use octovox::scene::Scene;
 
-use super::{file_dialog, journal, recent, script};
+use super::{journal, recent, script};
 
 /// A file being read on a background thread.
 pub(super) struct Loading {
@@ -28,8 +28,6 @@ pub(super) struct Document {
     /// editor, which played scripts drive too.
     pub editor: Editor,
     pub loading: Option<Loading>,
-    /// A native file dialog that is open.
-    pub file_dialog: Option<file_dialog::NativeDialog>,
     /// File ▸ Open recent.
     pub recent: recent::Recent,
     /// The crash-recovery journal of the open document (`octovox::journal`),
@@ -50,7 +48,6 @@ impl Default for Document {
         Document {
             editor: Editor::default(),
             loading: None,
-            file_dialog: None,
             recent: recent::Recent::load(),
             journal: None,
             journal_start: journal::JournalStart::default(),

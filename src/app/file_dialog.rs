@@ -61,8 +61,8 @@ impl App {
     /// Asks for a path for `kind`: in a native dialog where there is one,
     /// else in the window's file browser, starting at `start`.
     pub(super) fn ask_path(&mut self, kind: DialogKind, start: String) {
-        if self.doc.file_dialog.is_some() {
-            return self.ui.info("a file dialog is open");
+        if self.file_dialog.is_some() {
+            return self.session.ui.info("a file dialog is open");
         }
         if !available() {
             return self.open_browser(kind, &start);
@@ -77,15 +77,15 @@ impl App {
         match spawned {
             Ok(_) => {
                 report!("file dialog: native");
-                self.doc.file_dialog = Some(NativeDialog { kind, start, answer: rx });
+                self.file_dialog = Some(NativeDialog { kind, start, answer: rx });
             }
             Err(_) => self.open_browser(kind, &start),
         }
     }
 
     fn open_browser(&mut self, kind: DialogKind, start: &str) {
-        let recent: Vec<PathBuf> = self.doc.recent.files().cloned().collect();
-        self.ui.dialog = Some(Browser::new(kind, start, &recent));
+        let recent: Vec<PathBuf> = self.session.doc.recent.files().cloned().collect();
+        self.session.ui.dialog = Some(Browser::new(kind, start, &recent));
         // Drawn now, not at the next input: a click meant for it must not reach the scene.
         self.request_redraw();
         report!("file dialog: browser");
@@ -93,13 +93,13 @@ impl App {
 
     /// Carries out the answer of the open native dialog, once it came.
     pub(super) fn poll_file_dialog(&mut self, event_loop: &ActiveEventLoop) {
-        let Some(open) = &self.doc.file_dialog else { return };
+        let Some(open) = &self.file_dialog else { return };
         let (answer, took) = match open.answer.try_recv() {
             Ok(answer) => answer,
             Err(TryRecvError::Empty) => return,
             Err(TryRecvError::Disconnected) => (None, Duration::ZERO),
         };
-        let Some(open) = self.doc.file_dialog.take() else { return };
+        let Some(open) = self.file_dialog.take() else { return };
         match answer {
             Some(path) => self.execute(open.kind.command(path), event_loop),
             None if took < NO_DIALOG_WITHIN => {
@@ -107,7 +107,7 @@ impl App {
                 self.open_browser(open.kind, &open.start);
             }
             // Cancelled: an action that waited for a path waits no more.
-            None => self.ui.pending = None,
+            None => self.session.ui.pending = None,
         }
         self.request_redraw();
     }

@@ -5,8 +5,6 @@ use std::path::{Path, PathBuf};
 use std::sync::mpsc::{self, TryRecvError};
 use std::time::Instant;
 
-use winit::event_loop::ActiveEventLoop;
-
 use octovox::io::atomic::WriteOptions;
 use octovox::io::output::same_file;
 use octovox::scene::Scene;
@@ -18,9 +16,10 @@ use super::dialog_kind::DialogKind;
 use super::document::Loading;
 use super::gesture::Gesture;
 use super::journal::{Found, JournalStart, classify};
-use super::{App, Choice, Pending, camera_control, first_used_color, ui};
+use super::session::{Session, first_used_color};
+use super::{Choice, Pending, camera_control, ui};
 
-impl App {
+impl Session {
     /// Puts a new scene in place (load, New, a built-in scene) and uploads
     /// it whole; `source` is the script line that makes it (`load`, `new`,
     /// `demo`), which the recorder writes.
@@ -67,25 +66,25 @@ impl App {
     }
 
     /// Runs `action` now, or first asks about unsaved changes.
-    pub(super) fn guard_unsaved(&mut self, action: Pending, event_loop: &ActiveEventLoop) {
+    pub(super) fn guard_unsaved(&mut self, action: Pending) {
         if self.unsaved() {
             self.ui.pending = Some(action);
             self.ui.prompt_open = true;
         } else {
-            self.perform(action, event_loop);
+            self.perform(action);
         }
     }
 
-    pub(super) fn resolve(&mut self, choice: Choice, event_loop: &ActiveEventLoop) {
+    pub(super) fn resolve(&mut self, choice: Choice) {
         self.ui.prompt_open = false;
         let Some(pending) = self.ui.pending.take() else { return };
         match choice {
             Choice::Cancel => {}
-            Choice::Discard => self.perform(pending, event_loop),
+            Choice::Discard => self.perform(pending),
             Choice::Save => match self.state.path.clone() {
                 Some(path) => {
                     if self.save_document(&path, WriteOptions::default()) {
-                        self.perform(pending, event_loop);
+                        self.perform(pending);
                     } else if self.ui.replace.is_some() {
                         // Replacing from the prompt carries on with it.
                         self.ui.pending = Some(pending);
@@ -100,7 +99,7 @@ impl App {
         }
     }
 
-    pub(super) fn perform(&mut self, action: Pending, event_loop: &ActiveEventLoop) {
+    pub(super) fn perform(&mut self, action: Pending) {
         match action {
             Pending::New => {
                 self.replace_scene(Scene::default(), octovox::script::Line::New, None);
@@ -113,7 +112,7 @@ impl App {
             Pending::Quit => {
                 // Saved or discarded: nothing is left to recover.
                 self.close_journal();
-                event_loop.exit();
+                self.effects.exit = true;
             }
         }
     }
@@ -183,12 +182,12 @@ impl App {
 
     /// Saves, then makes `path` the document and carries on with an action
     /// that waited for a path to save to.
-    pub(super) fn save_as(&mut self, path: PathBuf, options: WriteOptions, event_loop: &ActiveEventLoop) {
+    pub(super) fn save_as(&mut self, path: PathBuf, options: WriteOptions) {
         if self.save_document(&path, options) {
             self.state.path = Some(path);
             self.update_title();
             if let Some(pending) = self.ui.pending.take() {
-                self.perform(pending, event_loop);
+                self.perform(pending);
             }
         }
     }
@@ -311,7 +310,7 @@ impl App {
                 report!("loaded: {} ({} voxels, {seconds:.2} s)", loading.path.display(), scene.solid_voxels());
                 self.replace_scene(scene, Load(loading.path.clone()), stamp);
                 // A camera from the command line wins for the file it came with.
-                let keep_camera = self.args.camera.is_some() && self.args.file.as_ref() == Some(&loading.path);
+                let keep_camera = self.camera_for.as_ref() == Some(&loading.path);
                 if !keep_camera {
                     // A new document starts in the default view, not the last one's.
                     self.state.camera = camera_control::fresh_camera(self.state.camera.fov_y_deg, None);

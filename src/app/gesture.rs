@@ -267,50 +267,6 @@ mod tests {
         assert_eq!(*editor.scene.palette.material(5), *diffuse, "one undo puts the entry back");
     }
 
-    /// An object drag (object mode): the press picks the object (`object
-    /// N`), the drag's whole-voxel moves over the ground are `object move`
-    /// lines inside one stroke, one undo step, as the journal writes them.
-    #[test]
-    fn an_object_drag_is_one_undo_step() {
-        let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/vox/format/test_groups.vox");
-        let mut editor = Editor::default();
-        editor.set_scene(octovox::io::load_scene(&file, 0).unwrap());
-        let before = editor.scene.voxels();
-        let mut journal = Journaled::new();
-        let script = "object 3\nstroke begin\nobject move 1 0 0\nobject move 0 0 -2\nobject move 2 0 0\nstroke end\n";
-        for line in octovox::script::parse_script(std::path::Path::new("drag.ovr"), script).unwrap().lines {
-            journal.run(&mut editor, &line.command);
-        }
-        let written = journal.written();
-        let lines: Vec<&str> = written.lines().filter(|l| l.starts_with("object") || l.starts_with("stroke")).collect();
-        assert_eq!(lines, script.lines().collect::<Vec<_>>(), "{written}");
-        assert_eq!(editor.history.steps(), (1, 0), "the drag is one undo step");
-        assert_ne!(editor.scene.voxels(), before, "the object moved");
-        editor.run(&Line::Undo(1)).unwrap();
-        assert_eq!(editor.scene.voxels(), before, "one undo puts it back");
-    }
-
-    /// A line drag is one `line` from the cell in front of the pressed face
-    /// to the one in front of the released face (one undo step); a box
-    /// select is one `select` from the pressed cell to the released one (on
-    /// the ground, the cell on it).
-    #[test]
-    fn a_line_drag_and_a_box_select_are_one_line_each() {
-        let mut editor = floor();
-        let (press, release) = (top(1, 1), top(6, 1));
-        let line = Line::Segment(press.in_front(), release.in_front());
-        assert_eq!(line.to_string(), "line 1 1 1 6 1 1");
-        editor.run(&line).unwrap();
-        assert_eq!((editor.scene.solid_voxels(), editor.history.steps()), (64 + 6, (1, 0)));
-        let ground = Pick { voxel: IVec3::new(9, -1, 9), normal: IVec3::Y, value: 0 };
-        let select = Line::Select(Some((press.cell(), ground.cell())));
-        assert_eq!(select.to_string(), "select 1 0 1 9 0 9");
-        editor.run(&select).unwrap();
-        let region = editor.selection.unwrap();
-        assert_eq!((region.min, region.max), (IVec3::new(1, 0, 1), IVec3::new(9, 0, 9)));
-        assert_eq!(editor.history.steps(), (1, 0), "a selection is no undo step");
-    }
-
     /// An Erase drag digs one layer, and a Paint drag follows the pointer
     /// to any face; a stroke that edits nothing leaves no step and no lines.
     #[test]

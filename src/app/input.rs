@@ -8,6 +8,7 @@ use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::keyboard::{KeyCode, ModifiersState, PhysicalKey};
 
 use super::command::{AppCommand, StrokePhase};
+use super::session::Pointer;
 use super::state::Tool;
 
 /// A right press becomes an orbit once the pointer moved this far (pixels);
@@ -43,19 +44,16 @@ impl Input {
         self.cursor
     }
 
-    /// Ctrl is held: a left drag from a face extrudes it.
-    pub fn ctrl_held(&self) -> bool {
-        self.modifiers.control_key()
-    }
-
-    /// Shift is held: a click with Paint fills.
-    pub fn shift_held(&self) -> bool {
-        self.modifiers.shift_key()
-    }
-
-    /// Alt is held: a click picks a colour.
-    pub fn alt_held(&self) -> bool {
-        self.modifiers.alt_key()
+    /// The pointer and the modifiers, as the session reads them: Ctrl held
+    /// (a left drag from a face extrudes it), Shift (a click with Paint
+    /// fills), Alt (a click picks a colour).
+    pub fn pointer(&self) -> Pointer {
+        Pointer {
+            cursor: self.cursor,
+            ctrl: self.modifiers.control_key(),
+            shift: self.modifiers.shift_key(),
+            alt: self.modifiers.alt_key(),
+        }
     }
 
     /// Fly direction (right, up, forward) while the right button is held.

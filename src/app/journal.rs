@@ -11,7 +11,7 @@ use octovox::journal::{FileStamp, RecoverError};
 use octovox::replay::Recorder;
 use octovox::script::Line;
 
-use super::App;
+use super::session::Session;
 
 /// What starts the open scene's journal: the lines that make the scene as
 /// it is on disk (or as it started, for an untitled one), and the stamp of
@@ -68,7 +68,7 @@ pub(super) fn classify(journal: &Path, document: Option<&Path>) -> Found {
     }
 }
 
-impl App {
+impl Session {
     /// Runs `f` on the recorder and on the scene's journal (started at the
     /// first unsaved change); an I/O error stops that one, and the status
     /// bar says the edits are not protected until a journal starts again

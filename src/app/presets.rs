@@ -10,6 +10,7 @@ use octovox::quality::{REFERENCE_SEED, Setting, flip, render_setting};
 use octovox::scene::Scene;
 use octovox::settings::{PathSettings, Shading, TraceMode};
 
+use super::session::Session;
 use super::state::EditorState;
 
 /// A named bundle of the quality knobs.
@@ -165,6 +166,28 @@ fn measure_all(
         .collect::<Result<Vec<_>, GpuError>>()?;
     measured.push(Measured { ms: reference_ms * ratio, flip: 0.0 });
     Ok(measured)
+}
+
+impl Session {
+    /// Measures the quality presets from the current camera (a second or
+    /// so on lavapipe; the window waits meanwhile) and prints the result.
+    pub(super) fn measure_presets(&mut self) {
+        let window = self.window_size();
+        let Some(renderer) = &mut self.renderer else { return };
+        match measure(renderer, &self.doc.editor.scene, &self.state.camera, window) {
+            Ok(measured) => {
+                let line: Vec<String> = PRESETS
+                    .iter()
+                    .zip(&measured)
+                    .map(|(p, m)| format!("{} {:.1} ms FLIP {:.3}", p.name, m.ms, m.flip))
+                    .collect();
+                report!("presets: {}", line.join("; "));
+                self.readouts.presets_measured = Some(measured);
+            }
+            Err(err) => self.ui.error(format!("cannot measure the presets: {err}")),
+        }
+        self.request_redraw();
+    }
 }
 
 #[cfg(test)]

@@ -8,8 +8,8 @@ use glam::IVec3;
 
 use octovox::edit::selection::Region;
 
-use super::App;
 use super::gesture::Gesture;
+use super::session::Session;
 use super::state::{Mode, Tool};
 
 /// The faces an extrude would move: those of the region around `face`
@@ -54,7 +54,20 @@ pub(super) fn ui_at(ctx: &egui::Context, view: egui::Rect, (x, y): (f64, f64)) -
     !view.contains(at) || ctx.layer_id_at(at).is_some_and(|layer| layer.order != egui::Order::Background)
 }
 
-impl App {
+impl Session {
+    /// The hover pick: what a click would edit, highlighted before any click.
+    pub(super) fn update_hover(&mut self) {
+        self.hover.pick = match self.pointer.cursor {
+            // A hover over a ray that gave up highlights nothing; a click says why.
+            Some((x, y)) if !self.hover.pointer_over_ui && self.doc.loading.is_none() => {
+                // What builds on the ground shows where it lands there too.
+                let on_ground = self.state.tool == Tool::Attach || self.state.mode != Mode::Brush;
+                if on_ground { self.pick_or_ground(x, y) } else { self.pick_at(x, y) }.ok().flatten()
+            }
+            _ => None,
+        };
+    }
+
     pub(super) fn update_previews(&mut self) {
         self.update_extrude_preview();
         self.update_fill_preview();
@@ -66,7 +79,7 @@ impl App {
     fn update_extrude_preview(&mut self) {
         let face = match self.gesture {
             Gesture::Extrude { face, .. } => Some(face),
-            _ if self.input.ctrl_held() && self.state.mode == Mode::Brush => self.hover.pick,
+            _ if self.pointer.ctrl && self.state.mode == Mode::Brush => self.hover.pick,
             _ => None,
         }
         .filter(|p| p.normal != IVec3::ZERO && p.value != 0)
@@ -81,7 +94,7 @@ impl App {
             let voxels = region.map(|r| r.into_iter().map(|(p, _)| p).collect()).unwrap_or_default();
             self.hover.extrude_preview = Some(ExtrudePreview { face, voxels, layers: 0 });
         }
-        let layers = self.input.cursor().and_then(|(x, y)| self.extrude_layers(x, y)).unwrap_or(0);
+        let layers = self.pointer.cursor.and_then(|(x, y)| self.extrude_layers(x, y)).unwrap_or(0);
         if let Some(preview) = &mut self.hover.extrude_preview {
             preview.layers = layers;
         }
@@ -94,7 +107,7 @@ impl App {
         let start = self
             .hover
             .pick
-            .filter(|_| plain_mode && self.state.tool == Tool::Paint && self.input.shift_held())
+            .filter(|_| plain_mode && self.state.tool == Tool::Paint && self.pointer.shift)
             .map(|p| p.voxel);
         let Some(start) = start else {
             self.hover.fill_preview = None;
@@ -120,6 +133,6 @@ impl App {
 
     /// The colour Alt+click would pick: the voxel's under the cursor.
     pub(super) fn eyedropper_preview(&self) -> Option<u8> {
-        self.hover.pick.filter(|p| self.input.alt_held() && p.value != 0).map(|p| p.value)
+        self.hover.pick.filter(|p| self.pointer.alt && p.value != 0).map(|p| p.value)
     }
 }

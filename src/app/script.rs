@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use octovox::replay::{DEFAULT_VIEWPORT, StepResult};
 use octovox::script::Script;
 
-use super::App;
+use super::session::Session;
 
 /// A script being played in the window, and what its lines set that the
 /// window itself has not: the size and the image of its renders.
@@ -37,7 +37,7 @@ impl Player {
     }
 }
 
-impl App {
+impl Session {
     /// Plays the next script line, if a script is playing and the app is
     /// idle (not loading). Prints the summary after the last line.
     pub(super) fn play_step(&mut self) {
@@ -82,11 +82,11 @@ impl App {
     }
 }
 
-impl App {
+impl Session {
     /// Opens `--replay` and `--record` files given on the command line.
-    pub(super) fn open_script_files(&mut self) {
-        if let Some(path) = self.args.replay.clone() {
-            match octovox::script::load_script(&path) {
+    pub(super) fn open_script_files(&mut self, replay: Option<&Path>, record: Option<&Path>) {
+        if let Some(path) = replay {
+            match octovox::script::load_script(path) {
                 Ok(script) => self.doc.player = Some(Player::new(script)),
                 Err(errors) => {
                     for error in &errors {
@@ -96,8 +96,8 @@ impl App {
                 }
             }
         }
-        if let Some(path) = self.args.record.clone() {
-            match octovox::replay::Recorder::create(&path) {
+        if let Some(path) = record {
+            match octovox::replay::Recorder::create(path) {
                 Ok(recorder) => self.doc.recorder = Some(recorder),
                 Err(err) => self.ui.error(format!("cannot record to {}: {err}", path.display())),
             }

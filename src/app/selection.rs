@@ -12,10 +12,11 @@ use octovox::edit::selection::Region;
 use octovox::script::Line;
 
 use super::gesture::{Gesture, SelectDrag};
+use super::session::Session;
 use super::state::Mode;
-use super::{App, Nudge, StrokePhase};
+use super::{Nudge, StrokePhase};
 
-impl App {
+impl Session {
     pub(super) fn select_drag(&mut self, phase: StrokePhase, x: f64, y: f64) {
         match phase {
             StrokePhase::Begin => {
@@ -86,7 +87,7 @@ impl App {
     /// Edit ▸ Paste: the block's min corner in the cell in front of the
     /// face under the cursor.
     pub(super) fn paste_at_cursor(&mut self) {
-        let Some((x, y)) = self.input.cursor() else { return };
+        let Some((x, y)) = self.pointer.cursor else { return };
         if let Some(pick) = self.pick_or_ground_or_say(x, y, "no face or ground under the cursor to paste on") {
             self.act(Line::Paste(pick.voxel + pick.normal), "paste");
         }
@@ -107,7 +108,7 @@ impl App {
     }
 }
 
-impl App {
+impl Session {
     /// Object mode: a press picks the object it hits (no edit), and a drag
     /// from it moves it over the ground's axes, one undo step.
     pub(super) fn object_click(&mut self, phase: StrokePhase, x: f64, y: f64) {

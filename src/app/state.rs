@@ -70,7 +70,7 @@ pub struct EditorState {
     /// The history's state when the scene was last saved or loaded
     /// (`History::state_id`); `None` when no state of it is in a file (a
     /// recovered journal's scene, or one saved in the middle of a stroke).
-    /// Whether there are unsaved changes is derived from it (`App::unsaved`).
+    /// Whether there are unsaved changes is derived from it (`Session::unsaved`).
     pub saved_state: Option<u64>,
     /// Frame time to hold while the camera moves (the render scale drops
     /// as far as needed), milliseconds.

@@ -14,6 +14,7 @@ use std::time::Instant;
 use egui::{Color32, Sense, Stroke, Vec2};
 
 use super::command::AppCommand;
+use super::session::Session;
 use octovox::scene::anim::{Ease, MAX_FPS, key_frame};
 use octovox::scene::graph::NodeKind;
 use octovox::scene::objects::Objects;
@@ -247,6 +248,51 @@ fn key_buttons(ui: &mut egui::Ui, objects: &Objects, playback: &mut Playback, sh
     let has_key = key_frames(objects, index).contains(&shown);
     if ui.add_enabled(has_key, egui::Button::new("Unkey")).on_hover_text("Shift+K").clicked() {
         out.push(pick(ObjectLine::Unkey));
+    }
+}
+
+impl Session {
+    /// Shows frame `frame` while playing or scrubbing: the editor's `frame
+    /// N`, uploaded and drawn, but not recorded or journaled (`timeline`).
+    pub(super) fn show_frame(&mut self, frame: u32) {
+        match self.doc.editor.play_frame(frame) {
+            Ok(_) => {
+                let upload = self.upload();
+                self.readouts.stats.last_edit_bytes = Some(upload.bytes);
+                self.readouts.stats.last_edit_ranges = upload.ranges;
+                self.request_redraw();
+            }
+            Err(err) => self.ui.error(format!("frame {frame} refused: {err}")),
+        }
+    }
+
+    /// Space, comma, period, K and Shift+K: play or pause, step a frame,
+    /// key or unkey the object the timeline keys.
+    pub(super) fn timeline_key(&mut self, command: &AppCommand) {
+        let Some(objects) = self.doc.editor.scene.objects() else {
+            return self.ui.info("this scene is one model: it has no animation");
+        };
+        let shown = u32::try_from(objects.frame).unwrap_or(u32::MAX);
+        let lines = match *command {
+            AppCommand::TogglePlay => toggle(&mut self.ui.playback, shown).into_iter().collect(),
+            AppCommand::StepFrame(by) => vec![octovox::script::Line::Frame(stepped(objects, shown, by))],
+            AppCommand::Key(on) => {
+                let line = if on {
+                    octovox::script::ObjectLine::Key(self.ui.playback.ease)
+                } else {
+                    octovox::script::ObjectLine::Unkey
+                };
+                match key_lines(objects, line) {
+                    Some(lines) => lines,
+                    None => return self.ui.info("pick an object to key it"),
+                }
+            }
+            _ => Vec::new(),
+        };
+        for line in lines {
+            let word = line.word();
+            self.act(line, word);
+        }
     }
 }
 
