@@ -185,7 +185,10 @@ fn a_key_pressed_while_playing_is_recorded_at_its_frame() {
     let display = session.display.clone();
     let lines = &mut session.lines;
     xdotool(&display, &["key", "space"]);
-    std::thread::sleep(Duration::from_millis(600));
+    // Long enough for a frame to be shown under a loaded CI runner (600 ms
+    // was not, once: the key came before the first frame played); short of
+    // the loop's 2.6 s, so playing has not wrapped back to frame 0.
+    std::thread::sleep(Duration::from_millis(1200));
     xdotool(&display, &["key", "k"]);
     let stopped = next_frame(lines);
     assert!(stopped > 0 && stopped != 9 && stopped != 30, "stopped at {stopped}");
