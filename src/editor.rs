@@ -401,7 +401,7 @@ impl Editor {
         Ok(match line {
             ObjectLine::Move(by) => (graph(objects.moved(index, *by)?), Picks::Same),
             ObjectLine::Rotate(axis) => (graph(objects.rotated(index, *axis, 1)?), Picks::Same),
-            ObjectLine::Turn { axis, quarters } => (graph(objects.rotated(index, *axis, *quarters)?), Picks::Same),
+            ObjectLine::Turn { axis, degrees } => (graph(objects.turned(index, *axis, degrees.0)?), Picks::Same),
             ObjectLine::Hide(hidden) => {
                 (graph(objects.with_attribute(index, "_hidden", hidden.then_some("1"))?), Picks::Same)
             }

@@ -17,7 +17,7 @@
 //! eases in and out (smoothstep); without it a key is `linear`.
 
 use super::graph::{Attributes, GraphError, is_set};
-use super::transform::Transform;
+use super::transform::Pose;
 
 /// The keyframe attribute octovox keeps a key's easing in.
 pub const EASE_KEY: &str = "_ov_ease";
@@ -131,31 +131,33 @@ fn bracket(timed: &[(u32, usize)], looping: bool, frame: u32) -> (usize, Option<
     (from.1, Some((to.1, t)))
 }
 
-/// The transform a transform node's keys give at `frame` (the identity for
-/// a node without keys).
+/// The pose a transform node's keys give at `frame` (the identity for a
+/// node without keys): translations move linearly as `ogt_vox` moves them;
+/// rotations hold the earlier key as in `ogt_vox`, unless a key turns
+/// freely (`_ov_turn`), then they turn by slerp (see [`Pose::toward`]).
 pub fn sample_transform(
     keys: &[Attributes],
     node_attributes: &Attributes,
     frame: u32,
     node: u32,
-) -> Result<Transform, GraphError> {
+) -> Result<Pose, GraphError> {
     if keys.is_empty() {
-        return Ok(Transform::IDENTITY);
+        return Ok(Pose::IDENTITY);
     }
     let timed = keys_in_time(keys.iter(), node)?;
     let (from, next) = bracket(&timed, is_set(node_attributes, "_loop"), frame);
-    let held = super::graph::parse_transform(&keys[from], node)?;
+    let held = super::graph::parse_pose(&keys[from], node)?;
     let Some((to, t)) = next else { return Ok(held) };
-    let toward = super::graph::parse_transform(&keys[to], node)?;
+    let toward = super::graph::parse_pose(&keys[to], node)?;
     let s = Ease::of(&keys[from], node)?.shaped(t);
-    let mut out = held;
-    for axis in 0..3 {
+    let mut translation = held.transform.translation;
+    for (axis, out) in translation.iter_mut().enumerate() {
         // f32 and a cast that rounds toward zero, as ogt_vox computes it
         // (exact up to 2^24; farther translations round as ogt_vox's do).
-        let (a, b) = (held.translation[axis] as f32, toward.translation[axis] as f32);
-        out.translation[axis] = i64::from((b * s + a * (1.0 - s)) as i32);
+        let (a, b) = (held.transform.translation[axis] as f32, toward.transform.translation[axis] as f32);
+        *out = i64::from((b * s + a * (1.0 - s)) as i32);
     }
-    Ok(out)
+    Ok(held.toward(&toward, f64::from(s), translation))
 }
 
 /// Which key of a shape node's models shows at `frame` (`None` for a shape
@@ -300,12 +302,12 @@ mod tests {
         key
     }
 
-    fn at(keys: &[Attributes], looping: bool, frame: u32) -> Transform {
+    fn at(keys: &[Attributes], looping: bool, frame: u32) -> crate::scene::transform::Transform {
         let mut node = Attributes::new();
         if looping {
             node.insert("_loop".into(), "1".into());
         }
-        sample_transform(keys, &node, frame, 7).unwrap()
+        sample_transform(keys, &node, frame, 7).unwrap().transform
     }
 
     /// animation.vox's three keys (0, 9, 30): held before and after,

@@ -123,6 +123,10 @@ pub enum ObjectRefusal {
     MergeWhich(usize),
     #[error("object {0} is hidden: show it (or its layer) to merge it")]
     MergeHidden(usize),
+    #[error("object {0} is turned by a free angle, or in a group that is: {1} it is not done yet")]
+    FreelyTurned(usize, &'static str),
+    #[error("object turn by {0}°: an angle is a finite number of degrees")]
+    BadAngle(String),
     #[error("the objects hold {voxels} voxels; a merge takes at most {limit} (one model of 256³)")]
     MergeTooLarge { voxels: u64, limit: u64 },
     #[error("an object goes before or after another object")]

@@ -11,7 +11,7 @@
 
 use std::collections::{BTreeMap, HashMap};
 
-use super::transform::{Placement, Rotation, Transform};
+use super::transform::{Placement, Pose, Rigid, Rotation, Transform, Turn};
 
 /// Most model placements (shape instances) one scene graph may produce.
 pub const MAX_INSTANCES: usize = 1 << 20;
@@ -151,7 +151,7 @@ impl Object {
     /// Model `model` of a file without a scene graph (an animation frame), as stored.
     pub fn frame(model: usize) -> Object {
         Object {
-            placement: Placement { model, transform: Transform::IDENTITY, centred: false },
+            placement: Placement { model, transform: Transform::IDENTITY, centred: false, turned: None },
             shape_node: 0,
             transform_node: None,
             name: None,
@@ -184,6 +184,7 @@ impl SceneGraph {
             stack: vec![Step::Enter { id: 0, parent: None, context: Context::ROOT }],
             visits: 0,
             voxels: 0,
+            rigids: Vec::new(),
             out: Walked::default(),
         };
         walk.run()
@@ -204,7 +205,7 @@ impl SceneGraph {
                 NodeKind::Transform { frames, .. } => {
                     for key in frames {
                         super::anim::key_frame(key, node.id)?;
-                        parse_transform(key, node.id)?;
+                        parse_pose(key, node.id)?;
                         super::anim::Ease::of(key, node.id)?;
                     }
                 }
@@ -229,6 +230,10 @@ impl SceneGraph {
 #[derive(Clone, Copy)]
 struct Context {
     transform: Transform,
+    /// The whole placement where a free turn was met on the way down, as
+    /// an entry of `Walk::rigids` (kept apart: the context is copied for
+    /// every node on the stack).
+    rigid: Option<u32>,
     hidden: bool,
     own_hidden: bool,
     /// The nearest nTRN above, and its layer.
@@ -243,6 +248,7 @@ struct Context {
 impl Context {
     const ROOT: Context = Context {
         transform: Transform::IDENTITY,
+        rigid: None,
         hidden: false,
         own_hidden: false,
         transform_node: None,
@@ -274,6 +280,8 @@ struct Walk<'a> {
     visits: usize,
     /// Voxels of all placements so far.
     voxels: usize,
+    /// The whole placements below free turns (`Context::rigid`).
+    rigids: Vec<Rigid>,
     out: Walked,
 }
 
@@ -400,8 +408,18 @@ impl<'a> Walk<'a> {
             None => context.name,
         };
         let own_hidden = is_set(&node.attributes, "_hidden");
+        let rigid = match (context.rigid, local.turn) {
+            (None, None) => None,
+            (above, _) => {
+                let above = above.map_or(Rigid::of_transform(context.transform), |k| self.rigids[k as usize]);
+                let at = u32::try_from(self.rigids.len()).map_err(|_| GraphError::Bad("too many turns".into()))?;
+                self.rigids.push(above.compose(Rigid::of_pose(&local)));
+                Some(at)
+            }
+        };
         Ok(Context {
-            transform: context.transform.compose(local),
+            transform: context.transform.compose(local.transform),
+            rigid,
             own_hidden,
             hidden: context.hidden || own_hidden || layer.is_some_and(|l| self.hidden_layers.contains(&l)),
             transform_node: Some(node.id),
@@ -437,7 +455,12 @@ impl<'a> Walk<'a> {
         }
         self.out.outline.push(OutlineRow::Object { index, depth: context.depth });
         self.out.objects.push(Object {
-            placement: Placement { model, transform: context.transform, centred: true },
+            placement: Placement {
+                model,
+                transform: context.transform,
+                centred: true,
+                turned: context.rigid.map(|k| self.rigids[k as usize]),
+            },
             shape_node: id,
             transform_node: context.transform_node,
             name: context.name,
@@ -482,6 +505,39 @@ fn parse_translation(text: &str) -> Option<[i64; 3]> {
     let mut parts = text.split_ascii_whitespace().map(|p| p.parse::<i32>().ok().map(i64::from));
     let t = [parts.next()??, parts.next()??, parts.next()??];
     parts.next().is_none().then_some(t)
+}
+
+/// The key of octovox's free turn in a keyframe (see `transform`): a unit
+/// quaternion `x y z w` in MagicaVoxel axes, which other readers ignore.
+pub const TURN_KEY: &str = "_ov_turn";
+
+/// Most a stored free turn's length may differ from 1 (it is normalized).
+const TURN_LENGTH_SLACK: f64 = 1e-6;
+
+/// Parses a keyframe's `_r`, `_t` and free turn `_ov_turn`.
+pub fn parse_pose(attributes: &Attributes, node: u32) -> Result<Pose, GraphError> {
+    let transform = parse_transform(attributes, node)?;
+    let Some(text) = attributes.get(TURN_KEY) else { return Ok(Pose { transform, turn: None }) };
+    let bad = || GraphError::Bad(format!("node {node} has a malformed turn {TURN_KEY}={text:?}"));
+    let parts: Vec<f64> =
+        text.split_ascii_whitespace().map(|p| p.parse::<f64>().map_err(|_| bad())).collect::<Result<_, _>>()?;
+    let [x, y, z, w] = parts[..] else { return Err(bad()) };
+    let q = glam::DQuat::from_xyzw(x, y, z, w);
+    if !q.is_finite() || (q.length() - 1.0).abs() > TURN_LENGTH_SLACK {
+        return Err(bad());
+    }
+    Ok(Pose { transform, turn: Some(Turn(q.normalize())) })
+}
+
+/// Writes a pose back: `_r` and `_t` ([`write_transform`]) and the free
+/// turn, exactly (Rust prints the shortest text that reads back the same
+/// number), or no `_ov_turn` without one.
+pub fn write_pose(attributes: &mut Attributes, pose: &Pose) {
+    write_transform(attributes, pose.transform);
+    match pose.turn {
+        Some(Turn(q)) => attributes.insert(TURN_KEY.to_owned(), format!("{} {} {} {}", q.x, q.y, q.z, q.w)),
+        None => attributes.remove(TURN_KEY),
+    };
 }
 
 /// Writes a transform back as `_r` and `_t` into a keyframe's attributes

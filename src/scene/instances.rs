@@ -104,9 +104,10 @@ impl InstanceTable {
             .map(|i| {
                 let object = &objects.list()[i];
                 let model = object.placement.model;
-                let map = objects.map(i);
                 let tree_origin = objects.models[model].tree.origin();
                 let mut instance = Instance { model, src: [0; 3], sign: [1; 3], offset: IVec3::ZERO, bounds: None };
+                // A scene with a free turn is drawn composed (`Scene::instanced`).
+                let Some(&map) = objects.map(i).cells() else { return instance };
                 for (row, (axis, sign, offset)) in map.rows().into_iter().enumerate() {
                     // w = sign · v + offset on cells; on points a mirrored
                     // axis adds one (cell v spans v..v + 1).

@@ -169,8 +169,11 @@ impl Scene {
     /// model saved in 256³ blocks, or a few small references) is drawn as
     /// its objects composed into one octree: CPU-emulated GPUs trace one
     /// octree 2.5–3.5x faster than instances (docs/bench/scene.md).
+    /// A scene with a free turn is drawn composed: its turned objects land
+    /// on the world cells their centres fall in, which instance records of
+    /// signed permutations cannot say.
     pub fn instanced(&self) -> Option<&objects::Objects> {
-        self.objects().filter(|o| match self.instancing {
+        self.objects().filter(|o| !o.has_free_turns()).filter(|o| match self.instancing {
             Instancing::Auto => draws_instances(o, &self.tree),
             Instancing::References => o.has_references(),
         })

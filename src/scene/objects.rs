@@ -18,7 +18,7 @@ use super::graph::{
     self, GraphError, Layer, NameEntry, Node, NodeKind, Object, OutlineRow, SceneGraph, Walked, path_of,
 };
 use super::octree::{Octree, WORLD_LIMIT};
-use super::transform::{CellMap, Rotation, Transform};
+use super::transform::{Placing, Pose, Rotation, Transform, Turn};
 use super::{EditError, ObjectRefusal, Op, Patch, Shape};
 
 /// Placements of one model beyond which an edit of it composes one box
@@ -78,7 +78,7 @@ pub struct Objects {
     outline: Vec<OutlineRow>,
     /// The walk's named transforms, which objects' paths are made of.
     names: Vec<NameEntry>,
-    maps: Vec<CellMap>,
+    maps: Vec<Placing>,
     /// The object edits go to, by index in walk order.
     pub selected: Option<usize>,
     /// The layer `object new` puts objects on (`layer N active`); the
@@ -87,7 +87,7 @@ pub struct Objects {
     /// While frames shown by [`Objects::show_frame`] are not composed: the
     /// placements the composed tree still holds, until [`Objects::catch_up`]
     /// composes what differs from them.
-    behind: Option<Vec<(usize, CellMap)>>,
+    behind: Option<Vec<(usize, Placing)>>,
 }
 
 /// Why the objects cannot be placed.
@@ -132,7 +132,7 @@ impl Objects {
     fn walk(&mut self, voxel_limit: usize) -> Result<(), ObjectsError> {
         Walked { objects: self.objects, outline: self.outline, names: self.names } =
             self.walked_at(self.frame, voxel_limit)?;
-        self.maps = self.cell_maps(&self.objects)?;
+        self.maps = self.placings(&self.objects)?;
         for (object, map) in self.objects.iter().zip(&self.maps) {
             if let Some((lo, hi)) = self.models[object.placement.model].tree.solid_bounds() {
                 let (lo, hi) = map.apply_box(lo, hi);
@@ -158,15 +158,21 @@ impl Objects {
         Ok(Walked { objects: vec![Object::frame(frame)], outline, names: Vec::new() })
     }
 
-    /// The cell map of each of `objects` (a walk's).
-    fn cell_maps(&self, objects: &[Object]) -> Result<Vec<CellMap>, ObjectsError> {
+    /// How each of `objects` (a walk's) lands on world cells.
+    fn placings(&self, objects: &[Object]) -> Result<Vec<Placing>, ObjectsError> {
         objects
             .iter()
             .map(|o| {
                 let model = o.placement.model;
-                o.placement.cell_map(self.models[model].size).ok_or(ObjectsError::OutsideWorld { model })
+                o.placement.placing(self.models[model].size).ok_or(ObjectsError::OutsideWorld { model })
             })
             .collect()
+    }
+
+    /// Whether an object is turned by a free angle (or is in a group that
+    /// is): it lands on cells through their centres, not exactly.
+    pub fn has_free_turns(&self) -> bool {
+        self.maps.iter().any(|m| m.cells().is_none())
     }
 
     /// The objects in walk order.
@@ -191,8 +197,8 @@ impl Objects {
         &self.outline
     }
 
-    /// The map from object `index`'s model cells to world cells.
-    pub fn map(&self, index: usize) -> CellMap {
+    /// How object `index`'s model cells land on world cells.
+    pub fn map(&self, index: usize) -> Placing {
         self.maps[index]
     }
 
@@ -230,9 +236,33 @@ impl Objects {
     /// Writes object `index`'s voxels inside the world box `lo..=hi` into
     /// `tree` (which holds that box), over what is there.
     fn insert_placed(&self, tree: &mut Octree, index: usize, (lo, hi): (IVec3, IVec3)) {
-        let map = self.maps[index];
         let model = &self.models[self.objects[index].placement.model].tree;
-        copy_cells(model, map.invert_box(lo, hi), tree, |p| map.apply(p));
+        match self.maps[index] {
+            Placing::Cells(map) => copy_cells(model, map.invert_box(lo, hi), tree, |p| map.apply(p)),
+            Placing::Turned(map) => {
+                // Every world cell takes the model cell that holds its centre's preimage.
+                let Some((mlo, mhi)) = model.solid_bounds() else { return };
+                let (wlo, whi) = map.apply_box(mlo, mhi);
+                let (wlo, whi) = (wlo.max(lo), whi.min(hi));
+                let mut batch: Vec<(IVec3, u8)> = Vec::new();
+                for z in wlo.z..=whi.z {
+                    for y in wlo.y..=whi.y {
+                        for x in wlo.x..=whi.x {
+                            let w = IVec3::new(x, y, z);
+                            let value = model.get(map.invert(w));
+                            if value != 0 {
+                                batch.push((w, value));
+                            }
+                        }
+                    }
+                    if batch.len() >= PLACED_BATCH {
+                        tree.insert_voxels(&batch);
+                        batch.clear();
+                    }
+                }
+                tree.insert_voxels(&batch);
+            }
+        }
     }
 
     /// Composes the world cells `lo..=hi` of `tree` again from the objects.
@@ -431,8 +461,8 @@ impl Objects {
 
     /// The world boxes of the placements that differ between `before` (a
     /// walk's [`Objects::drawn`]) and now.
-    fn changed_regions(&self, before: &[(usize, CellMap)]) -> Vec<(IVec3, IVec3)> {
-        let mut counts: HashMap<(usize, CellMap), i64> = HashMap::new();
+    fn changed_regions(&self, before: &[(usize, Placing)]) -> Vec<(IVec3, IVec3)> {
+        let mut counts: HashMap<(usize, Placing), i64> = HashMap::new();
         for key in before {
             *counts.entry(*key).or_default() += 1;
         }
@@ -493,15 +523,15 @@ impl Objects {
 
     /// Every object's cell map at frame `frame`, in walk order (the graph
     /// walked there, the models not copied): what an export samples.
-    pub fn maps_at(&self, frame: usize) -> Result<Vec<CellMap>, ObjectsError> {
-        self.cell_maps(&self.walked_at(frame, usize::MAX)?.objects)
+    pub fn maps_at(&self, frame: usize) -> Result<Vec<Placing>, ObjectsError> {
+        self.placings(&self.walked_at(frame, usize::MAX)?.objects)
     }
 
     /// The world box of every shown object's voxels at frame `frame`, the
     /// models not copied; `None` when none has any.
     pub fn bounds_at(&self, frame: usize) -> Result<Option<(IVec3, IVec3)>, ObjectsError> {
         let objects = self.walked_at(frame, usize::MAX)?.objects;
-        let maps = self.cell_maps(&objects)?;
+        let maps = self.placings(&objects)?;
         let boxes = objects.iter().zip(&maps).filter(|(o, _)| !o.hidden).filter_map(|(o, map)| {
             let (lo, hi) = self.models[o.placement.model].tree.solid_bounds()?;
             Some(map.apply_box(lo, hi))
@@ -527,7 +557,7 @@ impl Objects {
     }
 
     /// (model, cell map) of every visible object.
-    fn drawn(&self) -> Vec<(usize, CellMap)> {
+    fn drawn(&self) -> Vec<(usize, Placing)> {
         self.visible().map(|i| (self.objects[i].placement.model, self.maps[i])).collect()
     }
 
@@ -587,7 +617,7 @@ impl Objects {
     }
 
     /// What object `index`'s own transform node places it by at the frame shown.
-    fn own_transform(&self, node: &Node) -> Result<Transform, EditError> {
+    fn own_pose(&self, node: &Node) -> Result<Pose, EditError> {
         let NodeKind::Transform { frames, .. } = &node.kind else {
             return Err(ObjectRefusal::NotATransform(node.id).into());
         };
@@ -601,8 +631,8 @@ impl Objects {
         self.unlocked(&[index])?;
         let frame = self.key_frame()?;
         let mut node = self.transform_node(index)?.clone();
-        let shown = self.own_transform(&node)?;
-        let NodeKind::Transform { frames, .. } = &mut node.kind else { unreachable!("checked by own_transform") };
+        let shown = self.own_pose(&node)?;
+        let NodeKind::Transform { frames, .. } = &mut node.kind else { unreachable!("checked by own_pose") };
         let k = match anim::key_at(frames, frame, node.id)? {
             Some(k) => k,
             None => insert_key(frames, frame, shown, node.id)?,
@@ -638,11 +668,36 @@ impl Objects {
 
     /// The change that moves object `index` by `by` world voxels.
     pub fn moved(&self, index: usize, by: IVec3) -> Result<GraphChange, EditError> {
-        self.retransformed(index, |own, parent| {
+        self.retransformed(index, "moving", |own, parent| {
             // World (x, y, z) is MagicaVoxel (x, −z, y); the parent's turn
             // is undone so that the object moves along world axes.
             let step = parent.inverse().apply([by.x, -by.z, by.y].map(i64::from));
-            Transform { rotation: own.rotation, translation: [0, 1, 2].map(|i| own.translation[i] + step[i]) }
+            let translation = [0, 1, 2].map(|i| own.transform.translation[i] + step[i]);
+            Pose { transform: Transform { translation, ..own.transform }, ..own }
+        })
+    }
+
+    /// The change that turns object `index` `degrees` counter-clockwise
+    /// (negative: clockwise) about world axis `axis` (0, 1, 2 = x, y, z),
+    /// seen from its positive end, about its pivot. Whole quarter turns of
+    /// an object without a free turn stay signed permutations, exactly;
+    /// any other angle gives the keyframe a free turn (`_ov_turn`) and `_r`
+    /// the nearest quarter turns.
+    pub fn turned(&self, index: usize, axis: usize, degrees: f64) -> Result<GraphChange, EditError> {
+        if !degrees.is_finite() {
+            return Err(ObjectRefusal::BadAngle(degrees.to_string()).into());
+        }
+        let quarters = degrees / 90.0;
+        let own = self.own_pose(self.transform_node(index)?)?;
+        if quarters.fract() == 0.0 && own.turn.is_none() {
+            return self.rotated(index, axis, (quarters % 4.0) as i64);
+        }
+        // World x, y, z are MagicaVoxel +x, +z and −y.
+        let about = [glam::DVec3::X, glam::DVec3::Z, glam::DVec3::NEG_Y][axis.min(2)];
+        let turn = glam::DMat3::from_axis_angle(about, degrees.to_radians());
+        self.retransformed(index, "turning", |own, parent| {
+            let p = parent.matrix();
+            Pose::of_matrix(p.transpose() * turn * p * own.matrix(), own.transform.translation)
         })
     }
 
@@ -661,28 +716,46 @@ impl Objects {
             }
         };
         let turn = (0..quarters.rem_euclid(4)).fold(Rotation::IDENTITY, |turn, _| quarter.times(turn));
-        self.retransformed(index, |own, parent| Transform {
-            rotation: parent.inverse().times(turn).times(parent).times(own.rotation),
-            translation: own.translation,
+        if turn != Rotation::IDENTITY && self.own_pose(self.transform_node(index)?)?.turn.is_some() {
+            return self.turned(index, axis, 90.0 * quarters as f64);
+        }
+        self.retransformed(index, "turning", |own, parent| {
+            let rotation = parent.inverse().times(turn).times(parent).times(own.transform.rotation);
+            Pose { transform: Transform { rotation, ..own.transform }, ..own }
         })
     }
 
-    /// The change that gives object `index`'s shown keyframe the transform
-    /// `f(own, parent rotation)` makes.
+    /// The change that gives object `index`'s shown keyframe the pose
+    /// `f(own, parent rotation)` makes. Refused (as `doing`) where a group
+    /// above the object turns freely: its moves and turns would not follow
+    /// the world's axes.
     fn retransformed(
         &self,
         index: usize,
-        f: impl Fn(Transform, Rotation) -> Transform,
+        doing: &'static str,
+        f: impl Fn(Pose, Rotation) -> Pose,
     ) -> Result<GraphChange, EditError> {
         self.unlocked(&[index])?;
         let mut node = self.transform_node(index)?.clone();
-        let own = self.own_transform(&node)?;
+        let own = self.own_pose(&node)?;
+        if self.group_turns_freely(index, &own) {
+            return Err(ObjectRefusal::FreelyTurned(index, doing).into());
+        }
         let k = self.key_to_change(&mut node)?;
         let NodeKind::Transform { frames, .. } = &mut node.kind else { unreachable!("checked by key_to_change") };
         // The whole transform is parent · own, so the parent's rotation is whole · own⁻¹.
-        let parent = self.objects[index].placement.transform.rotation.times(own.rotation.inverse());
-        graph::write_transform(&mut frames[k], f(own, parent));
+        let parent = self.objects[index].placement.transform.rotation.times(own.transform.rotation.inverse());
+        graph::write_pose(&mut frames[k], &f(own, parent));
         Ok(GraphChange { nodes: vec![node], ..GraphChange::default() })
+    }
+
+    /// Whether a group above object `index` (whose own pose is `own`) turns
+    /// freely: the whole placement is not its own pose on a signed permutation.
+    fn group_turns_freely(&self, index: usize, own: &Pose) -> bool {
+        let Some(whole) = self.objects[index].placement.turned else { return false };
+        let parent = whole.m * own.matrix().transpose();
+        let nearest = Rotation::nearest(parent).matrix();
+        (parent - nearest).to_cols_array().iter().any(|d| d.abs() > 1e-9)
     }
 
     /// The change that moves object `index` into the group of object
@@ -699,8 +772,14 @@ impl Objects {
         let delta = self.parent_placement(target)?.inverse().compose(self.parent_placement(index)?);
         if let NodeKind::Transform { frames, .. } = &mut node.kind {
             for frame in frames.iter_mut() {
-                let own = graph::parse_transform(frame, node.id)?;
-                graph::write_transform(frame, delta.compose(own));
+                let own = graph::parse_pose(frame, node.id)?;
+                // D · q · R = (D q Dᵀ) · (D R): the turn is conjugated.
+                let d = delta.rotation.matrix();
+                let turn = own.turn.map(|Turn(q)| {
+                    let m = d * glam::DMat3::from_quat(q) * d.transpose();
+                    Turn(glam::DQuat::from_mat3(&m).normalize())
+                });
+                graph::write_pose(frame, &Pose { transform: delta.compose(own.transform), turn });
             }
         }
         let mut old_group = self.parent_group(node.id)?.clone();
@@ -725,8 +804,8 @@ impl Objects {
     /// Where object `index`'s group places it: its whole transform at the
     /// shown frame without its own.
     fn parent_placement(&self, index: usize) -> Result<Transform, EditError> {
-        let own = self.own_transform(self.transform_node(index)?)?;
-        Ok(self.objects[index].placement.transform.compose(own.inverse()))
+        let own = self.own_pose(self.transform_node(index)?)?;
+        Ok(self.objects[index].placement.transform.compose(own.transform.inverse()))
     }
 
     /// The change that sets an attribute of object `index`'s transform
@@ -1099,18 +1178,13 @@ fn copy_cells(from: &Octree, (lo, hi): (IVec3, IVec3), to: &mut Octree, map: imp
     to.insert_voxels(&batch);
 }
 
-/// Adds a key at `frame` holding `transform` among `keys`, before the
+/// Adds a key at `frame` holding `pose` among `keys`, before the
 /// first key of a later frame (keys stay in the order of their frames, as
 /// MagicaVoxel writes them); returns its index.
-fn insert_key(
-    keys: &mut Vec<graph::Attributes>,
-    frame: u32,
-    transform: Transform,
-    node: u32,
-) -> Result<usize, GraphError> {
+fn insert_key(keys: &mut Vec<graph::Attributes>, frame: u32, pose: Pose, node: u32) -> Result<usize, GraphError> {
     let mut key = graph::Attributes::new();
     key.insert("_f".to_owned(), frame.to_string());
-    graph::write_transform(&mut key, transform);
+    graph::write_pose(&mut key, &pose);
     let mut at = keys.len();
     for (k, other) in keys.iter().enumerate() {
         if anim::key_frame(other, node)? > frame {

@@ -20,7 +20,7 @@
 //! (equivalently `floor(R · (v − pivot + ½) + t)`). This is exact integer
 //! arithmetic, so every voxel lands on the cell MagicaVoxel draws it in.
 
-use glam::IVec3;
+use glam::{DMat3, DQuat, DVec3, IVec3};
 
 use super::Shape;
 
@@ -104,10 +104,15 @@ impl Transform {
 pub struct Placement {
     /// Index into the file's models.
     pub model: usize,
+    /// The placement by signed permutations: exact, and what MagicaVoxel
+    /// shows (a free turn's nearest quarter turns).
     pub transform: Transform,
     /// Whether model space is centred on the pivot `size / 2` (scene-graph
     /// files) or is the model's own grid (files without a scene graph).
     pub centred: bool,
+    /// The whole placement where a transform on the way down turns freely
+    /// (`_ov_turn`): what octovox draws then.
+    pub turned: Option<Rigid>,
 }
 
 impl Placement {
@@ -259,6 +264,324 @@ impl CellMap {
     }
 }
 
+// ----- free turns ---------------------------------------------------------------
+//
+// MagicaVoxel turns only by the 48 signed permutations. octovox keeps a turn
+// by any angle as a unit quaternion `_ov_turn` beside a keyframe's `_r`: the
+// keyframe's rotation is `turn · R(_r)`, where `_r` is the signed permutation
+// nearest the whole rotation (of the same handedness), so that a reader that
+// ignores `_ov_turn` shows the nearest quarter turns. A placement with no
+// free turn on its way down stays on the exact integer path ([`CellMap`]);
+// one with a free turn is a rigid map of points ([`Rigid`], [`TurnedMap`]).
+
+/// A free turn: a unit quaternion in MagicaVoxel axes, compared bit for
+/// bit (a turn read from a file is the one written).
+#[derive(Clone, Copy, Debug)]
+pub struct Turn(pub DQuat);
+
+impl PartialEq for Turn {
+    fn eq(&self, other: &Turn) -> bool {
+        self.0.to_array().map(f64::to_bits) == other.0.to_array().map(f64::to_bits)
+    }
+}
+
+impl Eq for Turn {}
+
+/// Turns closer to none than this many radians are none: what the float
+/// arithmetic of composing whole quarter turns leaves (1e-16 or so), far
+/// below the smallest turn anyone asks for (1e-7 rad is kept).
+const NO_TURN_RAD: f64 = 1e-12;
+
+impl Rotation {
+    /// The matrix of this signed permutation (row `i` has `sign[i]` in
+    /// column `axis[i]`).
+    pub fn matrix(self) -> DMat3 {
+        let mut cols = [DVec3::ZERO; 3];
+        for row in 0..3 {
+            cols[self.axis[row]][row] = self.sign[row] as f64;
+        }
+        DMat3::from_cols(cols[0], cols[1], cols[2])
+    }
+
+    /// Whether it is a turn (determinant +1), not a mirror image.
+    pub fn proper(self) -> bool {
+        self.matrix().determinant() > 0.0
+    }
+
+    /// The signed permutation nearest the orthogonal matrix `m` among those
+    /// of its handedness: the largest `trace(Pᵀ · m)`.
+    pub fn nearest(m: DMat3) -> Rotation {
+        let proper = m.determinant() > 0.0;
+        let score = |r: &Rotation| (0..3).map(|row| r.sign[row] as f64 * m.col(r.axis[row])[row]).sum::<f64>();
+        (0..=127u8)
+            .filter_map(Rotation::from_byte)
+            .filter(|r| r.proper() == proper)
+            .max_by(|a, b| score(a).total_cmp(&score(b)))
+            .unwrap_or(Rotation::IDENTITY)
+    }
+}
+
+/// A keyframe's transform, or one sampled between keyframes: the signed
+/// permutation and translation MagicaVoxel reads (`_r`, `_t`) and octovox's
+/// free turn on top (`_ov_turn`): the rotation is `turn · transform.rotation`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Pose {
+    pub transform: Transform,
+    pub turn: Option<Turn>,
+}
+
+impl Pose {
+    pub const IDENTITY: Pose = Pose { transform: Transform::IDENTITY, turn: None };
+
+    /// The whole rotation.
+    pub fn matrix(&self) -> DMat3 {
+        let r = self.transform.rotation.matrix();
+        self.turn.map_or(r, |turn| DMat3::from_quat(turn.0) * r)
+    }
+
+    /// The pose of the orthogonal matrix `m` and `translation`: the nearest
+    /// signed permutation of its handedness, and the turn left over (none
+    /// where it is no turn).
+    pub fn of_matrix(m: DMat3, translation: [i64; 3]) -> Pose {
+        let rotation = Rotation::nearest(m);
+        // m = q · R, so q = m · Rᵀ: a turn, as m and R have one handedness.
+        let rest = DQuat::from_mat3(&(m * rotation.matrix().transpose())).normalize();
+        let turn = (rest.angle_between(DQuat::IDENTITY) >= NO_TURN_RAD).then_some(Turn(rest));
+        Pose { transform: Transform { rotation, translation }, turn }
+    }
+
+    /// The pose `frac` of the way from `self` to `to` (`frac` eased
+    /// already): the rotation by slerp where either has a free turn and both
+    /// have one handedness, else held; the translation as given.
+    pub fn toward(&self, to: &Pose, frac: f64, translation: [i64; 3]) -> Pose {
+        let (a, b) = (self.matrix(), to.matrix());
+        let proper = a.determinant() > 0.0;
+        if (self.turn.is_none() && to.turn.is_none()) || proper != (b.determinant() > 0.0) {
+            return Pose { transform: Transform { translation, ..self.transform }, turn: self.turn };
+        }
+        // A mirror image is −1 times a turn: slerp the turns, mirror back.
+        let sign = if proper { 1.0 } else { -1.0 };
+        let (qa, qb) = (DQuat::from_mat3(&(a * sign)), DQuat::from_mat3(&(b * sign)));
+        let m = DMat3::from_quat(qa.slerp(qb, frac).normalize()) * sign;
+        Pose::of_matrix(m, translation)
+    }
+}
+
+/// A rigid map of MagicaVoxel points: `p ↦ m · p + t` (`m` orthogonal),
+/// compared bit for bit.
+#[derive(Clone, Copy, Debug)]
+pub struct Rigid {
+    pub m: DMat3,
+    pub t: DVec3,
+}
+
+impl PartialEq for Rigid {
+    fn eq(&self, other: &Rigid) -> bool {
+        self.m.to_cols_array().map(f64::to_bits) == other.m.to_cols_array().map(f64::to_bits)
+            && self.t.to_array().map(f64::to_bits) == other.t.to_array().map(f64::to_bits)
+    }
+}
+
+impl Eq for Rigid {}
+
+impl Rigid {
+    pub fn of_transform(transform: Transform) -> Rigid {
+        Rigid { m: transform.rotation.matrix(), t: DVec3::from_array(transform.translation.map(|c| c as f64)) }
+    }
+
+    pub fn of_pose(pose: &Pose) -> Rigid {
+        Rigid { m: pose.matrix(), ..Rigid::of_transform(pose.transform) }
+    }
+
+    /// The map that applies `child` first, then `self`.
+    pub fn compose(self, child: Rigid) -> Rigid {
+        Rigid { m: self.m * child.m, t: self.m * child.t + self.t }
+    }
+}
+
+/// Octovox's world axes from MagicaVoxel's on points: (x, y, z) → (x, z,
+/// 1 − y), the linear part here and the 1 in [`TurnedMap::new`]. On cells
+/// this is [`Placement::cell_map`]'s axis change: MagicaVoxel cell y (the
+/// points y..y + 1) is world cell z = −y (the points −y..−y + 1).
+fn world_axes() -> DMat3 {
+    DMat3::from_cols(DVec3::X, DVec3::NEG_Z, DVec3::Y)
+}
+
+/// A freely turned placement on cells: model grid point `x` is world point
+/// `a · x + shift + frac`. A model cell is drawn in the world cells whose
+/// centres its turned cube holds, so the map between cells goes by cell
+/// centres. The translation's whole part `shift` is taken off in integers
+/// before any rounding: an object far out lands on the cells it lands on
+/// near the origin, moved, and float error stays that of its own size.
+#[derive(Clone, Copy, Debug)]
+pub struct TurnedMap {
+    a: DMat3,
+    shift: IVec3,
+    frac: DVec3,
+}
+
+impl PartialEq for TurnedMap {
+    fn eq(&self, other: &TurnedMap) -> bool {
+        self.key() == other.key()
+    }
+}
+
+impl Eq for TurnedMap {}
+
+impl std::hash::Hash for TurnedMap {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        self.key().hash(state);
+    }
+}
+
+impl TurnedMap {
+    /// The map of a model of `size` placed by `rigid` about its pivot
+    /// (`centred`) or from its grid's corner.
+    pub fn new(rigid: Rigid, size: [u32; 3], centred: bool) -> TurnedMap {
+        let pivot = DVec3::from_array(size.map(|s| if centred { f64::from(s / 2) } else { 0.0 }));
+        let c = world_axes();
+        // The translation's whole part exactly (it is whole numbers, from
+        // `_t`), then what the turn of the pivot adds.
+        let whole = (c * rigid.t + DVec3::Z).round();
+        let frac = c * rigid.t + DVec3::Z - whole - c * (rigid.m * pivot);
+        TurnedMap { a: c * rigid.m, shift: whole.as_ivec3(), frac }
+    }
+
+    fn key(&self) -> [u64; 15] {
+        let mut key = [0; 15];
+        let values = self.a.to_cols_array().into_iter().chain(self.frac.to_array());
+        for (k, v) in key.iter_mut().zip(values) {
+            *k = v.to_bits();
+        }
+        for (k, v) in key[12..].iter_mut().zip(self.shift.to_array()) {
+            *k = u64::from(v as u32);
+        }
+        key
+    }
+
+    /// The world point of model grid point `x`, less the whole shift.
+    fn world_unshifted(&self, x: DVec3) -> DVec3 {
+        self.a * x + self.frac
+    }
+
+    /// The model grid point of world point `shift + u`.
+    fn model_unshifted(&self, u: DVec3) -> DVec3 {
+        self.a.transpose() * (u - self.frac)
+    }
+
+    /// World cell `w` less the shift, in exact integers.
+    fn unshifted(&self, w: IVec3) -> DVec3 {
+        (w.as_i64vec3() - self.shift.as_i64vec3()).as_dvec3()
+    }
+
+    /// The world cell holding model cell `v`'s centre.
+    pub fn apply(&self, v: IVec3) -> IVec3 {
+        self.world_unshifted(v.as_dvec3() + DVec3::splat(0.5)).floor().as_ivec3() + self.shift
+    }
+
+    /// The model cell whose turned cube holds world cell `w`'s centre.
+    pub fn invert(&self, w: IVec3) -> IVec3 {
+        self.model_unshifted(self.unshifted(w) + DVec3::splat(0.5)).floor().as_ivec3()
+    }
+
+    /// The world cells whose centres the turned cubes of model cells
+    /// `lo..=hi` may hold (the box around the turned box).
+    pub fn apply_box(&self, lo: IVec3, hi: IVec3) -> (IVec3, IVec3) {
+        let (min, max) = image_box(|x| self.world_unshifted(x), lo.as_dvec3(), (hi + IVec3::ONE).as_dvec3());
+        // A centre c in min..=max: c − ½ is a whole number there.
+        ((min - 0.5).ceil().as_ivec3() + self.shift, (max - 0.5).floor().as_ivec3() + self.shift)
+    }
+
+    /// The model cells [`TurnedMap::invert`] gives for the world cells
+    /// `lo..=hi`: those holding their centres' preimages.
+    pub fn invert_box(&self, lo: IVec3, hi: IVec3) -> (IVec3, IVec3) {
+        let half = DVec3::splat(0.5);
+        let (a, b) = (self.unshifted(lo) + half, self.unshifted(hi) + half);
+        let (min, max) = image_box(|u| self.model_unshifted(u), a, b);
+        (min.floor().as_ivec3(), max.floor().as_ivec3())
+    }
+}
+
+/// The box around the image under `f` of the box of points `a..=b`.
+fn image_box(f: impl Fn(DVec3) -> DVec3, a: DVec3, b: DVec3) -> (DVec3, DVec3) {
+    let corners = (0..8).map(|k| DVec3::new([a.x, b.x][k & 1], [a.y, b.y][(k >> 1) & 1], [a.z, b.z][k >> 2]));
+    corners.map(f).fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(l, h), p| (l.min(p), h.max(p)))
+}
+
+/// How an object's model cells land on world cells: exactly by a signed
+/// permutation and an offset, or by a free turn through cell centres.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Placing {
+    Cells(CellMap),
+    Turned(TurnedMap),
+}
+
+impl Placing {
+    /// The exact map, where the placement has no free turn.
+    pub fn cells(&self) -> Option<&CellMap> {
+        match self {
+            Placing::Cells(map) => Some(map),
+            Placing::Turned(_) => None,
+        }
+    }
+
+    pub fn apply(&self, v: IVec3) -> IVec3 {
+        match self {
+            Placing::Cells(map) => map.apply(v),
+            Placing::Turned(map) => map.apply(v),
+        }
+    }
+
+    pub fn invert(&self, w: IVec3) -> IVec3 {
+        match self {
+            Placing::Cells(map) => map.invert(w),
+            Placing::Turned(map) => map.invert(w),
+        }
+    }
+
+    pub fn apply_box(&self, lo: IVec3, hi: IVec3) -> (IVec3, IVec3) {
+        match self {
+            Placing::Cells(map) => map.apply_box(lo, hi),
+            Placing::Turned(map) => map.apply_box(lo, hi),
+        }
+    }
+
+    pub fn invert_box(&self, lo: IVec3, hi: IVec3) -> (IVec3, IVec3) {
+        match self {
+            Placing::Cells(map) => map.invert_box(lo, hi),
+            Placing::Turned(map) => map.invert_box(lo, hi),
+        }
+    }
+
+    /// The model cells a world brush shape covers, as a shape of the same
+    /// kind. Through a free turn a box becomes the box of the model's own
+    /// axes around the cells it reaches (a turned box is no box of cells).
+    pub fn invert_shape(&self, shape: &Shape) -> Shape {
+        match (self, *shape) {
+            (Placing::Cells(map), _) => map.invert_shape(shape),
+            (Placing::Turned(map), Shape::Voxel(p)) => Shape::Voxel(map.invert(p)),
+            (Placing::Turned(map), Shape::Sphere { center, radius }) => {
+                Shape::Sphere { center: map.invert(center), radius }
+            }
+            (Placing::Turned(map), Shape::Box { min, max }) => {
+                let (min, max) = map.invert_box(min, max);
+                Shape::Box { min, max }
+            }
+        }
+    }
+}
+
+impl Placement {
+    /// How this placement puts a model of `size` on world cells; `None`
+    /// where an exact offset leaves the 32-bit range.
+    pub fn placing(&self, size: [u32; 3]) -> Option<Placing> {
+        match self.turned {
+            Some(rigid) => Some(Placing::Turned(TurnedMap::new(rigid, size, self.centred))),
+            None => self.cell_map(size).map(Placing::Cells),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -286,8 +609,12 @@ mod tests {
         let size = [3, 4, 5];
         for byte in (0..=127u8).filter(|b| Rotation::from_byte(*b).is_some()) {
             let rotation = Rotation::from_byte(byte).unwrap();
-            let placement =
-                Placement { model: 0, transform: Transform { rotation, translation: [7, -3, 11] }, centred: true };
+            let placement = Placement {
+                model: 0,
+                transform: Transform { rotation, translation: [7, -3, 11] },
+                centred: true,
+                turned: None,
+            };
             let map = placement.cell_map(size).unwrap();
             for v in [[0u8, 0, 0], [2, 3, 4], [1, 2, 0]] {
                 let [x, y, z] = placement.place(v, size);
@@ -326,8 +653,12 @@ mod tests {
     #[test]
     fn flipped_axis_maps_cells_not_corners() {
         let flip_x = Rotation { axis: [0, 1, 2], sign: [-1, 1, 1] };
-        let placement =
-            Placement { model: 0, transform: Transform { rotation: flip_x, translation: [0, 0, 0] }, centred: true };
+        let placement = Placement {
+            model: 0,
+            transform: Transform { rotation: flip_x, translation: [0, 0, 0] },
+            centred: true,
+            turned: None,
+        };
         let size = [3, 1, 1];
         assert_eq!(placement.place([0, 0, 0], size), [0, 0, 0]);
         assert_eq!(placement.place([2, 0, 0], size), [-2, 0, 0]);
@@ -347,6 +678,7 @@ mod tests {
             model: 0,
             transform: Transform { rotation: quarter, translation: [10, 20, 30] },
             centred: true,
+            turned: None,
         };
         let size = [2, 3, 1];
         for x in 0..2u8 {

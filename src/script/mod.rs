@@ -293,6 +293,19 @@ pub enum Kind {
     Check,
 }
 
+/// An angle in degrees as a script gives it, compared bit for bit (a line
+/// printed and read again is the same line).
+#[derive(Clone, Copy, Debug)]
+pub struct Degrees(pub f64);
+
+impl PartialEq for Degrees {
+    fn eq(&self, other: &Degrees) -> bool {
+        self.0.to_bits() == other.0.to_bits()
+    }
+}
+
+impl Eq for Degrees {}
+
 /// What an `object` line does.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum ObjectLine {
@@ -326,12 +339,10 @@ pub enum ObjectLine {
     /// `object layer N`.
     Layer(u32),
     /// `object turn x|y|z DEGREES`: turn counter-clockwise seen from the
-    /// positive axis, about the pivot, by a whole number of quarter turns
-    /// (other angles are refused when the line is read: free turns are not
-    /// done yet).
+    /// positive axis, about the pivot, by any finite angle.
     Turn {
         axis: usize,
-        quarters: i64,
+        degrees: Degrees,
     },
     /// `object key [step|linear|smooth]`: key the transform at the frame
     /// shown with what it shows, eased that way to the next key.

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{DVec3, IVec3};
 
-use super::{AnimLine, LayerLine, Line, NumberedLine, ObjectLine, ObjectRef, PaletteLine, Script};
+use super::{AnimLine, Degrees, LayerLine, Line, NumberedLine, ObjectLine, ObjectRef, PaletteLine, Script};
 use crate::camera::{FOV_RANGE_DEG, check_fov};
 use crate::edit::brush::{Brush, Tool};
 use crate::scene::anim::{Ease, MAX_FPS};
@@ -503,17 +503,7 @@ fn parse_object(c: &mut Cursor) -> Result<ObjectLine, Fail> {
             let degrees = token.text.parse::<f64>().ok().filter(|d| d.is_finite()).ok_or_else(|| {
                 (token.column, format!("expected an angle in degrees (a number), found '{}'", token.text))
             })?;
-            let quarters = degrees / 90.0;
-            if degrees.abs() > 1e9 || (quarters - quarters.round()).abs() > 1e-9 {
-                return Err((
-                    token.column,
-                    format!(
-                        "object turn by {degrees}°: objects turn by quarter turns only for now (90, 180, -90, …); \
-                         free angles are not done yet"
-                    ),
-                ));
-            }
-            ObjectLine::Turn { axis, quarters: quarters.round() as i64 }
+            ObjectLine::Turn { axis, degrees: Degrees(degrees) }
         }
         "duplicate" => ObjectLine::Duplicate { reference: c.take("reference") },
         "unique" => ObjectLine::Unique,
@@ -762,11 +752,10 @@ mod tests {
             vec!["expected step, linear or smooth, found 'bouncy' at build.ovr:1:12"]
         );
         assert_eq!(errors("anim fps 0"), vec!["frames a second 0 is outside 1..=240 at build.ovr:1:10"]);
+        assert_eq!(errors("object turn y 45"), Vec::<String>::new(), "any angle");
         assert_eq!(
-            errors("object turn y 45"),
-            vec![
-                "object turn by 45°: objects turn by quarter turns only for now (90, 180, -90, …); free angles are not done yet at build.ovr:1:15"
-            ]
+            errors("object turn y inf"),
+            vec!["expected an angle in degrees (a number), found 'inf' at build.ovr:1:15"]
         );
         assert_eq!(
             errors("object turn y NaN"),
@@ -799,7 +788,7 @@ mod tests {
                     object duplicate\nobject duplicate reference\nobject unique\nobject delete\nobject rename top\n\
                     object layer 3\nlayer 4 \"roof tiles\"\nlayer 4 color 10 200 255\nlayer 2 active\nobject merge 3 \"tree 4/top\" 7\nobject before 2\nobject after \"a b\"\nobject lock\nobject unlock\nstroke begin\nstroke end\n\
                     frame 12\nanim range 0 30\nanim fps 24\nanim loop off\nexpect frame 12\nobject key smooth\nobject key\nobject unkey\n\
-                    object turn y -90\nobject turn x 450.0\n";
+                    object turn y -90\nobject turn x 450.0\nobject turn z 0.1\nobject turn x -1e-7\nobject turn y 89.9999\n";
         let script = parse_script(Path::new("t.ovr"), text).unwrap();
         let printed: String = script.lines.iter().map(|l| format!("{}\n", l.command)).collect();
         let again = parse_script(Path::new("t.ovr"), &printed).unwrap();
@@ -807,7 +796,7 @@ mod tests {
             script.lines.iter().map(|l| &l.command).collect::<Vec<_>>(),
             again.lines.iter().map(|l| &l.command).collect::<Vec<_>>()
         );
-        assert_eq!(script.lines.len(), 89);
+        assert_eq!(script.lines.len(), 92);
         // Each line's word is the one it is printed with.
         for line in &script.lines {
             assert_eq!(line.command.to_string().split(' ').next(), Some(line.command.word()), "{}", line.command);

@@ -105,8 +105,9 @@ impl fmt::Display for Line {
             Line::Object(ObjectLine::Layer(id)) => write!(f, "object layer {id}"),
             Line::Object(ObjectLine::Key(ease)) => write!(f, "object key {}", ease.name()),
             Line::Object(ObjectLine::Unkey) => write!(f, "object unkey"),
-            Line::Object(ObjectLine::Turn { axis, quarters }) => {
-                write!(f, "object turn {} {}", ["x", "y", "z"][*axis], quarters * 90)
+            // Rust prints the shortest text that reads back as the same number.
+            Line::Object(ObjectLine::Turn { axis, degrees }) => {
+                write!(f, "object turn {} {}", ["x", "y", "z"][*axis], degrees.0)
             }
             Line::Frame(n) => write!(f, "frame {n}"),
             Line::Anim(AnimLine::Range(a, b)) => write!(f, "anim range {a} {b}"),

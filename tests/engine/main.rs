@@ -25,6 +25,7 @@ mod palette_files;
 mod replay_cli;
 mod trace_cpu;
 mod trace_exact;
+mod turns;
 mod vox_info;
 mod vox_robust;
 mod vox_roundtrip;

@@ -13,7 +13,7 @@ use super::{ExportError, check_scale};
 use crate::scene::Scene;
 use crate::scene::graph::Node;
 use crate::scene::objects::Objects;
-use crate::scene::transform::CellMap;
+use crate::scene::transform::{CellMap, Placing};
 
 /// The meshes and the parts that place them.
 pub struct Exported {
@@ -82,6 +82,12 @@ impl Place {
         Place { rows: map.half_voxel_rows() }
     }
 
+    /// The place of an exact placing; a freely turned one (which `Exported::of`
+    /// meshes as drawn instead, never here) stays where it is.
+    fn of_placing(placing: &Placing) -> Place {
+        placing.cells().map_or(Place::IDENTITY, Place::of)
+    }
+
     /// The world position of a vertex at `p` (both in half voxels).
     pub fn apply_x2(&self, p: IVec3) -> IVec3 {
         IVec3::from_array(self.rows.map(|(axis, sign, offset)| sign * p[axis] + offset))
@@ -145,7 +151,10 @@ impl Exported {
     /// animation longer than [`MAX_EXPORT_FRAMES`].
     pub fn of(scene: &Scene, scale: f32, animated: bool) -> Result<Exported, ExportError> {
         check_scale(scene.drawn(), scale)?;
-        let Some(objects) = scene.objects() else {
+        // A scene with a free turn is meshed as drawn: its turned objects'
+        // cells are the world cells their centres land in, no signed
+        // permutation of a model's mesh.
+        let Some(objects) = scene.objects().filter(|o| !o.has_free_turns()) else {
             let mesh = NamedMesh { name: "voxels".into(), mesh: mesh_within_budget(scene.drawn())? };
             let part =
                 Part { groups: Vec::new(), name: "voxels".into(), mesh: 0, place: Place::IDENTITY, motion: None };
@@ -172,7 +181,7 @@ impl Exported {
             };
             let (groups, name) = names(objects, index);
             let motion = motions.remove(&index);
-            parts.push(Part { groups, name, mesh, place: Place::of(&objects.map(index)), motion });
+            parts.push(Part { groups, name, mesh, place: Place::of_placing(&objects.map(index)), motion });
         }
         let fps = objects.graph.as_ref().map_or(crate::scene::anim::DEFAULT_FPS, |g| g.animation.fps());
         Ok(Exported { meshes, parts, objects: true, fps })
@@ -207,7 +216,7 @@ fn motions(objects: &Objects) -> Result<HashMap<usize, Motion>, ExportError> {
     for frame in first..=last {
         let maps = objects.maps_at(frame as usize).map_err(|e| ExportError::Frame { frame, reason: e.to_string() })?;
         for (row, map) in places.iter_mut().zip(&maps) {
-            row.push(Place::of(map));
+            row.push(Place::of_placing(map));
         }
     }
     let mut motions = HashMap::new();
@@ -259,7 +268,7 @@ mod tests {
         for byte in 0..=u8::MAX {
             let Some(rotation) = Rotation::from_byte(byte) else { continue };
             let transform = Transform { rotation, translation: [5, -3, 7] };
-            let placement = Placement { model: 0, transform, centred: true };
+            let placement = Placement { model: 0, transform, centred: true, turned: None };
             let map = placement.cell_map([4, 6, 3]).unwrap();
             let place = Place::of(&map);
             let m = place.matrix(1.0).unwrap_or([1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1.]);

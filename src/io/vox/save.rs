@@ -342,7 +342,8 @@ pub fn save_objects(path: &Path, palette: &Palette, objects: &Objects, options: 
 /// # Errors
 /// As [`save_objects`].
 pub fn encode_objects(palette: &Palette, objects: &Objects) -> Result<Vec<u8>, VoxError> {
-    let (stored, cuts) = stored::layout(&objects.models);
+    let turned = objects.graph.as_ref().map_or_else(Vec::new, |g| stored::turned_models(g, objects.models.len()));
+    let (stored, cuts) = stored::layout(&objects.models, &turned);
     let mut children = Vec::new();
     let mut stored_voxels = Vec::with_capacity(stored.len());
     for entry in &stored {

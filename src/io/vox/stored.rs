@@ -39,15 +39,31 @@ fn grid_box(model: &Model) -> (IVec3, IVec3) {
     model.tree.solid_bounds().map_or((IVec3::ZERO, top), |(lo, hi)| (lo.min(IVec3::ZERO), hi.max(top)))
 }
 
+/// The grid of [`grid_box`] made to keep the model's pivot where it was
+/// loaded: the same reach each side of it. A model turned by a free angle
+/// is written so, as its placement could not follow a moved pivot in whole
+/// cells (`shift_frames`).
+fn pivot_keeping_box(model: &Model) -> (IVec3, IVec3) {
+    let (lo, hi) = grid_box(model);
+    if lo == IVec3::ZERO && hi == IVec3::from_array(model.size.map(|s| s as i32)) - IVec3::ONE {
+        // Not grown: written as loaded.
+        return (lo, hi);
+    }
+    let p = pivot(model.size);
+    let half = (p - lo).max(hi + IVec3::ONE - p);
+    (p - half, p + half - IVec3::ONE)
+}
+
 /// Every model as written: model `m` is entry `m` (a cut model's first
 /// piece), and the other pieces of cut models follow all of them. Returns
 /// the entries and, per model, the indices of its pieces when it was cut.
-pub(super) fn layout(models: &[Model]) -> (Vec<Stored>, Vec<Option<Vec<usize>>>) {
+/// Models `turned` names keep their pivot ([`pivot_keeping_box`]).
+pub(super) fn layout(models: &[Model], turned: &[bool]) -> (Vec<Stored>, Vec<Option<Vec<usize>>>) {
     let mut stored = Vec::with_capacity(models.len());
     let mut rest = Vec::new();
     let mut cuts = Vec::with_capacity(models.len());
     for (m, model) in models.iter().enumerate() {
-        let (lo, hi) = grid_box(model);
+        let (lo, hi) = if turned.get(m).copied().unwrap_or(false) { pivot_keeping_box(model) } else { grid_box(model) };
         let edge = hi - lo + IVec3::ONE;
         if edge.max_element() <= MAX_MODEL_EDGE as i32 {
             stored.push(Stored { model: m, size: edge.as_uvec3().to_array(), lo });
@@ -141,6 +157,25 @@ fn changed_model(graph: &SceneGraph, id: u32, changed: &[bool]) -> Result<Option
     Ok(Some(m as usize))
 }
 
+/// Which models a transform with a free turn (`_ov_turn`) on some key shows.
+pub(super) fn turned_models(graph: &SceneGraph, models: usize) -> Vec<bool> {
+    let mut turned = vec![false; models];
+    for node in &graph.nodes {
+        let NodeKind::Transform { child, frames, .. } = &node.kind else { continue };
+        if !frames.iter().any(|key| key.contains_key(graph::TURN_KEY)) {
+            continue;
+        }
+        if let Some(NodeKind::Shape { models: shown }) = graph.node(*child).map(|n| &n.kind) {
+            for (m, _) in shown {
+                if let Some(t) = turned.get_mut(*m as usize) {
+                    *t = true;
+                }
+            }
+        }
+    }
+    turned
+}
+
 /// Moves every keyframe of a transform by `offset` model cells (turned by
 /// its rotation), adding a keyframe to one without any.
 fn shift_frames(frames: &mut Vec<Attributes>, id: u32, offset: IVec3) -> Result<(), VoxError> {
@@ -151,6 +186,15 @@ fn shift_frames(frames: &mut Vec<Attributes>, id: u32, offset: IVec3) -> Result<
         frames.push(Attributes::new());
     }
     for frame in frames.iter_mut() {
+        if graph::parse_pose(frame, id)?.turn.is_some() {
+            // The offset turned freely is no whole number of cells; `layout`
+            // keeps such a model's pivot, so only a model another node shows
+            // unturned and cut differently comes here.
+            return Err(VoxError::Unsavable(format!(
+                "transform node {id} turns a model by a free angle whose pivot moved: \
+                 its place cannot be written in whole cells"
+            )));
+        }
         let mut transform = graph::parse_transform(frame, id)?;
         let moved = transform.rotation.apply([offset.x, offset.y, offset.z].map(i64::from));
         for (t, m) in transform.translation.iter_mut().zip(moved) {
