@@ -244,7 +244,13 @@ impl Session {
                 let absolute = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
                 // The hash the save computed: the file is not read again.
                 self.doc.journal_start = JournalStart::load(absolute, saved_hash.into_inner());
-                self.ui.info(format!("saved {}", path.display()));
+                match octovox::io::magicavoxel_note(path, &self.doc.editor.scene) {
+                    Some(note) => {
+                        report!("note: {note}");
+                        self.ui.info(format!("saved {}; {note}", path.display()));
+                    }
+                    None => self.ui.info(format!("saved {}", path.display())),
+                }
                 self.update_title();
                 true
             }

@@ -18,5 +18,8 @@ pub fn run(input: &Path, output: &Path, frame: usize, force: bool) -> anyhow::Re
     let options = WriteOptions::forced(force);
     octovox::io::save_scene(output, &scene, options).with_context(|| format!("saving {}", output.display()))?;
     say!("wrote {} voxels to {}", scene.solid_voxels(), output.display())?;
+    if let Some(note) = octovox::io::magicavoxel_note(output, &scene) {
+        say!("note: {note}")?;
+    }
     Ok(ExitCode::SUCCESS)
 }

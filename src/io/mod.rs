@@ -72,6 +72,18 @@ pub enum SaveError {
     Ovx(#[from] ovx::OvxError),
 }
 
+/// What a save to `path` should tell the user MagicaVoxel will show
+/// differently from octovox: objects turned by free angles, which a .vox
+/// gives MagicaVoxel at their nearest quarter turns (octovox reads the
+/// exact turn back from `_ov_turn`). `None` when it shows what octovox does.
+pub fn magicavoxel_note(path: &Path, scene: &Scene) -> Option<String> {
+    let turned = scene.objects().map_or(0, crate::scene::objects::Objects::freely_turned);
+    let vox = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("vox"));
+    (vox && turned > 0).then(|| {
+        format!("MagicaVoxel shows the {turned} object(s) turned by free angles at their nearest quarter turns")
+    })
+}
+
 /// Saves a scene as .ovx (the pool as it is) or as .vox (one model at a
 /// time), atomically: the old file survives a failed write (see
 /// [`atomic`]). Any other name is refused, so an imported mesh is never

@@ -172,7 +172,12 @@ impl Objects {
     /// Whether an object is turned by a free angle (or is in a group that
     /// is): it lands on cells through their centres, not exactly.
     pub fn has_free_turns(&self) -> bool {
-        self.maps.iter().any(|m| m.cells().is_none())
+        self.freely_turned() > 0
+    }
+
+    /// How many objects are turned by a free angle (or are in a group that is).
+    pub fn freely_turned(&self) -> usize {
+        self.maps.iter().filter(|m| m.cells().is_none()).count()
     }
 
     /// The objects in walk order.

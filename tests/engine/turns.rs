@@ -337,3 +337,22 @@ fn free_turn_keys_slerp_and_quarter_keys_step() {
     let stepped = turned([3, -2, 5], "object key\nframe 10\nobject key\nobject rotate y\nframe 9");
     assert!(drawn(&stepped) == drawn(&turned([3, -2, 5], "")), "a quarter key holds until its frame");
 }
+
+/// `octovox convert` of a file with a free turn says what MagicaVoxel will
+/// show, and writes the turn back exactly.
+#[test]
+fn convert_says_what_magicavoxel_shows_and_keeps_the_turn() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, output) = (dir.path().join("in.vox"), dir.path().join("out.vox"));
+    let editor = turned([3, -2, 5], "object turn z 22.5");
+    std::fs::write(&input, saved(&editor.scene)).unwrap();
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_octovox"))
+        .args(["convert", input.to_str().unwrap(), output.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(run.status.success(), "{stdout}{}", String::from_utf8_lossy(&run.stderr));
+    assert!(stdout.contains("note: MagicaVoxel shows the 1 object(s) turned by free angles"), "{stdout}");
+    let turn = |path: &std::path::Path| key_of(&dot_vox::load_bytes(&std::fs::read(path).unwrap()).unwrap()).3;
+    assert!(turn(&output).is_some() && turn(&output) == turn(&input), "the turn is written back as read");
+}

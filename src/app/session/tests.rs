@@ -195,3 +195,20 @@ fn an_object_drag_is_one_undo_step() {
     f.session.execute(AppCommand::Undo);
     assert_eq!(f.session.doc.editor.scene.voxels(), before, "one undo puts it back");
 }
+
+/// The Outliner's Turn row: the picked object turned by a typed angle is
+/// one `object turn` line, one undo step, and replays to the same voxels.
+#[test]
+fn a_typed_turn_is_one_line_and_one_undo_step() {
+    use octovox::script::{Degrees, ObjectLine, ObjectRef};
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/vox/format/test_groups.vox");
+    let scene = octovox::io::load_scene(&file, 0).unwrap();
+    let mut f = Fixture::new(scene, DVec3::new(0.0, 60.0, 90.0), DVec3::ZERO);
+    let before = f.session.doc.editor.scene.voxels();
+    let turn = ObjectLine::Turn { axis: 1, degrees: Degrees(30.5) };
+    f.session.execute(AppCommand::Lines(vec![Line::Object(ObjectLine::Pick(ObjectRef::Index(3))), Line::Object(turn)]));
+    assert_eq!(f.recorded(EDITS), ["object 3", "object turn y 30.5"]);
+    assert_eq!(f.session.doc.editor.history.steps(), (1, 0));
+    assert_ne!(f.session.doc.editor.scene.voxels(), before, "the object turned");
+    f.replays_the_same();
+}
