@@ -53,6 +53,40 @@ pub(super) fn moved_face(region: &Region, normal: IVec3, steps: i32) -> Option<R
     Region::new(min, max).ok()
 }
 
+/// Pixels either side of the rotation ring that a press grabs it within
+/// (times the window's scale).
+pub(super) const RING_GRAB: f64 = 8.0;
+/// Points between the picked object's farthest corner and its ring.
+const RING_MARGIN: f64 = 16.0;
+
+/// The rotation ring around the picked object's box `lo..=hi` (tree-local
+/// cells) as `basis` draws it: its centre and radius in the basis' pixels
+/// (the box's centre, and [`RING_MARGIN`] past its farthest corner, times
+/// `scale`, the basis' pixels per point).
+pub(super) fn ring(basis: &RayBasis, lo: IVec3, hi: IVec3, scale: f64) -> Option<(DVec2, f64)> {
+    let (a, b) = (lo.as_vec3(), (hi + IVec3::ONE).as_vec3());
+    let screen = |p: Vec3| basis.project(p).map(|(x, y)| DVec2::new(f64::from(x), f64::from(y)));
+    let centre = screen((a + b) * 0.5)?;
+    let mut radius: f64 = 0.0;
+    for k in 0..8 {
+        let corner = Vec3::new([a.x, b.x][k & 1], [a.y, b.y][(k >> 1) & 1], [a.z, b.z][k >> 2]);
+        radius = radius.max((screen(corner)? - centre).length());
+    }
+    Some((centre, radius + RING_MARGIN * scale))
+}
+
+/// The angle in degrees, counter-clockwise as seen on screen (y is down),
+/// of pixel `at` about `centre`.
+pub(super) fn screen_angle(centre: DVec2, at: (f64, f64)) -> f64 {
+    (-(at.1 - centre.y)).atan2(at.0 - centre.x).to_degrees()
+}
+
+/// `by` degrees brought into −180..180 (a drag across the ring's left
+/// side turns on, not back a whole turn).
+pub(super) fn wrapped(by: f64) -> f64 {
+    (by + 180.0).rem_euclid(360.0) - 180.0
+}
+
 #[cfg(test)]
 #[allow(clippy::unwrap_used)] // in tests a panic is the failure report
 mod tests {

@@ -25,6 +25,10 @@ pub(super) enum Gesture {
     /// at, the window pixel the drag began at, and how far it has moved so
     /// far (its moves are one undo step).
     ObjectDrag { at: IVec3, start: (f64, f64), moved: IVec3 },
+    /// The rotation ring dragged (object mode): the ring's centre in window
+    /// pixels, the pointer's last angle about it, the degrees dragged so far
+    /// and the whole degrees turned (its turns are one undo step).
+    Ring { centre: glam::DVec2, last: f64, dragged: f64, turned: i64 },
 }
 
 /// A selection drag under way.
@@ -89,9 +93,9 @@ impl Stroke {
 impl Gesture {
     /// Whether the gesture's edits are one undo step (between the `stroke
     /// begin` and `stroke end` it runs): a brush stroke, a held palette
-    /// control, an object drag.
+    /// control, an object drag, a ring drag.
     pub fn groups_edits(&self) -> bool {
-        matches!(self, Gesture::Stroke(_) | Gesture::Palette | Gesture::ObjectDrag { .. })
+        matches!(self, Gesture::Stroke(_) | Gesture::Palette | Gesture::ObjectDrag { .. } | Gesture::Ring { .. })
     }
 
     pub fn stroke_mut(&mut self) -> Option<&mut Stroke> {

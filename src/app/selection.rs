@@ -9,7 +9,7 @@ use glam::{DVec3, IVec3, Vec3};
 
 use octovox::camera::Camera;
 use octovox::edit::selection::Region;
-use octovox::script::Line;
+use octovox::script::{Line, ObjectLine};
 
 use super::gesture::{Gesture, SelectDrag};
 use super::session::Session;
@@ -98,7 +98,7 @@ impl Session {
     pub(super) fn nudge(&mut self, nudge: Nudge) {
         let step = nudge_step(&self.state.camera, nudge);
         if self.state.mode == Mode::Object {
-            return self.act(Line::Object(octovox::script::ObjectLine::Move(step)), "object");
+            return self.act(Line::Object(ObjectLine::Move(step)), "object");
         }
         if self.doc.editor.selection.is_none() {
             self.ui.info("nothing is selected: B, then drag a box");
@@ -112,6 +112,12 @@ impl Session {
     /// Object mode: a press picks the object it hits (no edit), and a drag
     /// from it moves it over the ground's axes, one undo step.
     pub(super) fn object_click(&mut self, phase: StrokePhase, x: f64, y: f64) {
+        if phase == StrokePhase::Begin
+            && let Some(centre) = self.ring_at(x, y)
+        {
+            let last = super::drag::screen_angle(centre, (x, y));
+            return self.begin_stroke(Gesture::Ring { centre, last, dragged: 0.0, turned: 0 });
+        }
         match phase {
             StrokePhase::Begin | StrokePhase::Click => {
                 let Ok(Some(pick)) = self.pick_at(x, y) else { return };
@@ -126,8 +132,50 @@ impl Session {
                     self.begin_stroke(Gesture::ObjectDrag { at: pick.voxel, start: (x, y), moved: IVec3::ZERO });
                 }
             }
+            StrokePhase::Move if matches!(self.gesture, Gesture::Ring { .. }) => self.drag_ring(x, y),
             StrokePhase::Move => self.drag_object(x, y),
             StrokePhase::End => self.close_strokes(),
+        }
+    }
+
+    /// The rotation ring around the picked object, in window pixels (the
+    /// one `ui::draw_selection` draws in points): its centre and radius.
+    pub(super) fn ring(&self) -> Option<(glam::DVec2, f64)> {
+        let objects = self.doc.editor.scene.pickable_objects()?;
+        let (lo, hi) = objects.selected.and_then(|i| objects.world_box(i))?;
+        let origin = self.doc.editor.scene.origin();
+        super::drag::ring(&self.view_basis(), lo - origin, hi - origin, self.view.scale_factor)
+    }
+
+    /// The ring's centre, where window pixel (x, y) is on the ring.
+    fn ring_at(&self, x: f64, y: f64) -> Option<glam::DVec2> {
+        let (centre, radius) = self.ring()?;
+        let off = ((glam::DVec2::new(x, y) - centre).length() - radius).abs();
+        (off <= super::drag::RING_GRAB * self.view.scale_factor).then_some(centre)
+    }
+
+    /// Turns the picked object about the world's up axis by the whole
+    /// degrees the pointer has gone round the ring since the press:
+    /// counter-clockwise on screen is counter-clockwise seen from above
+    /// (from below when the camera looks up).
+    fn drag_ring(&mut self, x: f64, y: f64) {
+        let Gesture::Ring { centre, last, dragged, turned } = self.gesture else { return };
+        let angle = super::drag::screen_angle(centre, (x, y));
+        let dragged = dragged + super::drag::wrapped(angle - last);
+        let from_below = self.state.camera.target.y > self.state.camera.eye.y;
+        let target = (if from_below { -dragged } else { dragged }).round() as i64;
+        if let Gesture::Ring { last, dragged: so_far, .. } = &mut self.gesture {
+            (*last, *so_far) = (angle, dragged);
+        }
+        if target == turned {
+            return;
+        }
+        let turn = ObjectLine::Turn { axis: 1, degrees: octovox::script::Degrees((target - turned) as f64) };
+        if let Err(err) = self.run_line(&Line::Object(turn)) {
+            return self.ui.error(format!("object refused: {err}"));
+        }
+        if let Gesture::Ring { turned, .. } = &mut self.gesture {
+            *turned = target;
         }
     }
 
@@ -139,7 +187,7 @@ impl Session {
         if steps == moved {
             return;
         }
-        if let Err(err) = self.run_line(&Line::Object(octovox::script::ObjectLine::Move(steps - moved))) {
+        if let Err(err) = self.run_line(&Line::Object(ObjectLine::Move(steps - moved))) {
             return self.ui.error(format!("object refused: {err}"));
         }
         if let Gesture::ObjectDrag { moved, .. } = &mut self.gesture {

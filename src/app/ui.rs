@@ -1022,6 +1022,9 @@ pub fn draw_selection(ui: &egui::Ui, state: &EditorState, info: &Info) {
         && let Some(bounds) = objects.selected.and_then(|i| objects.world_box(i))
     {
         outline_box(ui, state, info, bounds, super::outliner::PICKED, false);
+        if state.mode == Mode::Object {
+            draw_ring(ui, state, info, bounds);
+        }
     }
     if let Some(region) = info.selection {
         outline_box(
@@ -1032,6 +1035,21 @@ pub fn draw_selection(ui: &egui::Ui, state: &EditorState, info: &Info) {
             egui::Color32::from_rgb(90, 220, 255),
             state.mode == Mode::Select,
         );
+    }
+}
+
+/// Object mode: the rotation ring around the picked object's box, which a
+/// drag turns about the world's up axis (`Session::ring`, the same circle
+/// in window pixels).
+fn draw_ring(ui: &egui::Ui, state: &EditorState, info: &Info, (lo, hi): (IVec3, IVec3)) {
+    let screen = ui.ctx().content_rect();
+    let basis =
+        state.camera.basis(screen.width().max(1.0) as u32, screen.height().max(1.0) as u32, info.scene.origin());
+    let origin = info.scene.origin();
+    if let Some((centre, radius)) = super::drag::ring(&basis, lo - origin, hi - origin, 1.0) {
+        let centre = egui::pos2(centre.x as f32, centre.y as f32);
+        let stroke = Stroke::new(2.0, super::outliner::PICKED.gamma_multiply(0.8));
+        scene_painter(ui.ctx()).circle_stroke(centre, radius as f32, stroke);
     }
 }
 

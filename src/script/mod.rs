@@ -189,7 +189,7 @@ impl Line {
 
     /// Whether the line ends an open stroke before it runs: every line but
     /// the edits a stroke is made of (`place`, `remove`, `paint`, `object
-    /// N` and `object move` of a drag, `rgb` and `material` of a held
+    /// N`, `object move` and `object turn` of a drag, `rgb` and `material` of a held
     /// palette control), the view and the checks, which change nothing.
     /// The editor, the window's recorder and the crash journal go by this
     /// one rule, so a recording replays into the undo steps the window made.
@@ -201,7 +201,7 @@ impl Line {
                 | Line::Paint(_)
                 | Line::Rgb(..)
                 | Line::Material(..)
-                | Line::Object(ObjectLine::Pick(_) | ObjectLine::Move(_))
+                | Line::Object(ObjectLine::Pick(_) | ObjectLine::Move(_) | ObjectLine::Turn { .. })
         );
         !of_a_stroke && !matches!(self.kind(), Kind::Stroke | Kind::View | Kind::Check)
     }

@@ -212,3 +212,40 @@ fn a_typed_turn_is_one_line_and_one_undo_step() {
     assert_ne!(f.session.doc.editor.scene.voxels(), before, "the object turned");
     f.replays_the_same();
 }
+
+/// Object mode's rotation ring: a press on the ring around the picked
+/// object and a drag a quarter of the way round it, counter-clockwise on
+/// screen (seen from above), turn the object 90° about the world's up axis
+/// in whole degrees: `object turn y` lines of one stroke summing to 90,
+/// one undo step, the cells of `object rotate y`, and the same on replay.
+#[test]
+fn a_drag_round_the_ring_turns_the_picked_object() {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/assets/vox/format/test_groups.vox");
+    let scene = octovox::io::load_scene(&file, 0).unwrap();
+    let mut rotated = octovox::editor::Editor::default();
+    rotated.set_scene(scene.clone());
+    for line in ["object 3", "object rotate y"] {
+        rotated.run(&octovox::script::parse_script(Path::new("r.ovr"), line).unwrap().lines[0].command).unwrap();
+    }
+    let mut f = Fixture::new(scene, DVec3::new(2.0, 120.0, 8.0), DVec3::new(0.0, 0.0, 0.0));
+    f.session.execute(AppCommand::ToggleObject);
+    f.session.execute(AppCommand::Object(octovox::script::ObjectLine::Pick(octovox::script::ObjectRef::Index(3))));
+    let (centre, radius) = f.session.ring().expect("a ring around the picked object");
+    let at = |degrees: f64| {
+        let a = degrees.to_radians();
+        (centre.x + radius * a.cos(), centre.y - radius * a.sin())
+    };
+    let path: Vec<(f64, f64)> = (0..=9).map(|k| at(f64::from(k) * 10.0)).collect();
+    f.drag(Tool::Attach, &path);
+    let lines = f.recorded(EDITS);
+    assert_eq!(lines[..2], ["object 3", "stroke begin"], "{lines:?}");
+    assert_eq!(lines.last().map(String::as_str), Some("stroke end"));
+    let turned: f64 = lines[2..lines.len() - 1]
+        .iter()
+        .map(|l| l.strip_prefix("object turn y ").expect("a turn about y").parse::<f64>().unwrap())
+        .sum();
+    assert_eq!(turned, 90.0, "{lines:?}");
+    assert_eq!(f.session.doc.editor.history.steps(), (1, 0), "one undo step");
+    assert!(f.session.doc.editor.scene.voxels() == rotated.scene.voxels(), "the cells of a quarter rotate");
+    f.replays_the_same();
+}
