@@ -67,7 +67,6 @@ pub fn show(ui: &mut egui::Ui, objects: &Objects, state: &mut OutlinerState, out
             let models = objects.models.len();
             ui.strong(format!("Outliner ({} objects, {models} models)", objects.list().len()));
             rename_row(ui, objects, &mut state.rename, out);
-            turn_row(ui, objects, &mut state.turn, out);
             merge_row(ui, objects, &mut state.merge, out);
             ui.separator();
             egui::ScrollArea::vertical().id_salt("outliner").max_height(360.0).show(ui, |ui| {
@@ -75,6 +74,8 @@ pub fn show(ui: &mut egui::Ui, objects: &Objects, state: &mut OutlinerState, out
             });
             ui.separator();
             layers(ui, objects, state, out);
+            ui.separator();
+            turn_row(ui, objects, &mut state.turn, out);
         });
     });
 }

@@ -2,7 +2,8 @@
 //! 2,000 references whose trees rise and fall, each frame shown by the
 //! editor's `frame N` (the window's path) against the same forest standing
 //! still, with the bytes each frame uploads; and a turntable rendered as
-//! 1, 2 and 4 shards (`render --shard`), each shard its own process.
+//! 1, 2 and 4 shards (`render --shard`), each shard its own process; and
+//! a free turn against a quarter turn (`bench_turns`).
 
 use std::path::Path;
 use std::process::Command;
@@ -41,6 +42,7 @@ struct AnimRow {
     upload_bytes_per_frame: u64,
     instance_bytes: u64,
     turntable: TurntableRow,
+    turns: super::bench_turns::TurnsRow,
 }
 
 #[derive(Serialize)]
@@ -102,6 +104,7 @@ pub fn bench_anim(quick: bool) -> anyhow::Result<(String, String)> {
         upload_bytes_per_frame: bytes.iter().copied().max().unwrap_or(0),
         instance_bytes: octovox::scene::instances::word_bytes(count as usize),
         turntable: turntable(quick)?,
+        turns: super::bench_turns::bench_turns(quick, (width, height))?,
     };
     Ok((report(&row), serde_json::to_string_pretty(&[row])?))
 }
@@ -184,5 +187,5 @@ fn report(r: &AnimRow) -> String {
         let longest = seconds.iter().copied().fold(0.0, f64::max);
         md += &format!("| {n} | {} | {longest:.2} | {:.2} |\n", each.join(", "), seconds.iter().sum::<f64>());
     }
-    md
+    md + "\n" + &super::bench_turns::report(&r.turns)
 }

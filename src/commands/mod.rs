@@ -15,6 +15,7 @@ mod bench_effects;
 mod bench_quality;
 mod bench_scale;
 mod bench_scene;
+mod bench_turns;
 mod benches;
 mod convert;
 mod export;

@@ -191,11 +191,14 @@ fn a_key_pressed_while_playing_is_recorded_at_its_frame() {
     std::thread::sleep(Duration::from_millis(1200));
     xdotool(&display, &["key", "k"]);
     let stopped = next_frame(lines);
-    assert!(stopped > 0 && stopped != 9 && stopped != 30, "stopped at {stopped}");
-    lines.wait_for("object:", Duration::from_secs(10));
+    assert!(stopped > 0, "playing showed no frame before K");
+    // On a key's frame (9 under a loaded runner) K changes nothing: `ran:`.
+    let keyed = if [9, 30].contains(&stopped) { "ran: object key" } else { "object:" };
+    lines.wait_for(keyed, Duration::from_secs(10));
     let (recorded, saved, replayed) = session.save_quit_replay("");
     let mut want = vec![0, 9, stopped, 30];
     want.sort_unstable();
+    want.dedup();
     assert_eq!(saved, want);
     assert_eq!(replayed, want, "the recording keys the same frame:\n{recorded}");
 }
