@@ -356,3 +356,17 @@ fn convert_says_what_magicavoxel_shows_and_keeps_the_turn() {
     let turn = |path: &std::path::Path| key_of(&dot_vox::load_bytes(&std::fs::read(path).unwrap()).unwrap()).3;
     assert!(turn(&output).is_some() && turn(&output) == turn(&input), "the turn is written back as read");
 }
+
+/// .ovx keeps a free turn too: saved and loaded, the same cells, and the
+/// objects it holds save to the same .vox bytes.
+#[test]
+fn ovx_keeps_a_free_turn() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("turned.ovx");
+    let editor = turned([3, -2, 5], "object turn x 33.3\nobject turn z -71");
+    octovox::io::save_scene(&path, &editor.scene, octovox::io::atomic::WriteOptions::default()).unwrap();
+    let back = octovox::io::load_scene(&path, 0).unwrap();
+    let cells: Cells = back.voxels().into_iter().map(|(p, c)| ((p.x, p.y, p.z), c)).collect();
+    assert!(cells == drawn(&editor), "the same cells");
+    assert_eq!(saved(&back), saved(&editor.scene), "the same objects, turn and all");
+}
