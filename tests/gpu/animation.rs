@@ -228,7 +228,7 @@ fn a_free_turn_switches_the_herd_to_composed_and_back() {
     let camera = Camera::framing(lo, hi + glam::IVec3::new(12, 0, 0), 50.0);
     let (settings, size) = (RenderSettings::default(), (160, 120));
     let mut renderer = Renderer::headless().unwrap();
-    let mut draw = |scene: &mut octovox::scene::Scene, renderer: &mut Renderer| {
+    let draw = |scene: &mut octovox::scene::Scene, renderer: &mut Renderer| {
         renderer.sync(scene);
         renderer.render(scene, &camera, size, &settings, None).unwrap();
         renderer.read_image().unwrap()
