@@ -476,7 +476,7 @@ impl TurnedMap {
 
     /// The world cell holding model cell `v`'s centre.
     pub fn apply(&self, v: IVec3) -> IVec3 {
-        self.world_unshifted(v.as_dvec3() + DVec3::splat(0.5)).floor().as_ivec3() + self.shift
+        self.world_unshifted(v.as_dvec3() + DVec3::splat(0.5)).floor().as_ivec3().saturating_add(self.shift)
     }
 
     /// The model cell whose turned cube holds world cell `w`'s centre.
@@ -489,7 +489,9 @@ impl TurnedMap {
     pub fn apply_box(&self, lo: IVec3, hi: IVec3) -> (IVec3, IVec3) {
         let (min, max) = image_box(|x| self.world_unshifted(x), lo.as_dvec3(), (hi + IVec3::ONE).as_dvec3());
         // A centre c in min..=max: c − ½ is a whole number there.
-        ((min - 0.5).ceil().as_ivec3() + self.shift, (max - 0.5).floor().as_ivec3() + self.shift)
+        // Saturated: a box past the 32-bit range is refused by the world's limit after.
+        let (lo, hi) = ((min - 0.5).ceil().as_ivec3(), (max - 0.5).floor().as_ivec3());
+        (lo.saturating_add(self.shift), hi.saturating_add(self.shift))
     }
 
     /// The model cells [`TurnedMap::invert`] gives for the world cells
