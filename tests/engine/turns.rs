@@ -240,6 +240,11 @@ fn quarter_turns_through_free_angles_land_exactly_where_rotate_does() {
     }
     let editor = turned([3, -2, 5], "object turn y 120\nobject turn y 60");
     assert!(drawn(&editor) == drawn(&half), "120 + 60 is two rotates");
+    for axis in ["x", "z"] {
+        let free = turned([3, -2, 5], &format!("object turn {axis} 30\nobject turn {axis} 60"));
+        let exact = turned([3, -2, 5], &format!("object rotate {axis}"));
+        assert!(drawn(&free) == drawn(&exact), "about {axis}: 30 + 60 is a quarter rotate");
+    }
 }
 
 /// Hard angles (issue 49, item 3): a turn of 1e-7 rad moves no cell and is
