@@ -157,12 +157,22 @@ impl Session {
     /// Turns the picked object about the world's up axis by the whole
     /// degrees the pointer has gone round the ring since the press:
     /// counter-clockwise on screen is counter-clockwise seen from above
-    /// (from below when the camera looks up).
+    /// (from below when the eye is below the object's middle).
     fn drag_ring(&mut self, x: f64, y: f64) {
         let Gesture::Ring { centre, last, dragged, turned } = self.gesture else { return };
         let angle = super::drag::screen_angle(centre, (x, y));
         let dragged = dragged + super::drag::wrapped(angle - last);
-        let from_below = self.state.camera.target.y > self.state.camera.eye.y;
+        // Seen from below the ring's plane (the picked box's middle), or
+        // orthographically looking up, counter-clockwise turns the other way.
+        let objects = self.doc.editor.scene.pickable_objects();
+        let middle = objects
+            .and_then(|o| o.selected.and_then(|i| o.world_box(i)))
+            .map(|(lo, hi)| f64::from(lo.y + hi.y + 1) * 0.5);
+        let camera = &self.state.camera;
+        let from_below = match (camera.ortho, middle) {
+            (None, Some(y)) => camera.eye.y < y,
+            _ => camera.target.y > camera.eye.y,
+        };
         let target = (if from_below { -dragged } else { dragged }).round() as i64;
         if let Gesture::Ring { last, dragged: so_far, .. } = &mut self.gesture {
             (*last, *so_far) = (angle, dragged);

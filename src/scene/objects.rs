@@ -171,8 +171,16 @@ impl Objects {
 
     /// Whether an object is turned by a free angle (or is in a group that
     /// is): it lands on cells through their centres, not exactly.
+    /// Any keyframe, at any frame, counts: a scene with one is drawn and
+    /// exported the same way whatever frame is shown.
     pub fn has_free_turns(&self) -> bool {
         self.freely_turned() > 0
+            || self.graph.as_ref().is_some_and(|g| {
+                g.nodes.iter().any(|n| match &n.kind {
+                    NodeKind::Transform { frames, .. } => frames.iter().any(|k| k.contains_key(graph::TURN_KEY)),
+                    _ => false,
+                })
+            })
     }
 
     /// How many objects are turned by a free angle (or are in a group that is).
@@ -353,6 +361,11 @@ impl Objects {
         if let Some(k) = (0..self.objects.len()).find(|&k| self.objects[k].placement.model == model && self.locked(k)) {
             return Err(ObjectRefusal::LockedReference { locked: k, index }.into());
         }
+        if self.maps[index].cells().is_none() && matches!(shape, Shape::Box { .. }) {
+            // A world box is no box of the turned model's cells, and the box
+            // around them would reach past it.
+            return Err(ObjectRefusal::FreelyTurned(index, "a box edit of").into());
+        }
         let local = self.maps[index].invert_shape(shape);
         let patch = self.models[model].tree.apply_brush(&local, op)?;
         // Nothing changed (a delete over cells another placement of the
@@ -526,7 +539,7 @@ impl Objects {
         Ok(objects)
     }
 
-    /// Every object's cell map at frame `frame`, in walk order (the graph
+    /// How every object lands on world cells at frame `frame`, in walk order (the graph
     /// walked there, the models not copied): what an export samples.
     pub fn maps_at(&self, frame: usize) -> Result<Vec<Placing>, ObjectsError> {
         self.placings(&self.walked_at(frame, usize::MAX)?.objects)
@@ -692,6 +705,8 @@ impl Objects {
         if !degrees.is_finite() {
             return Err(ObjectRefusal::BadAngle(degrees.to_string()).into());
         }
+        // Exact, and keeps a huge angle's turn (1e17° in radians loses it).
+        let degrees = degrees % 360.0;
         let quarters = degrees / 90.0;
         let own = self.own_pose(self.transform_node(index)?)?;
         if quarters.fract() == 0.0 && own.turn.is_none() {
@@ -772,6 +787,13 @@ impl Objects {
             return Err(ObjectRefusal::RegroupSelf.into());
         }
         self.unlocked(&[index])?;
+        // The groups' places are signed permutations here: a freely turned
+        // group would move the object.
+        for k in [index, target] {
+            if self.group_turns_freely(k, &self.own_pose(self.transform_node(k)?)?) {
+                return Err(ObjectRefusal::FreelyTurned(k, "regrouping").into());
+            }
+        }
         let mut node = self.transform_node(index)?.clone();
         let target_id = self.transform_node(target)?.id;
         let delta = self.parent_placement(target)?.inverse().compose(self.parent_placement(index)?);
@@ -915,6 +937,10 @@ impl Objects {
             return Err(ObjectRefusal::MergeWhich(self.objects.len()).into());
         }
         self.unlocked(&all)?;
+        // A turned object's cells are no box-by-box image of its model's.
+        if let Some(&turned) = all.iter().find(|&&k| self.maps[k].cells().is_none()) {
+            return Err(ObjectRefusal::FreelyTurned(turned, "merging").into());
+        }
         if let Some(&hidden) = all.iter().find(|&&k| self.objects[k].hidden) {
             // Its voxels would show once part of a shown model.
             return Err(ObjectRefusal::MergeHidden(hidden).into());

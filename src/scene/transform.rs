@@ -346,7 +346,9 @@ impl Pose {
         let rotation = Rotation::nearest(m);
         // m = q · R, so q = m · Rᵀ: a turn, as m and R have one handedness.
         let rest = DQuat::from_mat3(&(m * rotation.matrix().transpose())).normalize();
-        let turn = (rest.angle_between(DQuat::IDENTITY) >= NO_TURN_RAD).then_some(Turn(rest));
+        // The angle from the vector part: acos(w) cannot tell turns below 1e-8.
+        let angle = 2.0 * rest.xyz().length().atan2(rest.w.abs());
+        let turn = (angle >= NO_TURN_RAD).then_some(Turn(rest));
         Pose { transform: Transform { rotation, translation }, turn }
     }
 
@@ -440,8 +442,9 @@ impl TurnedMap {
     pub fn new(rigid: Rigid, size: [u32; 3], centred: bool) -> TurnedMap {
         let pivot = DVec3::from_array(size.map(|s| if centred { f64::from(s / 2) } else { 0.0 }));
         let c = world_axes();
-        // The translation's whole part exactly (it is whole numbers, from
-        // `_t`), then what the turn of the pivot adds.
+        // The translation's whole part exactly (whole numbers from `_t`,
+        // unless a group above turns freely), then what the turn of the
+        // pivot adds.
         let whole = (c * rigid.t + DVec3::Z).round();
         let frac = c * rigid.t + DVec3::Z - whole - c * (rigid.m * pivot);
         TurnedMap { a: c * rigid.m, shift: whole.as_ivec3(), frac }

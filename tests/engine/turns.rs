@@ -375,3 +375,44 @@ fn ovx_keeps_a_free_turn() {
     assert!(cells == drawn(&editor), "the same cells");
     assert_eq!(saved(&back), saved(&editor.scene), "the same objects, turn and all");
 }
+
+/// What a free turn cannot do yet is refused, the scene unchanged (review
+/// of issue 49's turns): a merge with a turned object, and a box edit
+/// through one (a world box is no box of its model's cells).
+#[test]
+fn merges_and_box_edits_through_a_free_turn_are_refused() {
+    let file = super::vox_scene::assets().join("format/test_groups.vox");
+    let mut editor = Editor::default();
+    editor.set_scene(octovox::io::load_scene(&file, 0).unwrap());
+    run(&mut editor, "object 3\nobject turn y 30").unwrap();
+    let before = drawn(&editor);
+    let refused = run(&mut editor, "object merge 4").unwrap_err().to_string();
+    assert!(refused.contains("turned by a free angle"), "{refused}");
+    let (&(x, y, z), _) = before
+        .iter()
+        .find(|(p, _)| editor.scene.objects().unwrap().owner_at(glam::IVec3::new(p.0, p.1, p.2)) == Some(3))
+        .unwrap();
+    let refused = run(&mut editor, &format!("object 3\nbrush box 3 3 3\nremove {x} {y} {z}")).unwrap_err().to_string();
+    assert!(refused.contains("box edit"), "{refused}");
+    assert!(drawn(&editor) == before, "nothing changed");
+}
+
+/// The smallest turns are kept (1e-6°: its angle is read from the
+/// quaternion's vector part), a huge angle turns by what it is modulo 360,
+/// and a scene whose keys turn freely at some frame is drawn composed at
+/// every frame.
+#[test]
+fn tiny_huge_and_keyed_turns() {
+    let tiny = turned([3, -2, 5], "object turn y 0.000001");
+    assert!(key_of(&dot_vox::load_bytes(&saved(&tiny.scene)).unwrap()).3.is_some(), "1e-6° is kept");
+    let huge = turned([3, -2, 5], "object turn y 1e17");
+    let modulo = turned([3, -2, 5], &format!("object turn y {}", 1e17f64 % 360.0));
+    assert!(drawn(&huge) == drawn(&modulo), "1e17° is 1e17 mod 360");
+    let mut bytes = Vec::new();
+    crate::common::written::herd(200).write_vox(&mut bytes).unwrap();
+    let mut editor = Editor::default();
+    editor.set_scene(load(&bytes));
+    assert!(editor.scene.instanced().is_some());
+    run(&mut editor, "frame 10\nobject 7\nobject key\nobject turn y 30\nframe 0").unwrap();
+    assert!(editor.scene.instanced().is_none(), "composed at frame 0 too");
+}
