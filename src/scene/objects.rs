@@ -88,6 +88,8 @@ pub struct Objects {
     /// placements the composed tree still holds, until [`Objects::catch_up`]
     /// composes what differs from them.
     behind: Option<Vec<(usize, Placing)>>,
+    /// [`Objects::has_free_turns`], as the last walk found it.
+    free_turns: bool,
 }
 
 /// Why the objects cannot be placed.
@@ -123,6 +125,7 @@ impl Objects {
             selected: None,
             new_layer: None,
             behind: None,
+            free_turns: false,
         };
         objects.walk(voxel_limit)?;
         Ok(objects)
@@ -133,6 +136,7 @@ impl Objects {
         Walked { objects: self.objects, outline: self.outline, names: self.names } =
             self.walked_at(self.frame, voxel_limit)?;
         self.maps = self.placings(&self.objects)?;
+        self.free_turns = self.freely_turned() > 0 || Objects::keys_turn_freely(self.graph.as_ref());
         for (object, map) in self.objects.iter().zip(&self.maps) {
             if let Some((lo, hi)) = self.models[object.placement.model].tree.solid_bounds() {
                 let (lo, hi) = map.apply_box(lo, hi);
@@ -169,18 +173,22 @@ impl Objects {
             .collect()
     }
 
-    /// Whether an object is turned by a free angle (or is in a group that
-    /// is): it lands on cells through their centres, not exactly.
-    /// Any keyframe, at any frame, counts: a scene with one is drawn and
-    /// exported the same way whatever frame is shown.
+    /// Whether some keyframe, at any frame, turns freely: then objects land
+    /// on cells through their centres, not exactly, and the scene is drawn
+    /// and exported the same way whatever frame is shown. Found by the walk
+    /// (read on every upload: no scan of the graph here).
     pub fn has_free_turns(&self) -> bool {
-        self.freely_turned() > 0
-            || self.graph.as_ref().is_some_and(|g| {
-                g.nodes.iter().any(|n| match &n.kind {
-                    NodeKind::Transform { frames, .. } => frames.iter().any(|k| k.contains_key(graph::TURN_KEY)),
-                    _ => false,
-                })
+        self.free_turns
+    }
+
+    /// Whether a keyframe of `graph` holds a free turn.
+    fn keys_turn_freely(graph: Option<&SceneGraph>) -> bool {
+        graph.is_some_and(|g| {
+            g.nodes.iter().any(|n| match &n.kind {
+                NodeKind::Transform { frames, .. } => frames.iter().any(|k| k.contains_key(graph::TURN_KEY)),
+                _ => false,
             })
+        })
     }
 
     /// How many objects are turned by a free angle (or are in a group that is).

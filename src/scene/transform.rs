@@ -445,8 +445,9 @@ impl TurnedMap {
         // The translation's whole part exactly (whole numbers from `_t`,
         // unless a group above turns freely), then what the turn of the
         // pivot adds.
-        let whole = (c * rigid.t + DVec3::Z).round();
-        let frac = c * rigid.t + DVec3::Z - whole - c * (rigid.m * pivot);
+        let shift = c * rigid.t + DVec3::Z;
+        let whole = shift.round();
+        let frac = shift - whole - c * (rigid.m * pivot);
         TurnedMap { a: c * rigid.m, shift: whole.as_ivec3(), frac }
     }
 
