@@ -1,4 +1,7 @@
 //! Command-line interface: one enum variant per subcommand ([`CliCommand`]).
+//! The browser page reads only the window's options, from its query; the
+//! commands' helpers are the desktop's.
+#![cfg_attr(target_arch = "wasm32", allow(dead_code))]
 
 use std::path::PathBuf;
 

@@ -1,11 +1,22 @@
+#[cfg(not(target_arch = "wasm32"))]
 use std::process::ExitCode;
 
+#[cfg(not(target_arch = "wasm32"))]
 use clap::Parser;
 
 mod app;
 mod cli;
+#[cfg(not(target_arch = "wasm32"))]
 mod commands;
 
+/// The browser's entry: the page (web/index.html) calls it once the
+/// module is loaded.
+#[cfg(target_arch = "wasm32")]
+fn main() {
+    app::start();
+}
+
+#[cfg(not(target_arch = "wasm32"))]
 fn main() -> ExitCode {
     env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
     let cli = cli::Cli::parse();
@@ -23,6 +34,7 @@ fn main() -> ExitCode {
     }
 }
 
+#[cfg(not(target_arch = "wasm32"))]
 /// Mesa's implicit Vulkan layer `VK_LAYER_MESA_device_select` connects to
 /// Wayland to rank the GPUs, and where `XDG_RUNTIME_DIR` is not set (a
 /// shell over SSH, a cron job) libwayland prints "error: XDG_RUNTIME_DIR is
@@ -46,11 +58,13 @@ fn quiet_device_select() {
     }
 }
 
+#[cfg(not(target_arch = "wasm32"))]
 fn is_broken_pipe(err: &anyhow::Error) -> bool {
     err.chain()
         .any(|cause| cause.downcast_ref::<std::io::Error>().is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe))
 }
 
+#[cfg(not(target_arch = "wasm32"))]
 /// The error and its causes, skipping a cause that the text already quotes
 /// (our error types print their source in their own message).
 fn error_chain(err: &anyhow::Error) -> String {

@@ -99,7 +99,7 @@ pub fn render_setting(
             let settings = PathSettings { bounces, shadow_samples, seed, ..PathSettings::default() };
             let traced = scaled_size(size, render_scale);
             renderer.compile_path_kernel(scene, &settings)?;
-            let start = std::time::Instant::now();
+            let start = web_time::Instant::now();
             let view = PathView { scene, camera, size: traced, settings: &settings };
             accumulate(renderer, &view, spp, None, |_| ())?;
             if denoise {
@@ -119,7 +119,7 @@ pub fn render_setting(
             }
             // The first frame compiles nothing but warms caches; time the second.
             renderer.render(scene, camera, traced, &settings, None)?;
-            let start = std::time::Instant::now();
+            let start = web_time::Instant::now();
             renderer.render(scene, camera, traced, &settings, None)?;
             let ms = start.elapsed().as_secs_f64() * 1e3;
             Ok((ms, upscale(renderer.read_image()?, size)))

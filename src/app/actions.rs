@@ -53,12 +53,13 @@ const fn object(label: &'static str, code: KeyCode, line: ObjectLine) -> Action 
 }
 
 /// Every keyboard action, in menu order.
-pub static ACTIONS: [Action; 54] = [
+pub static ACTIONS: [Action; 55] = [
     ctrl("New", KeyCode::KeyN, FILE, AppCommand::New),
     ctrl("Open…", KeyCode::KeyO, FILE, AppCommand::AskOpen),
     ctrl("Save", KeyCode::KeyS, FILE, AppCommand::Save),
     ctrl_shift("Save As…", KeyCode::KeyS, FILE, AppCommand::AskSaveAs),
     ctrl("Export mesh…", KeyCode::KeyE, FILE, AppCommand::AskExport),
+    ctrl_shift("Play script…", KeyCode::KeyP, FILE, AppCommand::AskPlayScript),
     key("Screenshot", KeyCode::F12, FILE, AppCommand::Screenshot),
     ctrl("Quit", KeyCode::KeyQ, FILE, AppCommand::Quit),
     ctrl("Undo", KeyCode::KeyZ, EDIT, AppCommand::Undo),

@@ -165,6 +165,11 @@ pub enum AppCommand {
     AskOpen,
     AskSaveAs,
     AskExport,
+    /// Ask for a replay script to play in the window.
+    AskPlayScript,
+    /// Play a replay script (.ovr) from the scene as it is, a line a frame,
+    /// as `--replay` does.
+    PlayScript(PathBuf),
     /// Ask for a palette file to load, or to save the palette to.
     AskPalette {
         save: bool,

@@ -13,12 +13,13 @@ pub enum DialogKind {
     Export,
     LoadPalette,
     SavePalette,
+    PlayScript,
 }
 
 impl DialogKind {
     /// Whether it picks an existing file (rather than a name to write).
     pub fn opens(self) -> bool {
-        matches!(self, DialogKind::Open | DialogKind::LoadPalette)
+        matches!(self, DialogKind::Open | DialogKind::LoadPalette | DialogKind::PlayScript)
     }
 
     pub fn title(self) -> &'static str {
@@ -28,6 +29,7 @@ impl DialogKind {
             DialogKind::Export => "Export a mesh (.obj, .ply or .glb)",
             DialogKind::LoadPalette => "Load a palette (.png, .hex or .gpl)",
             DialogKind::SavePalette => "Save the palette as .png, .hex or .gpl",
+            DialogKind::PlayScript => "Play a replay script (.ovr)",
         }
     }
 
@@ -38,6 +40,7 @@ impl DialogKind {
             DialogKind::SaveAs => &["vox", "ovx"],
             DialogKind::Export => &["obj", "ply", "glb"],
             DialogKind::LoadPalette | DialogKind::SavePalette => &["png", "hex", "gpl"],
+            DialogKind::PlayScript => &["ovr"],
         }
     }
 
@@ -50,6 +53,7 @@ impl DialogKind {
             DialogKind::Export => AppCommand::Export(path),
             DialogKind::LoadPalette => AppCommand::Lines(vec![Line::Palette(PaletteLine::Load(path))]),
             DialogKind::SavePalette => AppCommand::Lines(vec![Line::Palette(PaletteLine::Save(path))]),
+            DialogKind::PlayScript => AppCommand::PlayScript(path),
         }
     }
 }

@@ -5,7 +5,7 @@
 
 use std::path::PathBuf;
 use std::sync::mpsc::Receiver;
-use std::time::Instant;
+use web_time::Instant;
 
 use octovox::editor::Editor;
 use octovox::io::LoadError;

@@ -1,9 +1,10 @@
 //! Scenes in and out of the window: replacing the scene, the unsaved-changes
-//! guard, saving, and loading on a background thread.
+//! guard, saving, and loading on a background thread (in the browser, at
+//! once: its files are in memory).
 
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::{self, TryRecvError};
-use std::time::Instant;
+use web_time::Instant;
 
 use octovox::io::atomic::WriteOptions;
 use octovox::io::output::same_file;
@@ -286,14 +287,20 @@ impl Session {
         let thread_path = path.clone();
         let progress = octovox::io::progress::Progress::default();
         let reporter = progress.clone();
-        let spawned = std::thread::Builder::new().name("vox loader".into()).spawn(move || {
+        let load = move || {
             // The stamp before the read: a change on disk after it is one the
             // journal's recovery then notices.
             let stamp = FileStamp::of(&thread_path).ok();
             let result = octovox::io::load_scene_with(&thread_path, 0, &reporter).map(|scene| (scene, stamp));
             // The window may have closed meanwhile; then nobody wants the scene.
             let _ = tx.send(result);
-        });
+        };
+        #[cfg(not(target_arch = "wasm32"))]
+        let spawned = std::thread::Builder::new().name("vox loader".into()).spawn(load);
+        // The page has one thread, and its files are in memory: read now;
+        // the next frame takes the scene as from a loader thread.
+        #[cfg(target_arch = "wasm32")]
+        let spawned = std::io::Result::Ok(load());
         match spawned {
             Ok(_) => self.doc.loading = Some(Loading { path, started: Instant::now(), progress, result: rx }),
             Err(err) => self.ui.error(format!("cannot start loading: {err}")),

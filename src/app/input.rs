@@ -1,11 +1,16 @@
-//! Mouse and keyboard: turns winit events that egui did not consume into
+//! Mouse and keyboard: turns input events that egui did not consume into
 //! [`AppCommand`]s, and remembers what is held (buttons, fly keys, modifiers).
+//! Both shells feed it: the desktop window its winit events
+//! ([`InputEvent::from_winit`]), the browser page egui's (`web::input`),
+//! named with winit's key and button names.
 
 use std::collections::HashSet;
 
 use glam::DVec3;
-use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
-use winit::keyboard::{KeyCode, ModifiersState, PhysicalKey};
+use winit::event::{ElementState, MouseButton};
+#[cfg(not(target_arch = "wasm32"))]
+use winit::event::{MouseScrollDelta, WindowEvent};
+use winit::keyboard::{KeyCode, ModifiersState};
 
 use super::command::{AppCommand, StrokePhase};
 use super::session::Pointer;
@@ -15,16 +20,66 @@ use super::state::Tool;
 /// released before that, it is a click.
 const CLICK_SLOP_PIXELS: f64 = 4.0;
 /// Pixels per wheel "line" for touchpads that report pixels.
+#[cfg(not(target_arch = "wasm32"))]
 const PIXELS_PER_LINE: f64 = 40.0;
 
 /// One key going down or up, as [`Input::on_key`] needs it.
-#[derive(Clone, Copy, Debug)]
-struct KeyInput {
-    code: KeyCode,
-    state: ElementState,
-    repeat: bool,
-    /// Sent by winit, not typed: see [`Input::on_key`].
-    synthetic: bool,
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KeyInput {
+    pub code: KeyCode,
+    pub state: ElementState,
+    pub repeat: bool,
+    /// Sent by the shell, not typed: see [`Input::on_key`].
+    pub synthetic: bool,
+}
+
+/// One input event, whichever shell saw it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum InputEvent {
+    Modifiers(ModifiersState),
+    FocusLost,
+    CursorLeft,
+    /// The pointer, in physical pixels of the view.
+    CursorMoved {
+        x: f64,
+        y: f64,
+    },
+    Button {
+        button: MouseButton,
+        pressed: bool,
+    },
+    /// Wheel steps ("lines"), up positive.
+    Wheel {
+        steps: f64,
+    },
+    Key(KeyInput),
+}
+
+#[cfg(not(target_arch = "wasm32"))]
+impl InputEvent {
+    /// The desktop window's event, where it is one the input reads.
+    pub fn from_winit(event: &WindowEvent) -> Option<InputEvent> {
+        Some(match event {
+            WindowEvent::ModifiersChanged(m) => InputEvent::Modifiers(m.state()),
+            WindowEvent::Focused(false) => InputEvent::FocusLost,
+            WindowEvent::CursorLeft { .. } => InputEvent::CursorLeft,
+            WindowEvent::CursorMoved { position, .. } => InputEvent::CursorMoved { x: position.x, y: position.y },
+            WindowEvent::MouseInput { state, button, .. } => {
+                InputEvent::Button { button: *button, pressed: *state == ElementState::Pressed }
+            }
+            WindowEvent::MouseWheel { delta, .. } => InputEvent::Wheel {
+                steps: match delta {
+                    MouseScrollDelta::LineDelta(_, y) => f64::from(*y),
+                    MouseScrollDelta::PixelDelta(p) => p.y / PIXELS_PER_LINE,
+                },
+            },
+            WindowEvent::KeyboardInput { event, is_synthetic, .. } => {
+                let winit::keyboard::PhysicalKey::Code(code) = event.physical_key else { return None };
+                InputEvent::Key(KeyInput { code, state: event.state, repeat: event.repeat, synthetic: *is_synthetic })
+            }
+            _ => return None,
+        })
+    }
 }
 
 #[derive(Debug, Default)]
@@ -74,11 +129,11 @@ impl Input {
     /// starts nothing, but releases and motion are always tracked so that no
     /// button stays stuck. `extruding`: a Ctrl+drag extrude is under way
     /// (the window's gesture), so motion and the release go to it.
-    pub fn on_event(&mut self, event: &WindowEvent, consumed: bool, tool: Tool, extruding: bool) -> Vec<AppCommand> {
+    pub fn on_event(&mut self, event: &InputEvent, consumed: bool, tool: Tool, extruding: bool) -> Vec<AppCommand> {
         let mut out = Vec::new();
         match event {
-            WindowEvent::ModifiersChanged(m) => self.modifiers = m.state(),
-            WindowEvent::Focused(false) => {
+            InputEvent::Modifiers(m) => self.modifiers = *m,
+            InputEvent::FocusLost => {
                 self.keys.clear();
                 if self.left {
                     self.left = false;
@@ -89,9 +144,8 @@ impl Input {
                 self.middle = false;
                 self.right = None;
             }
-            WindowEvent::CursorLeft { .. } => self.cursor = None,
-            WindowEvent::CursorMoved { position, .. } => {
-                let (x, y) = (position.x, position.y);
+            InputEvent::CursorLeft => self.cursor = None,
+            &InputEvent::CursorMoved { x, y } => {
                 if let Some((px, py)) = self.cursor {
                     let (dx, dy) = (x - px, y - py);
                     if let Some((start, moved)) = &mut self.right {
@@ -114,8 +168,7 @@ impl Input {
                     out.push(AppCommand::ExtrudeDrag { phase: StrokePhase::Move, x, y });
                 }
             }
-            WindowEvent::MouseInput { state, button, .. } => {
-                let pressed = *state == ElementState::Pressed;
+            &InputEvent::Button { button, pressed } => {
                 let at = self.cursor;
                 match (button, pressed) {
                     // Shift+click with Paint: flood fill.
@@ -168,26 +221,12 @@ impl Input {
                     _ => {}
                 }
             }
-            WindowEvent::MouseWheel { delta, .. } if !consumed => {
-                let steps = match delta {
-                    MouseScrollDelta::LineDelta(_, y) => f64::from(*y),
-                    MouseScrollDelta::PixelDelta(p) => p.y / PIXELS_PER_LINE,
-                };
-                out.push(AppCommand::Zoom { steps, at: self.cursor });
+            &InputEvent::Wheel { steps } if !consumed => out.push(AppCommand::Zoom { steps, at: self.cursor }),
+            InputEvent::Wheel { .. } => {}
+            &InputEvent::Key(key) => {
+                log::debug!("key {key:?} consumed={consumed} modifiers={:?}", self.modifiers);
+                out.extend(self.on_key(key, consumed));
             }
-            WindowEvent::KeyboardInput { event, is_synthetic, .. } => {
-                log::debug!(
-                    "key {:?} {:?} consumed={consumed} synthetic={is_synthetic} modifiers={:?}",
-                    event.physical_key,
-                    event.state,
-                    self.modifiers
-                );
-                if let PhysicalKey::Code(code) = event.physical_key {
-                    let key = KeyInput { code, state: event.state, repeat: event.repeat, synthetic: *is_synthetic };
-                    out.extend(self.on_key(key, consumed));
-                }
-            }
-            _ => {}
         }
         out
     }

@@ -4,11 +4,17 @@
 //! takes at the window's size and its error (mean FLIP) against the
 //! reference. Plain data: the panel shows it, `App` applies and measures.
 
+#[cfg(not(target_arch = "wasm32"))]
 use octovox::camera::Camera;
+#[cfg(not(target_arch = "wasm32"))]
 use octovox::gpu::{GpuError, Renderer};
+#[cfg(not(target_arch = "wasm32"))]
 use octovox::quality::{REFERENCE_SEED, Setting, flip, render_setting};
+#[cfg(not(target_arch = "wasm32"))]
 use octovox::scene::Scene;
-use octovox::settings::{PathSettings, Shading, TraceMode};
+#[cfg(not(target_arch = "wasm32"))]
+use octovox::settings::TraceMode;
+use octovox::settings::{PathSettings, Shading};
 
 use super::session::Session;
 use super::state::EditorState;
@@ -83,6 +89,7 @@ pub const PRESETS: [Preset; 5] = [
 ];
 
 /// Pixels of the measurement's images.
+#[cfg(not(target_arch = "wasm32"))]
 pub const MEASURE_SIZE: (u32, u32) = (256, 144);
 
 impl Preset {
@@ -97,6 +104,7 @@ impl Preset {
     }
 
     /// How the measurement draws a frame of this preset.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn setting(&self) -> Setting {
         match self.shading {
             Shading::Preview => {
@@ -127,6 +135,7 @@ pub struct Measured {
 /// Measures every preset on `renderer` from `camera`; the times are scaled
 /// to a frame of `window` pixels. Frames wait for the GPU meanwhile, and the
 /// path accumulation starts over afterwards.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn measure(
     renderer: &mut Renderer,
     scene: &Scene,
@@ -142,6 +151,7 @@ pub fn measure(
     result
 }
 
+#[cfg(not(target_arch = "wasm32"))]
 fn measure_all(
     renderer: &mut Renderer,
     scene: &Scene,
@@ -171,6 +181,7 @@ fn measure_all(
 impl Session {
     /// Measures the quality presets from the current camera (a second or
     /// so on lavapipe; the window waits meanwhile) and prints the result.
+    #[cfg(not(target_arch = "wasm32"))]
     pub(super) fn measure_presets(&mut self) {
         let window = self.window_size();
         let Some(renderer) = &mut self.renderer else { return };
@@ -187,6 +198,13 @@ impl Session {
             Err(err) => self.ui.error(format!("cannot measure the presets: {err}")),
         }
         self.request_redraw();
+    }
+
+    /// The browser cannot measure yet: FLIP is C++ and the page cannot
+    /// wait for the GPU's images (docs/web.md).
+    #[cfg(target_arch = "wasm32")]
+    pub(super) fn measure_presets(&mut self) {
+        self.ui.error("measuring the presets needs the desktop build (docs/web.md)".to_string());
     }
 }
 

@@ -410,6 +410,8 @@ impl Session {
                 let start = self.state.path.as_ref().map_or("saves/untitled.obj".into(), |p| p.with_extension("obj"));
                 self.ask_path(DialogKind::Export, start.display().to_string());
             }
+            AppCommand::AskPlayScript => self.ask_path(DialogKind::PlayScript, String::new()),
+            AppCommand::PlayScript(path) => self.open_script_files(Some(&path), None),
             AppCommand::AskPalette { save } => {
                 let kind = if save { DialogKind::SavePalette } else { DialogKind::LoadPalette };
                 self.ask_path(kind, if save { "saves/palette.png".into() } else { String::new() });

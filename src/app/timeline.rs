@@ -9,7 +9,7 @@
 //! frame where playing or scrubbing stops is a `frame N` line, so an edit
 //! made there replays where it was made.
 
-use std::time::Instant;
+use web_time::Instant;
 
 use egui::{Color32, Sense, Stroke, Vec2};
 

@@ -77,7 +77,7 @@ const STATS_REFRESH: std::time::Duration = std::time::Duration::from_millis(250)
 #[derive(Default)]
 pub struct ShownStats {
     stats: Stats,
-    taken: Option<std::time::Instant>,
+    taken: Option<web_time::Instant>,
 }
 
 impl ShownStats {
@@ -87,7 +87,7 @@ impl ShownStats {
         let age = self.taken.map_or(STATS_REFRESH, |at| at.elapsed());
         if age >= STATS_REFRESH {
             self.stats = current.clone();
-            self.taken = Some(std::time::Instant::now());
+            self.taken = Some(web_time::Instant::now());
         } else {
             ctx.request_repaint_after(STATS_REFRESH - age);
         }
@@ -156,7 +156,7 @@ pub struct UiState {
     /// journal starts again.
     pub journal_warning: Option<String>,
     /// Last message for the user, whether it is an error, and when it came.
-    pub message: Option<(String, bool, std::time::Instant)>,
+    pub message: Option<(String, bool, web_time::Instant)>,
 }
 
 /// A file a save would replace, which the user is asked about first.
@@ -176,14 +176,14 @@ impl UiState {
     pub fn error(&mut self, text: impl Into<String>) {
         let text = text.into();
         log::warn!("{text}");
-        self.message = Some((text, true, std::time::Instant::now()));
+        self.message = Some((text, true, web_time::Instant::now()));
     }
 
     /// A message that says what just happened: it goes after
     /// [`INFO_LIFETIME`], or at the next change (`saved …` no longer holds
     /// once the scene is edited again).
     pub fn info(&mut self, text: impl Into<String>) {
-        self.message = Some((text.into(), false, std::time::Instant::now()));
+        self.message = Some((text.into(), false, web_time::Instant::now()));
     }
 
     /// The scene changed: a message about what was before goes. Errors stay
@@ -194,8 +194,8 @@ impl UiState {
 
     /// The message to show `now`, if any: an info message past its lifetime
     /// is dropped.
-    pub fn current_message(&mut self, now: std::time::Instant) -> Option<(&str, bool, std::time::Duration)> {
-        let expired = |(_, is_error, at): &(String, bool, std::time::Instant)| {
+    pub fn current_message(&mut self, now: web_time::Instant) -> Option<(&str, bool, std::time::Duration)> {
+        let expired = |(_, is_error, at): &(String, bool, web_time::Instant)| {
             !is_error && now.saturating_duration_since(*at) >= INFO_LIFETIME
         };
         if self.message.as_ref().is_some_and(expired) {
@@ -755,7 +755,7 @@ fn message(ui: &mut egui::Ui, ui_state: &mut UiState) {
         ui.colored_label(Color32::from_rgb(255, 170, 60), format!("⚠ {warning}"));
     }
     let mut clear = false;
-    if let Some((text, is_error, left)) = ui_state.current_message(std::time::Instant::now()) {
+    if let Some((text, is_error, left)) = ui_state.current_message(web_time::Instant::now()) {
         ui.separator();
         let color = if is_error { Color32::from_rgb(255, 110, 100) } else { Color32::LIGHT_GREEN };
         ui.colored_label(color, text);
@@ -1101,7 +1101,8 @@ fn outline_box(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::time::{Duration, Instant};
+    use std::time::Duration;
+    use web_time::Instant;
 
     /// Issue 27, bug 4: "saved …" and "copied 6 voxels" stayed on screen
     /// long after they described anything.

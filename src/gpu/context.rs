@@ -67,9 +67,13 @@ impl GpuContext {
                 ..Default::default()
             })
             .await?;
-        let info = adapter.get_info();
-        let adapter_name = info.name.clone();
-        log::info!("GPU adapter: {adapter_name} ({:?}, {:?})", info.backend, info.device_type);
+        let (device, queue) = adapter.request_device(&Self::device_descriptor(&adapter)).await?;
+        Ok(Self::from_parts(instance, adapter, device, queue))
+    }
+
+    /// The device octovox asks of `adapter`: timestamps where there are
+    /// some, and the adapter's largest buffers, textures and bindings.
+    pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'static> {
         let features = adapter.features() & wgpu::Features::TIMESTAMP_QUERY;
         let supported = adapter.limits();
         // Big scenes need big storage buffers (the dense grid of a 10 M-voxel
@@ -83,16 +87,28 @@ impl GpuContext {
             max_storage_buffers_per_shader_stage: supported.max_storage_buffers_per_shader_stage,
             ..wgpu::Limits::default()
         };
-        let (device, queue) = adapter
-            .request_device(&wgpu::DeviceDescriptor {
-                label: Some("octovox device"),
-                required_features: features,
-                required_limits: limits,
-                ..Default::default()
-            })
-            .await?;
+        wgpu::DeviceDescriptor {
+            label: Some("octovox device"),
+            required_features: features,
+            required_limits: limits,
+            ..Default::default()
+        }
+    }
+
+    /// A context over a device opened elsewhere (the browser page's, by
+    /// eframe) with [`GpuContext::device_descriptor`].
+    pub fn from_parts(
+        instance: wgpu::Instance,
+        adapter: wgpu::Adapter,
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+    ) -> GpuContext {
+        let info = adapter.get_info();
+        let adapter_name = info.name.clone();
+        log::info!("GPU adapter: {adapter_name} ({:?}, {:?})", info.backend, info.device_type);
         device.on_uncaptured_error(Arc::new(|e: wgpu::Error| log::error!("wgpu: {e}")));
-        Ok(GpuContext { instance, adapter, device, queue, adapter_name, timestamps: !features.is_empty() })
+        let timestamps = device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        GpuContext { instance, adapter, device, queue, adapter_name, timestamps }
     }
 
     /// Compiles one of octovox's shader modules ([`super::shaders`]).
@@ -162,7 +178,7 @@ pub fn validated_on<T>(
 ) -> Result<T, GpuError> {
     let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let created = create(device);
-    match pollster::block_on(scope.pop()) {
+    match verdict(name, scope) {
         Some(err) => Err(GpuError::Shader { name: name.to_string(), message: err.to_string() }),
         None => Ok(created),
     }
@@ -201,8 +217,29 @@ pub(super) fn compute_pipeline(
 pub fn validated<T>(device: &wgpu::Device, work: impl FnOnce() -> Result<T, GpuError>) -> Result<T, GpuError> {
     let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let result = work();
-    match pollster::block_on(scope.pop()) {
+    match verdict("a frame", scope) {
         Some(err) => Err(GpuError::Validation(err.to_string())),
         None => result,
     }
+}
+
+/// The error a scope caught, if any. The desktop waits for the device's
+/// answer. WebGPU answers through a promise that the page's one thread
+/// cannot wait on: there the answer is logged when it comes (`what` names
+/// the work) and the work is taken as valid now.
+#[cfg(not(target_arch = "wasm32"))]
+fn verdict(_what: &str, scope: wgpu::ErrorScopeGuard) -> Option<wgpu::Error> {
+    pollster::block_on(scope.pop())
+}
+
+#[cfg(target_arch = "wasm32")]
+fn verdict(what: &str, scope: wgpu::ErrorScopeGuard) -> Option<wgpu::Error> {
+    let what = what.to_string();
+    let answer = scope.pop();
+    wasm_bindgen_futures::spawn_local(async move {
+        if let Some(err) = answer.await {
+            log::error!("wgpu: {what}: {err}");
+        }
+    });
+    None
 }

@@ -258,17 +258,23 @@ impl PathPass {
         self.bound_generation = buffers.generation;
     }
 
-    /// Starts compiling a kernel on a worker thread.
+    /// Starts compiling a kernel on a worker thread (on the desktop).
     fn start(&mut self, device: &wgpu::Device, key: KernelKey) {
         if self.kernels.contains_key(&key) {
             return;
         }
         let (tx, rx) = mpsc::channel();
         let (device, layout, module) = (device.clone(), self.pipeline_layout.clone(), self.module.clone());
-        std::thread::spawn(move || {
-            // The receiver may be gone (the pass was dropped): nothing to do then.
+        // The receiver may be gone (the pass was dropped): nothing to do then.
+        let work = move || {
             let _ = tx.send(compile(&device, &layout, &module, key));
-        });
+        };
+        #[cfg(not(target_arch = "wasm32"))]
+        std::thread::spawn(work);
+        // The browser's page has one thread here: the kernel is compiled now
+        // (WebGPU compiles it asynchronously behind the handle anyway).
+        #[cfg(target_arch = "wasm32")]
+        work();
         self.kernels.insert(key, Compiled::Compiling(rx));
     }
 

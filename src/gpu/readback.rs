@@ -3,6 +3,17 @@
 use super::{GpuContext, GpuError};
 
 /// Maps a `MAP_READ` buffer and returns its bytes.
+///
+/// # Errors
+/// In the browser always: WebGPU maps a buffer through a promise the
+/// page's one thread cannot wait on (docs/web.md lists what that leaves out).
+#[cfg(target_arch = "wasm32")]
+pub fn read_buffer(_gpu: &GpuContext, _buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
+    Err(GpuError::Readback("the browser cannot wait for GPU memory to be read back".into()))
+}
+
+/// Maps a `MAP_READ` buffer and returns its bytes.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn read_buffer(gpu: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>, GpuError> {
     let (tx, rx) = std::sync::mpsc::channel();
     buffer.slice(..).map_async(wgpu::MapMode::Read, move |result| {

@@ -532,7 +532,7 @@ impl Renderer {
             self.denoiser.encode(&self.gpu, &mut encoder, &Frame::of(&key.basis), true);
             Ok(())
         })?;
-        let start = std::time::Instant::now();
+        let start = web_time::Instant::now();
         self.gpu.checked(|| {
             self.gpu.queue.submit([encoder.finish()]);
             self.gpu.wait()

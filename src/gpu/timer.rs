@@ -8,7 +8,7 @@
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU8, Ordering};
-use std::time::Instant;
+use web_time::Instant;
 
 use super::readback::{read_buffer, staging_buffer};
 use super::{GpuContext, GpuError};
@@ -99,11 +99,17 @@ impl PassTimer {
         buffers: Vec<wgpu::CommandBuffer>,
     ) -> Result<f64, GpuError> {
         self.unwaited += 1;
-        if !self.trusted || self.unwaited.is_multiple_of(CHECK_EVERY) {
+        if !self.trusted || self.unwaited.is_multiple_of(CHECK_EVERY) || self.queries.is_none() {
             return self.submit_and_measure(gpu, buffers);
         }
-        let Some((_, _, read)) = &self.queries else { return self.submit_and_measure(gpu, buffers) };
+        self.submit_and_collect(gpu, buffers)
+    }
+
+    /// Submits `buffers`, has the timestamps mapped once the GPU is done,
+    /// and returns the latest read back so far.
+    fn submit_and_collect(&mut self, gpu: &GpuContext, buffers: Vec<wgpu::CommandBuffer>) -> Result<f64, GpuError> {
         gpu.queue.submit(buffers);
+        let Some((_, _, read)) = &self.queries else { return Ok(self.last_ms) };
         if self.state.compare_exchange(WRITTEN, MAPPING, Ordering::AcqRel, Ordering::Acquire).is_ok() {
             let state = Arc::clone(&self.state);
             read.slice(..).map_async(wgpu::MapMode::Read, move |result| {
@@ -130,7 +136,12 @@ impl PassTimer {
 
     /// Submits `buffers`, waits, and returns the pass's milliseconds (GPU
     /// timestamps if available, else wall time of submit + wait).
+    /// In the browser, which cannot wait for the GPU, the latest time read
+    /// back so far (a frame or more old), as for frames that do not wait.
     pub fn submit_and_measure(&mut self, gpu: &GpuContext, buffers: Vec<wgpu::CommandBuffer>) -> Result<f64, GpuError> {
+        if cfg!(target_arch = "wasm32") {
+            return self.submit_and_collect(gpu, buffers);
+        }
         let start = Instant::now();
         gpu.queue.submit(buffers);
         gpu.wait()?;

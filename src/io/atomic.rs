@@ -9,8 +9,11 @@
 //! - a read-only file is refused unless the caller says to overwrite it;
 //! - a temporary file that a killed save left behind is removed by the next
 //!   save of the same document (its name starts with the document's name).
+//!
+//! In the browser there is no disk: the bytes go into a buffer, which the
+//! page keeps and hands over as a download ([`super::page_files`]).
 
-use std::fs::{File, Permissions};
+use std::fs::File;
 use std::io;
 use std::path::{Path, PathBuf};
 
@@ -42,14 +45,25 @@ impl std::fmt::Debug for WriteOptions<'_> {
     }
 }
 
+/// What a save writes into: the temporary file beside the target, or in
+/// the browser a buffer. Writers use its `Write`, `Read` and `Seek` only.
+#[cfg(not(target_arch = "wasm32"))]
+pub type Target = File;
+#[cfg(target_arch = "wasm32")]
+pub type Target = io::Cursor<Vec<u8>>;
+
 /// The SHA-256 of a file's bytes, in lowercase hex.
 ///
 /// # Errors
 /// The file cannot be read.
 pub fn sha256_of(path: &Path) -> io::Result<String> {
+    sha256_hex(&mut File::open(path)?)
+}
+
+fn sha256_hex(bytes: &mut impl io::Read) -> io::Result<String> {
     use sha2::Digest as _;
     let mut hasher = sha2::Sha256::new();
-    io::copy(&mut File::open(path)?, &mut hasher)?;
+    io::copy(bytes, &mut hasher)?;
     Ok(hasher.finalize().iter().map(|b| format!("{b:02x}")).collect())
 }
 
@@ -85,7 +99,8 @@ pub fn is_read_only(path: &Path) -> bool {
 }
 
 /// Refuses targets that are not regular files (or absent).
-fn check_target(target: &Path, options: WriteOptions) -> io::Result<Option<Permissions>> {
+#[cfg(not(target_arch = "wasm32"))]
+fn check_target(target: &Path, options: WriteOptions) -> io::Result<Option<std::fs::Permissions>> {
     let meta = match std::fs::metadata(target) {
         Ok(meta) => meta,
         Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(None),
@@ -108,11 +123,13 @@ fn check_target(target: &Path, options: WriteOptions) -> io::Result<Option<Permi
 }
 
 /// Prefix of the temporary files of a save of `name`.
+#[cfg(not(target_arch = "wasm32"))]
 fn temp_prefix(name: &std::ffi::OsStr) -> String {
     format!(".{}.octovox-save-", name.to_string_lossy())
 }
 
 /// Removes temporary files a killed save of the same document left.
+#[cfg(not(target_arch = "wasm32"))]
 fn remove_stale_temporaries(dir: &Path, prefix: &str) {
     let Ok(entries) = std::fs::read_dir(dir) else { return };
     for entry in entries.flatten() {
@@ -131,10 +148,11 @@ fn remove_stale_temporaries(dir: &Path, prefix: &str) {
 /// # Errors
 /// The target is refused as described in the module comment; any I/O error
 /// of the temporary file or the rename is returned, and `path` is unchanged.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn write_atomically<E: From<io::Error>>(
     path: &Path,
     options: WriteOptions,
-    write: impl FnOnce(&mut File) -> Result<(), E>,
+    write: impl FnOnce(&mut Target) -> Result<(), E>,
 ) -> Result<(), E> {
     let target = resolve_target(path)?;
     let existing = check_target(&target, options)?;
@@ -165,12 +183,33 @@ pub fn write_atomically<E: From<io::Error>>(
     Ok(())
 }
 
-#[cfg(unix)]
+/// In the browser: `write` fills a buffer, which the page keeps as the
+/// file `path` and hands over as a download ([`super::page_files`]).
+///
+/// # Errors
+/// What `write` fails with; nothing is kept then.
+#[cfg(target_arch = "wasm32")]
+pub fn write_atomically<E: From<io::Error>>(
+    path: &Path,
+    options: WriteOptions,
+    write: impl FnOnce(&mut Target) -> Result<(), E>,
+) -> Result<(), E> {
+    let mut target = io::Cursor::new(Vec::new());
+    write(&mut target)?;
+    let bytes = target.into_inner();
+    if let Some(before_replace) = options.before_replace {
+        before_replace(&sha256_hex(&mut bytes.as_slice())?);
+    }
+    super::page_files::write(path, bytes);
+    Ok(())
+}
+
+#[cfg(all(unix, not(target_arch = "wasm32")))]
 fn set_new_file_permissions(builder: &mut tempfile::Builder<'_, '_>) {
     use std::os::unix::fs::PermissionsExt;
-    builder.permissions(Permissions::from_mode(0o666));
+    builder.permissions(std::fs::Permissions::from_mode(0o666));
 }
 
 /// Elsewhere a new file's default permissions are already the usual ones.
-#[cfg(not(unix))]
+#[cfg(not(any(unix, target_arch = "wasm32")))]
 fn set_new_file_permissions(_builder: &mut tempfile::Builder<'_, '_>) {}

@@ -3,7 +3,7 @@
 //! metadata claims (a FIFO, which a slow producer may feed, is read up to the
 //! limit like a regular file).
 
-use std::io::{self, Read};
+use std::io;
 use std::path::Path;
 
 /// Why an input could not be read: an I/O error, or a limit.
@@ -17,9 +17,24 @@ pub enum InputError {
     TooLarge { limit: u64 },
 }
 
+/// Reads all of `path`, refusing anything longer than `limit` bytes: in
+/// the browser, from the files the page holds ([`super::page_files`]).
+#[cfg(target_arch = "wasm32")]
+pub fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, InputError> {
+    let bytes = super::page_files::read(path).ok_or_else(|| {
+        io::Error::new(io::ErrorKind::NotFound, "the page holds no such file (open it with File ▸ Open or a drop)")
+    })?;
+    if bytes.len() as u64 > limit {
+        return Err(InputError::TooLarge { limit });
+    }
+    Ok(bytes)
+}
+
 /// Reads all of `path`, refusing devices, sockets and folders and anything
 /// longer than `limit` bytes.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, InputError> {
+    use std::io::Read as _;
     let file = std::fs::File::open(path)?;
     let meta = file.metadata()?;
     if !(meta.is_file() || is_fifo(&meta)) {
@@ -38,13 +53,13 @@ pub fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, InputError> {
     Ok(bytes)
 }
 
-#[cfg(unix)]
+#[cfg(all(unix, not(target_arch = "wasm32")))]
 fn is_fifo(meta: &std::fs::Metadata) -> bool {
     use std::os::unix::fs::FileTypeExt;
     meta.file_type().is_fifo()
 }
 
-#[cfg(not(unix))]
+#[cfg(not(any(unix, target_arch = "wasm32")))]
 fn is_fifo(_meta: &std::fs::Metadata) -> bool {
     false
 }

@@ -9,10 +9,13 @@ pub mod input;
 pub mod mesh;
 pub mod output;
 pub mod ovx;
+#[cfg(target_arch = "wasm32")]
+pub mod page_files;
 pub mod palette_file;
 pub mod png;
 pub mod progress;
 pub mod vox;
+mod zstd_frame;
 
 use std::path::Path;
 

@@ -14,8 +14,9 @@ use std::path::{Path, PathBuf};
 
 use glam::IVec3;
 
-use super::atomic::{WriteOptions, write_atomically};
+use super::atomic::{Target, WriteOptions, write_atomically};
 use super::progress::Progress;
+use super::zstd_frame::{FrameReader, write_frame};
 use crate::gpu_pool::{BRICK_BYTES, Brick, NODE_BYTES, NodeSlot, is_pointer, pointer_to, slot_of};
 use crate::scene::objects::Objects;
 use crate::scene::octree::{MAX_DEPTH, MIN_DEPTH, Octree};
@@ -38,10 +39,6 @@ const FIXED_PAYLOAD_BYTES: u64 = 12 + 4 + 4 + 8 + 8 + 256 * 4;
 const FLAG_OBJECTS: u32 = 1;
 /// Flags this version defines.
 const KNOWN_FLAGS: u32 = FLAG_OBJECTS;
-
-/// zstd level: fast (about the speed of writing the file) and within a
-/// few percent of level 9 on pools.
-const ZSTD_LEVEL: i32 = 3;
 
 /// Why an .ovx file could not be read or written.
 #[derive(Debug, thiserror::Error)]
@@ -93,10 +90,9 @@ pub fn save_ovx(path: &Path, scene: &Scene, options: WriteOptions) -> Result<(),
         let mut out = Counting::new(io::BufWriter::new(file));
         // The file length goes in once the frame is written (a seek back).
         out.write_all(&header(0, payload_len, flags))?;
-        let mut encoder = zstd::Encoder::new(&mut out, ZSTD_LEVEL)?;
-        encoder.include_checksum(true)?;
-        write_payload(&mut encoder, scene.drawn(), &scene.palette, &compact, objects.as_ref(), &materials)?;
-        encoder.finish()?;
+        write_frame(&mut out, |encoder| {
+            write_payload(encoder, scene.drawn(), &scene.palette, &compact, objects.as_ref(), &materials)
+        })?;
         let file_len = out.written + FOOTER_BYTES;
         let file = out.into_inner()?;
         use std::io::Seek;
@@ -139,7 +135,7 @@ fn header(file_len: u64, payload_len: u64, flags: u32) -> [u8; HEADER_BYTES as u
 }
 
 fn write_payload(
-    out: &mut impl Write,
+    out: &mut dyn Write,
     tree: &Octree,
     palette: &Palette,
     compact: &Compact,
@@ -269,9 +265,8 @@ pub fn decode_ovx(bytes: &[u8], progress: &Progress) -> Result<Scene, OvxError> 
     }
     crate::budget::check(|| format!("an .ovx pool of {payload_len} bytes"), payload_len)?;
     progress.start(payload_len);
-    let decoder =
-        zstd::Decoder::with_buffer(&body[HEADER_BYTES as usize..]).map_err(|e| corrupt(format!("zstd: {e}")))?;
-    let mut payload = Payload { decoder: decoder.single_frame(), progress, produced: 0, expected: payload_len };
+    let decoder = FrameReader::new(&body[HEADER_BYTES as usize..]).map_err(|e| corrupt(format!("zstd: {e}")))?;
+    let mut payload = Payload { decoder, progress, produced: 0, expected: payload_len };
     let scene = read_payload(&mut payload, flags & FLAG_OBJECTS != 0)?;
     payload.finish()?;
     Ok(scene)
@@ -290,7 +285,7 @@ const CHUNK_BYTES: usize = 1 << 20;
 /// header's payload length plus the one byte that shows the frame holds
 /// more, and from one zstd frame only.
 struct Payload<'a> {
-    decoder: zstd::Decoder<'a, &'a [u8]>,
+    decoder: FrameReader<'a>,
     progress: &'a Progress,
     /// Bytes the decoder has handed out.
     produced: u64,
@@ -325,7 +320,7 @@ impl Payload<'_> {
     /// The frame ended before the payload did: a second frame after it is
     /// its own error (the format has one).
     fn ended_early(&self) -> OvxError {
-        if self.decoder.get_ref().is_empty() {
+        if self.decoder.remaining() == 0 {
             corrupt(format!("the payload ends early ({} of its {} bytes)", self.produced, self.expected))
         } else {
             corrupt(format!(
@@ -375,7 +370,7 @@ impl Payload<'_> {
                 self.expected
             )));
         }
-        let after = self.decoder.get_ref().len();
+        let after = self.decoder.remaining();
         if after > 0 {
             return Err(corrupt(format!(
                 "{after} bytes follow the payload's zstd frame (a second frame?); the format has one frame"
@@ -564,8 +559,8 @@ impl<W: Write> Counting<W> {
     }
 }
 
-impl<'a> Counting<io::BufWriter<&'a mut std::fs::File>> {
-    fn into_inner(self) -> io::Result<&'a mut std::fs::File> {
+impl<'a> Counting<io::BufWriter<&'a mut Target>> {
+    fn into_inner(self) -> io::Result<&'a mut Target> {
         self.inner.into_inner().map_err(|e| e.into_error())
     }
 }
@@ -658,15 +653,19 @@ mod tests {
     }
 
     fn frame(parts: &[&[u8]], zeros: usize) -> Vec<u8> {
-        let mut encoder = zstd::Encoder::new(Vec::new(), ZSTD_LEVEL).unwrap();
-        for part in parts {
-            encoder.write_all(part).unwrap();
-        }
-        let block = vec![0u8; 1 << 20];
-        for start in (0..zeros).step_by(block.len()) {
-            encoder.write_all(&block[..block.len().min(zeros - start)]).unwrap();
-        }
-        encoder.finish().unwrap()
+        let mut out = Vec::new();
+        write_frame(&mut out, |encoder| {
+            for part in parts {
+                encoder.write_all(part)?;
+            }
+            let block = vec![0u8; 1 << 20];
+            for start in (0..zeros).step_by(block.len()) {
+                encoder.write_all(&block[..block.len().min(zeros - start)])?;
+            }
+            Ok(())
+        })
+        .unwrap();
+        out
     }
 
     fn refusal(bytes: &[u8]) -> (String, u64) {

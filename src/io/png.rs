@@ -28,7 +28,7 @@ pub fn save_png(image: &image::RgbaImage, path: &Path, options: WriteOptions) ->
 pub(crate) fn save_encoded(
     path: &Path,
     options: WriteOptions,
-    encode: impl FnOnce(&mut std::io::BufWriter<&mut std::fs::File>) -> Result<(), image::ImageError>,
+    encode: impl FnOnce(&mut std::io::BufWriter<&mut crate::io::atomic::Target>) -> Result<(), image::ImageError>,
 ) -> Result<(), PngError> {
     let result = crate::io::atomic::write_atomically(path, options, |file| {
         let mut out = std::io::BufWriter::new(file);

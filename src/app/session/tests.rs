@@ -249,3 +249,26 @@ fn a_drag_round_the_ring_turns_the_picked_object() {
     assert!(f.session.doc.editor.scene.voxels() == rotated.scene.voxels(), "the cells of a quarter rotate");
     f.replays_the_same();
 }
+
+/// File ▸ Play script… asks for a script, and the chosen one plays a
+/// line a frame through the edit path, from the scene as it is; its
+/// `expect` lines pass.
+#[test]
+fn a_script_chosen_in_the_window_plays_from_the_scene_as_it_is() {
+    let mut f = Fixture::floor();
+    f.session.execute(AppCommand::AskPlayScript);
+    let asked = f.session.take_effects().ask_path;
+    assert_eq!(asked.map(|(kind, _)| kind), Some(crate::app::dialog_kind::DialogKind::PlayScript));
+    let script = f.dir.path().join("tower.ovr");
+    std::fs::write(&script, "color 5\nplace 3 1 3\nplace 3 2 3\nexpect voxel 3 2 3 5\nexpect count 66\n").unwrap();
+    f.session.execute(AppCommand::PlayScript(script));
+    let mut frames = 0;
+    while f.session.doc.player.is_some() {
+        f.session.play_step();
+        frames += 1;
+    }
+    assert_eq!(frames, 6, "a line a frame, then the summary");
+    let scene = &f.session.doc.editor.scene;
+    assert_eq!((scene.voxel(IVec3::new(3, 1, 3)), scene.voxel(IVec3::new(3, 0, 3))), (5, 1), "placed on the floor");
+    assert!(f.session.doc.editor.history.can_undo());
+}

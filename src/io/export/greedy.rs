@@ -482,7 +482,7 @@ mod tests {
     #[ignore = "a measurement: cargo test --release --lib -- --ignored mesh_a_solid_1024_box"]
     fn mesh_a_solid_1024_box() {
         let tree = boxed(IVec3::ZERO, IVec3::splat(1023));
-        let started = std::time::Instant::now();
+        let started = web_time::Instant::now();
         let dense = std::env::var("OCTOVOX_MESH_BENCH").is_ok_and(|v| v == "dense");
         let mesh = if dense { dense::mesh(&tree) } else { mesh(&tree) };
         println!(

@@ -9,9 +9,9 @@ use std::time::{Duration, Instant};
 
 use winit::event_loop::ActiveEventLoop;
 
+use super::super::browser::Browser;
+use super::super::dialog_kind::DialogKind;
 use super::App;
-use super::browser::Browser;
-use super::dialog_kind::DialogKind;
 
 /// A dialog that answers faster than this never showed itself: nobody
 /// picks or cancels a file that fast.

@@ -10,7 +10,8 @@ use winit::event_loop::ActiveEventLoop;
 use octovox::gpu::GpuContext;
 use octovox::gpu::readback::{padded_row_bytes, read_buffer, staging_buffer};
 
-use super::{App, Gfx, SAVES_DIR};
+use super::super::SAVES_DIR;
+use super::{App, Gfx};
 
 /// The window's image copied for a screenshot: buffer, width, height, and
 /// whether its bytes are BGRA.

@@ -7,20 +7,11 @@ use std::time::{Duration, Instant};
 
 use winit::event_loop::ActiveEventLoop;
 
-use octovox::gpu::schedule::Wants;
-use octovox::gpu::{FrameInput, GpuContext, PathOptions, PathView, Submitted};
-use octovox::settings::{PathSettings, RenderSettings, Shading, TraceMode, View};
-use octovox::trace::grid::DenseGrid;
+use octovox::gpu::GpuContext;
 
-use super::gesture::Gesture;
-use super::state::Mode;
-use super::{App, Gfx, camera_control, capture, motion, slow_clicks, ui};
-
-/// Most bands a path-traced sample is split into.
-pub(super) const MAX_PATH_BANDS: u32 = 16;
-
-/// Shapes drawn over the scene this frame (`ui::take_scene_overlays`).
-type Overlays = Vec<egui::epaint::ClippedShape>;
+use super::super::drawing::{FrameFacts, Overlays, Panels};
+use super::super::{camera_control, motion, slow_clicks};
+use super::{App, Gfx, capture, frame_stats};
 
 impl App {
     pub(super) fn frame(&mut self, event_loop: &ActiveEventLoop) {
@@ -60,7 +51,7 @@ impl App {
             && self.frames.motion.moving();
         if let (Some(frames), Some(interval_ms), true) = (&mut self.frames.moving_frames, interval_ms, counted) {
             let s = &self.session.readouts.stats;
-            frames.push(motion::FrameParts {
+            frames.push(frame_stats::FrameParts {
                 interval_ms,
                 trace_ms: s.trace_ms,
                 panels_ms: s.panels_ms,
@@ -73,7 +64,7 @@ impl App {
         self.sync_view();
         self.session.update_hover();
         self.session.update_previews();
-        self.sync_grid();
+        self.session.sync_grid();
         let repaint_delay = full.viewport_output.get(&egui::ViewportId::ROOT).map(|v| v.repaint_delay);
         let Some(window_copy) = self.trace_and_present(&ctx, full, overlays) else { return };
         if std::mem::take(&mut self.frames.screenshot_requested) {
@@ -112,67 +103,16 @@ impl App {
     /// Lays out the panels and carries out the commands they produced.
     /// Returns egui's output and, apart, the shapes drawn over the scene.
     fn run_panels(&mut self, event_loop: &ActiveEventLoop) -> Option<(egui::Context, egui::FullOutput, Overlays)> {
-        let (paste, eyedropper, selection) =
-            (self.session.paste_preview(), self.session.eyedropper_preview(), self.session.shown_selection());
         let gfx = self.gfx.as_mut()?;
-        let renderer = self.session.renderer.as_ref()?;
+        self.session.renderer.as_ref()?;
         let raw_input = gfx.egui_state.take_egui_input(&gfx.window);
         let ctx = gfx.egui_state.egui_ctx().clone();
         slow_clicks::allow_for_frame_length(&ctx, &raw_input);
-        let loading = self
-            .session
-            .doc
-            .loading
-            .as_ref()
-            .map(|l| (l.path.clone(), l.started.elapsed().as_secs_f64(), l.progress.fraction()));
-        let mut commands = Vec::new();
-        let mut overlays = Vec::new();
-        let mut view = None;
-        let mut full = {
-            let info = ui::Info {
-                palette: &self.session.doc.editor.scene.palette,
-                scene: &self.session.doc.editor.scene,
-                line_start: self.session.gesture.line_start(),
-                stats: self.session.readouts.shown_stats.take(&ctx, &self.session.readouts.stats),
-                adapter: &renderer.gpu.adapter_name,
-                timestamps: renderer.timed_by_gpu(),
-                loading: loading.as_ref().map(|(p, s, f)| (p.as_path(), *s, *f)),
-                can_undo: self.session.doc.editor.history.can_undo(),
-                can_redo: self.session.doc.editor.history.can_redo(),
-                history: {
-                    let (steps, bytes) = self.session.doc.editor.history.usage();
-                    (steps, bytes, self.session.doc.editor.history.memory_limit_bytes)
-                },
-                presets: self.session.readouts.presets_measured.as_deref(),
-                selection,
-                has_clipboard: self.session.doc.editor.clipboard().is_some(),
-                recent: self.session.doc.recent.files().cloned().collect(),
-                extrude: self.session.hover.extrude_preview.as_ref().map(|p| (p.voxels.as_slice(), p.face.1, p.layers)),
-                fill: self.session.hover.fill_preview.as_ref().map(|p| p.region),
-                paste,
-                eyedropper,
-                objects: self.session.doc.editor.scene.pickable_objects(),
-                ground: self.session.doc.editor.ground,
-            };
-            let (state, ui_state, tools) =
-                (&mut self.session.state, &mut self.session.ui, &self.session.doc.editor.tools);
-            let pick = self.session.hover.pick;
-            ctx.run_ui(raw_input, |ui| {
-                commands = ui::show(ui, state, tools, ui_state, &info);
-                view = Some(ui.available_rect_before_wrap());
-                ui::draw_ground(ui, state, &info);
-                ui::draw_selection(ui, state, &info);
-                if let Some((voxels, normal, layers)) = info.extrude {
-                    ui::draw_extrude(ui, state, &info, voxels, normal, layers);
-                } else if let Some(pick) = pick.filter(|_| state.mode.uses_brush() && info.fill.is_none()) {
-                    ui::draw_brush_outline(ui, state, tools, &pick, &info);
-                }
-                ui::draw_action_previews(ui, state, &info);
-                overlays = ui::take_scene_overlays(ui.ctx());
-            })
-        };
+        let session = &mut self.session;
+        let mut panels = None;
+        let mut full = ctx.run_ui(raw_input, |ui| panels = Some(session.show_panels(ui)));
+        let Panels { commands, overlays } = panels?;
         self.session.hover.pointer_over_ui = ctx.is_pointer_over_egui();
-        self.session.hover.view = view;
         gfx.egui_state.handle_platform_output(&gfx.window, std::mem::take(&mut full.platform_output));
         if !commands.is_empty() {
             log::debug!("panel commands {commands:?}");
@@ -180,10 +120,7 @@ impl App {
         for command in commands {
             self.execute(command, event_loop);
         }
-        // A palette control let go without a last change still ends its step.
-        if matches!(self.session.gesture, Gesture::Palette) && !ctx.input(|i| i.pointer.any_down()) {
-            self.session.close_strokes();
-        }
+        self.session.palette_released(&ctx);
         Some((ctx, full, overlays))
     }
 
@@ -196,8 +133,7 @@ impl App {
         mut full: egui::FullOutput,
         overlays: Overlays,
     ) -> Option<Option<capture::WindowCopy>> {
-        let (trace_size, selection, modal) =
-            (self.session.trace_size(), self.session.shown_selection(), self.modal_open());
+        let modal = self.modal_open();
         let gfx = self.gfx.as_mut()?;
         let renderer = self.session.renderer.as_mut()?;
         let tessellate_started = Instant::now();
@@ -219,52 +155,9 @@ impl App {
         let acquired = Instant::now();
         let device = renderer.gpu.device.clone();
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
-        // While a file loads, previews only: a path-traced sample of a big
-        // view takes seconds on a CPU adapter, and the closed prompt or the
-        // progress would not show until it ended (issue 47, item 6).
-        let wants_path =
-            path_traced(&self.session.state, self.frames.motion.moving()) && self.session.doc.loading.is_none();
-        let (scene, state) = (&self.session.doc.editor.scene, &self.session.state);
-        // Where clicks build on the ground, the ground plane is drawn, and
-        // takes the voxels' shadows.
-        let plane = self.session.doc.editor.ground_plane();
-        let path_settings = PathSettings { ground: plane, ..state.path_settings };
-        let view = PathView { scene, camera: &state.camera, size: trace_size, settings: &path_settings };
-        // Select mode tints the selected voxels in path-traced frames too
-        // (not the brush's reach, which follows the pointer: every move
-        // would start the accumulation over).
-        let tinted = selection.filter(|_| state.mode == Mode::Select).map(|r| (r.min, r.max));
-        let grid = self.session.doc.editor.ground.then(|| state.ground_grid());
-        // A dialog over the view holds the accumulation where it is: its
-        // frames stay cheap, and the dialog answers at once.
-        let held = modal.then_some(renderer.path.accumulation.samples);
-        let sample_target = held.unwrap_or(state.sample_target).max(1);
-        let wants = Wants { denoise: state.denoise, estimate_noise: true, sample_target };
-        let options = PathOptions { highlight: tinted, grid, wants };
-        let restarts = wants_path && renderer.path_restarts(&view, false, &options);
-        let path = wants_path && (!restarts || self.frames.preview_before_path);
-        self.frames.preview_before_path = wants_path && !path;
-        let input = if path {
-            FrameInput::Path { view, restart: false, options }
-        } else {
-            // Select mode tints the selected voxels; the brush's modes what it would touch.
-            let highlight = match self.session.state.mode {
-                Mode::Select => selection.map(|r| (r.min, r.max)),
-                Mode::Object => None,
-                Mode::Brush | Mode::Line => self.session.hover.pick.map(|pick| {
-                    self.session.state.preview_box(
-                        &self.session.doc.editor.tools,
-                        &pick,
-                        self.session.gesture.line_start(),
-                    )
-                }),
-            };
-            let settings = RenderSettings { ground: plane, ..state.settings };
-            FrameInput::preview(scene, &state.camera, trace_size, &settings, highlight, grid)
-        };
-        if let Err(err) = renderer.encode(&mut encoder, &input) {
-            log::error!("trace failed: {err}");
-        }
+        let facts = FrameFacts { moving: self.frames.motion.moving(), modal };
+        let path = self.session.encode_trace(&mut encoder, facts, &mut self.frames.preview_before_path);
+        let Some(renderer) = self.session.renderer.as_mut() else { return Some(None) };
         let view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
         gfx.blit.prepare(&device, renderer.output_view());
         // The blit and the panels are render passes labelled with their
@@ -276,7 +169,7 @@ impl App {
             .then(|| capture::copy_frame(gfx, &renderer.gpu, &mut encoder, &frame.texture));
         let recorded = Instant::now();
         match renderer.submit(user_buffers, encoder) {
-            Ok(submitted) => self.frame_submitted(path, submitted),
+            Ok(submitted) => self.session.frame_submitted(path, submitted, &mut self.frames.path_reported),
             Err(err) => log::error!("the frame failed: {err}"),
         }
         let (Some(gfx), Some(renderer)) = (self.gfx.as_mut(), self.session.renderer.as_ref()) else {
@@ -294,58 +187,10 @@ impl App {
         Some(window_copy)
     }
 
-    /// What a submitted frame took, for the stats and the path tracer's
-    /// band size.
-    fn frame_submitted(&mut self, path: bool, submitted: Submitted) {
-        let Some(renderer) = self.session.renderer.as_mut() else { return };
-        if !path {
-            self.session.readouts.stats.trace_ms = submitted.ms;
-            (self.session.readouts.stats.path, self.session.readouts.stats.noise) = (None, None);
-            return;
-        }
-        let Some(frame) = submitted.path else { return };
-        if frame.added {
-            self.session.readouts.stats.trace_ms = frame.ms;
-            // A slow sample is spread over frames of about the frame-time
-            // target: a frame that must show a moved camera then waits for
-            // one band, not a whole sample.
-            let bands = (frame.ms / f64::from(self.session.state.frame_target_ms)).ceil();
-            renderer.path_bands = (bands as u32).clamp(1, MAX_PATH_BANDS);
-            self.session.readouts.stats.noise = match renderer.noise_estimate() {
-                Ok(noise) => noise,
-                Err(err) => {
-                    log::warn!("no noise estimate: {err}");
-                    None
-                }
-            };
-            if let Some(noise) = self.session.readouts.stats.noise
-                && frame.samples.is_power_of_two()
-            {
-                report!("noise: {noise:.5} at {} samples", frame.samples);
-            }
-        }
-        // Once the view is final: the samples done and, with Denoise on,
-        // their filter (which runs a stage a frame after the last sample).
-        let done = frame.samples >= self.session.state.sample_target.max(1) && !renderer.denoise_pending();
-        if done && !self.frames.path_reported {
-            let effects = frame.effects.names().join(" ");
-            report!("path: {} samples, effects [{effects}]", frame.samples);
-        }
-        self.frames.path_reported = done;
-        self.session.readouts.stats.path = Some(frame);
-    }
-
     /// Keeps drawing while something moves; otherwise waits for input (or
     /// for when egui asks to be drawn again).
     fn schedule_repaint(&mut self, repaint_delay: Option<Duration>) {
-        let filtering = self.session.renderer.as_ref().is_some_and(|renderer| renderer.denoise_pending());
-        let accumulating = !self.modal_open()
-            && self
-                .session
-                .readouts
-                .stats
-                .path
-                .is_some_and(|p| p.samples < self.session.state.sample_target || filtering);
+        let accumulating = self.session.accumulating(self.modal_open());
         let animating = accumulating
             || self.frames.preview_before_path
             || self.session.doc.loading.is_some()
@@ -369,35 +214,6 @@ impl App {
     /// Whether a dialog of the window or the desktop waits for an answer.
     fn modal_open(&self) -> bool {
         self.session.ui.modal_open() || self.file_dialog.is_some()
-    }
-
-    /// Rebuilds and uploads the dense grid while grid mode is on and the voxels changed.
-    fn sync_grid(&mut self) {
-        let Some(renderer) = &mut self.session.renderer else { return };
-        let revision = self.session.doc.editor.scene.revision();
-        if self.session.state.settings.mode != TraceMode::Grid || renderer.grid_of() == Some(revision) {
-            return;
-        }
-        let sent = match DenseGrid::from_octree(self.session.doc.editor.scene.drawn()) {
-            Ok(grid) => renderer.set_grid(&grid, revision).map_err(|err| err.to_string()),
-            Err(err) => Err(err.to_string()),
-        };
-        if let Err(err) = sent {
-            self.session.state.settings.mode = TraceMode::Svo;
-            self.session.ui.error(format!("{err}; back to SVO"));
-        }
-    }
-}
-
-/// Whether this frame is path traced: by the user's choice, and at rest
-/// only in the default mode (the preview keeps a moving camera fluid).
-fn path_traced(state: &super::state::EditorState, moving: bool) -> bool {
-    // The path tracer walks the SVO and shades; the grid and the debug views are the preview's.
-    let shaded_svo = state.settings.mode == TraceMode::Svo && state.settings.view == View::Shaded;
-    match state.shading {
-        Shading::Preview => false,
-        Shading::Rest => shaded_svo && !moving,
-        Shading::Path => shaded_svo,
     }
 }
 

@@ -6,7 +6,8 @@
 use std::cell::Cell;
 use std::time::Instant;
 
-use super::motion;
+use super::super::motion;
+use super::frame_stats;
 use crate::cli::WindowArgs;
 
 /// `--bench-frames`: frames left and the measurements so far.
@@ -29,7 +30,7 @@ pub(super) struct FrameClock {
     /// The render scale while the camera moves.
     pub motion: motion::MotionScale,
     /// Frame intervals while the camera moved (`--frame-stats`).
-    pub moving_frames: Option<motion::MovingFrames>,
+    pub moving_frames: Option<frame_stats::MovingFrames>,
     /// The last frame traced the preview in place of a path-traced frame
     /// that would have started the accumulation over; the next one starts it.
     pub preview_before_path: bool,
@@ -48,7 +49,7 @@ impl FrameClock {
             screenshot_requested: false,
             bench: args.bench_frames.map(|n| Bench { left: n.max(1), total: n.max(1), started: None, trace_ms: 0.0 }),
             motion: motion::MotionScale::default(),
-            moving_frames: args.frame_stats.then(motion::MovingFrames::default),
+            moving_frames: args.frame_stats.then(frame_stats::MovingFrames::default),
             preview_before_path: false,
             path_reported: false,
         }
