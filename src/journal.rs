@@ -35,17 +35,59 @@ pub fn untitled_journal_path(dir: &Path, pid: u32) -> PathBuf {
     dir.join(format!(".untitled-{pid}{JOURNAL_SUFFIX}"))
 }
 
+/// This session's number in the names of its untitled journals: the
+/// process id on the desktop; in the browser, where a page has none, a
+/// random number drawn once per page.
+#[cfg(not(target_arch = "wasm32"))]
+pub fn session_id() -> u32 {
+    std::process::id()
+}
+
+#[cfg(target_arch = "wasm32")]
+pub fn session_id() -> u32 {
+    thread_local! {
+        static ID: u32 = {
+            let mut bytes = [0u8; 4];
+            // Without randomness, two pages share a name: the later one's
+            // journal replaces the earlier's, which it would have offered.
+            let _ = getrandom::fill(&mut bytes);
+            u32::from_le_bytes(bytes)
+        };
+    }
+    ID.with(|id| *id)
+}
+
+/// The process id in an untitled journal's name.
+fn untitled_session(name: &str) -> Option<u32> {
+    name.strip_prefix(".untitled-")?.strip_suffix(JOURNAL_SUFFIX)?.parse().ok()
+}
+
+/// Untitled journals among the page's files of pages gone (a page's
+/// journals outlive it in the browser's storage), newest name last.
+#[cfg(target_arch = "wasm32")]
+pub fn orphaned_untitled(dir: &Path) -> Vec<PathBuf> {
+    let mut found: Vec<PathBuf> = crate::io::page_files::list(dir)
+        .into_iter()
+        .filter(|path| {
+            let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+            untitled_session(&name).is_some_and(|id| id != session_id())
+        })
+        .collect();
+    found.sort();
+    found
+}
+
 /// Untitled journals in `dir` of sessions no longer running (no
 /// `/proc/PID`), newest first.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn orphaned_untitled(dir: &Path) -> Vec<PathBuf> {
     let Ok(entries) = std::fs::read_dir(dir) else { return Vec::new() };
     let mut found: Vec<(std::time::SystemTime, PathBuf)> = entries
         .filter_map(Result::ok)
         .filter(|entry| {
             let name = entry.file_name().to_string_lossy().into_owned();
-            let pid = name.strip_prefix(".untitled-").and_then(|rest| rest.strip_suffix(JOURNAL_SUFFIX));
-            pid.and_then(|p| p.parse::<u32>().ok())
-                .is_some_and(|pid| pid != std::process::id() && !Path::new("/proc").join(pid.to_string()).exists())
+            untitled_session(&name)
+                .is_some_and(|pid| pid != session_id() && !Path::new("/proc").join(pid.to_string()).exists())
         })
         .filter_map(|entry| Some((entry.metadata().ok()?.modified().ok()?, entry.path())))
         .collect();
@@ -63,7 +105,22 @@ pub fn snapshot_path(journal: &Path) -> PathBuf {
 /// The journal of `document` if one was left behind.
 pub fn find(document: &Path) -> Option<PathBuf> {
     let path = journal_path(document);
-    path.is_file().then_some(path)
+    #[cfg(not(target_arch = "wasm32"))]
+    let found = path.is_file();
+    #[cfg(target_arch = "wasm32")]
+    let found = crate::io::page_files::exists(&path);
+    found.then_some(path)
+}
+
+/// Removes a journal and its snapshot: its edits were saved, recovered
+/// into another journal, or discarded. Either may be missing.
+pub fn discard(journal: &Path) {
+    for path in [snapshot_path(journal), journal.to_path_buf()] {
+        #[cfg(not(target_arch = "wasm32"))]
+        let _ = std::fs::remove_file(path);
+        #[cfg(target_arch = "wasm32")]
+        let _ = crate::io::page_files::remove(&path);
+    }
 }
 
 /// What a journal noted of a file when it started: the file its `load`
@@ -199,6 +256,14 @@ pub enum RecoverError {
 }
 
 /// Whether another process holds `journal`'s lock (a window editing with it).
+/// A page holds no lock: its journals are the tab's own.
+#[cfg(target_arch = "wasm32")]
+pub fn is_live(_journal: &Path) -> bool {
+    false
+}
+
+/// Whether another process holds `journal`'s lock (a window editing with it).
+#[cfg(not(target_arch = "wasm32"))]
 pub fn is_live(journal: &Path) -> bool {
     std::fs::File::open(journal).is_ok_and(|file| matches!(file.try_lock(), Err(std::fs::TryLockError::WouldBlock)))
 }

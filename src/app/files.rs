@@ -146,8 +146,7 @@ impl Session {
             // the dead session's journal and snapshot go.
             self.restart_journal_from_snapshot();
             if self.doc.journal.is_some() {
-                let _ = std::fs::remove_file(octovox::journal::snapshot_path(journal));
-                let _ = std::fs::remove_file(journal);
+                octovox::journal::discard(journal);
             }
         }
         let what = document.as_ref().map_or_else(|| "the untitled scene".to_string(), |d| d.display().to_string());
@@ -178,7 +177,7 @@ impl Session {
 
     /// Where this session journals a scene that has no file.
     pub(super) fn untitled_journal_path(&self) -> PathBuf {
-        octovox::journal::untitled_journal_path(Path::new(super::SAVES_DIR), std::process::id())
+        octovox::journal::untitled_journal_path(Path::new(super::SAVES_DIR), octovox::journal::session_id())
     }
 
     /// Saves, then makes `path` the document and carries on with an action
@@ -300,7 +299,10 @@ impl Session {
         // The page has one thread, and its files are in memory: read now;
         // the next frame takes the scene as from a loader thread.
         #[cfg(target_arch = "wasm32")]
-        let spawned = std::io::Result::Ok(load());
+        let spawned = {
+            load();
+            std::io::Result::Ok(())
+        };
         match spawned {
             Ok(_) => self.doc.loading = Some(Loading { path, started: Instant::now(), progress, result: rx }),
             Err(err) => self.ui.error(format!("cannot start loading: {err}")),

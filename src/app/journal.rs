@@ -58,8 +58,7 @@ pub(super) fn classify(journal: &Path, document: Option<&Path>) -> Found {
     match octovox::journal::read(journal, document, octovox::journal::Checks::default()) {
         Err(err @ RecoverError::Live { .. }) => Found::Live(err.to_string()),
         Err(err @ RecoverError::Saved { .. }) => {
-            let _ = std::fs::remove_file(octovox::journal::snapshot_path(journal));
-            let _ = std::fs::remove_file(journal);
+            octovox::journal::discard(journal);
             Found::Stale(format!("{err}: removed it"))
         }
         Err(err @ RecoverError::Changed { .. }) => Found::Offer(Some(err.to_string())),
@@ -173,7 +172,7 @@ impl Session {
             };
             if let Err(err) = write(&mut journal) {
                 // No journal that holds only part of its start is left behind.
-                let _ = std::fs::remove_file(journal.path());
+                octovox::journal::discard(journal.path());
                 return Err(err);
             }
             Ok(journal)
@@ -222,8 +221,7 @@ impl Session {
     /// discarded.
     pub(super) fn close_journal(&mut self) {
         if let Some(journal) = self.doc.journal.take() {
-            let _ = std::fs::remove_file(octovox::journal::snapshot_path(journal.path()));
-            let _ = std::fs::remove_file(journal.path());
+            octovox::journal::discard(journal.path());
         }
         self.ui.journal_warning = None;
     }

@@ -420,9 +420,7 @@ impl Session {
             AppCommand::Screenshot => self.effects.screenshot = true,
             AppCommand::Resolve(choice) => self.resolve(choice),
             AppCommand::RecoverJournal(journal, checks) => self.recover_journal(&journal, checks),
-            AppCommand::DiscardJournal(journal) => {
-                let _ = std::fs::remove_file(journal);
-            }
+            AppCommand::DiscardJournal(journal) => octovox::journal::discard(&journal),
         }
         self.request_redraw();
     }

@@ -29,10 +29,9 @@ const CANVAS_ID: &str = "octovox";
 const STATUS_ID: &str = "status";
 
 /// The scene's texture: the blit writes the trace's sRGB-encoded bytes
-/// as they are, and egui samples them through an sRGB view (decoded to
-/// linear, as egui's own textures are).
+/// as they are, which is what egui's textures hold (gamma-encoded
+/// `Rgba8Unorm`).
 const SCENE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
-const SCENE_VIEW_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 
 thread_local! {
     /// The running page: kept for as long as the page lives.
@@ -185,6 +184,8 @@ impl WebApp {
         // The page never waits for the GPU: it cannot (docs/web.md).
         renderer.wait_for_frames = false;
         renderer.path_bands = drawing::MAX_PATH_BANDS / 2;
+        // Journals a page before this one left: the session offers them.
+        files::restore_kept();
         let mut session = Session::start(args);
         session.renderer = Some(renderer);
         session.upload();
@@ -219,9 +220,6 @@ impl WebApp {
         }
         if effects.screenshot {
             self.session.ui.error("the page takes no screenshots: use the browser's (docs/web.md)".to_string());
-        }
-        for name in files::download_written() {
-            report!("downloaded: {name}");
         }
         if let Some((kind, start)) = effects.ask_path
             && let Some(command) = self.files.ask(ctx, kind, &start)
@@ -298,23 +296,21 @@ impl WebApp {
                 dimension: wgpu::TextureDimension::D2,
                 format: SCENE_FORMAT,
                 usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[SCENE_VIEW_FORMAT],
+                view_formats: &[],
             });
             let target = texture.create_view(&wgpu::TextureViewDescriptor::default());
-            let shown = texture
-                .create_view(&wgpu::TextureViewDescriptor { format: Some(SCENE_VIEW_FORMAT), ..Default::default() });
             let mut egui_renderer = state.renderer.write();
             let id = match self.scene.take() {
                 Some(old) => {
                     egui_renderer.update_egui_texture_from_wgpu_texture(
                         &state.device,
-                        &shown,
+                        &target,
                         wgpu::FilterMode::Nearest,
                         old.id,
                     );
                     old.id
                 }
-                None => egui_renderer.register_native_texture(&state.device, &shown, wgpu::FilterMode::Nearest),
+                None => egui_renderer.register_native_texture(&state.device, &target, wgpu::FilterMode::Nearest),
             };
             self.scene = Some(SceneTexture { size, target, id });
         }
@@ -394,6 +390,12 @@ impl eframe::App for WebApp {
         self.session.update_previews();
         self.session.sync_grid();
         self.trace(&ctx);
+        // What this frame wrote (a Save, an Export, a script's `save`) goes
+        // to the user.
+        for name in files::download_written() {
+            report!("downloaded: {name}");
+        }
+        files::store_kept();
         self.session.readouts.stats.frame_ms = started.elapsed().as_secs_f64() * 1e3;
         if !self.ready && self.session.doc.loading.is_none() {
             self.ready = true;

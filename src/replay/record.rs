@@ -11,10 +11,33 @@ use crate::edit::mirror::Mirror;
 use crate::editor::Tools;
 use crate::script::{Kind, Line};
 
+/// Where a recorder's lines go: a file, or in the browser one of the
+/// page's files ([`crate::io::page_files`]).
+#[cfg(not(target_arch = "wasm32"))]
+type Sink = std::fs::File;
+#[cfg(target_arch = "wasm32")]
+type Sink = PageFile;
+
+/// One of the browser page's files, written at its end.
+#[cfg(target_arch = "wasm32")]
+pub struct PageFile(PathBuf);
+
+#[cfg(target_arch = "wasm32")]
+impl Write for PageFile {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        crate::io::page_files::append(&self.0, buf);
+        Ok(buf.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
 /// Writes script lines as the user works. Lines are flushed as they are
 /// written, so a crash loses nothing that was recorded.
 pub struct Recorder {
-    out: std::io::BufWriter<std::fs::File>,
+    out: std::io::BufWriter<Sink>,
     path: PathBuf,
     camera: Option<Camera>,
     brush: Option<Brush>,
@@ -40,7 +63,7 @@ impl Recorder {
 
     /// A recorder whose file starts with the comment `# HEADER`.
     pub fn with_header(path: &Path, header: &str) -> std::io::Result<Recorder> {
-        let mut recorder = Recorder::on(path, std::fs::File::create(path)?);
+        let mut recorder = Recorder::on(path, create(path)?);
         recorder.line(&format!("# {header}"))?;
         Ok(recorder)
     }
@@ -54,6 +77,7 @@ impl Recorder {
     /// # Errors
     /// The file cannot be opened, is locked by another process
     /// (`WouldBlock`), or cannot be written.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn journal(path: &Path, header: &str) -> std::io::Result<Recorder> {
         let file = std::fs::OpenOptions::new().read(true).write(true).create(true).truncate(false).open(path)?;
         lock(&file, path)?;
@@ -68,20 +92,28 @@ impl Recorder {
         started
     }
 
+    /// A crash journal at `path` among the page's files, which the page
+    /// keeps in the browser's storage (one tab holds a page's journals).
+    ///
+    /// # Errors
+    /// None in practice (the page's files are memory).
+    #[cfg(target_arch = "wasm32")]
+    pub fn journal(path: &Path, header: &str) -> std::io::Result<Recorder> {
+        Recorder::with_header(path, header)
+    }
+
     /// A recorder that goes on at the end of an existing script (a recovered
     /// journal, locked as [`Recorder::journal`] locks it): the camera, brush
     /// and colour are written again before the next edit, and undo does not
     /// reach before this point.
     pub fn append(path: &Path) -> std::io::Result<Recorder> {
-        let file = std::fs::OpenOptions::new().append(true).open(path)?;
-        lock(&file, path)?;
-        let mut recorder = Recorder::on(path, file);
+        let mut recorder = Recorder::on(path, open_to_append(path)?);
         // The script may end with mirror planes on; this recorder starts with none.
         recorder.command(&Line::Mirror(None))?;
         Ok(recorder)
     }
 
-    fn on(path: &Path, file: std::fs::File) -> Recorder {
+    fn on(path: &Path, file: Sink) -> Recorder {
         Recorder {
             out: std::io::BufWriter::new(file),
             path: path.to_path_buf(),
@@ -269,7 +301,35 @@ impl Recorder {
     }
 }
 
+#[cfg(not(target_arch = "wasm32"))]
+fn create(path: &Path) -> std::io::Result<Sink> {
+    std::fs::File::create(path)
+}
+
+#[cfg(target_arch = "wasm32")]
+fn create(path: &Path) -> std::io::Result<Sink> {
+    crate::io::page_files::write(path, Vec::new());
+    Ok(PageFile(path.to_path_buf()))
+}
+
+/// An existing journal, locked, to write at its end.
+#[cfg(not(target_arch = "wasm32"))]
+fn open_to_append(path: &Path) -> std::io::Result<Sink> {
+    let file = std::fs::OpenOptions::new().append(true).open(path)?;
+    lock(&file, path)?;
+    Ok(file)
+}
+
+#[cfg(target_arch = "wasm32")]
+fn open_to_append(path: &Path) -> std::io::Result<Sink> {
+    if !crate::io::page_files::exists(path) {
+        return Err(std::io::Error::new(std::io::ErrorKind::NotFound, "the page holds no such journal"));
+    }
+    Ok(PageFile(path.to_path_buf()))
+}
+
 /// Takes the advisory lock of a journal, or says who holds it.
+#[cfg(not(target_arch = "wasm32"))]
 fn lock(file: &std::fs::File, path: &Path) -> std::io::Result<()> {
     file.try_lock().map_err(|err| match err {
         std::fs::TryLockError::WouldBlock => std::io::Error::new(

@@ -195,3 +195,51 @@ fn download(name: &str, bytes: &[u8]) -> Result<(), String> {
         .map_err(|e| super::js_text(&e))?;
     Ok(())
 }
+
+/// Prefix of the browser-storage keys of the page's kept files.
+const STORED: &str = "octovox-file:";
+
+/// The kept files (crash journals, their snapshots) a page before this
+/// one left in the browser's storage, back among the page's files: the
+/// session offers to recover them as the desktop's does.
+pub fn restore_kept() {
+    let Some(storage) = local_storage() else { return };
+    let count = storage.length().unwrap_or(0);
+    let keys: Vec<String> = (0..count).filter_map(|i| storage.key(i).ok().flatten()).collect();
+    for key in keys {
+        let Some(path) = key.strip_prefix(STORED) else { continue };
+        if let Ok(Some(text)) = storage.get_item(&key) {
+            // One char per byte (see `store_kept`).
+            let bytes: Option<Vec<u8>> = text.chars().map(|c| u8::try_from(u32::from(c)).ok()).collect();
+            match bytes {
+                Some(bytes) => page_files::provide(Path::new(path), bytes),
+                None => log::warn!("the stored {path} is not octovox's: left alone"),
+            }
+        }
+    }
+}
+
+/// Stores the kept files changed this frame in the browser's storage (and
+/// forgets removed ones), so that a closed or crashed tab leaves them.
+/// Bytes are stored one char each: storage holds text.
+pub fn store_kept() {
+    let changed = page_files::take_changed();
+    if changed.is_empty() {
+        return;
+    }
+    let Some(storage) = local_storage() else { return };
+    for (path, bytes) in changed {
+        let key = format!("{STORED}{}", path.display());
+        let stored = match bytes {
+            Some(bytes) => storage.set_item(&key, &bytes.iter().map(|&b| char::from(b)).collect::<String>()),
+            None => storage.remove_item(&key),
+        };
+        if let Err(err) = stored {
+            log::error!("cannot keep {} in the browser's storage: {}", path.display(), super::js_text(&err));
+        }
+    }
+}
+
+fn local_storage() -> Option<web_sys::Storage> {
+    web_sys::window()?.local_storage().ok().flatten()
+}
