@@ -37,6 +37,7 @@ mod document;
 mod drag;
 mod drawing;
 mod files;
+mod frame_bench;
 mod gesture;
 mod gizmo;
 mod host;

@@ -17,6 +17,7 @@ use web_time::Instant;
 use octovox::gpu::{BlitMode, BlitPass, GpuContext, Renderer};
 
 use super::drawing::{self, FrameFacts};
+use super::frame_bench::Bench;
 use super::input::Input;
 use super::motion::{FrameTimes, MotionScale};
 use super::session::Session;
@@ -168,6 +169,8 @@ struct WebApp {
     preview_before_path: bool,
     path_reported: bool,
     ready: bool,
+    /// `?bench-frames=N`, as the desktop's `--bench-frames N`.
+    bench: Option<Bench>,
 }
 
 impl WebApp {
@@ -203,6 +206,7 @@ impl WebApp {
             preview_before_path: false,
             path_reported: false,
             ready: false,
+            bench: args.bench_frames.map(Bench::new),
         })
     }
 
@@ -317,6 +321,25 @@ impl WebApp {
         self.scene.as_ref()
     }
 
+    /// Counts a frame of `?bench-frames=N` and asks for the next; after
+    /// the last, reports as the desktop does. The page's frames come as the
+    /// browser draws them (at most its display's rate).
+    fn bench_step(&mut self, ctx: &egui::Context) {
+        if !self.ready {
+            return;
+        }
+        let Some(bench) = &mut self.bench else { return };
+        let clock =
+            self.session.renderer.as_ref().map_or("", |r| if r.timed_by_gpu() { "GPU timestamps" } else { "wall" });
+        match bench.frame(self.session.trace_size(), self.session.readouts.stats.trace_ms, clock) {
+            Some(line) => {
+                report!("{line}");
+                self.bench = None;
+            }
+            None => ctx.request_repaint(),
+        }
+    }
+
     /// Traces the scene into its texture and submits it, ahead of egui's
     /// own submit of this frame.
     fn trace(&mut self, ctx: &egui::Context) {
@@ -402,5 +425,6 @@ impl eframe::App for WebApp {
             let (w, h) = self.session.view.window;
             report!("octovox: ready {w}x{h}");
         }
+        self.bench_step(&ctx);
     }
 }

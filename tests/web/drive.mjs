@@ -5,6 +5,8 @@
 // screenshots and the page's downloads. The Rust side checks them.
 //
 //   node tests/web/drive.mjs SCENARIO OUT [FILE]
+//
+// (For `bench`, FILE is the rest of the page's query, e.g. shading=preview.)
 import http from "node:http";
 import fs from "node:fs";
 import path from "node:path";
@@ -201,6 +203,16 @@ const scenarios = {
     await line(/^recovered: the untitled scene$/);
     await keys("Escape");
     await saveAs("recovered.vox");
+  },
+  // Time to the first frame and `?bench-frames=N` (docs/bench/web.md):
+  // QUERY is the rest of the page's query.
+  async bench() {
+    const started = Date.now();
+    await open(`?bench-frames=${process.env.OCTOVOX_BENCH_FRAMES || 60}&${given || ""}`);
+    const firstFrameMs = Date.now() - started;
+    const bench = await line(/^bench: /);
+    fs.writeFileSync(path.join(out, "bench.json"), JSON.stringify({ firstFrameMs, bench }));
+    console.log(`first frame after ${firstFrameMs} ms; ${bench}`);
   },
   // File ▸ Play script… (Ctrl+Shift+P): the script's own `save` line
   // writes the file the page downloads.

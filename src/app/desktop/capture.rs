@@ -2,7 +2,6 @@
 //! back or time them. Kept out of the frame function so it stays readable.
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 use anyhow::Context as _;
 use winit::event_loop::ActiveEventLoop;
@@ -68,26 +67,10 @@ impl App {
         let clock =
             self.session.renderer.as_ref().map_or("", |g| if g.timed_by_gpu() { "GPU timestamps" } else { "wall" });
         let Some(bench) = &mut self.frames.bench else { return };
-        match bench.started {
-            // The first ready frame warms up; timing starts after it.
-            None => bench.started = Some(Instant::now()),
-            Some(started) => {
-                bench.trace_ms += self.session.readouts.stats.trace_ms;
-                bench.left -= 1;
-                if bench.left == 0 {
-                    let seconds = started.elapsed().as_secs_f64();
-                    let n = f64::from(bench.total);
-                    report!(
-                        "bench: {} frames at {w}x{h}: {:.2} fps, {:.1} ms/frame, trace {:.1} ms ({clock})",
-                        bench.total,
-                        n / seconds,
-                        seconds * 1e3 / n,
-                        bench.trace_ms / n,
-                    );
-                    self.frames.bench = None;
-                    event_loop.exit();
-                }
-            }
+        if let Some(line) = bench.frame((w, h), self.session.readouts.stats.trace_ms, clock) {
+            report!("{line}");
+            self.frames.bench = None;
+            event_loop.exit();
         }
     }
 }

@@ -6,17 +6,10 @@
 use std::cell::Cell;
 use std::time::Instant;
 
+use super::super::frame_bench::Bench;
 use super::super::motion;
 use super::frame_stats;
 use crate::cli::WindowArgs;
-
-/// `--bench-frames`: frames left and the measurements so far.
-pub(super) struct Bench {
-    pub left: u32,
-    pub total: u32,
-    pub started: Option<Instant>,
-    pub trace_ms: f64,
-}
 
 pub(super) struct FrameClock {
     /// The first frame has been presented (`octovox: ready` printed).
@@ -47,7 +40,7 @@ impl FrameClock {
             next_repaint: None,
             redraw_wanted: Cell::new(true),
             screenshot_requested: false,
-            bench: args.bench_frames.map(|n| Bench { left: n.max(1), total: n.max(1), started: None, trace_ms: 0.0 }),
+            bench: args.bench_frames.map(Bench::new),
             motion: motion::MotionScale::default(),
             moving_frames: args.frame_stats.then(frame_stats::MovingFrames::default),
             preview_before_path: false,
