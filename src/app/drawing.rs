@@ -15,6 +15,10 @@ use super::{AppCommand, ui};
 /// Most bands a path-traced sample is split into.
 pub(super) const MAX_PATH_BANDS: u32 = 16;
 
+/// Whether the path tracer's noise is measured: it is read back from the
+/// GPU, which the browser's page cannot wait for (docs/web.md).
+const NOISE_READ_BACK: bool = cfg!(not(target_arch = "wasm32"));
+
 /// Shapes drawn over the scene this frame (`ui::take_scene_overlays`).
 pub(super) type Overlays = Vec<egui::epaint::ClippedShape>;
 
@@ -126,7 +130,7 @@ impl Session {
         // frames stay cheap, and the dialog answers at once.
         let held = facts.modal.then_some(renderer.path.accumulation.samples);
         let sample_target = held.unwrap_or(state.sample_target).max(1);
-        let wants = Wants { denoise: state.denoise, estimate_noise: true, sample_target };
+        let wants = Wants { denoise: state.denoise, estimate_noise: NOISE_READ_BACK, sample_target };
         let options = PathOptions { highlight: tinted, grid, wants };
         let restarts = wants_path && renderer.path_restarts(&view, false, &options);
         let path = wants_path && (!restarts || *preview_before_path);
@@ -171,9 +175,10 @@ impl Session {
             // one band, not a whole sample.
             let bands = (frame.ms / f64::from(self.state.frame_target_ms)).ceil();
             renderer.path_bands = (bands as u32).clamp(1, MAX_PATH_BANDS);
-            stats.noise = match renderer.noise_estimate() {
-                Ok(noise) => noise,
-                Err(err) => {
+            stats.noise = match NOISE_READ_BACK.then(|| renderer.noise_estimate()) {
+                None => None,
+                Some(Ok(noise)) => noise,
+                Some(Err(err)) => {
                     log::warn!("no noise estimate: {err}");
                     None
                 }

@@ -61,10 +61,11 @@ async fn run() -> Result<(), String> {
         .get_element_by_id(CANVAS_ID)
         .and_then(|e| e.dyn_into::<web_sys::HtmlCanvasElement>().ok())
         .ok_or_else(|| format!("the page has no canvas #{CANVAS_ID}"))?;
-    if !has_webgpu() {
-        return Err("This browser has no WebGPU, which octovox draws with. Chrome, Edge (113 or later) and \
-                    Firefox (141 or later on Windows) have it; on Linux, Chrome needs \
-                    --enable-unsafe-webgpu. The desktop build runs on Vulkan: see the README."
+    if !has_webgpu_adapter().await {
+        return Err("This browser offers no WebGPU, which octovox draws with (it is missing, turned off, or \
+                    no GPU can serve it). Chrome and Edge 113 or later and Firefox 141 or later on Windows \
+                    have it; on Linux, Chrome needs --enable-unsafe-webgpu. The desktop build runs on \
+                    Vulkan: see the README."
             .into());
     }
     let (args, open) = args_from_query()?;
@@ -119,9 +120,23 @@ fn decode(text: &str) -> String {
     js_sys::decode_uri_component(&text.replace('+', " ")).map_or_else(|_| text.to_string(), String::from)
 }
 
-fn has_webgpu() -> bool {
+/// Whether `navigator.gpu` is there and gives an adapter (Chromium on
+/// Linux has the object but no adapter unless WebGPU is turned on).
+async fn has_webgpu_adapter() -> bool {
     let Some(window) = web_sys::window() else { return false };
-    js_sys::Reflect::get(&window.navigator(), &"gpu".into()).is_ok_and(|gpu| !gpu.is_undefined() && !gpu.is_null())
+    let Ok(gpu) = js_sys::Reflect::get(&window.navigator(), &"gpu".into()) else { return false };
+    if gpu.is_undefined() || gpu.is_null() {
+        return false;
+    }
+    let request =
+        js_sys::Reflect::get(&gpu, &"requestAdapter".into()).ok().and_then(|f| f.dyn_into::<js_sys::Function>().ok());
+    let Some(promise) = request.and_then(|f| f.call0(&gpu).ok()).and_then(|p| p.dyn_into::<js_sys::Promise>().ok())
+    else {
+        return false;
+    };
+    wasm_bindgen_futures::JsFuture::from(promise)
+        .await
+        .is_ok_and(|adapter| !adapter.is_null() && !adapter.is_undefined())
 }
 
 fn js_text(value: &wasm_bindgen::JsValue) -> String {

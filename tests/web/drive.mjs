@@ -45,18 +45,14 @@ function serve() {
 
 const server = await serve();
 const base = `http://127.0.0.1:${server.address().port}`;
+// WebGPU on SwiftShader: without the Vulkan flags the canvas screenshots
+// blank. The `nogpu` scenario is a browser without WebGPU (Chromium on
+// Linux without the flag).
+const webgpu = ["--enable-unsafe-webgpu", "--enable-features=Vulkan", "--use-vulkan=swiftshader", "--use-angle=vulkan"];
 const browser = await puppeteer.launch({
   executablePath: chromium,
   headless: true,
-  // WebGPU on SwiftShader: without the Vulkan flags the canvas screenshots blank.
-  args: [
-    "--no-sandbox",
-    "--enable-unsafe-webgpu",
-    "--enable-features=Vulkan",
-    "--use-vulkan=swiftshader",
-    "--use-angle=vulkan",
-    "--window-size=1280,720",
-  ],
+  args: ["--no-sandbox", "--window-size=1280,720", ...(scenario === "nogpu" ? [] : webgpu)],
 });
 const messages = [];
 let page;
@@ -213,6 +209,16 @@ const scenarios = {
     const bench = await line(/^bench: /);
     fs.writeFileSync(path.join(out, "bench.json"), JSON.stringify({ firstFrameMs, bench }));
     console.log(`first frame after ${firstFrameMs} ms; ${bench}`);
+  },
+  // A browser without WebGPU: the page says so instead of a blank canvas.
+  async nogpu() {
+    page = await browser.newPage();
+    page.on("console", (m) => messages.push({ type: m.type(), text: m.text() }));
+    await page.goto(`${base}/`);
+    await page.waitForSelector("#status.error", { timeout: TIMEOUT_MS });
+    const shown = await page.$eval("#status", (e) => (e.hidden ? "" : e.textContent.trim()));
+    fs.writeFileSync(path.join(out, "status.txt"), shown);
+    await shot("nogpu.png");
   },
   // File ▸ Play script… (Ctrl+Shift+P): the script's own `save` line
   // writes the file the page downloads.

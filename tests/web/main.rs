@@ -216,3 +216,12 @@ fn a_reload_after_edits_offers_them_back() {
     let removed: Vec<_> = before.difference(&recovered).collect();
     assert_eq!((added.len(), removed.len()), (1, 0), "added {added:?}, removed {removed:?}");
 }
+
+/// A browser without WebGPU gets a message in the page that says so and
+/// what to do, not a blank canvas.
+#[test]
+fn a_browser_without_webgpu_is_told_so() {
+    let out = drive("nogpu", None);
+    let shown = std::fs::read_to_string(out.path().join("status.txt")).unwrap();
+    assert!(shown.contains("no WebGPU") && shown.contains("desktop build"), "the page shows {shown:?}");
+}
