@@ -24,6 +24,14 @@ pub fn journal_path(document: &Path) -> PathBuf {
 /// The journal file names end so; `octovox recover` takes one directly.
 const JOURNAL_SUFFIX: &str = ".octovox-journal.ovr";
 
+/// The document whose journal `journal` is ([`journal_path`] backwards);
+/// `None` for an untitled scene's journal or another file.
+pub fn document_of(journal: &Path) -> Option<PathBuf> {
+    let name = journal.file_name()?.to_string_lossy().into_owned();
+    let document = name.strip_prefix('.')?.strip_suffix(JOURNAL_SUFFIX)?;
+    (untitled_session(&name).is_none() && !document.is_empty()).then(|| journal.with_file_name(document))
+}
+
 /// Whether `path` names a journal (rather than a document).
 pub fn is_journal(path: &Path) -> bool {
     path.file_name().is_some_and(|n| n.to_string_lossy().ends_with(JOURNAL_SUFFIX))
@@ -149,6 +157,7 @@ impl FileStamp {
     ///
     /// # Errors
     /// As [`FileStamp::of`].
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn with_hash(path: &Path, sha256: Option<String>) -> std::io::Result<FileStamp> {
         let meta = std::fs::metadata(path)?;
         if !meta.is_file() {
@@ -161,6 +170,22 @@ impl FileStamp {
             None => crate::io::atomic::sha256_of(path)?,
         };
         Ok(FileStamp { size: meta.len(), modified: modified.map_or(0, |d| d.as_secs()), sha256 })
+    }
+
+    /// [`FileStamp::of`] of one of the browser page's files (its time unknown).
+    ///
+    /// # Errors
+    /// The page holds no such file.
+    #[cfg(target_arch = "wasm32")]
+    pub fn with_hash(path: &Path, sha256: Option<String>) -> std::io::Result<FileStamp> {
+        let size = crate::io::page_files::read(path).map(|bytes| bytes.len() as u64).ok_or_else(|| {
+            std::io::Error::new(std::io::ErrorKind::NotFound, "the page holds no such file")
+        })?;
+        let sha256 = match sha256 {
+            Some(known) => known,
+            None => crate::io::atomic::sha256_of(path)?,
+        };
+        Ok(FileStamp { size, modified: 0, sha256 })
     }
 
     /// The journal's note of the file it edits: `source size=N modified=S sha256=HEX`.
@@ -336,9 +361,8 @@ fn check_lines<'a>(journal: &Path, script: &'a Script, document: Option<&Path>) 
     }
     let owned = match (first, document) {
         (Some(Line::Load(owner)), Some(document)) => {
-            let id = |p: &Path| std::fs::canonicalize(p).ok();
-            let owner = id(owner);
-            owner.is_some() && (owner == id(document) || owner == id(&snapshot_path(journal)))
+            use crate::io::output::same_file;
+            same_file(owner, document) || same_file(owner, &snapshot_path(journal))
         }
         (Some(first), None) => is_scene(first),
         _ => false,
@@ -472,5 +496,13 @@ mod tests {
         drop(recorder);
         assert!(!is_live(&journal));
         assert!(recover(&document, Checks::default()).is_ok());
+    }
+
+    #[test]
+    fn a_documents_journal_names_its_document_and_an_untitled_one_none() {
+        let document = Path::new("models/chr_knight.vox");
+        assert_eq!(document_of(&journal_path(document)), Some(document.to_path_buf()));
+        assert_eq!(document_of(&untitled_journal_path(Path::new("saves"), 42)), None);
+        assert_eq!(document_of(Path::new("models/chr_knight.vox")), None);
     }
 }

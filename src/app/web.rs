@@ -205,6 +205,16 @@ impl WebApp {
         // Journals a page before this one left: the session offers them.
         files::restore_kept();
         let mut session = Session::start(args);
+        let kept = files::kept_documents();
+        if !kept.is_empty() {
+            let names: Vec<String> = kept.iter().map(|d| d.display().to_string()).collect();
+            report!("kept: {}", names.join(", "));
+            // The page cannot keep the files themselves: the user opens them.
+            session.ui.info(format!(
+                "unsaved edits of {} are kept in this browser: open the file again to recover them",
+                names.join(", ")
+            ));
+        }
         session.renderer = Some(renderer);
         session.upload();
         let files = files::Inbox::default();

@@ -13,7 +13,6 @@
 //! In the browser there is no disk: the bytes go into a buffer, which the
 //! page keeps and hands over as a download ([`super::page_files`]).
 
-use std::fs::File;
 use std::io;
 use std::path::{Path, PathBuf};
 
@@ -48,16 +47,22 @@ impl std::fmt::Debug for WriteOptions<'_> {
 /// What a save writes into: the temporary file beside the target, or in
 /// the browser a buffer. Writers use its `Write`, `Read` and `Seek` only.
 #[cfg(not(target_arch = "wasm32"))]
-pub type Target = File;
+pub type Target = std::fs::File;
 #[cfg(target_arch = "wasm32")]
 pub type Target = io::Cursor<Vec<u8>>;
 
-/// The SHA-256 of a file's bytes, in lowercase hex.
+/// The SHA-256 of a file's bytes (in the browser, one of the page's
+/// files), in lowercase hex.
 ///
 /// # Errors
 /// The file cannot be read.
 pub fn sha256_of(path: &Path) -> io::Result<String> {
-    sha256_hex(&mut File::open(path)?)
+    #[cfg(not(target_arch = "wasm32"))]
+    return sha256_hex(&mut std::fs::File::open(path)?);
+    #[cfg(target_arch = "wasm32")]
+    super::page_files::read(path)
+        .ok_or_else(|| io::Error::new(io::ErrorKind::NotFound, "the page holds no such file"))
+        .and_then(|bytes| sha256_hex(&mut bytes.as_slice()))
 }
 
 fn sha256_hex(bytes: &mut impl io::Read) -> io::Result<String> {

@@ -97,11 +97,19 @@ fn extension_of(path: &Path) -> String {
 }
 
 /// True when both paths name one existing file (through links and `..`).
+#[cfg(not(target_arch = "wasm32"))]
 pub fn same_file(a: &Path, b: &Path) -> bool {
     match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
         (Ok(a), Ok(b)) => a == b,
         _ => false,
     }
+}
+
+/// Whether `a` and `b` name the same file: in the browser the page's
+/// files have one name each.
+#[cfg(target_arch = "wasm32")]
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    a == b && crate::io::page_files::exists(a)
 }
 
 #[cfg(test)]

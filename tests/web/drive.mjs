@@ -220,6 +220,29 @@ const scenarios = {
     fs.writeFileSync(path.join(out, "status.txt"), shown);
     await shot("nogpu.png");
   },
+  // An edit of an opened file, a reload: the page says the edits are
+  // kept; opening the file again offers them back.
+  async reopen() {
+    await open("?shading=preview");
+    await pick(given, "Control", "KeyO");
+    await line(new RegExp(`^loaded: ${path.basename(given)}`));
+    await page.mouse.move(640, 10);
+    await saveAs("before.vox");
+    let from = messages.length;
+    await page.mouse.click(758, 372);
+    await line(/^edit: /, from);
+    from = messages.length;
+    await open("?shading=preview");
+    await line(new RegExp(`^kept: before\\.vox$`), from);
+    from = messages.length;
+    await pick(path.join(out, "before.vox"), "Control", "KeyO");
+    await line(/^asking: recover /, from);
+    await keys("Tab");
+    await keys("Enter");
+    await line(/^recovered: before\.vox$/, from);
+    await keys("Escape");
+    await saveAs("recovered.vox");
+  },
   // File ▸ Play script… (Ctrl+Shift+P): the script's own `save` line
   // writes the file the page downloads.
   async replay() {

@@ -103,6 +103,22 @@ fn place(data: &dot_vox::DotVoxData, node: u32, at: [i32; 3], out: &mut BTreeSet
     }
 }
 
+/// `after` holds what `before` holds and exactly one voxel more.
+fn assert_one_voxel_added(before: &Path, after: &Path) {
+    let (before, after) = (world_voxels(before), world_voxels(after));
+    let added: Vec<_> = after.difference(&before).collect();
+    let removed: Vec<_> = before.difference(&after).collect();
+    assert_eq!((added.len(), removed.len()), (1, 0), "added {added:?}, removed {removed:?}");
+}
+
+/// A copy of the shared asset `name` (vox/magicavoxel), for the page.
+fn asset_copy(name: &str) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let given = dir.path().join(name);
+    std::fs::copy(root().join("../shared/assets/vox/magicavoxel").join(name), &given).unwrap();
+    (dir, given)
+}
+
 /// The page starts without a console error and draws the demo scene as
 /// the desktop window draws it from the same camera: SwiftShader's WebGPU
 /// in Chromium beside lavapipe's Vulkan under Xvfb, the same session and
@@ -149,11 +165,7 @@ fn the_page_draws_the_demo_scene_as_the_desktop_window_does() {
 fn clicks_place_and_erase_and_ctrl_z_undoes() {
     let out = drive("edit", None);
     assert_no_errors(out.path());
-    let before = world_voxels(&out.path().join("before.vox"));
-    let after = world_voxels(&out.path().join("after.vox"));
-    let added: Vec<_> = after.difference(&before).collect();
-    let removed: Vec<_> = before.difference(&after).collect();
-    assert_eq!((added.len(), removed.len()), (1, 0), "added {added:?}, removed {removed:?}");
+    assert_one_voxel_added(&out.path().join("before.vox"), &out.path().join("after.vox"));
     let (placed, shown) =
         (image::open(out.path().join("placed.png")).unwrap(), image::open(out.path().join("before.png")).unwrap());
     assert_ne!(placed.as_bytes(), shown.as_bytes(), "the placed voxel shows");
@@ -163,9 +175,7 @@ fn clicks_place_and_erase_and_ctrl_z_undoes() {
 /// same voxels.
 #[test]
 fn a_vox_from_the_file_picker_opens_and_saves_the_same_voxels() {
-    let dir = tempfile::tempdir().unwrap();
-    let given = dir.path().join("chr_knight.vox");
-    std::fs::copy(root().join("../shared/assets/vox/magicavoxel/chr_knight.vox"), &given).unwrap();
+    let (_dir, given) = asset_copy("chr_knight.vox");
     let out = drive("open", Some(&given));
     assert_no_errors(out.path());
     assert_eq!(world_voxels(&out.path().join("copy.vox")), world_voxels(&given));
@@ -174,9 +184,7 @@ fn a_vox_from_the_file_picker_opens_and_saves_the_same_voxels() {
 /// `?open=URL` opens a model shared as a link.
 #[test]
 fn a_model_shared_as_a_link_opens() {
-    let dir = tempfile::tempdir().unwrap();
-    let given = dir.path().join("teapot.vox");
-    std::fs::copy(root().join("../shared/assets/vox/magicavoxel/teapot.vox"), &given).unwrap();
+    let (_dir, given) = asset_copy("teapot.vox");
     let out = drive("link", Some(&given));
     assert_no_errors(out.path());
     assert_eq!(world_voxels(&out.path().join("linked.vox")), world_voxels(&given));
@@ -210,11 +218,17 @@ fn a_script_played_in_the_page_gives_what_octovox_replay_gives() {
 fn a_reload_after_edits_offers_them_back() {
     let out = drive("recover", None);
     assert_no_errors(out.path());
-    let before = world_voxels(&out.path().join("before.vox"));
-    let recovered = world_voxels(&out.path().join("recovered.vox"));
-    let added: Vec<_> = recovered.difference(&before).collect();
-    let removed: Vec<_> = before.difference(&recovered).collect();
-    assert_eq!((added.len(), removed.len()), (1, 0), "added {added:?}, removed {removed:?}");
+    assert_one_voxel_added(&out.path().join("before.vox"), &out.path().join("recovered.vox"));
+}
+
+/// An edit of an opened (then saved) file, a reload: the page says the
+/// edits are kept, and opening the file again offers them back.
+#[test]
+fn a_files_edits_come_back_when_it_is_opened_after_a_reload() {
+    let (_dir, given) = asset_copy("chr_knight.vox");
+    let out = drive("reopen", Some(&given));
+    assert_no_errors(out.path());
+    assert_one_voxel_added(&out.path().join("before.vox"), &out.path().join("recovered.vox"));
 }
 
 /// A browser without WebGPU gets a message in the page that says so and

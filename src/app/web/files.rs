@@ -219,6 +219,15 @@ pub fn restore_kept() {
     }
 }
 
+/// The documents whose journals the browser kept: their unsaved edits
+/// are offered back when they are opened again.
+pub fn kept_documents() -> Vec<PathBuf> {
+    let mut documents: Vec<PathBuf> =
+        page_files::list(Path::new("")).iter().filter_map(|journal| octovox::journal::document_of(journal)).collect();
+    documents.sort();
+    documents
+}
+
 /// Stores the kept files changed this frame in the browser's storage (and
 /// forgets removed ones), so that a closed or crashed tab leaves them.
 /// Bytes are stored one char each: storage holds text.
