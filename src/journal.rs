@@ -178,9 +178,9 @@ impl FileStamp {
     /// The page holds no such file.
     #[cfg(target_arch = "wasm32")]
     pub fn with_hash(path: &Path, sha256: Option<String>) -> std::io::Result<FileStamp> {
-        let size = crate::io::page_files::read(path).map(|bytes| bytes.len() as u64).ok_or_else(|| {
-            std::io::Error::new(std::io::ErrorKind::NotFound, "the page holds no such file")
-        })?;
+        let size = crate::io::page_files::read(path)
+            .map(|bytes| bytes.len() as u64)
+            .ok_or_else(|| std::io::Error::new(std::io::ErrorKind::NotFound, "the page holds no such file"))?;
         let sha256 = match sha256 {
             Some(known) => known,
             None => crate::io::atomic::sha256_of(path)?,

@@ -8,7 +8,7 @@
 //! in the browser's storage instead of handing them over.
 
 use std::cell::RefCell;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 thread_local! {
@@ -16,15 +16,37 @@ thread_local! {
     static FILES: RefCell<HashMap<PathBuf, Vec<u8>>> = RefCell::new(HashMap::new());
     /// Files written since the page last took them.
     static WRITTEN: RefCell<Vec<PathBuf>> = const { RefCell::new(Vec::new()) };
-    /// Kept files (journals, their snapshots) changed or removed since the
-    /// page last stored them.
+    /// Files kept by choice (the recent files and their list).
+    static KEPT: RefCell<HashSet<PathBuf>> = RefCell::new(HashSet::new());
+    /// Kept files changed, removed or let go since the page last stored them.
     static CHANGED: RefCell<Vec<PathBuf>> = const { RefCell::new(Vec::new()) };
 }
 
-/// Whether octovox keeps `path` for itself (a crash journal or its
-/// snapshot): stored in the browser, never downloaded.
+/// The page's own files (the recent-files list) live in this folder.
+pub const OWN_FOLDER: &str = "octovox";
+
+/// Whether octovox writes `path` for itself, never to hand over: a crash
+/// journal or its snapshot, or one of the page's own files.
+fn is_own(path: &Path) -> bool {
+    path.file_name().is_some_and(|n| n.to_string_lossy().contains(".octovox-journal.")) || path.starts_with(OWN_FOLDER)
+}
+
+/// Whether the page keeps `path` in the browser's storage: its own files
+/// and those kept by [`keep`].
 pub fn is_kept(path: &Path) -> bool {
-    path.file_name().is_some_and(|n| n.to_string_lossy().contains(".octovox-journal."))
+    is_own(path) || KEPT.with(|kept| kept.borrow().contains(path))
+}
+
+/// Keeps `path` in the browser's storage from now on, or lets it go
+/// (`kept` false: it stays among the page's files until the page closes).
+pub fn keep(path: &Path, kept: bool) {
+    let changed = KEPT.with(|set| {
+        let mut set = set.borrow_mut();
+        if kept { set.insert(path.to_path_buf()) } else { set.remove(path) }
+    });
+    if changed {
+        CHANGED.with(|q| q.borrow_mut().push(path.to_path_buf()));
+    }
 }
 
 /// Keeps `bytes` as the file `path` (a file the user gave the page).
@@ -43,11 +65,15 @@ pub fn exists(path: &Path) -> bool {
 }
 
 /// Keeps what octovox wrote to `path` and queues it for the page: to
-/// download, or for a kept file to store.
+/// download unless it is octovox's own, and to store if it is kept.
 pub fn write(path: &Path, bytes: Vec<u8>) {
     provide(path, bytes);
-    let queue = if is_kept(path) { &CHANGED } else { &WRITTEN };
-    queue.with(|q| q.borrow_mut().push(path.to_path_buf()));
+    if is_kept(path) {
+        CHANGED.with(|q| q.borrow_mut().push(path.to_path_buf()));
+    }
+    if !is_own(path) {
+        WRITTEN.with(|q| q.borrow_mut().push(path.to_path_buf()));
+    }
 }
 
 /// Adds `bytes` at the end of the file `path` (made if missing).
@@ -79,12 +105,12 @@ pub fn list(dir: &Path) -> Vec<PathBuf> {
 }
 
 /// The kept files changed since the last call, with their bytes now
-/// (`None`: removed), for the page to store.
+/// (`None`: removed or let go), for the page to store.
 pub fn take_changed() -> Vec<(PathBuf, Option<Vec<u8>>)> {
     let mut paths = CHANGED.with(|q| std::mem::take(&mut *q.borrow_mut()));
     paths.sort();
     paths.dedup();
-    paths.into_iter().map(|path| (path.clone(), read(&path))).collect()
+    paths.into_iter().map(|path| (path.clone(), is_kept(&path).then(|| read(&path)).flatten())).collect()
 }
 
 /// The files written since the last call, oldest first, with their bytes.

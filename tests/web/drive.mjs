@@ -243,6 +243,23 @@ const scenarios = {
     await keys("Escape");
     await saveAs("recovered.vox");
   },
+  // A file opened, a reload: File ▸ Open recent (real clicks on the menu)
+  // opens it again from the browser's storage.
+  async recent() {
+    await open("?shading=preview");
+    await pick(given, "Control", "KeyO");
+    await line(new RegExp(`^loaded: ${path.basename(given)}`));
+    let from = messages.length;
+    await open("?shading=preview");
+    await page.mouse.click(19, 12); // File
+    await page.mouse.move(60, 85, { steps: 5 }); // Open recent ▸
+    await new Promise((r) => setTimeout(r, 500));
+    await page.mouse.move(205, 85, { steps: 10 }); // the newest entry
+    await shot("recent-menu.png");
+    await page.mouse.click(205, 85);
+    await line(new RegExp(`^loaded: ${path.basename(given)}`), from);
+    await saveAs("reopened.vox");
+  },
   // File ▸ Play script… (Ctrl+Shift+P): the script's own `save` line
   // writes the file the page downloads.
   async replay() {

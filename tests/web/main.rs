@@ -239,3 +239,13 @@ fn a_browser_without_webgpu_is_told_so() {
     let shown = std::fs::read_to_string(out.path().join("status.txt")).unwrap();
     assert!(shown.contains("no WebGPU") && shown.contains("desktop build"), "the page shows {shown:?}");
 }
+
+/// File ▸ Open recent after a reload, by real clicks on the menu, opens
+/// the file from the browser's storage: the same voxels.
+#[test]
+fn open_recent_after_a_reload_opens_the_kept_file() {
+    let (_dir, given) = asset_copy("chr_knight.vox");
+    let out = drive("recent", Some(&given));
+    assert_no_errors(out.path());
+    assert_eq!(world_voxels(&out.path().join("reopened.vox")), world_voxels(&given));
+}

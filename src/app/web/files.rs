@@ -199,9 +199,10 @@ fn download(name: &str, bytes: &[u8]) -> Result<(), String> {
 /// Prefix of the browser-storage keys of the page's kept files.
 const STORED: &str = "octovox-file:";
 
-/// The kept files (crash journals, their snapshots) a page before this
-/// one left in the browser's storage, back among the page's files: the
-/// session offers to recover them as the desktop's does.
+/// The kept files (crash journals and their snapshots, the recent files
+/// and their list) a page before this one left in the browser's storage,
+/// back among the page's files: the session offers to recover the
+/// journals as the desktop's does, and File ▸ Open recent lists the files.
 pub fn restore_kept() {
     let Some(storage) = local_storage() else { return };
     let count = storage.length().unwrap_or(0);
@@ -212,7 +213,10 @@ pub fn restore_kept() {
             // One char per byte (see `store_kept`).
             let bytes: Option<Vec<u8>> = text.chars().map(|c| u8::try_from(u32::from(c)).ok()).collect();
             match bytes {
-                Some(bytes) => page_files::provide(Path::new(path), bytes),
+                Some(bytes) => {
+                    page_files::provide(Path::new(path), bytes);
+                    page_files::keep(Path::new(path), true);
+                }
                 None => log::warn!("the stored {path} is not octovox's: left alone"),
             }
         }
