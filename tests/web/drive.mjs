@@ -260,6 +260,17 @@ const scenarios = {
     await line(new RegExp(`^loaded: ${path.basename(given)}`), from);
     await saveAs("reopened.vox");
   },
+  // File ▸ Export mesh… (Ctrl+E) of a model shared as a link: the
+  // prompt answered with a .glb name, the mesh downloaded.
+  async export() {
+    await open(`?shading=preview&open=/given/${path.basename(given)}`);
+    await line(new RegExp(`^loaded: ${path.basename(given)}`));
+    const from = messages.length;
+    answers.push("model.glb");
+    await keys("Control", "KeyE");
+    await line(/^downloaded: model\.glb$/, from);
+    await waitForFile(path.join(out, "model.glb"));
+  },
   // File ▸ Play script… (Ctrl+Shift+P): the script's own `save` line
   // writes the file the page downloads.
   async replay() {

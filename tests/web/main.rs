@@ -249,3 +249,29 @@ fn open_recent_after_a_reload_opens_the_kept_file() {
     assert_no_errors(out.path());
     assert_eq!(world_voxels(&out.path().join("reopened.vox")), world_voxels(&given));
 }
+
+/// File ▸ Export mesh… in the page downloads the .glb `octovox export`
+/// writes for the same file, byte for byte, and the Khronos validator
+/// passes it.
+#[test]
+fn an_export_from_the_page_is_the_native_export() {
+    let (dir, given) = asset_copy("chr_knight.vox");
+    let out = drive("export", Some(&given));
+    assert_no_errors(out.path());
+    let native = dir.path().join("native.glb");
+    let export = Command::new(env!("CARGO_BIN_EXE_octovox")).arg("export").arg(&given).arg("-o").arg(&native).output();
+    let export = export.unwrap();
+    assert!(export.status.success(), "{}", String::from_utf8_lossy(&export.stderr));
+    let page = out.path().join("model.glb");
+    assert!(
+        std::fs::read(&page).unwrap() == std::fs::read(&native).unwrap(),
+        "the page's .glb differs from octovox export's"
+    );
+    let validator = Command::new("node").arg(root().join("tests/gltf/validate.js")).arg(&page).output().unwrap();
+    assert!(
+        validator.status.success(),
+        "{}{}",
+        String::from_utf8_lossy(&validator.stdout),
+        String::from_utf8_lossy(&validator.stderr)
+    );
+}

@@ -318,10 +318,13 @@ fn material(palette: &Palette, index: u8, extensions_used: &mut BTreeSet<String>
 
 /// A palette byte, sRGB-encoded as MagicaVoxel and the colour picker show
 /// it, as the linear value glTF's colour factors hold (a viewer encodes it
-/// back, so it shows the palette colour).
+/// back, so it shows the palette colour). Computed in f64 and rounded
+/// once: `f32::powf` differs by an ulp between the desktop's libm and the
+/// browser build's, and the same file must export the same bytes on both.
 fn srgb_to_linear(byte: u8) -> f32 {
-    let c = f32::from(byte) / 255.0;
-    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+    let c = f64::from(byte) / 255.0;
+    let linear = if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) };
+    linear as f32
 }
 
 /// The GLB container: a 12-byte header, the JSON chunk padded with spaces
