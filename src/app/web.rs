@@ -3,8 +3,10 @@
 //! shows the scene as the desktop's window does: egui's panels over the
 //! trace, which the one renderer draws each frame into a texture the size
 //! of the canvas. Input goes through the same table (`input`), panels and
-//! trace through the same code (`drawing`). What the page cannot do yet
-//! (files, recovery, the preset measurement) it says where it is asked.
+//! trace through the same code (`drawing`); files through the page's
+//! (`files`). What the page cannot do yet (what must wait for the GPU: the
+//! preset measurement, a script's renders; screenshots) it says where it
+//! is asked.
 
 mod events;
 mod files;
@@ -18,7 +20,8 @@ use octovox::gpu::{BlitMode, BlitPass, GpuContext, Renderer};
 
 use super::drawing::{self, FrameFacts};
 use super::frame_bench::Bench;
-use super::input::Input;
+use super::gesture::Gesture;
+use super::input::{Input, InputEvent};
 use super::motion::{FrameTimes, MotionScale};
 use super::session::Session;
 use super::{AppCommand, camera_control, preview, slow_clicks};
@@ -288,22 +291,18 @@ impl WebApp {
         let wants_keys = ctx.egui_wants_keyboard_input() || self.session.ui.prompt_open;
         for event in events.iter().flat_map(|e| events::translate(e, ppp)) {
             let consumed = match event {
-                super::input::InputEvent::Button { pressed: true, .. } | super::input::InputEvent::Wheel { .. } => {
-                    // Decided by position against the last frame's panels,
-                    // as on the desktop (issue 47, item 1).
-                    let at = match event {
-                        super::input::InputEvent::Wheel { .. } => self.input.cursor(),
-                        _ => self.input.cursor(),
-                    };
-                    match (self.session.hover.view, at) {
+                // Decided by position against the last frame's panels, as
+                // on the desktop (issue 47, item 1); none yet: the panels'.
+                InputEvent::Button { pressed: true, .. } | InputEvent::Wheel { .. } => {
+                    match (self.session.hover.view, self.input.cursor()) {
                         (Some(view), Some(at)) => preview::ui_at(ctx, view, at),
                         _ => true,
                     }
                 }
-                super::input::InputEvent::Key(_) => wants_keys,
+                InputEvent::Key(_) => wants_keys,
                 _ => false,
             } || self.session.ui.prompt_open;
-            let extruding = matches!(self.session.gesture, super::gesture::Gesture::Extrude { .. });
+            let extruding = matches!(self.session.gesture, Gesture::Extrude { .. });
             let commands = self.input.on_event(&event, consumed, self.session.state.tool, extruding);
             self.session.pointer = self.input.pointer();
             for command in commands {
