@@ -113,11 +113,7 @@ pub fn snapshot_path(journal: &Path) -> PathBuf {
 /// The journal of `document` if one was left behind.
 pub fn find(document: &Path) -> Option<PathBuf> {
     let path = journal_path(document);
-    #[cfg(not(target_arch = "wasm32"))]
-    let found = path.is_file();
-    #[cfg(target_arch = "wasm32")]
-    let found = crate::io::page_files::exists(&path);
-    found.then_some(path)
+    crate::io::input::is_file(&path).then_some(path)
 }
 
 /// Removes a journal and its snapshot: its edits were saved, recovered
@@ -178,14 +174,9 @@ impl FileStamp {
     /// The page holds no such file.
     #[cfg(target_arch = "wasm32")]
     pub fn with_hash(path: &Path, sha256: Option<String>) -> std::io::Result<FileStamp> {
-        let size = crate::io::page_files::read(path)
-            .map(|bytes| bytes.len() as u64)
-            .ok_or_else(|| std::io::Error::new(std::io::ErrorKind::NotFound, "the page holds no such file"))?;
-        let sha256 = match sha256 {
-            Some(known) => known,
-            None => crate::io::atomic::sha256_of(path)?,
-        };
-        Ok(FileStamp { size, modified: 0, sha256 })
+        let bytes = crate::io::page_files::read_existing(path)?;
+        let sha256 = sha256.unwrap_or_else(|| crate::io::atomic::sha256_of_bytes(&bytes));
+        Ok(FileStamp { size: bytes.len() as u64, modified: 0, sha256 })
     }
 
     /// The journal's note of the file it edits: `source size=N modified=S sha256=HEX`.

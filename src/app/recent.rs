@@ -34,7 +34,7 @@ impl Recent {
 
     /// The listed files that still exist, newest first.
     pub fn files(&self) -> impl Iterator<Item = &PathBuf> {
-        self.files.iter().filter(|p| exists(p))
+        self.files.iter().filter(|p| octovox::io::input::is_file(p))
     }
 
     /// Puts `path` first and saves the list.
@@ -81,14 +81,4 @@ fn list_file() -> Option<PathBuf> {
 #[cfg(target_arch = "wasm32")]
 fn list_file() -> Option<PathBuf> {
     Some(Path::new(octovox::io::page_files::OWN_FOLDER).join("recent.txt"))
-}
-
-#[cfg(not(target_arch = "wasm32"))]
-fn exists(path: &Path) -> bool {
-    path.is_file()
-}
-
-#[cfg(target_arch = "wasm32")]
-fn exists(path: &Path) -> bool {
-    octovox::io::page_files::exists(path)
 }

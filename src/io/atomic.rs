@@ -57,19 +57,26 @@ pub type Target = io::Cursor<Vec<u8>>;
 /// # Errors
 /// The file cannot be read.
 pub fn sha256_of(path: &Path) -> io::Result<String> {
+    use sha2::Digest as _;
     #[cfg(not(target_arch = "wasm32"))]
-    return sha256_hex(&mut std::fs::File::open(path)?);
+    let hasher = {
+        let mut hasher = sha2::Sha256::new();
+        io::copy(&mut std::fs::File::open(path)?, &mut hasher)?;
+        hasher
+    };
     #[cfg(target_arch = "wasm32")]
-    super::page_files::read(path)
-        .ok_or_else(|| io::Error::new(io::ErrorKind::NotFound, "the page holds no such file"))
-        .and_then(|bytes| sha256_hex(&mut bytes.as_slice()))
+    let hasher = sha2::Sha256::new_with_prefix(super::page_files::read_existing(path)?);
+    Ok(hex(&hasher.finalize()))
 }
 
-fn sha256_hex(bytes: &mut impl io::Read) -> io::Result<String> {
+/// The SHA-256 of `bytes`, in lowercase hex.
+pub fn sha256_of_bytes(bytes: &[u8]) -> String {
     use sha2::Digest as _;
-    let mut hasher = sha2::Sha256::new();
-    io::copy(bytes, &mut hasher)?;
-    Ok(hasher.finalize().iter().map(|b| format!("{b:02x}")).collect())
+    hex(&sha2::Sha256::digest(bytes))
+}
+
+fn hex(digest: &[u8]) -> String {
+    digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 
 /// Why the target cannot be written; `io::Error`s keep their own text.
@@ -203,7 +210,7 @@ pub fn write_atomically<E: From<io::Error>>(
     write(&mut target)?;
     let bytes = target.into_inner();
     if let Some(before_replace) = options.before_replace {
-        before_replace(&sha256_hex(&mut bytes.as_slice())?);
+        before_replace(&sha256_of_bytes(&bytes));
     }
     super::page_files::write(path, bytes);
     Ok(())

@@ -21,13 +21,19 @@ pub enum InputError {
 /// the browser, from the files the page holds ([`super::page_files`]).
 #[cfg(target_arch = "wasm32")]
 pub fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, InputError> {
-    let bytes = super::page_files::read(path).ok_or_else(|| {
-        io::Error::new(io::ErrorKind::NotFound, "the page holds no such file (open it with File ▸ Open or a drop)")
-    })?;
+    let bytes = super::page_files::read_existing(path)?;
     if bytes.len() as u64 > limit {
         return Err(InputError::TooLarge { limit });
     }
     Ok(bytes)
+}
+
+/// Whether `path` is a regular file (in the browser, one of the page's files).
+pub fn is_file(path: &Path) -> bool {
+    #[cfg(not(target_arch = "wasm32"))]
+    return path.is_file();
+    #[cfg(target_arch = "wasm32")]
+    super::page_files::exists(path)
 }
 
 /// Reads all of `path`, refusing devices, sockets and folders and anything

@@ -109,7 +109,7 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
 /// files have one name each.
 #[cfg(target_arch = "wasm32")]
 pub fn same_file(a: &Path, b: &Path) -> bool {
-    a == b && crate::io::page_files::exists(a)
+    a == b && crate::io::input::is_file(a)
 }
 
 #[cfg(test)]

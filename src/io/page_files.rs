@@ -59,6 +59,22 @@ pub fn read(path: &Path) -> Option<Vec<u8>> {
     FILES.with(|files| files.borrow().get(path).cloned())
 }
 
+/// The bytes of the file `path`.
+///
+/// # Errors
+/// The page holds no such file.
+pub fn read_existing(path: &Path) -> std::io::Result<Vec<u8>> {
+    read(path).ok_or_else(not_found)
+}
+
+/// The error of a name the page holds no file by.
+pub fn not_found() -> std::io::Error {
+    std::io::Error::new(
+        std::io::ErrorKind::NotFound,
+        "the page holds no such file (open it with File ▸ Open or a drop)",
+    )
+}
+
 /// Whether the page holds a file `path`.
 pub fn exists(path: &Path) -> bool {
     FILES.with(|files| files.borrow().contains_key(path))
@@ -91,7 +107,7 @@ pub fn append(path: &Path, bytes: &[u8]) {
 pub fn remove(path: &Path) -> std::io::Result<()> {
     let removed = FILES.with(|files| files.borrow_mut().remove(path));
     if removed.is_none() {
-        return Err(std::io::Error::new(std::io::ErrorKind::NotFound, "the page holds no such file"));
+        return Err(not_found());
     }
     if is_kept(path) {
         CHANGED.with(|q| q.borrow_mut().push(path.to_path_buf()));

@@ -322,10 +322,8 @@ fn open_to_append(path: &Path) -> std::io::Result<Sink> {
 
 #[cfg(target_arch = "wasm32")]
 fn open_to_append(path: &Path) -> std::io::Result<Sink> {
-    if !crate::io::page_files::exists(path) {
-        return Err(std::io::Error::new(std::io::ErrorKind::NotFound, "the page holds no such journal"));
-    }
-    Ok(PageFile(path.to_path_buf()))
+    use crate::io::page_files;
+    page_files::exists(path).then(|| PageFile(path.to_path_buf())).ok_or_else(page_files::not_found)
 }
 
 /// Takes the advisory lock of a journal, or says who holds it.
