@@ -200,11 +200,16 @@ impl Session {
         stats.path = Some(frame);
     }
 
-    /// Whether the path tracer still has work for this view: samples to
-    /// add or their filter to run (not while a dialog holds it).
-    pub(super) fn accumulating(&self, modal: bool) -> bool {
+    /// Whether the next frame is wanted at once, whatever the input: the
+    /// path tracer has samples to add or their filter to run (not while a
+    /// dialog holds it), a preview stands in for a path-traced frame, a
+    /// file loads or a script plays. (The shells add their own: flying,
+    /// `--bench-frames`.)
+    pub(super) fn keeps_drawing(&self, facts: FrameFacts, preview_before_path: bool) -> bool {
         let filtering = self.renderer.as_ref().is_some_and(|renderer| renderer.denoise_pending());
-        !modal && self.readouts.stats.path.is_some_and(|p| p.samples < self.state.sample_target || filtering)
+        let accumulating =
+            !facts.modal && self.readouts.stats.path.is_some_and(|p| p.samples < self.state.sample_target || filtering);
+        accumulating || preview_before_path || self.doc.loading.is_some() || self.doc.player.is_some()
     }
 
     /// What a file being loaded shows: its path, the seconds since it

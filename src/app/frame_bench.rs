@@ -4,6 +4,8 @@
 
 use web_time::Instant;
 
+use super::session::Session;
+
 /// Frames left and the measurements so far.
 pub struct Bench {
     left: u32,
@@ -17,22 +19,23 @@ impl Bench {
         Bench { left: frames.max(1), total: frames.max(1), started: None, trace_ms: 0.0 }
     }
 
-    /// Counts a frame that traced `size` pixels in `trace_ms` (by `clock`);
-    /// after the last, the line to report: "bench: N frames at WxH: F fps,
-    /// M ms/frame, trace T ms (CLOCK)".
-    pub fn frame(&mut self, size: (u32, u32), trace_ms: f64, clock: &str) -> Option<String> {
+    /// Counts a frame `session` just drew; after the last, the line to
+    /// report: "bench: N frames at WxH: F fps, M ms/frame, trace T ms
+    /// (GPU timestamps|wall)".
+    pub fn frame(&mut self, session: &Session) -> Option<String> {
         let Some(started) = self.started else {
             self.started = Some(Instant::now());
             return None;
         };
-        self.trace_ms += trace_ms;
+        self.trace_ms += session.readouts.stats.trace_ms;
         self.left -= 1;
         if self.left > 0 {
             return None;
         }
         let seconds = started.elapsed().as_secs_f64();
         let n = f64::from(self.total);
-        let (w, h) = size;
+        let (w, h) = session.trace_size();
+        let clock = session.renderer.as_ref().map_or("", |r| if r.timed_by_gpu() { "GPU timestamps" } else { "wall" });
         Some(format!(
             "bench: {} frames at {w}x{h}: {:.2} fps, {:.1} ms/frame, trace {:.1} ms ({clock})",
             self.total,

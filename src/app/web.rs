@@ -353,9 +353,7 @@ impl WebApp {
             return;
         }
         let Some(bench) = &mut self.bench else { return };
-        let clock =
-            self.session.renderer.as_ref().map_or("", |r| if r.timed_by_gpu() { "GPU timestamps" } else { "wall" });
-        match bench.frame(self.session.trace_size(), self.session.readouts.stats.trace_ms, clock) {
+        match bench.frame(&self.session) {
             Some(line) => {
                 report!("{line}");
                 self.bench = None;
@@ -379,11 +377,8 @@ impl WebApp {
             Ok(submitted) => self.session.frame_submitted(path, submitted, &mut self.path_reported),
             Err(err) => log::error!("the frame failed: {err}"),
         }
-        let animating = self.session.accumulating(facts.modal)
-            || self.preview_before_path
-            || self.session.doc.loading.is_some()
-            || self.input.fly_direction().is_some()
-            || self.session.doc.player.is_some();
+        let animating =
+            self.session.keeps_drawing(facts, self.preview_before_path) || self.input.fly_direction().is_some();
         if animating {
             ctx.request_repaint();
         } else if let Some(at) = self.motion.settles_at() {

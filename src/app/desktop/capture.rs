@@ -63,11 +63,8 @@ impl App {
         if !self.frames.ready {
             return;
         }
-        let (w, h) = self.session.trace_size();
-        let clock =
-            self.session.renderer.as_ref().map_or("", |g| if g.timed_by_gpu() { "GPU timestamps" } else { "wall" });
         let Some(bench) = &mut self.frames.bench else { return };
-        if let Some(line) = bench.frame((w, h), self.session.readouts.stats.trace_ms, clock) {
+        if let Some(line) = bench.frame(&self.session) {
             report!("{line}");
             self.frames.bench = None;
             event_loop.exit();

@@ -190,13 +190,10 @@ impl App {
     /// Keeps drawing while something moves; otherwise waits for input (or
     /// for when egui asks to be drawn again).
     fn schedule_repaint(&mut self, repaint_delay: Option<Duration>) {
-        let accumulating = self.session.accumulating(self.modal_open());
-        let animating = accumulating
-            || self.frames.preview_before_path
-            || self.session.doc.loading.is_some()
+        let facts = FrameFacts { moving: self.frames.motion.moving(), modal: self.modal_open() };
+        let animating = self.session.keeps_drawing(facts, self.frames.preview_before_path)
             || self.input.fly_direction().is_some()
-            || self.frames.bench.is_some()
-            || self.session.doc.player.is_some();
+            || self.frames.bench.is_some();
         self.frames.next_repaint = match repaint_delay {
             _ if animating => Some(Instant::now()),
             // An open native dialog is looked at ten times a second.
