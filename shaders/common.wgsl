@@ -101,6 +101,13 @@ struct Hit {
     found: bool,
     // The instance hit (NO_INSTANCE: a scene of one model).
     instance: u32,
+    // A freely turned object's face (`TurnedFace` in src/trace/mod.rs):
+    // `voxel` then holds the hit cell's turned centre, `normal_code` is the
+    // nearest axis, and these the face's normal and the centre of the cell
+    // in front of it.
+    turned: bool,
+    turned_normal: vec3<f32>,
+    outside: vec3<f32>,
 }
 
 struct Slab {
@@ -260,10 +267,15 @@ fn surface_albedo(value: u32) -> vec3<f32> {
     return select(unpack4x8unorm(palette[min(value, 255u)]).rgb, GROUND_ALBEDO, value == GROUND_SURFACE);
 }
 
+// The face's normal as shading sees it (twin of `Hit::shading_normal`).
+fn hit_normal(hit: Hit) -> vec3<f32> {
+    return select(normal_vector(hit.normal_code), hit.turned_normal, hit.turned);
+}
+
 // The shadow ray starts in the empty voxel in front of the entered face.
 fn shadow_ray(hit: Hit) -> Ray {
     let o = vec3<f32>(hit.voxel) + normal_vector(hit.normal_code) + vec3<f32>(0.5);
-    return make_ray(o, SUN_DIR);
+    return make_ray(select(o, hit.outside, hit.turned), SUN_DIR);
 }
 
 fn sky_color(d: vec3<f32>) -> vec3<f32> {
@@ -299,7 +311,7 @@ fn gave_up(hit: Hit) -> bool {
 
 // Twin of `shade` in src/trace/render.rs.
 fn shade(hit: Hit, d: vec3<f32>, in_shadow: bool) -> vec3<f32> {
-    let n = normal_vector(hit.normal_code);
+    let n = hit_normal(hit);
     switch (u.view) {
         case VIEW_ITERATIONS: {
             return heat(f32(hit.iterations) / 160.0);

@@ -13,25 +13,45 @@ override INSTANCES: bool = false;
 const NO_ENTRY: f32 = 3.0e38;
 
 // An instance: its model's tree, and model cell m[j] = ±s[src[j]] + offset[j]
-// of scene cell s (minus where `negative[j]`).
+// of scene cell s (minus where `negative[j]`); or where `turned`, model
+// point m = rows · s + t of scene point s (`Turned` in src/scene/instances.rs).
 struct Instance {
     tree: Tree,
     src: vec3<u32>,
     negative: vec3<bool>,
     offset: vec3<i32>,
+    turned: bool,
+    rows: mat3x3<f32>,
+    t: vec3<f32>,
 }
 
 fn load_instance(index: u32) -> Instance {
     let at = (u.instance_nodes * BVH_NODE_WORDS + index * INSTANCE_WORDS) / 4u;
     let a = instances[at];
     let b = instances[at + 1u];
-    let axes = a.w >> 8u;
+    let axes = (a.w & ~TURNED_BIT) >> 8u;
     var inst: Instance;
     inst.tree = Tree(a.x, a.w & 0xffu, a.y, a.z, b.x);
     inst.src = vec3<u32>(axes & 3u, (axes >> 2u) & 3u, (axes >> 4u) & 3u);
     inst.negative = (vec3<u32>(axes) & vec3<u32>(64u, 128u, 256u)) != vec3<u32>(0u);
     inst.offset = bitcast<vec3<i32>>(b.yzw);
+    inst.turned = (a.w & TURNED_BIT) != 0u;
+    if (inst.turned) {
+        inst.t = bitcast<vec3<f32>>(b.yzw);
+        // The rows as the columns of a matrix: `v * rows` is rows · v.
+        inst.rows = mat3x3<f32>(
+            bitcast<vec4<f32>>(instances[at + 2u]).xyz,
+            bitcast<vec4<f32>>(instances[at + 3u]).xyz,
+            bitcast<vec4<f32>>(instances[at + 4u]).xyz,
+        );
+    }
     return inst;
+}
+
+// A turned instance's scene point of model point `m` (`Turned::scene_point`:
+// the rows are orthogonal, so their transpose undoes them).
+fn turned_scene_point(inst: Instance, m: vec3<f32>) -> vec3<f32> {
+    return inst.rows * (m - inst.t);
 }
 
 // A node of the tree of boxes (its words: src/scene/instances.rs).
@@ -55,6 +75,9 @@ fn load_node(i: u32) -> BoxNode {
 
 // The ray in the model's tree-local frame: the same t reaches the same point.
 fn model_ray(inst: Instance, r: Ray) -> Ray {
+    if (inst.turned) {
+        return make_ray(r.o * inst.rows + inst.t, r.d * inst.rows);
+    }
     let s = select(vec3<f32>(1.0), vec3<f32>(-1.0), inst.negative);
     let o = vec3<f32>(r.o[inst.src.x], r.o[inst.src.y], r.o[inst.src.z]);
     let d = vec3<f32>(r.d[inst.src.x], r.d[inst.src.y], r.d[inst.src.z]);
@@ -62,8 +85,40 @@ fn model_ray(inst: Instance, r: Ray) -> Ray {
     return Ray(s * o + vec3<f32>(inst.offset), s * d, s * inv);
 }
 
+// The code of the axis nearest `n` (twin of `nearest_axis`).
+fn nearest_axis_code(n: vec3<f32>) -> u32 {
+    let a = abs(n);
+    var axis = 2u;
+    if (a.x >= a.y && a.x >= a.z) {
+        axis = 0u;
+    } else if (a.y >= a.z) {
+        axis = 1u;
+    }
+    return 1u + 2u * axis + select(0u, 1u, n[axis] < 0.0);
+}
+
+// A hit in a turned model's frame, in the scene's (twin of `turned_hit` in
+// src/trace/instanced.rs).
+fn turned_hit(inst: Instance, h: Hit) -> Hit {
+    var out = h;
+    out.voxel = vec3<i32>(floor(turned_scene_point(inst, vec3<f32>(h.voxel) + vec3<f32>(0.5))));
+    if (h.normal_code != 0u) {
+        let n = normal_vector(h.normal_code);
+        out.turned = true;
+        out.turned_normal = inst.rows * n;
+        out.normal_code = nearest_axis_code(out.turned_normal);
+        out.outside = turned_scene_point(inst, vec3<f32>(h.voxel) + n + vec3<f32>(0.5));
+    }
+    return out;
+}
+
 // A hit in the model's frame, in the scene's.
 fn scene_hit(inst: Instance, index: u32, h: Hit) -> Hit {
+    if (inst.turned) {
+        var out = turned_hit(inst, h);
+        out.instance = index;
+        return out;
+    }
     var out = h;
     let d = h.voxel - inst.offset;
     // Cell m spans m..m + 1: mirrored, its low corner is the image of m + 1.

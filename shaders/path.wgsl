@@ -179,11 +179,28 @@ fn ior_of(index: u32) -> f32 {
 // The point where the ray enters the voxel it found: on the entered face's
 // plane exactly (twin of `surface_point`).
 fn surface_point(r: Ray, hit: Hit) -> vec3<f32> {
+    if (hit.turned) {
+        // A turned face lies on no plane of the grid.
+        return r.o + r.d * hit.t;
+    }
     let lo = vec3<f32>(hit.voxel);
     var p = clamp(r.o + r.d * hit.t, lo, lo + vec3<f32>(1.0));
     let axis = (hit.normal_code - 1u) / 2u;
     p[axis] = lo[axis] + select(0.0, 1.0, hit.normal_code % 2u == 1u);
     return p;
+}
+
+// How far a ray leaving the face `hit` starts off it (twin of `lift_of` in
+// src/trace/path/mod.rs): TURNED_LIFT of the point's size on a turned face.
+fn lift_of(hit: Hit, p: vec3<f32>) -> f32 {
+    let a = abs(p);
+    return select(0.0, TURNED_LIFT * max(max(max(a.x, a.y), a.z), 1.0), hit.turned);
+}
+
+// Where a ray in direction `dir` leaving the face at `p` (normal `n`)
+// starts: `lift` off the face, on the side `dir` goes to (twin of `leave`).
+fn leave(p: vec3<f32>, n: vec3<f32>, lift: f32, dir: vec3<f32>) -> vec3<f32> {
+    return p + n * select(-lift, lift, dot(dir, n) >= 0.0);
 }
 
 fn environment(dir: vec3<f32>, lights_counted: bool) -> vec3<f32> {
@@ -425,7 +442,9 @@ fn radiance(ray_in: Ray) -> vec3<f32> {
             return radiance;
         }
         let p = surface_point(ray, hit);
-        let n = normal_vector(hit.normal_code);
+        let n = hit_normal(hit);
+        let lift = lift_of(hit, p);
+        let p_out = leave(p, n, lift, n);
         let d = normalize(ray.d);
         let value = hit.value;
         let m = material_of(value);
@@ -465,7 +484,7 @@ fn radiance(ray_in: Ray) -> vec3<f32> {
                 let lobe = glossy_lobe(-d, albedo, m);
                 let sampled = lobe.alpha >= MIN_SAMPLED_ALPHA;
                 if (sampled) {
-                    radiance += beta * direct(p, n, lobe) / p_spec;
+                    radiance += beta * direct(p_out, n, lobe) / p_spec;
                 }
                 let s = metal_lobe(d, n, albedo, m);
                 if (!s.ok) {
@@ -476,7 +495,7 @@ fn radiance(ray_in: Ray) -> vec3<f32> {
                 lights_counted = sampled;
             } else {
                 let diffuse = albedo * (1.0 - m.metalness) / (1.0 - p_spec);
-                radiance += beta * diffuse * direct(p, n, diffuse_lobe());
+                radiance += beta * diffuse * direct(p_out, n, diffuse_lobe());
                 let u1 = rng_next();
                 let u2 = rng_next();
                 dir = cosine_direction(n, u1, u2);
@@ -486,7 +505,7 @@ fn radiance(ray_in: Ray) -> vec3<f32> {
         } else {
             bounces += 1u;
             let albedo = surface_albedo(value);
-            radiance += beta * albedo * direct(p, n, diffuse_lobe());
+            radiance += beta * albedo * direct(p_out, n, diffuse_lobe());
             let u1 = rng_next();
             let u2 = rng_next();
             dir = cosine_direction(n, u1, u2);
@@ -496,7 +515,7 @@ fn radiance(ray_in: Ray) -> vec3<f32> {
         if (transmissions > MAX_TRANSMISSIONS) {
             return radiance;
         }
-        ray = make_ray(p, dir);
+        ray = make_ray(leave(p, n, lift, dir), dir);
     }
     return radiance;
 }

@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 
 use super::layout::{FLOOR_ROW, GRID_MIX, HIGHLIGHT_MIX, HIGHLIGHT_TINT, ROW_TILES};
 use crate::gpu_pool::{LOD_WORD, NODE_WORDS, POINTER_BIT};
-use crate::scene::instances::{BVH_NODE_WORDS, BVH_STACK, EMPTY_BIT, INSTANCE_WORDS, NO_INSTANCE, TIE_T};
+use crate::scene::instances::{BVH_NODE_WORDS, BVH_STACK, EMPTY_BIT, INSTANCE_WORDS, NO_INSTANCE, TIE_T, TURNED_BIT};
 use crate::settings::{SUN_DIR, View};
 use crate::trace::denoise;
 use crate::trace::path::{self, materials};
@@ -33,6 +33,7 @@ pub fn shared_constants() -> String {
     line("INSTANCE_WORDS", "u32", format!("{INSTANCE_WORDS}u"));
     line("NO_INSTANCE", "u32", format!("{NO_INSTANCE:#x}u"));
     line("TIE_T", "f32", format!("{TIE_T:?}"));
+    line("TURNED_BIT", "u32", format!("{TURNED_BIT:#x}u"));
     line("ROW_TILES", "u32", format!("{ROW_TILES}u"));
     line("FLOOR_ROW", "u32", format!("{FLOOR_ROW}u"));
     line("HIGHLIGHT_TINT", "vec3<f32>", vec3(HIGHLIGHT_TINT));
@@ -50,6 +51,7 @@ pub fn shared_constants() -> String {
     line("R2_STEP_Y", "u32", format!("{}u", path::rng::R2_STEP[1]));
     line("R2_SHIFT_SEED", "u32", format!("{:#x}u", path::rng::R2_SHIFT_SEED));
     line("MAX_TRANSMISSIONS", "u32", format!("{}u", path::MAX_TRANSMISSIONS));
+    line("TURNED_LIFT", "f32", format!("{:?}", path::TURNED_LIFT));
     line("MIN_SAMPLED_ALPHA", "f32", format!("{:?}", path::MIN_SAMPLED_ALPHA));
     line("MATERIAL_DIFFUSE", "u32", format!("{}u", materials::MATERIAL_DIFFUSE));
     line("MATERIAL_METAL", "u32", format!("{}u", materials::MATERIAL_METAL));

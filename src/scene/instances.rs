@@ -1,7 +1,7 @@
 //! The top level of two-level ray tracing: one record per placed object
 //! (its model, and the signed permutation and integer offset that take
-//! scene cells to the model's cells) and a bounding-volume tree over their
-//! boxes. The GPU reads both as words ([`InstanceTable::words`]); the CPU
+//! scene cells to the model's cells, or for a free turn the rigid map of
+//! points, [`Turned`]) and a bounding-volume tree over their boxes. The GPU reads both as words ([`InstanceTable::words`]); the CPU
 //! reference walks the same records (`crate::trace::instanced`).
 //!
 //! The tree is balanced over the objects in walk order: its shape depends
@@ -9,9 +9,10 @@
 //! changes its leaf and the boxes above it that change, nothing else. Walk
 //! order follows the file's groups, which MagicaVoxel users build spatially.
 
-use glam::IVec3;
+use glam::{DMat3, DVec3, IVec3, Vec3};
 
 use super::objects::{Model, Objects};
+use super::transform::Placing;
 use crate::gpu_pool::{BRICK_BYTES, NODE_BYTES, PoolTooLarge};
 
 /// Words of one tree node on the GPU: the box's min corner and its max
@@ -31,12 +32,15 @@ pub const LEAF_WORD: usize = 7;
 /// under it hidden or empty. A traversal skips it without a box test.
 pub const EMPTY_BIT: u32 = 0x8000_0000;
 /// Words of one instance record on the GPU (see [`InstanceTable::words`]).
-pub const INSTANCE_WORDS: usize = 8;
+pub const INSTANCE_WORDS: usize = 20;
+/// Bit of a record's depth word marking a freely turned instance: the
+/// words after it hold its map of points ([`Turned`]).
+pub const TURNED_BIT: u32 = 0x8000_0000;
 /// The instance of a hit in a scene of one model.
 pub const NO_INSTANCE: u32 = u32::MAX;
 // `load_node` and `load_instance` in shaders/instances.wgsl read a node and
 // a record as two four-word loads, by these positions.
-const _: () = assert!(BVH_NODE_WORDS == 8 && SKIP_WORD == 6 && LEAF_WORD == 7 && INSTANCE_WORDS == 8);
+const _: () = assert!(BVH_NODE_WORDS == 8 && SKIP_WORD == 6 && LEAF_WORD == 7 && INSTANCE_WORDS == 20);
 
 /// Two hits closer than this (in t, relative to t, at least 1) count as one
 /// distance: the later object in walk order wins there, as composing gives.
@@ -45,8 +49,9 @@ const _: () = assert!(BVH_NODE_WORDS == 8 && SKIP_WORD == 6 && LEAF_WORD == 7 &&
 pub const TIE_T: f32 = 1.0 / 65536.0;
 
 /// One placed object: scene-local cell `s` is model tree-local cell `m` with
-/// `m[j] = sign[j] · s[src[j]] + offset[j]` (continuous points likewise).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// `m[j] = sign[j] · s[src[j]] + offset[j]` (continuous points likewise),
+/// unless it is freely turned (`turned`).
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Instance {
     pub model: usize,
     pub src: [usize; 3],
@@ -54,6 +59,74 @@ pub struct Instance {
     pub offset: IVec3,
     /// Inclusive scene-local box of its voxels; `None` when hidden or empty.
     pub bounds: Option<(IVec3, IVec3)>,
+    pub turned: Option<Turned>,
+}
+
+/// A freely turned instance as the tracers move rays: tree-local model
+/// point `m = rows · s + t` of scene-local point `s`, in f32 as the GPU
+/// computes it (`rows` orthogonal, a mirror included). A quarter turn given
+/// as a free one has rows of 0 and ±1 and a whole `t`, so it moves rays
+/// exactly as the integer path does. Twin of `model_ray` in
+/// shaders/instances.wgsl.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Turned {
+    pub rows: [Vec3; 3],
+    pub t: Vec3,
+}
+
+impl Turned {
+    /// The turned map of model grid points `x = m · (w − shift) + c` of
+    /// world points `w` (`TurnedMap::to_model`), for a scene whose local
+    /// cells start at world cell `origin` and a tree whose cells start at
+    /// model cell `tree_origin`. The translation is summed in f64 and
+    /// rounded once.
+    pub fn new((m, shift, c): (DMat3, IVec3, DVec3), origin: IVec3, tree_origin: IVec3) -> Turned {
+        let t = m * (origin - shift).as_dvec3() + c - tree_origin.as_dvec3();
+        let m = m.transpose();
+        Turned { rows: [m.x_axis.as_vec3(), m.y_axis.as_vec3(), m.z_axis.as_vec3()], t: t.as_vec3() }
+    }
+
+    /// `rows · v`, each row's products summed left to right (as the shader).
+    fn times(&self, v: Vec3) -> Vec3 {
+        Vec3::from_array(self.rows.map(|r| r.x * v.x + r.y * v.y + r.z * v.z))
+    }
+
+    /// `rowsᵀ · v`: the inverse, as the rows are orthogonal.
+    fn times_transposed(&self, v: Vec3) -> Vec3 {
+        let [a, b, c] = self.rows;
+        a * v.x + b * v.y + c * v.z
+    }
+
+    /// The model tree-local point of scene-local point `p`.
+    pub fn model_point(&self, p: Vec3) -> Vec3 {
+        self.times(p) + self.t
+    }
+
+    /// The model direction of scene direction `d`.
+    pub fn model_dir(&self, d: Vec3) -> Vec3 {
+        self.times(d)
+    }
+
+    /// The scene-local point of model tree-local point `m`.
+    pub fn scene_point(&self, m: Vec3) -> Vec3 {
+        self.times_transposed(m - self.t)
+    }
+
+    /// The scene direction of model direction `n`.
+    pub fn scene_dir(&self, n: Vec3) -> Vec3 {
+        self.times_transposed(n)
+    }
+
+    /// The record's words after the header: `t`, then the rows, each
+    /// padded to four words, as f32 bits.
+    fn words(&self) -> [u32; 15] {
+        let mut words = [0; 15];
+        words[..3].copy_from_slice(&self.t.to_array().map(f32::to_bits));
+        for (i, row) in self.rows.iter().enumerate() {
+            words[3 + 4 * i..6 + 4 * i].copy_from_slice(&row.to_array().map(f32::to_bits));
+        }
+        words
+    }
 }
 
 impl Instance {
@@ -89,7 +162,7 @@ pub struct BvhNode {
 }
 
 /// The instances of a scene of objects and the tree over their boxes.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct InstanceTable {
     pub instances: Vec<Instance>,
     pub nodes: Vec<BvhNode>,
@@ -105,9 +178,19 @@ impl InstanceTable {
                 let object = &objects.list()[i];
                 let model = object.placement.model;
                 let tree_origin = objects.models[model].tree.origin();
-                let mut instance = Instance { model, src: [0; 3], sign: [1; 3], offset: IVec3::ZERO, bounds: None };
-                // A scene with a free turn is drawn composed (`Scene::instanced`).
-                let Some(&map) = objects.map(i).cells() else { return instance };
+                let mut instance =
+                    Instance { model, src: [0; 3], sign: [1; 3], offset: IVec3::ZERO, bounds: None, turned: None };
+                let map = match objects.map(i) {
+                    Placing::Cells(map) => map,
+                    Placing::Turned(map) => {
+                        instance.turned = Some(Turned::new(map.to_model(), origin, tree_origin));
+                        instance.bounds = model_bounds[model]
+                            .filter(|_| !object.hidden)
+                            .map(|(lo, hi)| map.cover_box(lo, hi))
+                            .map(|(lo, hi)| (lo - origin, hi - origin));
+                        return instance;
+                    }
+                };
                 for (row, (axis, sign, offset)) in map.rows().into_iter().enumerate() {
                     // w = sign · v + offset on cells; on points a mirrored
                     // axis adds one (cell v spans v..v + 1).
@@ -134,8 +217,9 @@ impl InstanceTable {
     /// instance, given where each model's pool lies in the pool buffer.
     /// A record: the model's root word, its first node slot, the word its
     /// bricks start at, its depth in the low byte with the axes above
-    /// (`src[j]` in bits 8 + 2j, a mirrored `j` in bit 14 + j), its
-    /// iteration bound, and the offset.
+    /// (`src[j]` in bits 8 + 2j, a mirrored `j` in bit 14 + j, and
+    /// [`TURNED_BIT`]), its iteration bound, and the offset; a turned
+    /// record has its map of points there instead ([`Turned::words`]).
     pub fn words(&self, models: &[Model], regions: &[ModelRegion], brick_words: u32) -> Vec<u32> {
         let mut words = Vec::with_capacity(self.nodes.len() * BVH_NODE_WORDS + self.instances.len() * INSTANCE_WORDS);
         for node in &self.nodes {
@@ -154,14 +238,22 @@ impl InstanceTable {
                 axes |= (instance.src[j] as u32) << (2 * j);
                 axes |= u32::from(instance.sign[j] < 0) << (6 + j);
             }
+            let (turned, tail) = match &instance.turned {
+                Some(turned) => (TURNED_BIT, turned.words()),
+                None => {
+                    let mut tail = [0; 15];
+                    tail[..3].copy_from_slice(&instance.offset.to_array().map(|c| c as u32));
+                    (0, tail)
+                }
+            };
             words.extend([
                 tree.root_word(),
                 region.node_base,
                 brick_words + 2 * region.brick_base,
-                tree.depth() | axes << 8,
+                tree.depth() | axes << 8 | turned,
                 super::octree::iteration_bound(tree.depth()),
             ]);
-            words.extend(instance.offset.to_array().map(|c| c as u32));
+            words.extend(tail);
         }
         words
     }

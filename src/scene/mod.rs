@@ -169,11 +169,13 @@ impl Scene {
     /// model saved in 256³ blocks, or a few small references) is drawn as
     /// its objects composed into one octree: CPU-emulated GPUs trace one
     /// octree 2.5–3.5x faster than instances (docs/bench/scene.md).
-    /// A scene with a free turn is drawn composed: its turned objects land
-    /// on the world cells their centres fall in, which instance records of
-    /// signed permutations cannot say.
+    /// A scene with a free turn is always drawn as instances: a turned
+    /// object is traced exactly in its own frame (its record holds the
+    /// rotation), while the composed tree, which checks, counts and saves
+    /// read, holds the world cells its turned cells' centres fall in.
     pub fn instanced(&self) -> Option<&objects::Objects> {
-        self.objects().filter(|o| !o.has_free_turns()).filter(|o| match self.instancing {
+        self.objects().filter(|o| match self.instancing {
+            _ if o.has_free_turns() => true,
             Instancing::Auto => draws_instances(o, &self.tree),
             Instancing::References => o.has_references(),
         })

@@ -498,6 +498,24 @@ impl TurnedMap {
         (lo.saturating_add(self.shift), hi.saturating_add(self.shift))
     }
 
+    /// The world cells the turned cubes of model cells `lo..=hi` reach
+    /// into: the cells around the turned box of points, which an exact
+    /// tracer's box must hold (wider than [`TurnedMap::apply_box`]).
+    pub fn cover_box(&self, lo: IVec3, hi: IVec3) -> (IVec3, IVec3) {
+        let (min, max) = image_box(|x| self.world_unshifted(x), lo.as_dvec3(), (hi + IVec3::ONE).as_dvec3());
+        let (lo, hi) = (min.floor().as_ivec3(), max.ceil().as_ivec3() - IVec3::ONE);
+        (lo.saturating_add(self.shift), hi.saturating_add(self.shift))
+    }
+
+    /// The map from world points to model grid points, in parts: model
+    /// point `x = m · (w − shift) + c` of world point `w`, with `m`
+    /// orthogonal and `shift` the translation's whole part (kept out of
+    /// the floats, so the tracers subtract it before they round).
+    pub fn to_model(&self) -> (DMat3, IVec3, DVec3) {
+        let m = self.a.transpose();
+        (m, self.shift, -(m * self.frac))
+    }
+
     /// The model cells [`TurnedMap::invert`] gives for the world cells
     /// `lo..=hi`: those holding their centres' preimages.
     pub fn invert_box(&self, lo: IVec3, hi: IVec3) -> (IVec3, IVec3) {

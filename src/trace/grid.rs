@@ -98,7 +98,7 @@ pub fn trace(grid: &DenseGrid, ray: &Ray) -> Hit {
         let value = grid.at(voxel);
         if value != 0 {
             let normal = if axis == NO_AXIS { IVec3::ZERO } else { ray.entry_normal(axis) };
-            return Hit { value, voxel, normal, cell_level: 0, iterations, gave_up: false };
+            return Hit { value, voxel, normal, cell_level: 0, iterations, gave_up: false, turned: None };
         }
         // Exit t of each plane, recomputed from the plane (not accumulated).
         let exits = (voxel.as_vec3() + far_offset - ray.origin) * ray.inv;

@@ -4,12 +4,12 @@
 //! tree of instance boxes and the same rule for ties, so change both
 //! together.
 
-use glam::IVec3;
+use glam::{IVec3, Vec3};
 
 use super::svo::{self, Crossing};
-use super::{Footprint, Hit, Ray};
+use super::{Footprint, Hit, Ray, TurnedFace, nearest_axis};
 use crate::scene::Scene;
-use crate::scene::instances::{BVH_STACK, Instance, InstanceTable, TIE_T};
+use crate::scene::instances::{BVH_STACK, Instance, InstanceTable, TIE_T, Turned};
 use crate::scene::objects::Model;
 use crate::scene::octree::Octree;
 
@@ -140,6 +140,9 @@ fn entry_t(table: &InstanceTable, i: usize, ray: &Ray, until: f32) -> Option<f32
 
 /// The ray in the model's tree-local frame: the same t reaches the same point.
 fn model_ray(instance: &Instance, ray: &Ray) -> Ray {
+    if let Some(turned) = &instance.turned {
+        return Ray::new(turned.model_point(ray.origin), turned.model_dir(ray.dir));
+    }
     let mut out = *ray;
     for j in 0..3 {
         let (src, sign) = (instance.src[j], instance.sign[j] as f32);
@@ -152,6 +155,25 @@ fn model_ray(instance: &Instance, ray: &Ray) -> Ray {
 
 /// A crossing in the model's frame, in the scene's.
 fn scene_crossing(instance: &Instance, index: u32, c: Crossing) -> Crossing {
-    let hit = Hit { voxel: instance.cell_to_scene(c.hit.voxel), normal: instance.dir_to_scene(c.hit.normal), ..c.hit };
+    let hit = match &instance.turned {
+        Some(turned) => turned_hit(turned, c.hit),
+        None => {
+            Hit { voxel: instance.cell_to_scene(c.hit.voxel), normal: instance.dir_to_scene(c.hit.normal), ..c.hit }
+        }
+    };
     Crossing { hit, instance: Some(index), ..c }
+}
+
+/// A hit in a turned model's frame, in the scene's: the cell holding the
+/// hit cell's centre, the axis nearest the face's normal, and the face.
+/// Twin of `turned_hit` in shaders/instances.wgsl.
+fn turned_hit(turned: &Turned, hit: Hit) -> Hit {
+    let centre = |cell: IVec3| turned.scene_point(cell.as_vec3() + Vec3::splat(0.5));
+    let voxel = centre(hit.voxel).floor().as_ivec3();
+    if hit.normal == IVec3::ZERO {
+        return Hit { voxel, ..hit };
+    }
+    let normal = turned.scene_dir(hit.normal.as_vec3());
+    let face = TurnedFace { normal, outside: centre(hit.voxel + hit.normal), cell: hit.voxel, cell_normal: hit.normal };
+    Hit { voxel, normal: nearest_axis(normal), turned: Some(face), ..hit }
 }

@@ -57,8 +57,10 @@ pub const NO_AXIS: usize = 3;
 pub const MIN_DIRECTION: f32 = 1.0 / 8_388_608.0; // 2^-23
 
 /// What a ray found. `voxel` is tree-local; `normal` is the entered face
-/// (zero when the ray starts inside a solid voxel).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+/// (zero when the ray starts inside a solid voxel). In a freely turned
+/// object `voxel` is the cell holding the hit cell's turned centre, `normal`
+/// the axis nearest the face's, and `turned` the face exactly.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct Hit {
     pub value: u8,
     pub voxel: IVec3,
@@ -70,9 +72,28 @@ pub struct Hit {
     /// The ray ran out of iterations ([`iteration_bound`]) before it hit a
     /// voxel or left the tree: not a miss, an unknown.
     pub gave_up: bool,
+    pub turned: Option<TurnedFace>,
+}
+
+/// The face of a freely turned object's cell that a ray entered, in the
+/// scene's frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TurnedFace {
+    pub normal: Vec3,
+    /// The centre of the model cell in front of the face (where a shadow
+    /// ray starts, as from the empty voxel in front of an unturned face).
+    pub outside: Vec3,
+    /// The model cell hit (tree-local) and the face's model normal.
+    pub cell: IVec3,
+    pub cell_normal: IVec3,
 }
 
 impl Hit {
+    /// The face's normal as shading sees it (zero: none).
+    pub fn shading_normal(&self) -> Vec3 {
+        self.turned.map_or(self.normal.as_vec3(), |face| face.normal)
+    }
+
     pub fn is_hit(&self) -> bool {
         self.value != 0
     }
@@ -96,6 +117,7 @@ impl Hit {
             cell_level: (info >> 11) & 31,
             iterations: info >> 16,
             gave_up: info >> 16 == GAVE_UP_RECORD,
+            turned: None,
         }
     }
 }
@@ -115,6 +137,22 @@ pub fn normal_code(n: IVec3) -> u32 {
         }
     }
     0
+}
+
+/// The unit axis vector nearest `n` (ties to x, then y): a turned face's
+/// normal as a code. Twin of `nearest_axis_code` in shaders/instances.wgsl.
+pub fn nearest_axis(n: Vec3) -> IVec3 {
+    let a = n.abs();
+    let axis = if a.x >= a.y && a.x >= a.z {
+        0
+    } else if a.y >= a.z {
+        1
+    } else {
+        2
+    };
+    let mut out = IVec3::ZERO;
+    out[axis] = if n[axis] < 0.0 { -1 } else { 1 };
+    out
 }
 
 pub fn normal_from_code(code: u32) -> IVec3 {

@@ -86,6 +86,9 @@ pub fn ground_landings(hits: &[Hit], basis: &RayBasis, y: i32) -> Vec<Option<Lan
 /// voxel in front of the entered face, so it never starts inside the surface
 /// (shadows are per face, which suits voxels). Mirrors `shadow_origin` in WGSL.
 pub fn shadow_ray(hit: &Hit) -> Option<Ray> {
+    if let Some(face) = hit.turned.filter(|_| hit.is_hit()) {
+        return Some(Ray::new(face.outside, Vec3::from(SUN_DIR)));
+    }
     (hit.is_hit() && hit.normal != IVec3::ZERO).then(|| sun_ray_from(hit.voxel + hit.normal))
 }
 
@@ -114,9 +117,10 @@ pub fn shade(hit: &Hit, dir: Vec3, palette: &Palette, view: View, in_shadow: boo
         View::Shaded if hit.is_hit() => {
             let c = palette.color(hit.value);
             let albedo = Vec3::new(f32::from(c[0]), f32::from(c[1]), f32::from(c[2])) / 255.0;
-            let lambert = hit.normal.as_vec3().dot(Vec3::from(SUN_DIR)).max(0.0);
+            let n = hit.shading_normal();
+            let lambert = n.dot(Vec3::from(SUN_DIR)).max(0.0);
             let sun = if in_shadow { 0.0 } else { lambert };
-            let sky = if hit.normal == IVec3::ZERO { 0.0 } else { 0.5 + 0.5 * hit.normal.y as f32 };
+            let sky = if hit.normal == IVec3::ZERO { 0.0 } else { 0.5 + 0.5 * n.y };
             albedo * (0.25 + 0.15 * sky + 0.6 * sun)
         }
         View::Shaded if hit.gave_up() => GAVE_UP_COLOR,
@@ -124,7 +128,7 @@ pub fn shade(hit: &Hit, dir: Vec3, palette: &Palette, view: View, in_shadow: boo
         View::Iterations => heat(hit.iterations as f32 / 160.0),
         View::Depth if hit.is_hit() => heat((hit.cell_level as f32 + 1.0) / 8.0),
         View::Depth => Vec3::ZERO,
-        View::Normals if hit.is_hit() => hit.normal.as_vec3() * 0.5 + Vec3::splat(0.5),
+        View::Normals if hit.is_hit() => hit.shading_normal() * 0.5 + Vec3::splat(0.5),
         View::Normals => Vec3::ZERO,
     };
     display_rgba(rgb)

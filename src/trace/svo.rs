@@ -171,6 +171,6 @@ fn child_cell(ray: &Ray, min: IVec3, level: u32, t: f32, entry_axis: usize) -> I
 fn hit_cell(ray: &Ray, value: u8, min: IVec3, level: u32, t: f32, axis: usize, iterations: u32) -> Crossing {
     let voxel = ray.voxel_in_box(min, min + IVec3::splat((1 << level) - 1), t, axis);
     let normal = if axis == NO_AXIS { IVec3::ZERO } else { ray.entry_normal(axis) };
-    let hit = Hit { value, voxel, normal, cell_level: level, iterations, gave_up: false };
+    let hit = Hit { value, voxel, normal, cell_level: level, iterations, gave_up: false, turned: None };
     Crossing { hit, t, found: true, instance: None }
 }

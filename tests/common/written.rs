@@ -55,3 +55,62 @@ pub fn herd(count: u32) -> DotVoxData {
         layers: vec![Layer { attributes: dict(&[("_name", "0".into())]) }],
     }
 }
+
+/// `count` objects of one 6 × 5 × 4 block (a colour per layer, a notch cut
+/// into one corner) on a grid 14 apart, each turned by a random unit
+/// quaternion `_ov_turn` (beside `_r` 4, no quarter turn) drawn from `seed`.
+pub fn turned_herd(count: u32, seed: u64) -> DotVoxData {
+    let mut voxels = Vec::new();
+    for x in 0..6u8 {
+        for y in 0..5u8 {
+            for z in 0..4u8 {
+                if !(x < 2 && y < 2 && z > 1) {
+                    voxels.push(Voxel { x, y, z, i: 20 + 16 * z + (x + y) % 3 });
+                }
+            }
+        }
+    }
+    let mut state = seed;
+    let mut uniform = move || {
+        // SplitMix64: a fixed, seedable stream.
+        state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut scenes = vec![
+        SceneNode::Transform { attributes: dict(&[]), frames: vec![], child: 1, layer_id: u32::MAX },
+        SceneNode::Group { attributes: dict(&[]), children: (0..count).map(|k| 2 + 2 * k).collect() },
+    ];
+    for k in 0..count {
+        let (x, y) = ((k % 10) as i32 * 14, (k / 10) as i32 * 14);
+        // A uniform random rotation (Shoemake's subgroup algorithm).
+        let (u1, u2, u3) = (uniform(), uniform() * std::f64::consts::TAU, uniform() * std::f64::consts::TAU);
+        let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
+        let q = [a * u2.sin(), a * u2.cos(), b * u3.sin(), b * u3.cos()];
+        let key = dict(&[
+            ("_t", format!("{x} {y} {}", (k % 3) as i32 * 5)),
+            ("_ov_turn", format!("{} {} {} {}", q[0], q[1], q[2], q[3])),
+        ]);
+        scenes.push(SceneNode::Transform {
+            attributes: dict(&[("_name", format!("turned {k}"))]),
+            frames: vec![Frame::new(key)],
+            child: 3 + 2 * k,
+            layer_id: 0,
+        });
+        scenes.push(SceneNode::Shape {
+            attributes: dict(&[]),
+            models: vec![ShapeModel { model_id: 0, attributes: dict(&[]) }],
+        });
+    }
+    DotVoxData {
+        version: 200,
+        index_map: Vec::new(),
+        models: vec![Model { size: Size { x: 6, y: 5, z: 4 }, voxels }],
+        palette: dot_vox::DEFAULT_PALETTE.to_vec(),
+        materials: Vec::new(),
+        scenes,
+        layers: vec![Layer { attributes: dict(&[("_name", "0".into())]) }],
+    }
+}

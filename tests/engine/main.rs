@@ -26,6 +26,7 @@ mod replay_cli;
 mod trace_cpu;
 mod trace_exact;
 mod turns;
+mod turns_traced;
 mod vox_info;
 mod vox_robust;
 mod vox_roundtrip;

@@ -211,12 +211,12 @@ fn model_pixels_any(image: &image::RgbaImage) -> usize {
     image.pixels().filter(|p| p[0].abs_diff(p[1]) > 30 || p[1].abs_diff(p[2]) > 30 && p[0] > p[2]).count()
 }
 
-/// A free turn (issue 49) makes a scene of instances draw composed: the
-/// renderer that drew the herd as instances draws it, one object turned by
-/// 30°, as a renderer given the saved and reloaded scene afresh does, and
-/// back as instances after the undo, pixel for pixel.
+/// A free turn (issue 49) is traced exactly in the turned object's frame:
+/// the renderer that drew the herd draws it, one object turned by 30°, as
+/// the CPU reference and a renderer given the saved and reloaded scene
+/// afresh do, and as before after the undo, pixel for pixel.
 #[test]
-fn a_free_turn_switches_the_herd_to_composed_and_back() {
+fn a_free_turn_draws_as_the_cpu_and_the_reloaded_file_and_undoes() {
     use octovox::camera::Camera;
     use octovox::gpu::Renderer;
     use octovox::settings::RenderSettings;
@@ -240,16 +240,18 @@ fn a_free_turn_switches_the_herd_to_composed_and_back() {
         }
     };
     run(&mut editor, "object 7\nobject turn y 30");
-    assert!(editor.scene.instanced().is_none(), "drawn composed");
+    assert!(editor.scene.instanced().is_some_and(|o| o.has_free_turns()), "traced as turned instances");
     let turned = draw(&mut editor.scene, &mut renderer);
+    let cpu = octovox::trace::render::render_scene_cpu(&editor.scene, None, &camera, size, &settings);
     let saved = octovox::io::vox::encode_objects(&editor.scene.palette, editor.scene.objects().unwrap()).unwrap();
     let mut fresh = octovox::io::vox::load_vox_scene(&saved, 0).unwrap().0;
     let afresh = draw(&mut fresh, &mut Renderer::headless().unwrap());
     let differing =
         |a: &image::RgbaImage, b: &image::RgbaImage| a.pixels().zip(b.pixels()).filter(|(p, q)| p != q).count();
     assert_ne!(differing(&before, &turned), 0, "the turn shows");
+    assert_eq!(differing(&turned, &cpu), 0, "as the CPU reference draws");
     assert_eq!(differing(&turned, &afresh), 0, "as the reloaded file draws");
     run(&mut editor, "undo 1");
-    assert!(editor.scene.instanced().is_some(), "instances again");
+    assert!(editor.scene.instanced().is_some_and(|o| !o.has_free_turns()), "no turn again");
     assert_eq!(differing(&before, &draw(&mut editor.scene, &mut renderer)), 0, "undone");
 }

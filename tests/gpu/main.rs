@@ -11,3 +11,4 @@ mod denoise;
 mod ground;
 mod path_trace;
 mod trace_gpu;
+mod turns;

@@ -29,7 +29,7 @@ use super::ground::{self, GROUND_ALBEDO, Landing};
 use super::instanced::Traced;
 use super::render::GAVE_UP_COLOR;
 use super::svo::Crossing;
-use super::{Hit, Ray, argmin, normal_code};
+use super::{Hit, Ray, argmin, nearest_axis, normal_code};
 use crate::camera::{Camera, RayBasis};
 use crate::scene::Scene;
 use crate::settings::{EffectsChoice, PathSettings, SUN_DIR};
@@ -44,6 +44,13 @@ pub const MAX_SAMPLE_RADIANCE: f32 = 32.0;
 /// Most passes through glass surfaces in one path (they do not count as
 /// bounces, so that clear glass does not darken what lies behind it).
 pub const MAX_TRANSMISSIONS: u32 = 16;
+/// How far a ray leaving a freely turned face starts off it, relative to
+/// the point's largest coordinate (at least 1). A turned face lies on no
+/// plane of the grid: the hit point is on it only to rounding, and a ray
+/// started there could find the cell it just left (a bounce stopped dead,
+/// glass left where it was entered). Unturned faces need none: their hit
+/// point lies on the face's plane exactly.
+pub const TURNED_LIFT: f32 = 1.0 / 65536.0;
 
 /// The ground's entry in [`PathScene`]'s material and albedo tables, after
 /// the palette's 256 (the shaders get it from `crate::gpu::prelude`).
@@ -152,7 +159,7 @@ impl PathScene<'_> {
             return Some((land.point(ray), Vec3::Y, GROUND_SURFACE));
         }
         (c.found && c.hit.normal != IVec3::ZERO)
-            .then(|| (surface_point(ray, c), c.hit.normal.as_vec3(), usize::from(c.hit.value)))
+            .then(|| (surface_point(ray, c), c.hit.shading_normal(), usize::from(c.hit.value)))
     }
 
     /// The denoiser's guide of pixel (x, y): the first hit of its centre
@@ -163,7 +170,7 @@ impl PathScene<'_> {
         let c = self.cross(&ray, 0, None);
         match self.surface(&ray, &c) {
             Some((p, n, surface)) if !self.left_to_samples(self.materials[surface].kind) => {
-                Guide::filtered(p, normal_code(n.as_ivec3()))
+                Guide::filtered(p, normal_code(nearest_axis(n)))
             }
             _ => Guide::LEFT,
         }
@@ -185,6 +192,7 @@ impl PathScene<'_> {
             if c.hit.gave_up {
                 return radiance + beta * GAVE_UP_COLOR;
             }
+            let lift = lift_of(&c, &ray);
             let Some((p, n, surface)) = self.surface(&ray, &c) else {
                 if c.found {
                     // The ray started inside a solid voxel: nothing to see.
@@ -233,7 +241,7 @@ impl PathScene<'_> {
                     // them by reflection.
                     let sampled = lobe.alpha >= MIN_SAMPLED_ALPHA;
                     if sampled {
-                        radiance += beta * self.direct(p, n, &lobe, rng) / p_spec;
+                        radiance += beta * self.direct(leave(p, n, lift, n), n, &lobe, rng) / p_spec;
                     }
                     let Some((next, weight)) = metal_lobe(d, n, albedo, &material, rng) else { return radiance };
                     dir = next;
@@ -241,7 +249,7 @@ impl PathScene<'_> {
                     lights_counted = sampled;
                 } else {
                     let albedo = albedo * (1.0 - material.metalness) / (1.0 - p_spec);
-                    radiance += beta * albedo * self.direct(p, n, &Lobe::DIFFUSE, rng);
+                    radiance += beta * albedo * self.direct(leave(p, n, lift, n), n, &Lobe::DIFFUSE, rng);
                     dir = cosine_direction(n, rng.uniform(), rng.uniform());
                     beta *= albedo;
                     lights_counted = true;
@@ -249,7 +257,7 @@ impl PathScene<'_> {
             } else {
                 bounces += 1;
                 let albedo = self.albedo[surface];
-                radiance += beta * albedo * self.direct(p, n, &Lobe::DIFFUSE, rng);
+                radiance += beta * albedo * self.direct(leave(p, n, lift, n), n, &Lobe::DIFFUSE, rng);
                 dir = cosine_direction(n, rng.uniform(), rng.uniform());
                 beta *= albedo;
                 lights_counted = true;
@@ -257,7 +265,7 @@ impl PathScene<'_> {
             if transmissions > MAX_TRANSMISSIONS {
                 return radiance;
             }
-            ray = Ray::new(p, dir);
+            ray = Ray::new(leave(p, n, lift, dir), dir);
         }
     }
 
@@ -424,10 +432,28 @@ fn emitter_point(light: &Emitter, p: Vec3, u1: f32, u2: f32, u3: f32) -> Option<
     Some((q, axis, faces))
 }
 
+/// How far a ray leaving the face `c` found starts off it: [`TURNED_LIFT`]
+/// of the hit point's size on a turned face, none on any other. Twin of
+/// `lift_of` in `shaders/path.wgsl`.
+fn lift_of(c: &Crossing, ray: &Ray) -> f32 {
+    let p = ray.origin + ray.dir * c.t;
+    if c.hit.turned.is_some() { TURNED_LIFT * p.abs().max_element().max(1.0) } else { 0.0 }
+}
+
+/// Where a ray in direction `dir` leaving the face at `p` (normal `n`)
+/// starts: `lift` off the face, on the side `dir` goes to.
+fn leave(p: Vec3, n: Vec3, lift: f32, dir: Vec3) -> Vec3 {
+    p + n * if dir.dot(n) >= 0.0 { lift } else { -lift }
+}
+
 /// The point where a ray enters the voxel it found: on the entered face's
 /// plane exactly, inside the face.
 pub fn surface_point(ray: &Ray, c: &Crossing) -> Vec3 {
     let hit: &Hit = &c.hit;
+    if hit.turned.is_some() {
+        // A turned face lies on no plane of the grid.
+        return ray.origin + ray.dir * c.t;
+    }
     let lo = hit.voxel.as_vec3();
     let mut p = (ray.origin + ray.dir * c.t).clamp(lo, lo + Vec3::ONE);
     let axis = argmin(-hit.normal.abs().as_vec3());
