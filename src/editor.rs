@@ -309,6 +309,17 @@ impl Editor {
         Some(Line::Object(ObjectLine::Pick(ObjectRef::Index(owner))))
     }
 
+    /// The `object N` line a click on `picked` runs before its edit: the
+    /// turned object whose model cell it hit, or the object drawn at its
+    /// voxel ([`Editor::object_line_at`]).
+    pub fn object_line_for(&self, picked: &crate::trace::pick::Picked) -> Option<Line> {
+        let Some(model) = picked.model else { return self.object_line_at(picked.voxel) };
+        let objects = self.scene.pickable_objects()?;
+        let index = model.object;
+        (objects.selected != Some(index) && !objects.locked(index))
+            .then_some(Line::Object(ObjectLine::Pick(ObjectRef::Index(index))))
+    }
+
     /// The objects of a scene of several, or why an `object`/`layer` line
     /// cannot change anything.
     fn objects(&self) -> Result<&Objects, EditorError> {
@@ -395,7 +406,12 @@ impl Editor {
     /// The edits an `object` line makes of the picked object, and what is
     /// picked after them.
     fn picked_object_edits(&self, line: &ObjectLine) -> Result<(Vec<Edit>, Picks), EditorError> {
-        let index = self.picked_object()?;
+        // A click's edit in a scene of one object goes to it, picked or not.
+        let only = self.objects()?.list().len() == 1;
+        let index = match line {
+            ObjectLine::Cell { .. } if only => self.objects()?.selected.unwrap_or(0),
+            _ => self.picked_object()?,
+        };
         let objects = self.objects()?;
         let graph = |change| vec![Edit::Graph(Box::new(change))];
         Ok(match line {
@@ -412,6 +428,10 @@ impl Editor {
             ObjectLine::Layer(layer) => (graph(objects.on_layer(index, *layer)?), Picks::Same),
             ObjectLine::Key(ease) => (graph(objects.keyed(index, *ease)?), Picks::Same),
             ObjectLine::Unkey => (graph(objects.unkeyed(index)?), Picks::Same),
+            ObjectLine::Cell { tool, at } => {
+                let op = crate::edit::brush::tool_op(*tool, self.tools.color);
+                (vec![Edit::InModel { object: index, shape: self.tools.brush.shape_at(*at), op }], Picks::Same)
+            }
             ObjectLine::Delete => (graph(objects.deleted(index)?), Picks::None),
             ObjectLine::Duplicate { reference: true } => {
                 let (change, id) = objects.duplicated(index, None)?;

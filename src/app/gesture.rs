@@ -79,7 +79,8 @@ impl Stroke {
         if self.last_center == Some(center) {
             return None;
         }
-        let line = octovox::script::edit_command(self.tool, center);
+        let model = pick.model.map(|m| (m.cell, m.normal));
+        let line = octovox::script::click_command(self.tool, pick.voxel, pick.normal, model);
         Some(StrokeStep { line, layer, center, first: self.last_center.is_none() })
     }
 
@@ -218,7 +219,7 @@ mod tests {
     }
 
     fn top(x: i32, z: i32) -> Pick {
-        Pick { voxel: IVec3::new(x, 0, z), normal: IVec3::Y, value: 1 }
+        Pick { voxel: IVec3::new(x, 0, z), normal: IVec3::Y, value: 1, model: None }
     }
 
     /// Issue 46: gestures were tested only through Xvfb. An Attach drag
@@ -229,7 +230,7 @@ mod tests {
     #[test]
     fn an_attach_stroke_places_along_its_face_in_one_undo_step() {
         let mut editor = floor();
-        let placed_top = Pick { voxel: IVec3::new(1, 1, 2), normal: IVec3::Y, value: 1 };
+        let placed_top = Pick { voxel: IVec3::new(1, 1, 2), normal: IVec3::Y, value: 1, model: None };
         let picks = [top(1, 2), top(1, 2), placed_top, top(2, 2), top(3, 2)];
         let lines = stroke(&mut editor, Tool::Attach, &picks);
         assert_eq!(
@@ -276,14 +277,14 @@ mod tests {
     #[test]
     fn erase_stays_on_its_layer_paint_goes_anywhere_and_an_empty_stroke_is_nothing() {
         let mut editor = floor();
-        let below = Pick { voxel: IVec3::new(2, -1, 2), normal: IVec3::Y, value: 1 };
+        let below = Pick { voxel: IVec3::new(2, -1, 2), normal: IVec3::Y, value: 1, model: None };
         let lines = stroke(&mut editor, Tool::Erase, &[top(1, 1), below, top(2, 1)]);
         assert_eq!(lines, ["brush voxel", "stroke begin", "remove 1 0 1", "remove 2 0 1", "stroke end"]);
-        let side = Pick { voxel: IVec3::new(7, 0, 5), normal: IVec3::X, value: 1 };
+        let side = Pick { voxel: IVec3::new(7, 0, 5), normal: IVec3::X, value: 1, model: None };
         let lines = stroke(&mut editor, Tool::Paint, &[top(4, 4), side]);
         assert_eq!(lines, ["brush voxel", "color 1", "stroke begin", "paint 4 0 4", "paint 7 0 5", "stroke end"]);
         assert_eq!(editor.history.steps(), (2, 0));
-        let inside = Pick { voxel: IVec3::new(3, 0, 3), normal: IVec3::ZERO, value: 1 };
+        let inside = Pick { voxel: IVec3::new(3, 0, 3), normal: IVec3::ZERO, value: 1, model: None };
         assert!(stroke(&mut editor, Tool::Attach, &[inside]).is_empty(), "no face to attach to");
         assert_eq!(editor.history.steps(), (2, 0), "an empty stroke leaves no step");
     }

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use glam::{DVec3, IVec3};
+use glam::DVec3;
 
 use octovox::camera::Camera;
 use octovox::editor::Editor;
@@ -70,9 +70,8 @@ impl Host for Session {
         }
     }
 
-    fn pick(&mut self, x: u32, y: u32) -> Result<Option<(IVec3, IVec3, u8)>, pick::GaveUp> {
-        let pick = self.pick_or_ground(f64::from(x) + 0.5, f64::from(y) + 0.5)?;
-        Ok(pick.map(|pick| (pick.voxel, pick.normal, pick.value)))
+    fn pick(&mut self, x: u32, y: u32) -> Result<Option<pick::Picked>, pick::GaveUp> {
+        self.pick_or_ground(f64::from(x) + 0.5, f64::from(y) + 0.5)
     }
 
     fn save(&mut self, path: &Path) -> Result<(), HostError> {

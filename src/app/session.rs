@@ -484,7 +484,7 @@ impl Session {
         let px = ((x * f64::from(w) / f64::from(window_w)) as u32).min(w - 1);
         let py = ((y * f64::from(h) / f64::from(window_h)) as u32).min(h - 1);
         let hit = pick::pick_with_ground(&self.doc.editor.scene, &self.state.camera, (w, h), (px, py), ground)?;
-        Ok(hit.map(|hit| Pick { voxel: hit.voxel, normal: hit.normal, value: hit.value }))
+        Ok(hit)
     }
 
     /// The voxel under window pixel (x, y) for a click; when there is none,
@@ -705,7 +705,7 @@ impl Session {
         // one to the end); each step is the script line a click there is:
         // the same path as every line, recorded and journaled as one edit
         // of the stroke.
-        let picked = self.doc.editor.object_line_at(pick.voxel).filter(|_| step.first);
+        let picked = self.doc.editor.object_line_for(&pick).filter(|_| step.first);
         let ran = picked
             .map_or(Ok(()), |picked| self.run_line(&picked).map(|_| ()))
             .and_then(|()| self.run_line(&step.line).map(|_| ()));

@@ -14,28 +14,9 @@ pub use octovox::edit::brush::{Brush, Tool, click_edit};
 use octovox::editor::Tools;
 use octovox::settings::{PathSettings, RenderSettings, Shading};
 
-/// The voxel and face under the cursor, in world coordinates.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Pick {
-    pub voxel: IVec3,
-    pub normal: IVec3,
-    /// The voxel's colour; 0 for the ground (the cell under y = 0).
-    pub value: u8,
-}
-
-impl Pick {
-    /// The cell a selection starts or ends on: the voxel, or on the ground
-    /// the cell on it.
-    pub fn cell(&self) -> IVec3 {
-        if self.value == 0 { self.voxel + self.normal } else { self.voxel }
-    }
-
-    /// The cell in front of the picked face: where a line drag starts or
-    /// ends.
-    pub fn in_front(&self) -> IVec3 {
-        self.voxel + self.normal
-    }
-}
+/// The voxel and face under the cursor, in world coordinates (and on a
+/// freely turned object the model cell).
+pub use octovox::trace::pick::Picked as Pick;
 
 /// The brush shapes the panel offers; switching shapes keeps each one's
 /// last size (in `EditorState`).
@@ -237,7 +218,7 @@ mod tests {
     #[test]
     fn attach_places_in_front_of_the_face() {
         let (state, tools) = (EditorState::default(), Tools { color: 7, ..Tools::default() });
-        let pick = Pick { voxel: IVec3::new(1, 2, 3), normal: IVec3::Y, value: 4 };
+        let pick = Pick { voxel: IVec3::new(1, 2, 3), normal: IVec3::Y, value: 4, model: None };
         let (center, edit) = state.edit_at(&tools, Tool::Attach, &pick);
         assert_eq!(center, IVec3::new(1, 3, 3));
         assert_eq!(edit, Edit::Brush { shape: Shape::Voxel(center), op: Op::Place(7) });
@@ -250,7 +231,7 @@ mod tests {
     fn brush_sizes_follow_the_kind() {
         let mut state = EditorState { box_size: 4, ..EditorState::default() };
         let mut tools = Tools { brush: state.brush_of(BrushKind::Box), ..Tools::default() };
-        let pick = Pick { voxel: IVec3::ZERO, normal: IVec3::X, value: 1 };
+        let pick = Pick { voxel: IVec3::ZERO, normal: IVec3::X, value: 1, model: None };
         assert_eq!(state.preview_box(&tools, &pick, None), (IVec3::new(-1, -2, -2), IVec3::new(2, 1, 1)));
         state.sphere_radius = 2;
         tools.brush = state.brush_of(BrushKind::Sphere);

@@ -1,9 +1,10 @@
 //! `octovox bench anim`: what playing an animation costs. A forest of
-//! 2,000 references whose trees rise and fall, each frame shown by the
-//! editor's `frame N` (the window's path) against the same forest standing
-//! still, with the bytes each frame uploads; and a turntable rendered as
-//! 1, 2 and 4 shards (`render --shard`), each shard its own process; and
-//! a free turn against a quarter turn (`bench_turns`).
+//! 2,000 references leaning by free turns, whose trees rise and fall and
+//! turn, each frame shown by the editor's `frame N` (the window's path)
+//! against the same forest standing still, with the bytes each frame
+//! uploads, and the still forest against one of quarter turns only; a
+//! turntable rendered as 1, 2 and 4 shards (`render --shard`), each shard
+//! its own process; and a free turn against a quarter turn (`bench_turns`).
 
 use std::path::Path;
 use std::process::Command;
@@ -18,7 +19,7 @@ use octovox::gpu::Renderer;
 use octovox::settings::RenderSettings;
 
 use super::bench::{header, median};
-use super::bench_scene::{MOVING_FRAMES, forest};
+use super::bench_scene::{MOVING_FRAMES, Stand, forest};
 
 #[derive(Serialize)]
 struct AnimRow {
@@ -34,6 +35,9 @@ struct AnimRow {
     /// The same frame of the forest standing still: the upload (nothing)
     /// and the preview.
     frame_ms_still: f64,
+    /// The still forest's frame with its trees by quarter turns only (no
+    /// free turn: the integer instance path).
+    frame_ms_aligned: f64,
     /// Of a playing frame, showing it alone (`Editor::play_frame`).
     show_ms: f64,
     /// Composing the CPU's octree once playing stops halfway through the
@@ -59,19 +63,23 @@ pub fn bench_anim(quick: bool) -> anyhow::Result<(String, String)> {
     let count = if quick { 200 } else { 2000 };
     let (width, height, rounds) = if quick { (320, 180, 6) } else { (1280, 720, MOVING_FRAMES) };
     let mut playing = Editor::default();
-    playing.set_scene(forest(count, true)?);
-    let mut still = forest(count, false)?;
+    playing.set_scene(forest(count, Stand { turned: true, moving: true })?);
+    let mut still = forest(count, Stand { turned: true, moving: false })?;
+    let mut aligned = forest(count, Stand { turned: false, moving: false })?;
     let renderer = || Renderer::headless().context("bench anim needs a GPU (lavapipe works)");
-    let (mut playing_renderer, mut still_renderer) = (renderer()?, renderer()?);
+    let (mut playing_renderer, mut still_renderer, mut aligned_renderer) = (renderer()?, renderer()?, renderer()?);
     let (lo, hi) = still.solid_bounds().context("an empty forest")?;
     let camera = Camera::framing(lo, hi + glam::IVec3::new(0, 8, 0), 50.0);
     let settings = RenderSettings { shadows: false, ..RenderSettings::default() };
     playing_renderer.sync(&mut playing.scene);
     still_renderer.sync(&mut still);
-    // One warm-up frame each, then the two alternate, frame by frame.
+    aligned_renderer.sync(&mut aligned);
+    // One warm-up frame each, then the three alternate, frame by frame.
     playing_renderer.render(&playing.scene, &camera, (width, height), &settings, None)?;
     still_renderer.render(&still, &camera, (width, height), &settings, None)?;
+    aligned_renderer.render(&aligned, &camera, (width, height), &settings, None)?;
     let (mut playing_ms, mut still_ms, mut show_ms, mut bytes) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut aligned_ms = Vec::new();
     for frame in 1..=rounds {
         let start = Instant::now();
         playing.play_frame(frame)?;
@@ -83,6 +91,10 @@ pub fn bench_anim(quick: bool) -> anyhow::Result<(String, String)> {
         still_renderer.sync(&mut still);
         still_renderer.render(&still, &camera, (width, height), &settings, None)?;
         still_ms.push(start.elapsed().as_secs_f64() * 1e3);
+        let start = Instant::now();
+        aligned_renderer.sync(&mut aligned);
+        aligned_renderer.render(&aligned, &camera, (width, height), &settings, None)?;
+        aligned_ms.push(start.elapsed().as_secs_f64() * 1e3);
     }
     // Stopped halfway, where every tree stands furthest from where the
     // composed octree holds it (the loop's last frame is its first again).
@@ -99,6 +111,7 @@ pub fn bench_anim(quick: bool) -> anyhow::Result<(String, String)> {
         drawn_as: if playing.scene.instanced().is_some() { "instances" } else { "composed" },
         frame_ms_playing: median(playing_ms),
         frame_ms_still: median(still_ms),
+        frame_ms_aligned: median(aligned_ms),
         show_ms: median(show_ms),
         catch_up_ms,
         upload_bytes_per_frame: bytes.iter().copied().max().unwrap_or(0),
@@ -152,10 +165,13 @@ fn report(r: &AnimRow) -> String {
     let mut md = header(&format!("Playing an animation of {} references", r.objects));
     md += &format!(
         "Adapter: **{}**, {}×{}, SVO preview without shadows. The forest of `bench scene` ({} references of one \
-         tree, drawn as **{}**), each tree keyed to rise 1 to 8 voxels and come back over {} frames, looping. A \
-         playing frame is the window's (`Editor::play_frame`: every key sampled; a scene drawn as instances \
-         composes its CPU octree, which picking and checks read, only once playing stops), the upload and the \
-         preview; a still frame is the same forest without keys, upload and preview. Median of {} frames, the two alternating after one warm-up each.\n\n",
+         tree, drawn as **{}**), each tree leaning 12° and turned about the up axis by its own free angle \
+         (`_ov_turn`, traced exactly in its own frame), keyed to rise 1 to 8 voxels and turn 40° (slerp) and come \
+         back over {} frames, looping. A playing frame is the window's (`Editor::play_frame`: every key sampled; \
+         a scene drawn as instances composes its CPU octree, which picking and checks read, only once playing \
+         stops), the upload and the preview; a still frame is the same forest without keys, upload and preview; \
+         an axis-aligned frame is the forest by quarter turns only (the integer instance path). Median of {} \
+         frames, the three alternating after one warm-up each.\n\n",
         r.adapter, r.width, r.height, r.objects, r.drawn_as, MOVING_FRAMES, r.frames
     );
     md += "| measure | playing | still | playing / still | target |\n|---|---|---|---|---|\n";
@@ -164,6 +180,12 @@ fn report(r: &AnimRow) -> String {
         r.frame_ms_playing,
         r.frame_ms_still,
         r.frame_ms_playing / r.frame_ms_still.max(1e-9)
+    );
+    md += &format!(
+        "| still: turned against axis-aligned, frame ms | {:.2} | {:.2} | {:.2} | ≤ 1.3 |\n",
+        r.frame_ms_still,
+        r.frame_ms_aligned,
+        r.frame_ms_still / r.frame_ms_aligned.max(1e-9)
     );
     md += &format!("| of which showing the frame, ms | {:.2} | | | |\n", r.show_ms);
     md += &format!(

@@ -132,10 +132,29 @@ fn tree_model() -> Model {
     Model { size: [15, 15, 27], tree }
 }
 
+/// How the trees of [`forest`] stand: by quarter turns only, or leaning
+/// by free turns too; still, or keyed to move over [`MOVING_FRAMES`].
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) struct Stand {
+    pub turned: bool,
+    pub moving: bool,
+}
+
+/// A tree's free turn at a key (`_ov_turn`): about MagicaVoxel's up axis
+/// by its own angle (`spin` more at the loop's middle) and leaning 12°.
+fn lean(k: u32, spin: f64) -> String {
+    let about_up = (f64::from(k * 37 % 90) + 5.0 + spin).to_radians();
+    let q = glam::DQuat::from_rotation_z(about_up) * glam::DQuat::from_rotation_x(12f64.to_radians());
+    format!("{} {} {} {}", q.x, q.y, q.z, q.w)
+}
+
 /// 2,000 placements of one model on a 50 × 40 grid, each turned by one of
-/// the eight rotations that keep z up; with `moving`, each also keyed to
-/// rise and come back over [`MOVING_FRAMES`] frames, looping (`bench anim`).
-pub(super) fn forest(count: u32, moving: bool) -> anyhow::Result<Scene> {
+/// the eight rotations that keep z up, and where `stand.turned` leaning by
+/// a free turn; where `stand.moving`, each also keyed to rise and come
+/// back over [`MOVING_FRAMES`] frames (turning 40° and back, where
+/// turned), looping (`bench anim`).
+pub(super) fn forest(count: u32, stand: Stand) -> anyhow::Result<Scene> {
+    let moving = stand.moving;
     let upright: Vec<u8> =
         (0..=127u8).filter(|b| Rotation::from_byte(*b).is_some_and(|r| r.apply([0, 0, 1]) == [0, 0, 1])).collect();
     let attributes = Attributes::new;
@@ -153,19 +172,23 @@ pub(super) fn forest(count: u32, moving: bool) -> anyhow::Result<Scene> {
     ];
     for k in 0..count {
         let (x, y) = ((k % 50) as i32 * 24, (k / 50) as i32 * 24);
-        let key = |f: u32, z: u32| -> Attributes {
-            [
+        let key = |f: u32, z: u32, spin: f64| -> Attributes {
+            let mut key: Attributes = [
                 ("_f".to_owned(), f.to_string()),
                 ("_t".to_owned(), format!("{x} {y} {z}")),
                 ("_r".to_owned(), upright[k as usize % upright.len()].to_string()),
             ]
-            .into()
+            .into();
+            if stand.turned {
+                key.insert(octovox::scene::graph::TURN_KEY.to_owned(), lean(k, spin));
+            }
+            key
         };
         // Each tree rises its own height (1 to 8 voxels) and comes back.
         let frames = if moving {
-            vec![key(0, 13), key(MOVING_FRAMES / 2, 14 + k % 8), key(MOVING_FRAMES, 13)]
+            vec![key(0, 13, 0.0), key(MOVING_FRAMES / 2, 14 + k % 8, 40.0), key(MOVING_FRAMES, 13, 0.0)]
         } else {
-            vec![key(0, 13)]
+            vec![key(0, 13, 0.0)]
         };
         let mut named: Attributes = [("_name".to_owned(), format!("tree {k}"))].into();
         if moving {
@@ -205,7 +228,7 @@ fn timed(runs: usize, mut f: impl FnMut() -> anyhow::Result<()>) -> anyhow::Resu
 pub fn bench_scene(quick: bool) -> anyhow::Result<(String, String)> {
     let count = if quick { 200 } else { 2000 };
     let (width, height, frames, loads) = if quick { (320, 180, 3, 1) } else { (1280, 720, 9, 3) };
-    let scene = forest(count, false)?;
+    let scene = forest(count, Stand { turned: false, moving: false })?;
     let objects = scene.objects().context("a scene of objects")?;
     let forest_bytes = encode_objects(&scene.palette, objects)?;
     let merged_bytes = encode_vox(&scene.palette, &scene.voxels())?;

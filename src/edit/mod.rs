@@ -31,6 +31,8 @@ pub enum Edit {
     /// A brush in object `object`'s model (what a brush becomes in a scene
     /// of objects: see [`Edit::resolved`]).
     InObject { object: usize, shape: Shape, op: Op },
+    /// A brush in object `object`'s model cells (as its .vox numbers them).
+    InModel { object: usize, shape: Shape, op: Op },
     /// Put back cells saved by an earlier edit (what undo sends).
     Restore(Patch),
     /// Put back cells of model `model` (what undo sends for `InObject`).
@@ -100,6 +102,10 @@ impl Edit {
                 let (model, patch) = scene.apply_in_object(*object, shape, *op)?;
                 Ok(Edit::RestoreModel { model, patch })
             }
+            Edit::InModel { object, shape, op } => {
+                let (model, patch) = scene.apply_in_model(*object, shape, *op)?;
+                Ok(Edit::RestoreModel { model, patch })
+            }
             Edit::RestoreModel { model, patch } => {
                 Ok(Edit::RestoreModel { model: *model, patch: scene.apply_model_patch(*model, patch)? })
             }
@@ -130,7 +136,7 @@ impl Edit {
     pub fn estimated_bytes(&self) -> u64 {
         let own = 2 * std::mem::size_of::<Edit>() as u64;
         own.saturating_add(match self {
-            Edit::Brush { shape, .. } | Edit::InObject { shape, .. } => {
+            Edit::Brush { shape, .. } | Edit::InObject { shape, .. } | Edit::InModel { shape, .. } => {
                 shape.surface_voxels().saturating_mul(crate::scene::apply::EDIT_BYTES_PER_SURFACE_VOXEL)
             }
             Edit::Clear { min, max } => Shape::Box { min: *min, max: *max }
@@ -342,7 +348,9 @@ impl History {
 
 fn edit_bytes(edit: &Edit) -> usize {
     match edit {
-        Edit::Brush { .. } | Edit::Clear { .. } | Edit::InObject { .. } | Edit::PopModel => std::mem::size_of::<Edit>(),
+        Edit::Brush { .. } | Edit::Clear { .. } | Edit::InObject { .. } | Edit::InModel { .. } | Edit::PopModel => {
+            std::mem::size_of::<Edit>()
+        }
         Edit::Graph(change) => change.heap_bytes(),
         Edit::AddModel(model) => usize::try_from(model.tree.pool().live_bytes()).unwrap_or(usize::MAX),
         Edit::Restore(patch) | Edit::RestoreModel { patch, .. } => patch.heap_bytes(),

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use glam::{DVec3, IVec3};
+use glam::DVec3;
 
 use super::step::{Host, HostError, StepError, StepResult, step};
 use crate::camera::Camera;
@@ -186,10 +186,9 @@ impl Host for Runner {
         self.viewport = (width, height);
     }
 
-    fn pick(&mut self, x: u32, y: u32) -> Result<Option<(IVec3, IVec3, u8)>, pick::GaveUp> {
+    fn pick(&mut self, x: u32, y: u32) -> Result<Option<pick::Picked>, pick::GaveUp> {
         let (scene, ground) = (&self.editor.scene, self.editor.ground);
-        let hit = pick::pick_with_ground(scene, &self.camera, self.viewport, (x, y), ground)?;
-        Ok(hit.map(|hit| (hit.voxel, hit.normal, hit.value)))
+        pick::pick_with_ground(scene, &self.camera, self.viewport, (x, y), ground)
     }
 
     fn save(&mut self, path: &Path) -> Result<(), HostError> {

@@ -10,12 +10,12 @@
 
 use std::path::Path;
 
-use glam::{DVec3, IVec3};
+use glam::DVec3;
 
 use crate::edit::selection::Region;
 use crate::editor::{Editor, EditorError, Outcome};
 use crate::io::png::{differing_fraction, load_png, save_png};
-use crate::script::{Line, PaletteLine, edit_command};
+use crate::script::{Line, PaletteLine, click_command};
 use crate::trace::pick;
 
 /// The size of renders (and of the pixels `click` names headless) before a
@@ -48,7 +48,7 @@ pub trait Host {
     ///
     /// # Errors
     /// The traversal gave up.
-    fn pick(&mut self, x: u32, y: u32) -> Result<Option<(IVec3, IVec3, u8)>, pick::GaveUp>;
+    fn pick(&mut self, x: u32, y: u32) -> Result<Option<pick::Picked>, pick::GaveUp>;
 
     /// `save PATH`.
     ///
@@ -173,22 +173,20 @@ fn host_line(host: &mut impl Host, base: &Path, line: &Line) -> Result<StepResul
         Line::Projection(ortho) => host.set_projection(*ortho),
         Line::Click { x, y, tool } => {
             let expected = format!("pixel ({x}, {y}) to hit a voxel");
-            let (voxel, normal) = match host.pick(*x, *y) {
-                Ok(Some((voxel, normal, value))) if value != 0 || *tool == crate::edit::brush::Tool::Attach => {
-                    (voxel, normal)
-                }
+            let hit = match host.pick(*x, *y) {
+                Ok(Some(hit)) if hit.value != 0 || *tool == crate::edit::brush::Tool::Attach => hit,
                 Ok(Some(_)) => return Ok(StepResult::Failed { expected, got: "the ground (attach only)".into() }),
                 Ok(None) => return Ok(StepResult::Failed { expected, got: "no voxel under it".into() }),
                 Err(gave_up) => return Ok(StepResult::Failed { expected, got: gave_up.to_string() }),
             };
             // The object it hits is picked; then the place, remove or paint
             // of the cell it picks, as the mouse does.
-            let picked = host.editor().object_line_at(voxel);
+            let picked = host.editor().object_line_for(&hit);
             if let Some(line) = &picked {
                 host.editor().run(line)?;
             }
-            let center = crate::edit::brush::click_target(*tool, voxel, normal);
-            return Ok(match step(host, base, &edit_command(*tool, center))? {
+            let model = hit.model.map(|m| (m.cell, m.normal));
+            return Ok(match step(host, base, &click_command(*tool, hit.voxel, hit.normal, model))? {
                 StepResult::Ran(ran) => StepResult::Ran(Ran { picked, ..ran }),
                 other => other,
             });

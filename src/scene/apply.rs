@@ -210,6 +210,16 @@ impl Scene {
         self.touched(applied)
     }
 
+    /// Applies a brush given in object `index`'s model cells
+    /// ([`Objects::apply_model_brush`]).
+    ///
+    /// [`Objects::apply_model_brush`]: super::objects::Objects::apply_model_brush
+    pub fn apply_in_model(&mut self, index: usize, shape: &Shape, op: Op) -> Result<(usize, Patch), EditError> {
+        let (objects, tree) = self.objects_and_drawn_mut()?;
+        let applied = objects.apply_model_brush(tree, index, shape, op);
+        self.touched(applied)
+    }
+
     /// Puts back model `model`'s cells from an undo patch.
     pub fn apply_model_patch(&mut self, model: usize, patch: &Patch) -> Result<Patch, EditError> {
         let (objects, tree) = self.objects_and_drawn_mut()?;

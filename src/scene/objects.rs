@@ -361,6 +361,27 @@ impl Objects {
         shape: &Shape,
         op: Op,
     ) -> Result<(usize, Patch), EditError> {
+        let map = self.maps.get(index).ok_or(ObjectRefusal::NoObject(index))?;
+        if map.cells().is_none() && matches!(shape, Shape::Box { .. }) {
+            // A world box is no box of the turned model's cells, and the box
+            // around them would reach past it.
+            return Err(ObjectRefusal::FreelyTurned(index, "a box edit of").into());
+        }
+        let local = map.invert_shape(shape);
+        self.apply_model_brush(tree, index, &local, op)
+    }
+
+    /// Applies a brush given in object `index`'s model cells (as its .vox
+    /// numbers them: what a click on a freely turned object edits, where a
+    /// model cell may stand for no world cell) and composes every
+    /// placement of the model again; returns the model's undo patch.
+    pub fn apply_model_brush(
+        &mut self,
+        tree: &mut Octree,
+        index: usize,
+        local: &Shape,
+        op: Op,
+    ) -> Result<(usize, Patch), EditError> {
         let model = self.objects.get(index).ok_or(ObjectRefusal::NoObject(index))?.placement.model;
         self.unlocked(&[index])?;
         self.catch_up(tree)?;
@@ -369,13 +390,7 @@ impl Objects {
         if let Some(k) = (0..self.objects.len()).find(|&k| self.objects[k].placement.model == model && self.locked(k)) {
             return Err(ObjectRefusal::LockedReference { locked: k, index }.into());
         }
-        if self.maps[index].cells().is_none() && matches!(shape, Shape::Box { .. }) {
-            // A world box is no box of the turned model's cells, and the box
-            // around them would reach past it.
-            return Err(ObjectRefusal::FreelyTurned(index, "a box edit of").into());
-        }
-        let local = self.maps[index].invert_shape(shape);
-        let patch = self.models[model].tree.apply_brush(&local, op)?;
+        let patch = self.models[model].tree.apply_brush(local, op)?;
         // Nothing changed (a delete over cells another placement of the
         // model already emptied): nothing to compose again.
         if patch.bounds().is_some() {

@@ -133,6 +133,7 @@ impl Line {
     pub fn kind(&self) -> Kind {
         match self {
             Line::Place(_) | Line::Paint(_) | Line::Segment(..) | Line::Fill(_) => Kind::Edit { color: true },
+            Line::Object(ObjectLine::Cell { tool, .. }) => Kind::Edit { color: *tool != Tool::Erase },
             Line::Remove(_)
             | Line::Extrude(..)
             | Line::Cut
@@ -201,7 +202,9 @@ impl Line {
                 | Line::Paint(_)
                 | Line::Rgb(..)
                 | Line::Material(..)
-                | Line::Object(ObjectLine::Pick(_) | ObjectLine::Move(_) | ObjectLine::Turn { .. })
+                | Line::Object(
+                    ObjectLine::Pick(_) | ObjectLine::Move(_) | ObjectLine::Turn { .. } | ObjectLine::Cell { .. }
+                )
         );
         !of_a_stroke && !matches!(self.kind(), Kind::Stroke | Kind::View | Kind::Check)
     }
@@ -349,6 +352,14 @@ pub enum ObjectLine {
     Key(Ease),
     /// `object unkey`: take the key at the frame shown out.
     Unkey,
+    /// `object place|remove|paint X Y Z`: the brush at cell X Y Z of the
+    /// picked object's model (its own cells, as its .vox numbers them):
+    /// what a click on a freely turned object runs, as a model cell there
+    /// may stand for no world cell.
+    Cell {
+        tool: Tool,
+        at: IVec3,
+    },
 }
 
 /// What an `anim` line sets (each an undoable edit of the document).
@@ -420,6 +431,19 @@ pub struct NumberedLine {
 pub struct Script {
     pub path: PathBuf,
     pub lines: Vec<NumberedLine>,
+}
+
+/// The line a click with `tool` on a voxel and face runs: the edit of
+/// the world cell it names ([`edit_command`]), or on a freely turned
+/// object the edit of the model cell under the cursor (`model`: the cell
+/// and its face's normal, in the model's cells).
+pub fn click_command(tool: Tool, voxel: IVec3, normal: IVec3, model: Option<(IVec3, IVec3)>) -> Line {
+    match model {
+        Some((cell, normal)) => {
+            Line::Object(ObjectLine::Cell { tool, at: crate::edit::brush::click_target(tool, cell, normal) })
+        }
+        None => edit_command(tool, crate::edit::brush::click_target(tool, voxel, normal)),
+    }
 }
 
 /// The edit a `place`/`remove`/`paint` line (or a recorded click) becomes.

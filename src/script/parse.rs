@@ -59,6 +59,9 @@ pub(super) const NAME_KEYWORDS: &[&str] = &[
     "key",
     "unkey",
     "turn",
+    "place",
+    "remove",
+    "paint",
 ];
 
 /// Reads the tokens of one line, left to right, with errors that point at
@@ -475,7 +478,7 @@ fn parse_command(c: &mut Cursor) -> Result<Line, Fail> {
 /// `object N|NAME`, and what the picked object does: `new NAME`, `move DX
 /// DY DZ`, `rotate x|y|z`, `duplicate [reference]`, `unique`, `delete`,
 /// `hide`, `show`, `lock`, `unlock`, `rename NAME`, `layer N`, `before N|NAME`, `after
-/// N|NAME`, `merge N|NAME…`. (An object
+/// N|NAME`, `merge N|NAME…`, `turn`, `key`, `unkey`, `place|remove|paint X Y Z`. (An object
 /// named like one of these words is picked by its index or its path.)
 fn parse_object(c: &mut Cursor) -> Result<ObjectLine, Fail> {
     let word = c.word("an object index or name, or what the picked object does")?;
@@ -516,6 +519,9 @@ fn parse_object(c: &mut Cursor) -> Result<ObjectLine, Fail> {
                 .ok_or((word.column, format!("expected step, linear or smooth, found '{}'", word.text)))?,
         }),
         "unkey" => ObjectLine::Unkey,
+        "place" => ObjectLine::Cell { tool: Tool::Attach, at: c.position()? },
+        "remove" => ObjectLine::Cell { tool: Tool::Erase, at: c.position()? },
+        "paint" => ObjectLine::Cell { tool: Tool::Paint, at: c.position()? },
         _ => ObjectLine::Pick(object_ref(word)?),
     })
 }
@@ -788,7 +794,8 @@ mod tests {
                     object duplicate\nobject duplicate reference\nobject unique\nobject delete\nobject rename top\n\
                     object layer 3\nlayer 4 \"roof tiles\"\nlayer 4 color 10 200 255\nlayer 2 active\nobject merge 3 \"tree 4/top\" 7\nobject before 2\nobject after \"a b\"\nobject lock\nobject unlock\nstroke begin\nstroke end\n\
                     frame 12\nanim range 0 30\nanim fps 24\nanim loop off\nexpect frame 12\nobject key smooth\nobject key\nobject unkey\n\
-                    object turn y -90\nobject turn x 450.0\nobject turn z 0.1\nobject turn x -1e-7\nobject turn y 89.9999\n";
+                    object turn y -90\nobject turn x 450.0\nobject turn z 0.1\nobject turn x -1e-7\nobject turn y 89.9999\n\
+                    object place 1 -2 3\nobject remove 0 0 0\nobject paint -4 5 6\nobject \"place\"\n";
         let script = parse_script(Path::new("t.ovr"), text).unwrap();
         let printed: String = script.lines.iter().map(|l| format!("{}\n", l.command)).collect();
         let again = parse_script(Path::new("t.ovr"), &printed).unwrap();
@@ -796,7 +803,7 @@ mod tests {
             script.lines.iter().map(|l| &l.command).collect::<Vec<_>>(),
             again.lines.iter().map(|l| &l.command).collect::<Vec<_>>()
         );
-        assert_eq!(script.lines.len(), 92);
+        assert_eq!(script.lines.len(), 96);
         // Each line's word is the one it is printed with.
         for line in &script.lines {
             assert_eq!(line.command.to_string().split(' ').next(), Some(line.command.word()), "{}", line.command);

@@ -6,7 +6,7 @@ use std::fmt;
 use glam::IVec3;
 
 use super::{AnimLine, LayerLine, Line, ObjectLine, ObjectRef, PaletteLine};
-use crate::edit::brush::Brush;
+use crate::edit::brush::{Brush, Tool};
 
 /// Writes a command back as a script line (what `--record` produces).
 impl fmt::Display for Line {
@@ -108,6 +108,14 @@ impl fmt::Display for Line {
             // Rust prints the shortest text that reads back as the same number.
             Line::Object(ObjectLine::Turn { axis, degrees }) => {
                 write!(f, "object turn {} {}", ["x", "y", "z"][*axis], degrees.0)
+            }
+            Line::Object(ObjectLine::Cell { tool, at }) => {
+                let word = match tool {
+                    Tool::Attach => "place",
+                    Tool::Erase => "remove",
+                    Tool::Paint => "paint",
+                };
+                write!(f, "object {word} {}", v(*at))
             }
             Line::Frame(n) => write!(f, "frame {n}"),
             Line::Anim(AnimLine::Range(a, b)) => write!(f, "anim range {a} {b}"),

@@ -326,8 +326,13 @@ fn the_comb_ray_reaches_the_wall_in_the_pick() {
     };
     let depth = tree.depth();
     let scene = octovox::scene::Scene::new(Default::default(), tree);
-    let hit = octovox::trace::pick::pick(&scene, &camera, (1, 1), 0, 0).unwrap().expect("the wall");
-    assert_eq!(hit.voxel.x, 4010);
+    let picked = octovox::trace::pick::pick(&scene, &camera, (1, 1), 0, 0).unwrap().expect("the wall");
+    assert_eq!(picked.voxel.x, 4010);
+    // The pick's own ray, traced alone for its count.
+    let (origin, dir) = camera.basis(1, 1, scene.origin()).ray(0, 0);
+    let traced = octovox::trace::instanced::Traced::of(&scene);
+    let hit = traced.trace(&octovox::trace::Ray::new(origin, dir), octovox::trace::Footprint::EXACT);
+    assert_eq!(hit.voxel.x + scene.origin().x, 4010);
     println!("the comb ray took {} iterations", hit.iterations);
     assert!(hit.iterations > 4096, "{} iterations", hit.iterations);
     assert!(hit.iterations < octovox::trace::iteration_bound(depth));

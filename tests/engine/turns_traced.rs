@@ -392,27 +392,26 @@ fn cell_of(p: V) -> [i64; 3] {
     p.map(|c| c.floor() as i64)
 }
 
-/// Picking through a free turn (what a click does): the world cell a pick
-/// names belongs to the model cell the exact ray meets first, and the cell
-/// across the picked face to its neighbour in model space, unless that
-/// model cell owns no world cell (its turned cube holds no cell centre);
-/// then erasing the picked cell removes that model cell and attaching adds
-/// its neighbour, read back from the saved file by dot_vox.
+/// Picking through a free turn (what a click does): the pick names the
+/// model cell the exact ray meets first and the face it enters, and the
+/// world cell that cell stands for where it stands for one (some model
+/// cells hold no world cell's centre: then the cell holding its turned
+/// centre stands in). `click` lines run by `octovox replay` erase the model
+/// cell under the cursor, a stand-in one too, and attach its neighbour
+/// across the face, read back from the saved file by dot_vox.
 #[test]
-fn picks_name_the_model_cell_under_the_cursor_through_a_free_turn() {
+fn clicks_edit_the_model_cell_under_the_cursor_through_a_free_turn() {
     use octovox::camera::Camera;
-    let mut editor = turned([0, 0, 0], "object turn y 30\nobject turn x 20");
-    let exact = Exact::of(&dot_vox::load_bytes(&saved(&editor.scene)).unwrap());
+    let editor = turned([0, 0, 0], "object turn y 30\nobject turn x 20");
+    let bytes = saved(&editor.scene);
+    let exact = Exact::of(&dot_vox::load_bytes(&bytes).unwrap());
     let owner = |w: glam::IVec3| cell_of(exact.model_point(w.as_dvec3().to_array().map(|c| c + 0.5)));
-    let owns_some = |c: [i64; 3]| {
-        let centre = exact.world_point(c.map(|v| v as f64 + 0.5)).map(|v| v.floor() as i32);
-        (0..27).any(|k| owner(glam::IVec3::from(centre) + glam::IVec3::new(k % 3 - 1, k / 3 % 3 - 1, k / 9 - 1)) == c)
-    };
     let (lo, hi) = editor.scene.solid_bounds().unwrap();
     let camera = Camera::framing(lo, hi, 40.0);
     let size = (64, 48);
     let basis = camera.basis(size.0, size.1, editor.scene.origin());
-    let (mut picks, mut stand_ins, mut first) = (0, 0, None);
+    let (mut picks, mut stand_ins) = (0, 0);
+    let (mut erase_stand_in, mut attach) = (None, None);
     for y in (0..size.1).step_by(2) {
         for x in (0..size.0).step_by(2) {
             let Some(hit) = octovox::trace::pick::pick(&editor.scene, &camera, size, x, y).unwrap() else { continue };
@@ -440,31 +439,54 @@ fn picks_name_the_model_cell_under_the_cursor_through_a_free_turn() {
                 .unwrap();
             let mut across = cell;
             across[axis] += if dm[axis] > 0.0 { -1 } else { 1 };
+            let model = hit.model.unwrap_or_else(|| panic!("pixel ({x}, {y}): a model cell"));
+            let as_i64 = |v: glam::IVec3| v.to_array().map(i64::from);
+            assert_eq!(as_i64(model.cell), cell, "pixel ({x}, {y}): the model cell under the cursor");
+            assert_eq!(as_i64(model.cell + model.normal), across, "pixel ({x}, {y}): the face entered");
             picks += 1;
+            let inside = |c: [i64; 3]| (0..3).all(|i| c[i] >= 0 && c[i] < [9, 6, 4][i]);
             if owner(hit.voxel) != cell {
-                assert!(!owns_some(cell), "pixel ({x}, {y}): picked {} for model cell {cell:?}", hit.voxel);
                 stand_ins += 1;
-                continue;
-            }
-            if owns_some(across) {
-                assert_eq!(owner(hit.voxel + hit.normal), across, "pixel ({x}, {y}): attach lands across the face");
-            }
-            // An attach inside the model's grid (one outside it grows the
-            // model, which the saved file then shifts).
-            if (0..3).all(|i| across[i] >= 0 && across[i] < [9, 6, 4][i]) {
-                first.get_or_insert((hit, cell, across));
+                erase_stand_in.get_or_insert(((x, y), cell));
+            } else if inside(across) {
+                attach.get_or_insert(((x, y), across));
             }
         }
     }
-    println!("{picks} picks, {stand_ins} of model cells that own no world cell");
-    assert!(picks > 100 && stand_ins * 5 < picks, "{picks} picks, {stand_ins} stand-ins");
-    let (hit, cell, across) = first.unwrap();
-    let model_has = |editor: &Editor, c: [i64; 3]| {
-        let data = dot_vox::load_bytes(&saved(&editor.scene)).unwrap();
-        data.models[0].voxels.iter().any(|v| [v.x, v.y, v.z].map(i64::from) == c)
+    println!("{picks} picks, {stand_ins} on model cells that stand for no world cell");
+    assert!(picks > 100 && stand_ins > 0, "{picks} picks, {stand_ins} stand-ins");
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("turned.vox"), &bytes).unwrap();
+    let click = |(x, y): (u32, u32), tool: &str| {
+        let script = format!(
+            "load turned.vox\nviewport {} {}\ncamera {} {} {} {} {} {} {}\nclick {x} {y} {tool}\nsave out.vox\n",
+            size.0,
+            size.1,
+            camera.eye.x,
+            camera.eye.y,
+            camera.eye.z,
+            camera.target.x,
+            camera.target.y,
+            camera.target.z,
+            camera.fov_y_deg
+        );
+        std::fs::write(dir.path().join("click.ovr"), script).unwrap();
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_octovox"))
+            .args(["replay", "--cpu", "--force"])
+            .arg(dir.path().join("click.ovr"))
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stdout));
+        let data = dot_vox::load_bytes(&std::fs::read(dir.path().join("out.vox")).unwrap()).unwrap();
+        let model: std::collections::BTreeSet<[i64; 3]> =
+            data.models[0].voxels.iter().map(|v| [v.x, v.y, v.z].map(i64::from)).collect();
+        model
     };
-    assert!(model_has(&editor, cell) && !model_has(&editor, across));
-    let (w, a) = (hit.voxel, hit.voxel + hit.normal);
-    run(&mut editor, &format!("place {} {} {}\nremove {} {} {}", a.x, a.y, a.z, w.x, w.y, w.z)).unwrap();
-    assert!(!model_has(&editor, cell) && model_has(&editor, across), "erase and attach went to those model cells");
+    let before: std::collections::BTreeSet<[i64; 3]> = exact.cells.iter().map(|c| c.map(|v| v as i64)).collect();
+    let (pixel, cell) = erase_stand_in.unwrap();
+    let erased = click(pixel, "erase");
+    assert_eq!(before.difference(&erased).collect::<Vec<_>>(), [&cell], "erase took the stand-in model cell");
+    let (pixel, across) = attach.unwrap();
+    let attached = click(pixel, "attach");
+    assert_eq!(attached.difference(&before).collect::<Vec<_>>(), [&across], "attach added the cell across the face");
 }
