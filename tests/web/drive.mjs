@@ -118,9 +118,12 @@ async function waitForFile(file) {
 /// Gives the page `file` through its file picker, opened by `combo`.
 /// Puppeteer turns the picker's interception on asynchronously, and a
 /// picker that opens before that is missed: the keys are pressed again
-/// (the page asks for one file at a time) until one is caught.
+/// (the page asks for one file at a time) until one is caught, for as long
+/// as any wait here (a page busy drawing on a loaded machine answers keys
+/// late).
 async function pick(file, ...combo) {
-  for (let tries = 0; ; tries++) {
+  const start = Date.now();
+  for (;;) {
     const chooser = page.waitForFileChooser({ timeout: 5000 });
     await page.evaluate(() => 0);
     await keys(...combo);
@@ -128,7 +131,7 @@ async function pick(file, ...combo) {
       await (await chooser).accept([file]);
       return;
     } catch (err) {
-      if (tries >= 3) throw err;
+      if (Date.now() - start >= TIMEOUT_MS) throw err;
     }
   }
 }
