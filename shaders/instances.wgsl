@@ -23,6 +23,9 @@ struct Instance {
     turned: bool,
     rows: mat3x3<f32>,
     t: vec3<f32>,
+    // The model's solid box, tree-local (`Turned::solid`); lo > hi: none.
+    solid_lo: vec3<f32>,
+    solid_hi: vec3<f32>,
 }
 
 fn load_instance(index: u32) -> Instance {
@@ -39,11 +42,14 @@ fn load_instance(index: u32) -> Instance {
     if (inst.turned) {
         inst.t = bitcast<vec3<f32>>(b.yzw);
         // The rows as the columns of a matrix: `v * rows` is rows · v.
-        inst.rows = mat3x3<f32>(
-            bitcast<vec4<f32>>(instances[at + 2u]).xyz,
-            bitcast<vec4<f32>>(instances[at + 3u]).xyz,
-            bitcast<vec4<f32>>(instances[at + 4u]).xyz,
-        );
+        let r0 = instances[at + 2u];
+        let r1 = instances[at + 3u];
+        let r2 = instances[at + 4u];
+        inst.rows = mat3x3<f32>(bitcast<vec3<f32>>(r0.xyz), bitcast<vec3<f32>>(r1.xyz), bitcast<vec3<f32>>(r2.xyz));
+        // Each row's fourth word: one axis of the solid box, lo | hi << 16.
+        let box_words = vec3<u32>(r0.w, r1.w, r2.w);
+        inst.solid_lo = vec3<f32>(box_words & vec3<u32>(0xffffu)) - vec3<f32>(SOLID_BOX_SLACK);
+        inst.solid_hi = vec3<f32>(box_words >> vec3<u32>(16u)) + vec3<f32>(1.0 + SOLID_BOX_SLACK);
     }
     return inst;
 }
@@ -83,6 +89,16 @@ fn model_ray(inst: Instance, r: Ray) -> Ray {
     let d = vec3<f32>(r.d[inst.src.x], r.d[inst.src.y], r.d[inst.src.z]);
     let inv = vec3<f32>(r.inv[inst.src.x], r.inv[inst.src.y], r.inv[inst.src.z]);
     return Ray(s * o + vec3<f32>(inst.offset), s * d, s * inv);
+}
+
+// Whether a turned instance's model ray misses its solid box after t_min
+// (twin of `Turned::misses_solid`; an instance with no box is walked).
+fn misses_solid(inst: Instance, mr: Ray, t_min: f32) -> bool {
+    if (!inst.turned || any(inst.solid_lo > inst.solid_hi)) {
+        return false;
+    }
+    let s = slab(mr, inst.solid_lo, inst.solid_hi);
+    return !(s.t_enter <= s.t_exit && s.t_exit >= max(t_min, 0.0));
 }
 
 // The code of the axis nearest `n` (twin of `nearest_axis`).
@@ -237,11 +253,16 @@ fn trace_scene(r: Ray, t_min: f32, medium: u32, inside: u32, lod: vec2<f32>) -> 
             }
             let index = leaf - 1u;
             let inst = load_instance(index);
-            let h = cross_tree(inst.tree, model_ray(inst, r), t_min, select(0u, medium, index == inside), lod);
-            iterations += h.iterations;
-            gave_up = gave_up || (!h.found && h.iterations >= inst.tree.max_iterations);
-            if (h.found && wins(h.t, index, best)) {
-                best = scene_hit(inst, index, h);
+            let mr = model_ray(inst, r);
+            // A turned object's solid box, tighter than its scene box;
+            // glass the ray is in is left at its tree's face: walked.
+            if (index == inside || !misses_solid(inst, mr, 0.0)) {
+                let h = cross_tree(inst.tree, mr, t_min, select(0u, medium, index == inside), lod);
+                iterations += h.iterations;
+                gave_up = gave_up || (!h.found && h.iterations >= inst.tree.max_iterations);
+                if (h.found && wins(h.t, index, best)) {
+                    best = scene_hit(inst, index, h);
+                }
             }
         }
         // The next node on the stack still within reach, if any.

@@ -6,7 +6,9 @@ use std::fmt::Write as _;
 
 use super::layout::{FLOOR_ROW, GRID_MIX, HIGHLIGHT_MIX, HIGHLIGHT_TINT, ROW_TILES};
 use crate::gpu_pool::{LOD_WORD, NODE_WORDS, POINTER_BIT};
-use crate::scene::instances::{BVH_NODE_WORDS, BVH_STACK, EMPTY_BIT, INSTANCE_WORDS, NO_INSTANCE, TIE_T, TURNED_BIT};
+use crate::scene::instances::{
+    BVH_NODE_WORDS, BVH_STACK, EMPTY_BIT, INSTANCE_WORDS, NO_INSTANCE, SOLID_BOX_SLACK, TIE_T, TURNED_BIT,
+};
 use crate::settings::{SUN_DIR, View};
 use crate::trace::denoise;
 use crate::trace::path::{self, materials};
@@ -34,6 +36,7 @@ pub fn shared_constants() -> String {
     line("NO_INSTANCE", "u32", format!("{NO_INSTANCE:#x}u"));
     line("TIE_T", "f32", format!("{TIE_T:?}"));
     line("TURNED_BIT", "u32", format!("{TURNED_BIT:#x}u"));
+    line("SOLID_BOX_SLACK", "f32", format!("{SOLID_BOX_SLACK:?}"));
     line("ROW_TILES", "u32", format!("{ROW_TILES}u"));
     line("FLOOR_ROW", "u32", format!("{FLOOR_ROW}u"));
     line("HIGHLIGHT_TINT", "vec3<f32>", vec3(HIGHLIGHT_TINT));

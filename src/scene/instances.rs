@@ -72,7 +72,16 @@ pub struct Instance {
 pub struct Turned {
     pub rows: [Vec3; 3],
     pub t: Vec3,
+    /// The model's solid cells' box, tree-local and inclusive, where each
+    /// corner fits 16 bits (the record's spare words hold it): a ray that
+    /// meets the turned object's scene box but misses this is not walked
+    /// (a turned box's scene box holds much empty space).
+    pub solid: Option<(IVec3, IVec3)>,
 }
+
+/// How far the solid box is grown before a ray is tested against it, in
+/// voxels: a ray that grazes it is walked (the walk decides).
+pub const SOLID_BOX_SLACK: f32 = 1.0 / 256.0;
 
 impl Turned {
     /// The turned map of model grid points `x = m · (w − shift) + c` of
@@ -80,10 +89,27 @@ impl Turned {
     /// cells start at world cell `origin` and a tree whose cells start at
     /// model cell `tree_origin`. The translation is summed in f64 and
     /// rounded once.
-    pub fn new((m, shift, c): (DMat3, IVec3, DVec3), origin: IVec3, tree_origin: IVec3) -> Turned {
+    pub fn new(
+        (m, shift, c): (DMat3, IVec3, DVec3),
+        origin: IVec3,
+        tree_origin: IVec3,
+        solid: Option<(IVec3, IVec3)>,
+    ) -> Turned {
         let t = m * (origin - shift).as_dvec3() + c - tree_origin.as_dvec3();
         let m = m.transpose();
-        Turned { rows: [m.x_axis.as_vec3(), m.y_axis.as_vec3(), m.z_axis.as_vec3()], t: t.as_vec3() }
+        let fits = |v: IVec3| v.cmpge(IVec3::ZERO).all() && v.cmple(IVec3::splat(0xffff)).all();
+        let solid = solid.map(|(lo, hi)| (lo - tree_origin, hi - tree_origin)).filter(|&(lo, hi)| fits(lo) && fits(hi));
+        Turned { rows: [m.x_axis.as_vec3(), m.y_axis.as_vec3(), m.z_axis.as_vec3()], t: t.as_vec3(), solid }
+    }
+
+    /// Whether a ray in the model's frame (`model_ray`) misses the solid
+    /// box, grown by [`SOLID_BOX_SLACK`], after `t_min`. Twin of
+    /// `misses_solid` in shaders/instances.wgsl.
+    pub fn misses_solid(&self, ray: &crate::trace::Ray, t_min: f32) -> bool {
+        let Some((lo, hi)) = self.solid else { return false };
+        let slack = Vec3::splat(SOLID_BOX_SLACK);
+        let (enter, exit, _) = ray.slab(lo.as_vec3() - slack, (hi + IVec3::ONE).as_vec3() + slack);
+        !(enter <= exit && exit >= t_min.max(0.0))
     }
 
     /// `rows · v`, each row's products summed left to right (as the shader).
@@ -117,13 +143,15 @@ impl Turned {
         self.times_transposed(n)
     }
 
-    /// The record's words after the header: `t`, then the rows, each
-    /// padded to four words, as f32 bits.
+    /// The record's words after the header: `t`, then the rows as f32
+    /// bits, each followed by one axis of the solid box (its low corner in
+    /// the low 16 bits, its high corner above; none: low above high).
     fn words(&self) -> [u32; 15] {
         let mut words = [0; 15];
         words[..3].copy_from_slice(&self.t.to_array().map(f32::to_bits));
         for (i, row) in self.rows.iter().enumerate() {
             words[3 + 4 * i..6 + 4 * i].copy_from_slice(&row.to_array().map(f32::to_bits));
+            words[6 + 4 * i] = self.solid.map_or(0xffff, |(lo, hi)| lo[i] as u32 | (hi[i] as u32) << 16);
         }
         words
     }
@@ -183,7 +211,7 @@ impl InstanceTable {
                 let map = match objects.map(i) {
                     Placing::Cells(map) => map,
                     Placing::Turned(map) => {
-                        instance.turned = Some(Turned::new(map.to_model(), origin, tree_origin));
+                        instance.turned = Some(Turned::new(map.to_model(), origin, tree_origin, model_bounds[model]));
                         instance.bounds = model_bounds[model]
                             .filter(|_| !object.hidden)
                             .map(|(lo, hi)| map.cover_box(lo, hi))

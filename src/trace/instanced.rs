@@ -68,11 +68,17 @@ impl<'a> Traced<'a> {
                 let instance = &table.instances[index as usize];
                 let tree = &models[instance.model].tree;
                 let m = if inside == Some(index) { medium } else { 0 };
-                let c = svo::cross(tree, &model_ray(instance, ray), m, footprint);
-                iterations = iterations.saturating_add(c.hit.iterations);
-                gave_up |= c.hit.gave_up;
-                if c.found && wins(c.t, index, best) {
-                    best = Some(scene_crossing(instance, index, c));
+                let model_ray = model_ray(instance, ray);
+                // A turned object's solid box, tighter than its scene box;
+                // glass the ray is in is left at its tree's face: walked.
+                let misses = inside != Some(index) && instance.turned.is_some_and(|t| t.misses_solid(&model_ray, 0.0));
+                if !misses {
+                    let c = svo::cross(tree, &model_ray, m, footprint);
+                    iterations = iterations.saturating_add(c.hit.iterations);
+                    gave_up |= c.hit.gave_up;
+                    if c.found && wins(c.t, index, best) {
+                        best = Some(scene_crossing(instance, index, c));
+                    }
                 }
             } else {
                 // The right child is the node after the left one's subtree;
