@@ -492,3 +492,63 @@ fn the_outliner_shows_an_objects_layer_and_moves_it() {
     let dot_vox::SceneNode::Transform { layer_id, .. } = &data.scenes[node as usize] else { panic!("node {node}") };
     assert_eq!(*layer_id, 2, "object {index} is on layer 2");
 }
+
+/// A real click on a freely turned object (issue 49) attaches across the
+/// face of the model cell under the cursor, in model space (the window
+/// runs `object place X Y Z` of that model's cell): the saved file, read
+/// by dot_vox, holds exactly that cell more in that model.
+#[test]
+fn a_click_on_a_turned_object_attaches_across_its_model_face() {
+    use octovox::trace::pick::pick;
+    let (dir, file, _) = groups_document();
+    // Object 3 of the file turned by 30° about MagicaVoxel's z (written
+    // with dot_vox: `_ov_turn` beside its key).
+    let mut data = dot_vox::load_bytes(&std::fs::read(&file).unwrap()).unwrap();
+    let scene = octovox::io::load_scene(&file, 0).unwrap();
+    let node = scene.objects().unwrap().list()[3].transform_node.unwrap() as usize;
+    let dot_vox::SceneNode::Transform { frames, .. } = &mut data.scenes[node] else { panic!("a transform") };
+    frames[0].attributes.insert("_ov_turn".into(), "0 0 0.25881904510252074 0.9659258262890683".into());
+    let mut bytes = Vec::new();
+    data.write_vox(&mut bytes).unwrap();
+    std::fs::write(&file, &bytes).unwrap();
+    let scene = octovox::io::load_scene(&file, 0).unwrap();
+    let objects = scene.objects().unwrap();
+    let model = objects.list()[3].placement.model;
+    let size = data.models[model].size;
+    // Inside the model's grid (a cell outside grows it, and the saved file
+    // shifts its cells).
+    let inside = |c: glam::IVec3| {
+        c.cmpge(glam::IVec3::ZERO).all() && c.cmplt(glam::IVec3::new(size.x as i32, size.y as i32, size.z as i32)).all()
+    };
+    // The window's field of view (`--camera` sets the eye and target).
+    let camera = Camera::framing(objects.world_box(3).unwrap().0, objects.world_box(3).unwrap().1, 50.0);
+    // A pixel whose pick (and its neighbours') hits one model cell face of
+    // object 3, clear of the panels.
+    let at = |x: u32, y: u32| pick(&scene, &camera, (WIDTH, HEIGHT), x, y).unwrap().and_then(|p| p.model);
+    let (x, y, face) = (FREE_Y + 4..HEIGHT - 4)
+        .step_by(3)
+        .flat_map(|y| (FREE_X + 4..OUTLINER_X - 4).step_by(3).map(move |x| (x, y)))
+        .find_map(|(x, y)| {
+            let face = at(x, y).filter(|m| m.object == 3 && inside(m.cell + m.normal))?;
+            let steady = (-2..=2).all(|d: i32| {
+                at(x.wrapping_add_signed(d), y) == Some(face) && at(x, y.wrapping_add_signed(d)) == Some(face)
+            });
+            steady.then_some((x, y, face))
+        })
+        .expect("a pixel on the turned object");
+    let across = face.cell + face.normal;
+    let cells = |file: &std::path::Path| -> std::collections::BTreeSet<[i32; 3]> {
+        let data = dot_vox::load_bytes(&std::fs::read(file).unwrap()).unwrap();
+        data.models[model].voxels.iter().map(|v| [v.x, v.y, v.z].map(i32::from)).collect()
+    };
+    let before = cells(&file);
+
+    let (_xvfb, display) = start_xvfb();
+    let (_app, mut lines, window) = open_ready(&display, dir.path(), &document_args(&file, &camera, &[]));
+    click(&display, &window, &mut lines, x, y);
+    assert!(lines.seen.iter().any(|l| l == "ran: object 3"), "{:?}", lines.seen);
+    save(&display, &mut lines, &file);
+    let after = cells(&file);
+    assert_eq!(after.difference(&before).collect::<Vec<_>>(), [&across.to_array()], "the cell across the face");
+    assert_eq!(before.difference(&after).count(), 0);
+}
