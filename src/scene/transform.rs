@@ -507,6 +507,12 @@ impl TurnedMap {
         (lo.saturating_add(self.shift), hi.saturating_add(self.shift))
     }
 
+    /// The map from model grid points to world points: world point
+    /// `a · x + at` of model grid point `x`.
+    pub fn to_world(&self) -> (DMat3, DVec3) {
+        (self.a, self.shift.as_dvec3() + self.frac)
+    }
+
     /// The map from world points to model grid points, in parts: model
     /// point `x = m · (w − shift) + c` of world point `w`, with `m`
     /// orthogonal and `shift` the translation's whole part (kept out of

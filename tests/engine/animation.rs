@@ -398,7 +398,7 @@ fn info_follows_the_frame_and_says_the_range() {
 /// The node's place at `time` by the animation's samplers, as the column-
 /// major matrix T · R · S (a sampler holds its last sample at or before
 /// `time`: the samples are at every frame where the place changes).
-fn sampled_node(glb: &super::export::Glb, node: usize, time: f64) -> serde_json::Value {
+pub(crate) fn sampled_node(glb: &super::export::Glb, node: usize, time: f64) -> serde_json::Value {
     let mut out = glb.json["nodes"][node].clone();
     let animation = &glb.json["animations"][0];
     for channel in animation["channels"].as_array().unwrap() {

@@ -490,3 +490,52 @@ fn clicks_edit_the_model_cell_under_the_cursor_through_a_free_turn() {
     let attached = click(pixel, "attach");
     assert_eq!(attached.difference(&before).collect::<Vec<_>>(), [&across], "attach added the cell across the face");
 }
+
+/// `export` to .glb of an object keyed by free turns (10° at frame 0, 50°
+/// at frame 10): the Khronos validator passes it, its rotation slerps
+/// between samples (LINEAR), and the node's sampled
+/// place puts the model's mesh, at frames 0, 5 and 10, where the turn the
+/// test reads from each saved file puts the model (at frame 5 the still
+/// block turned by 30°, halfway by slerp), to 10⁻⁴ voxel.
+#[test]
+fn the_glb_export_turns_freely_turned_objects_as_keyed() {
+    let keyed = turned([3, -2, 5], "object turn y 10\nobject key\nframe 10\nobject key\nobject turn y 40\nframe 0");
+    let dir = tempfile::tempdir().unwrap();
+    let (vox, glb) = (dir.path().join("keyed.vox"), dir.path().join("keyed.glb"));
+    std::fs::write(&vox, saved(&keyed.scene)).unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_octovox"))
+        .args(["export", vox.to_str().unwrap(), "-o", glb.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    super::export::validate_gltf(&[&glb]);
+    let read = super::export::read_glb(&glb);
+    let node = read.json["nodes"].as_array().unwrap().iter().position(|n| n["name"] == "block").unwrap();
+    // Its rotation slerps between the samples (LINEAR), as the keys do.
+    let animation = &read.json["animations"][0];
+    let rotation = animation["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["target"]["node"] == serde_json::json!(node) && c["target"]["path"] == "rotation");
+    let sampler = rotation.expect("a rotation channel")["sampler"].as_u64().unwrap() as usize;
+    assert_eq!(animation["samplers"][sampler]["interpolation"], "LINEAR");
+    let expected = |script: &str| Exact::of(&dot_vox::load_bytes(&saved(&turned([3, -2, 5], script).scene)).unwrap());
+    for (frame, exact) in
+        [(0, expected("object turn y 10")), (5, expected("object turn y 30")), (10, expected("object turn y 50"))]
+    {
+        let mut json = read.json.clone();
+        json["nodes"][node] = super::animation::sampled_node(&read, node, f64::from(frame) / 12.0);
+        let placed = super::export_scene::placed_meshes(&json);
+        let (_, _, matrix) = placed.iter().find(|(name, ..)| name == "block").unwrap();
+        let far = read
+            .positions
+            .iter()
+            .map(|&p| {
+                let (got, want) = (super::export_scene::apply(matrix, p), exact.world_point(p));
+                (0..3).map(|i| (got[i] - want[i]).abs()).fold(0.0, f64::max)
+            })
+            .fold(0.0, f64::max);
+        assert!(far < 1e-4, "frame {frame}: a vertex {far} voxels off");
+    }
+}

@@ -216,8 +216,9 @@ impl Buffers {
     }
 
     /// One animation driving every moving node: its translation (STEP where
-    /// its keys hold, else LINEAR), its rotation and its scale (STEP: turns
-    /// are held between keys); `None` when nothing moves.
+    /// its keys hold, else LINEAR), its rotation (LINEAR where it turns
+    /// freely between keys that do not hold, else STEP: quarter turns are
+    /// held between keys) and its scale (STEP); `None` when nothing moves.
     fn animation(&mut self, moving: &[(usize, &Motion)], fps: u32, scale: f32) -> Option<Value> {
         let (mut samplers, mut channels) = (Vec::new(), Vec::new());
         for &(node, motion) in moving {
@@ -225,9 +226,20 @@ impl Buffers {
             let input = self.float_accessor(&times, 1, "SCALAR", true);
             let trs: Vec<_> = motion.samples.iter().map(|(_, place)| place.trs(scale)).collect();
             let translation: Vec<f32> = trs.iter().flat_map(|t| t.0).collect();
-            let rotation: Vec<f32> = trs.iter().flat_map(|t| t.1).collect();
             let scaling: Vec<f32> = trs.iter().flat_map(|t| t.2).collect();
             let step = if motion.step { "STEP" } else { "LINEAR" };
+            // Free turns slerp between keys, as glTF's LINEAR rotation does
+            // (each sample on the near side of the last: the short way).
+            let slerped = !motion.step && motion.samples.iter().any(|(_, place)| place.is_turned());
+            let mut last = glam::Vec4::W;
+            let rotation: Vec<f32> = trs
+                .iter()
+                .flat_map(|t| {
+                    let q = glam::Vec4::from_array(t.1);
+                    last = if slerped && q.dot(last) < 0.0 { -q } else { q };
+                    last.to_array()
+                })
+                .collect();
             let mut channel = |path: &str, values: &[f32], width: usize, kind: &str, interpolation: &str| {
                 let output = self.float_accessor(values, width, kind, false);
                 samplers.push(json!({"input": input, "output": output, "interpolation": interpolation}));
@@ -236,7 +248,7 @@ impl Buffers {
             // All three, even where one holds over the range: the node's own
             // values are those of the frame exported, which may lie outside it.
             channel("translation", &translation, 3, "VEC3", step);
-            channel("rotation", &rotation, 4, "VEC4", "STEP");
+            channel("rotation", &rotation, 4, "VEC4", if slerped { "LINEAR" } else { "STEP" });
             channel("scale", &scaling, 3, "VEC3", "STEP");
         }
         (!channels.is_empty()).then(|| json!({"name": "animation", "samplers": samplers, "channels": channels}))

@@ -28,7 +28,7 @@ pub fn obj(exported: &Exported, scale: f32, mtl_name: &str) -> Vec<u8> {
 fn write_part(text: &mut String, exported: &Exported, part: &Part, scale: f32, first: usize) -> usize {
     let mesh = &exported.meshes[part.mesh].mesh;
     for &p in &mesh.positions_x2 {
-        let [x, y, z] = part.place.apply_x2(p).to_array().map(|c| c as f32 * 0.5 * scale);
+        let [x, y, z] = part.place.apply_x2(p).to_array().map(|c| (c * 0.5 * f64::from(scale)) as f32);
         let _ = writeln!(text, "v {x} {y} {z}");
     }
     let colors: std::collections::BTreeSet<u8> = mesh.triangles.iter().map(|(_, c)| *c).collect();

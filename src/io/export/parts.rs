@@ -1,19 +1,20 @@
 //! What an export writes, before any format: each model's mesh once, and
 //! the parts that place them. A file of one model is one part, `voxels`, at
 //! its place. A scene of objects is a part per visible object, named by its
-//! path of named transforms, placed by its exact cell map, and sharing its
-//! model's mesh with every other placement of that model (a reference).
+//! path of named transforms, placed by its exact cell map (or a freely
+//! turned one by its rigid map, as it is traced), and sharing its model's
+//! mesh with every other placement of that model (a reference).
 
 use std::collections::HashMap;
 
-use glam::IVec3;
+use glam::{DMat3, DQuat, DVec3, IVec3};
 
 use super::greedy::{VoxelMesh, mesh_within_budget};
 use super::{ExportError, check_scale};
 use crate::scene::Scene;
 use crate::scene::graph::Node;
 use crate::scene::objects::Objects;
-use crate::scene::transform::{CellMap, Placing};
+use crate::scene::transform::Placing;
 
 /// The meshes and the parts that place them.
 pub struct Exported {
@@ -68,41 +69,85 @@ impl Part {
     }
 }
 
-/// A signed permutation and an offset on points in half voxels: the exact
-/// map from a mesh's vertices to the world (y up).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Place {
-    rows: [(usize, i32, i32); 3],
+/// How a mesh's vertices (in half voxels) land in the world (y up): by a
+/// signed permutation and an offset, exactly, or for a freely turned object
+/// by its rigid map (`world = m · p + t`, in half voxels), compared bit for
+/// bit.
+#[derive(Clone, Copy, Debug)]
+pub enum Place {
+    Cells([(usize, i32, i32); 3]),
+    Turned { m: DMat3, t: DVec3 },
+}
+
+impl PartialEq for Place {
+    fn eq(&self, other: &Place) -> bool {
+        match (self, other) {
+            (Place::Cells(a), Place::Cells(b)) => a == b,
+            (Place::Turned { m: a, t: s }, Place::Turned { m: b, t: u }) => {
+                a.to_cols_array().map(f64::to_bits) == b.to_cols_array().map(f64::to_bits)
+                    && s.to_array().map(f64::to_bits) == u.to_array().map(f64::to_bits)
+            }
+            _ => false,
+        }
+    }
 }
 
 impl Place {
-    pub const IDENTITY: Place = Place { rows: [(0, 1, 0), (1, 1, 0), (2, 1, 0)] };
+    pub const IDENTITY: Place = Place::Cells([(0, 1, 0), (1, 1, 0), (2, 1, 0)]);
 
-    fn of(map: &CellMap) -> Place {
-        Place { rows: map.half_voxel_rows() }
-    }
-
-    /// The place of an exact placing; a freely turned one (which `Exported::of`
-    /// meshes as drawn instead, never here) stays where it is.
     fn of_placing(placing: &Placing) -> Place {
-        placing.cells().map_or(Place::IDENTITY, Place::of)
+        match placing {
+            Placing::Cells(map) => Place::Cells(map.half_voxel_rows()),
+            Placing::Turned(map) => {
+                let (m, at) = map.to_world();
+                Place::Turned { m, t: at * 2.0 }
+            }
+        }
     }
 
-    /// The world position of a vertex at `p` (both in half voxels).
-    pub fn apply_x2(&self, p: IVec3) -> IVec3 {
-        IVec3::from_array(self.rows.map(|(axis, sign, offset)| sign * p[axis] + offset))
+    /// Whether it is a free turn's.
+    pub fn is_turned(&self) -> bool {
+        matches!(self, Place::Turned { .. })
+    }
+
+    /// The linear part as a matrix.
+    fn linear(&self) -> DMat3 {
+        match *self {
+            Place::Cells(rows) => {
+                let mut columns = [DVec3::ZERO; 3];
+                for (row, (axis, sign, _)) in rows.into_iter().enumerate() {
+                    columns[axis][row] = f64::from(sign);
+                }
+                DMat3::from_cols(columns[0], columns[1], columns[2])
+            }
+            Place::Turned { m, .. } => m,
+        }
+    }
+
+    /// The translation, in half voxels.
+    fn offset(&self) -> DVec3 {
+        match *self {
+            Place::Cells(rows) => DVec3::from_array(rows.map(|(_, _, offset)| f64::from(offset))),
+            Place::Turned { t, .. } => t,
+        }
+    }
+
+    /// The world position of a vertex at `p`, both in half voxels (exact
+    /// whole numbers but through a free turn).
+    pub fn apply_x2(&self, p: IVec3) -> DVec3 {
+        match *self {
+            Place::Cells(rows) => {
+                IVec3::from_array(rows.map(|(axis, sign, offset)| sign * p[axis] + offset)).as_dvec3()
+            }
+            Place::Turned { m, t } => m * p.as_dvec3() + t,
+        }
     }
 
     /// Whether the map mirrors (its determinant is −1): a mesh placed by it
     /// must wind its triangles the other way to stay outward. (glTF does
     /// this itself from the node's matrix.)
     pub fn mirrors(&self) -> bool {
-        let [(a, ..), (b, ..), _] = self.rows;
-        // A permutation of three is odd when it swaps two and keeps one:
-        // exactly when its first two rows read axes in falling cyclic order.
-        let odd = (b + 3 - a) % 3 == 2;
-        let negatives = self.rows.iter().filter(|(_, sign, _)| *sign < 0).count();
-        odd != (negatives % 2 == 1)
+        self.linear().determinant() < 0.0
     }
 
     /// A triangle's corners in the order that keeps it outward once placed.
@@ -114,16 +159,12 @@ impl Place {
     /// glTF animates them: a map that mirrors is a turn after a mirror of x
     /// (scale −1 on x).
     pub fn trs(&self, scale: f32) -> ([f32; 3], [f32; 4], [f32; 3]) {
-        let mut columns = [glam::Vec3::ZERO; 3];
-        let mut translation = [0.0; 3];
-        for (row, (axis, sign, offset)) in self.rows.into_iter().enumerate() {
-            columns[axis][row] = sign as f32;
-            translation[row] = offset as f32 * 0.5 * scale;
-        }
         let flip = if self.mirrors() { -1.0 } else { 1.0 };
-        columns[0] *= flip;
-        let rotation = glam::Quat::from_mat3(&glam::Mat3::from_cols(columns[0], columns[1], columns[2])).normalize();
-        (translation, rotation.to_array(), [flip, 1.0, 1.0])
+        let linear = self.linear();
+        let turn = DMat3::from_cols(linear.x_axis * flip, linear.y_axis, linear.z_axis);
+        let rotation = DQuat::from_mat3(&turn).normalize().as_quat();
+        let translation = (self.offset() * 0.5 * f64::from(scale)).as_vec3();
+        (translation.to_array(), rotation.to_array(), [flip as f32, 1.0, 1.0])
     }
 
     /// The map as a column-major 4×4 matrix on coordinates scaled by
@@ -132,12 +173,8 @@ impl Place {
         if *self == Place::IDENTITY {
             return None;
         }
-        let mut m = [0.0; 16];
-        for (row, (axis, sign, offset)) in self.rows.into_iter().enumerate() {
-            m[axis * 4 + row] = sign as f32;
-            m[12 + row] = offset as f32 * 0.5 * scale;
-        }
-        m[15] = 1.0;
+        let mut m = glam::Mat4::from_mat3(self.linear().as_mat3()).to_cols_array();
+        m[12..15].copy_from_slice(&(self.offset() * 0.5 * f64::from(scale)).as_vec3().to_array());
         Some(m)
     }
 }
@@ -151,10 +188,7 @@ impl Exported {
     /// animation longer than [`MAX_EXPORT_FRAMES`].
     pub fn of(scene: &Scene, scale: f32, animated: bool) -> Result<Exported, ExportError> {
         check_scale(scene.drawn(), scale)?;
-        // A scene with a free turn is meshed as drawn: its turned objects'
-        // cells are the world cells their centres land in, no signed
-        // permutation of a model's mesh.
-        let Some(objects) = scene.objects().filter(|o| !o.has_free_turns()) else {
+        let Some(objects) = scene.objects() else {
             let mesh = NamedMesh { name: "voxels".into(), mesh: mesh_within_budget(scene.drawn())? };
             let part =
                 Part { groups: Vec::new(), name: "voxels".into(), mesh: 0, place: Place::IDENTITY, motion: None };
@@ -270,15 +304,16 @@ mod tests {
             let transform = Transform { rotation, translation: [5, -3, 7] };
             let placement = Placement { model: 0, transform, centred: true, turned: None };
             let map = placement.cell_map([4, 6, 3]).unwrap();
-            let place = Place::of(&map);
+            let place = Place::of_placing(&Placing::Cells(map));
             let m = place.matrix(1.0).unwrap_or([1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1., 0., 0., 0., 0., 1.]);
             let det =
                 glam::Mat3::from_cols_slice(&[m[0], m[1], m[2], m[4], m[5], m[6], m[8], m[9], m[10]]).determinant();
             assert_eq!(place.mirrors(), det < 0.0, "rotation byte {byte}");
             for v in [IVec3::new(0, 0, 0), IVec3::new(3, 5, 2), IVec3::new(1, 4, 0)] {
                 let cell = map.apply(v);
-                let corners: Vec<IVec3> =
-                    (0..8).map(|k| place.apply_x2(2 * v + 2 * IVec3::new(k & 1, (k >> 1) & 1, k >> 2))).collect();
+                let corners: Vec<IVec3> = (0..8)
+                    .map(|k| place.apply_x2(2 * v + 2 * IVec3::new(k & 1, (k >> 1) & 1, k >> 2)).as_ivec3())
+                    .collect();
                 let lo = corners.iter().copied().reduce(IVec3::min).unwrap();
                 let hi = corners.iter().copied().reduce(IVec3::max).unwrap();
                 assert_eq!((lo, hi), (2 * cell, 2 * cell + 2), "rotation byte {byte}, cell {v}");

@@ -31,7 +31,7 @@ pub fn ply(exported: &Exported, palette: &Palette, scale: f32) -> Vec<u8> {
         let part = &exported.parts[p];
         let at = part.place.apply_x2(exported.meshes[part.mesh].mesh.positions_x2[v as usize]);
         for c in at.to_array() {
-            bytes.extend((c as f32 * 0.5 * scale).to_le_bytes());
+            bytes.extend(((c * 0.5 * f64::from(scale)) as f32).to_le_bytes());
         }
         bytes.extend(&palette.color(color)[..3]);
     }
