@@ -18,7 +18,7 @@ use super::graph::{
     self, GraphError, Layer, NameEntry, Node, NodeKind, Object, OutlineRow, SceneGraph, Walked, path_of,
 };
 use super::octree::{Octree, WORLD_LIMIT};
-use super::transform::{Placing, Pose, Rotation, Transform, Turn};
+use super::transform::{Placing, Pose, Rotation, Transform, Turn, TurnedMap};
 use super::{EditError, ObjectRefusal, Op, Patch, Shape};
 
 /// Placements of one model beyond which an edit of it composes one box
@@ -260,29 +260,7 @@ impl Objects {
         let model = &self.models[self.objects[index].placement.model].tree;
         match self.maps[index] {
             Placing::Cells(map) => copy_cells(model, map.invert_box(lo, hi), tree, |p| map.apply(p)),
-            Placing::Turned(map) => {
-                // Every world cell takes the model cell that holds its centre's preimage.
-                let Some((mlo, mhi)) = model.solid_bounds() else { return };
-                let (wlo, whi) = map.apply_box(mlo, mhi);
-                let (wlo, whi) = (wlo.max(lo), whi.min(hi));
-                let mut batch: Vec<(IVec3, u8)> = Vec::new();
-                for z in wlo.z..=whi.z {
-                    for y in wlo.y..=whi.y {
-                        for x in wlo.x..=whi.x {
-                            let w = IVec3::new(x, y, z);
-                            let value = model.get(map.invert(w));
-                            if value != 0 {
-                                batch.push((w, value));
-                            }
-                        }
-                    }
-                    if batch.len() >= PLACED_BATCH {
-                        tree.insert_voxels(&batch);
-                        batch.clear();
-                    }
-                }
-                tree.insert_voxels(&batch);
-            }
+            Placing::Turned(map) => resample_cells(model, &map, (lo, hi), tree),
         }
     }
 
@@ -1212,6 +1190,38 @@ impl GraphChange {
 /// signed permutation maps a box onto a box), so a solid region costs its
 /// surface; single voxels go in batches of at most [`PLACED_BATCH`], so
 /// memory stays small whatever the model.
+/// Composes a freely turned model into the world cells `lo..=hi`: every
+/// world cell takes the model cell that holds its centre's preimage. Each
+/// uniform cell of the model gives the world cells of its turned cube's
+/// box whose preimage it holds, so the work follows the model's cells
+/// (a sparse model spread over a large box costs its cells, not its box)
+/// and every world cell is written once, by its own model cell.
+fn resample_cells(model: &Octree, map: &TurnedMap, (lo, hi): (IVec3, IVec3), to: &mut Octree) {
+    let (mlo, mhi) = map.invert_box(lo, hi);
+    let mut batch: Vec<(IVec3, u8)> = Vec::new();
+    model.for_each_solid_cell_in(mlo, mhi, |min, size, value| {
+        let max = min + IVec3::splat(size - 1);
+        let (wlo, whi) = map.apply_box(min, max);
+        let (wlo, whi) = (wlo.max(lo), whi.min(hi));
+        for z in wlo.z..=whi.z {
+            for y in wlo.y..=whi.y {
+                for x in wlo.x..=whi.x {
+                    let w = IVec3::new(x, y, z);
+                    let m = map.invert(w);
+                    if m.cmpge(min).all() && m.cmple(max).all() {
+                        batch.push((w, value));
+                    }
+                }
+            }
+        }
+        if batch.len() >= PLACED_BATCH {
+            to.insert_voxels(&batch);
+            batch.clear();
+        }
+    });
+    to.insert_voxels(&batch);
+}
+
 fn copy_cells(from: &Octree, (lo, hi): (IVec3, IVec3), to: &mut Octree, map: impl Fn(IVec3) -> IVec3) {
     let mut batch: Vec<(IVec3, u8)> = Vec::new();
     from.for_each_solid_cell_in(lo, hi, |min, size, value| {

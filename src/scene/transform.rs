@@ -492,9 +492,12 @@ impl TurnedMap {
     /// `lo..=hi` may hold (the box around the turned box).
     pub fn apply_box(&self, lo: IVec3, hi: IVec3) -> (IVec3, IVec3) {
         let (min, max) = image_box(|x| self.world_unshifted(x), lo.as_dvec3(), (hi + IVec3::ONE).as_dvec3());
-        // A centre c in min..=max: c − ½ is a whole number there.
+        // A centre c in min..=max: c − ½ is a whole number there. Widened
+        // by TIE_SLACK: a centre on the box's face to rounding may go to a
+        // model cell inside (`invert` rounds the other way round), and a
+        // region composed again must hold it.
         // Saturated: a box past the 32-bit range is refused by the world's limit after.
-        let (lo, hi) = ((min - 0.5).ceil().as_ivec3(), (max - 0.5).floor().as_ivec3());
+        let (lo, hi) = ((min - 0.5 - TIE_SLACK).ceil().as_ivec3(), (max - 0.5 + TIE_SLACK).floor().as_ivec3());
         (lo.saturating_add(self.shift), hi.saturating_add(self.shift))
     }
 
@@ -528,9 +531,16 @@ impl TurnedMap {
         let half = DVec3::splat(0.5);
         let (a, b) = (self.unshifted(lo) + half, self.unshifted(hi) + half);
         let (min, max) = image_box(|u| self.model_unshifted(u), a, b);
-        (min.floor().as_ivec3(), max.floor().as_ivec3())
+        // Widened as `apply_box` is: a centre's preimage on a face to
+        // rounding may fall in the cell beyond.
+        ((min - TIE_SLACK).floor().as_ivec3(), (max + TIE_SLACK).floor().as_ivec3())
     }
 }
+
+/// How far (in voxels) a cell centre may lie outside a turned box and
+/// still be counted in: more than the rounding of the map's f64 arithmetic
+/// on a model's size, far less than any real distance between centres.
+const TIE_SLACK: f64 = 1e-9;
 
 /// The box around the image under `f` of the box of points `a..=b`.
 fn image_box(f: impl Fn(DVec3) -> DVec3, a: DVec3, b: DVec3) -> (DVec3, DVec3) {

@@ -539,3 +539,29 @@ fn the_glb_export_turns_freely_turned_objects_as_keyed() {
         assert!(far < 1e-4, "frame {frame}: a vertex {far} voxels off");
     }
 }
+
+/// A sparse model spread over a large box (three voxels in 256³) turns
+/// by its cells, not its box (the box around it turned by 45° holds 10⁸
+/// world cells): every cell drawn holds, by its centre's preimage, one of
+/// the model's voxels, and there are no more than such cells can be.
+#[test]
+fn a_sparse_model_turns_by_its_cells() {
+    let voxels = vec![
+        Voxel { x: 0, y: 0, z: 0, i: 3 },
+        Voxel { x: 255, y: 255, z: 255, i: 4 },
+        Voxel { x: 128, y: 3, z: 200, i: 5 },
+    ];
+    let mut editor = Editor::default();
+    editor.set_scene(load(&scene_of(Model { size: Size { x: 256, y: 256, z: 256 }, voxels }, [0, 0, 0])));
+    let start = std::time::Instant::now();
+    run(&mut editor, "object block\nobject turn y 45\nobject turn x 30").unwrap();
+    println!("turned in {:?}", start.elapsed());
+    let exact = Exact::of(&dot_vox::load_bytes(&saved(&editor.scene)).unwrap());
+    let drawn = editor.scene.voxels();
+    assert!(!drawn.is_empty() && drawn.len() <= 3 * 4, "{} cells drawn", drawn.len());
+    for (w, _) in drawn {
+        let p = exact.model_point(w.as_dvec3().to_array().map(|c| c + 0.5));
+        let cell = cell_of(p).map(|c| c as f64);
+        assert!(exact.cells.contains(&cell), "world cell {w} holds model point {p:?}, no voxel");
+    }
+}
