@@ -124,15 +124,17 @@ async function waitForFile(file) {
 async function pick(file, ...combo) {
   const start = Date.now();
   for (;;) {
-    const chooser = page.waitForFileChooser({ timeout: 5000 });
+    // Its failure is taken at once: the keys below may take longer than
+    // the wait, and a rejection nobody handles yet ends node.
+    const chooser = page.waitForFileChooser({ timeout: 5000 }).catch((err) => err);
     await page.evaluate(() => 0);
     await keys(...combo);
-    try {
-      await (await chooser).accept([file]);
+    const got = await chooser;
+    if (!(got instanceof Error)) {
+      await got.accept([file]);
       return;
-    } catch (err) {
-      if (Date.now() - start >= TIMEOUT_MS) throw err;
     }
+    if (Date.now() - start >= TIMEOUT_MS) throw got;
   }
 }
 
