@@ -23,23 +23,28 @@ pub fn dict(pairs: &[(&str, String)]) -> dot_vox::Dict {
 /// along x and back (some step, some loop), enough that the scene is drawn
 /// as instances.
 pub fn herd(count: u32) -> DotVoxData {
-    let mut scenes = vec![
-        SceneNode::Transform { attributes: dict(&[]), frames: vec![], child: 1, layer_id: u32::MAX },
-        SceneNode::Group { attributes: dict(&[]), children: (0..count).map(|k| 2 + 2 * k).collect() },
-    ];
-    for k in 0..count {
+    let objects = (0..count).map(|k| {
         let (x, y) = ((k % 20) as i32 * 16, (k / 20) as i32 * 16);
         let key = |f: u32, dx: i32| Frame::new(dict(&[("_f", f.to_string()), ("_t", format!("{} {y} 0", x + dx))]));
         let mut attributes = vec![("_name", format!("cow {k}"))];
         if k % 3 == 0 {
             attributes.push(("_loop", "1".to_owned()));
         }
-        scenes.push(SceneNode::Transform {
-            attributes: dict(&attributes),
-            frames: vec![key(0, 0), key(6 + k % 5, 3 + (k % 7) as i32), key(20, 0)],
-            child: 3 + 2 * k,
-            layer_id: 0,
-        });
+        (dict(&attributes), vec![key(0, 0), key(6 + k % 5, 3 + (k % 7) as i32), key(20, 0)])
+    });
+    placements_of(model(6, 30), objects.collect())
+}
+
+/// A scene of one model placed once per object under one group: each
+/// object's transform attributes and keys, in order.
+fn placements_of(model: Model, objects: Vec<(dot_vox::Dict, Vec<Frame>)>) -> DotVoxData {
+    let count = objects.len() as u32;
+    let mut scenes = vec![
+        SceneNode::Transform { attributes: dict(&[]), frames: vec![], child: 1, layer_id: u32::MAX },
+        SceneNode::Group { attributes: dict(&[]), children: (0..count).map(|k| 2 + 2 * k).collect() },
+    ];
+    for (k, (attributes, frames)) in (0..count).zip(objects) {
+        scenes.push(SceneNode::Transform { attributes, frames, child: 3 + 2 * k, layer_id: 0 });
         scenes.push(SceneNode::Shape {
             attributes: dict(&[]),
             models: vec![ShapeModel { model_id: 0, attributes: dict(&[]) }],
@@ -48,7 +53,7 @@ pub fn herd(count: u32) -> DotVoxData {
     DotVoxData {
         version: 200,
         index_map: Vec::new(),
-        models: vec![model(6, 30)],
+        models: vec![model],
         palette: dot_vox::DEFAULT_PALETTE.to_vec(),
         materials: Vec::new(),
         scenes,
@@ -79,11 +84,7 @@ pub fn turned_herd(count: u32, seed: u64) -> DotVoxData {
         z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
         ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
     };
-    let mut scenes = vec![
-        SceneNode::Transform { attributes: dict(&[]), frames: vec![], child: 1, layer_id: u32::MAX },
-        SceneNode::Group { attributes: dict(&[]), children: (0..count).map(|k| 2 + 2 * k).collect() },
-    ];
-    for k in 0..count {
+    let objects = (0..count).map(|k| {
         let (x, y) = ((k % 10) as i32 * 14, (k / 10) as i32 * 14);
         // A uniform random rotation (Shoemake's subgroup algorithm).
         let (u1, u2, u3) = (uniform(), uniform() * std::f64::consts::TAU, uniform() * std::f64::consts::TAU);
@@ -93,24 +94,7 @@ pub fn turned_herd(count: u32, seed: u64) -> DotVoxData {
             ("_t", format!("{x} {y} {}", (k % 3) as i32 * 5)),
             ("_ov_turn", format!("{} {} {} {}", q[0], q[1], q[2], q[3])),
         ]);
-        scenes.push(SceneNode::Transform {
-            attributes: dict(&[("_name", format!("turned {k}"))]),
-            frames: vec![Frame::new(key)],
-            child: 3 + 2 * k,
-            layer_id: 0,
-        });
-        scenes.push(SceneNode::Shape {
-            attributes: dict(&[]),
-            models: vec![ShapeModel { model_id: 0, attributes: dict(&[]) }],
-        });
-    }
-    DotVoxData {
-        version: 200,
-        index_map: Vec::new(),
-        models: vec![Model { size: Size { x: 6, y: 5, z: 4 }, voxels }],
-        palette: dot_vox::DEFAULT_PALETTE.to_vec(),
-        materials: Vec::new(),
-        scenes,
-        layers: vec![Layer { attributes: dict(&[("_name", "0".into())]) }],
-    }
+        (dict(&[("_name", format!("turned {k}"))]), vec![Frame::new(key)])
+    });
+    placements_of(Model { size: Size { x: 6, y: 5, z: 4 }, voxels }, objects.collect())
 }

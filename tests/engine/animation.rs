@@ -421,16 +421,7 @@ pub(crate) fn sampled_node(glb: &super::export::Glb, node: usize, time: f64) -> 
 /// every frame checked, on the cells the independent composition fills.
 #[test]
 fn the_glb_export_animates_what_moves_and_passes_the_validator() {
-    let dir = tempfile::tempdir().unwrap();
-    let (vox, glb) = (dir.path().join("cart.vox"), dir.path().join("cart.glb"));
-    std::fs::write(&vox, bytes_of(&cart())).unwrap();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_octovox"))
-        .args(["export", vox.to_str().unwrap(), "-o", glb.to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    super::export::validate_gltf(&[&glb]);
-    let read = super::export::read_glb(&glb);
+    let read = super::export::exported_glb(&bytes_of(&cart()));
     let animation = &read.json["animations"][0];
     let named = |name: &str| read.json["nodes"].as_array().unwrap().iter().position(|n| n["name"] == name).unwrap();
     let driven: std::collections::BTreeSet<(u64, String)> = animation["channels"]

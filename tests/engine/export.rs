@@ -164,6 +164,18 @@ pub(crate) fn read_glb(path: &Path) -> Glb {
 /// Runs the Khronos glTF validator (`tests/gltf/validate.js`) on `files`
 /// and prints its report; fails on any error or warning, and when Node.js
 /// or the validator is missing.
+/// `octovox export` of the .vox `bytes` to a .glb in a new folder, which
+/// the Khronos validator passes; what the .glb holds.
+pub(crate) fn exported_glb(bytes: &[u8]) -> Glb {
+    let dir = tempfile::tempdir().unwrap();
+    let (vox, glb) = (dir.path().join("scene.vox"), dir.path().join("scene.glb"));
+    std::fs::write(&vox, bytes).unwrap();
+    let out = octovox(&["export", vox.to_str().unwrap(), "-o", glb.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out));
+    validate_gltf(&[&glb]);
+    read_glb(&glb)
+}
+
 pub(crate) fn validate_gltf(files: &[&Path]) {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/gltf/validate.js");
     let out = Command::new("node").arg(script).args(files).output().unwrap_or_else(|err| {

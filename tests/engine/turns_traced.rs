@@ -500,16 +500,7 @@ fn clicks_edit_the_model_cell_under_the_cursor_through_a_free_turn() {
 #[test]
 fn the_glb_export_turns_freely_turned_objects_as_keyed() {
     let keyed = turned([3, -2, 5], "object turn y 10\nobject key\nframe 10\nobject key\nobject turn y 40\nframe 0");
-    let dir = tempfile::tempdir().unwrap();
-    let (vox, glb) = (dir.path().join("keyed.vox"), dir.path().join("keyed.glb"));
-    std::fs::write(&vox, saved(&keyed.scene)).unwrap();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_octovox"))
-        .args(["export", vox.to_str().unwrap(), "-o", glb.to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    super::export::validate_gltf(&[&glb]);
-    let read = super::export::read_glb(&glb);
+    let read = super::export::exported_glb(&saved(&keyed.scene));
     let node = read.json["nodes"].as_array().unwrap().iter().position(|n| n["name"] == "block").unwrap();
     // Its rotation slerps between the samples (LINEAR), as the keys do.
     let animation = &read.json["animations"][0];
