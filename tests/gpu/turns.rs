@@ -67,3 +67,38 @@ fn a_hundred_turned_objects_trace_on_the_gpu_as_on_the_cpu() {
     agreement.assert_good("GPU vs CPU, turned instances");
     assert!(differing_pixels * 500 < pixels, "{differing_pixels} of {pixels} shaded pixels differ");
 }
+
+/// Quarter turns and mirrors given as free turns (`_ov_turn` the identity
+/// beside `_r`) take the general path on the GPU and find the same hits,
+/// cell and face, as the integer path, on every pixel of the hard-case
+/// cameras.
+#[test]
+fn quarter_turns_through_the_general_path_hit_as_the_integer_path_on_the_gpu() {
+    use crate::path_trace::{instanced_material_scene, turned_material_scene};
+    let (mut integer, mut general) = (instanced_material_scene(), turned_material_scene([Some("0 0 0 1"); 3]));
+    assert!(general.instanced().is_some_and(|o| o.has_free_turns()));
+    assert!(integer.instanced().is_some_and(|o| !o.has_free_turns()));
+    assert_eq!(integer.origin(), general.origin());
+    let size = (80, 60);
+    let settings =
+        RenderSettings { mode: TraceMode::Svo, view: View::Shaded, shadows: true, ..RenderSettings::default() };
+    let mut renderer = Renderer::headless().expect("a GPU adapter (lavapipe on CI)");
+    renderer.hit_records = true;
+    let (lo, hi) = integer.solid_bounds().unwrap();
+    let (mut pixels, mut hits) = (0, 0);
+    for camera in cameras_for(lo, hi) {
+        let mut draw = |scene: &mut octovox::scene::Scene| {
+            renderer.sync(scene);
+            renderer.render(scene, &camera, size, &settings, None).unwrap();
+            renderer.read_hits().unwrap()
+        };
+        let (a, b) = (draw(&mut integer), draw(&mut general));
+        for (x, y) in a.iter().zip(&b) {
+            assert_eq!((x.value, x.voxel, x.normal), (y.value, y.voxel, y.normal), "camera {camera:?}");
+        }
+        pixels += a.len();
+        hits += a.iter().filter(|h| h.is_hit()).count();
+    }
+    println!("{hits} hits of {pixels} pixels, all the same");
+    assert!(hits * 10 > pixels, "{hits} hits");
+}
