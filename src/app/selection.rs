@@ -121,7 +121,7 @@ impl Session {
         match phase {
             StrokePhase::Begin | StrokePhase::Click => {
                 let Ok(Some(pick)) = self.pick_at(x, y) else { return };
-                match self.doc.editor.object_line_at(pick.voxel) {
+                match self.doc.editor.object_line_for(&pick) {
                     Some(line) => self.act(line, "object"),
                     None if self.doc.editor.scene.objects().is_none() => {
                         return self.ui.info("the scene is one model: no objects to pick");

@@ -552,3 +552,70 @@ fn a_click_on_a_turned_object_attaches_across_its_model_face() {
     assert_eq!(after.difference(&before).collect::<Vec<_>>(), [&across.to_array()], "the cell across the face");
     assert_eq!(before.difference(&after).count(), 0);
 }
+
+/// Object mode's ring (issue 49): a real drag round the ring turns the
+/// picked object freely about the up axis by the degrees dragged, K keys
+/// it, and the saved file (read by dot_vox) holds the turn as `_ov_turn`
+/// on the object's key, the angle the drag went round.
+#[test]
+fn the_ring_turns_the_picked_object_freely_and_k_keys_it() {
+    let (dir, file, scene) = groups_document();
+    let objects = scene.objects().unwrap();
+    let (lo, hi) = scene.solid_bounds().unwrap();
+    let camera = Camera::framing(lo, hi, 50.0);
+    let last = objects.list().len() - 1;
+    let (x, y, voxel, _) =
+        stable_pixel_left_of(OUTLINER_X, scene.drawn(), &camera, |v, _| objects.owner_at(v).is_some_and(|o| o != last));
+    let owner = objects.owner_at(voxel).unwrap();
+    let node = objects.list()[owner].transform_node.expect("a transform above the object") as usize;
+    // The ring as the window draws it: about the picked box's centre on
+    // screen, 16 pixels past its farthest corner.
+    let basis = camera.basis(WIDTH, HEIGHT, scene.origin());
+    let (blo, bhi) = objects.world_box(owner).unwrap();
+    let (a, b) = ((blo - scene.origin()).as_vec3(), (bhi - scene.origin() + glam::IVec3::ONE).as_vec3());
+    let (cx, cy) = basis.project((a + b) * 0.5).unwrap();
+    let radius = (0..8)
+        .map(|k| {
+            let corner = glam::Vec3::new([a.x, b.x][k & 1], [a.y, b.y][(k >> 1) & 1], [a.z, b.z][k >> 2]);
+            let (px, py) = basis.project(corner).unwrap();
+            ((px - cx).powi(2) + (py - cy).powi(2)).sqrt()
+        })
+        .fold(0.0, f32::max)
+        + 16.0;
+    let on_ring = |degrees: f32| {
+        let r = degrees.to_radians();
+        ((cx + radius * r.cos()).round() as i32, (cy - radius * r.sin()).round() as i32)
+    };
+
+    let (_xvfb, display) = start_xvfb();
+    let (_app, mut lines, window) = open_ready(&display, dir.path(), &document_args(&file, &camera, &[]));
+    xdotool(&display, &["key", "Tab"]);
+    xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y.to_string()]);
+    std::thread::sleep(Duration::from_millis(300));
+    xdotool(&display, &["click", "1"]);
+    assert_eq!(lines.wait_for("ran: object", Duration::from_secs(30)), format!("ran: object {owner}"));
+    let (gx, gy) = on_ring(0.0);
+    xdotool(&display, &["mousemove", "--window", &window, &gx.to_string(), &gy.to_string()]);
+    std::thread::sleep(Duration::from_millis(300));
+    xdotool(&display, &["mousedown", "1"]);
+    for step in 1..=8 {
+        let (px, py) = on_ring(5.0 * step as f32);
+        xdotool(&display, &["mousemove", "--window", &window, &px.to_string(), &py.to_string()]);
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    xdotool(&display, &["mouseup", "1"]);
+    // Each whole degree dragged is a turn written to the instance words.
+    lines.wait_for("edit:", Duration::from_secs(30));
+    std::thread::sleep(Duration::from_millis(500));
+    xdotool(&display, &["key", "k"]);
+    lines.wait_for("object:", Duration::from_secs(30));
+    save(&display, &mut lines, &file);
+    let data = dot_vox::load_bytes(&std::fs::read(&file).unwrap()).unwrap();
+    let dot_vox::SceneNode::Transform { frames, .. } = &data.scenes[node] else { panic!("node {node}") };
+    let turn = frames[0].attributes.get("_ov_turn").unwrap_or_else(|| panic!("a free turn in {frames:?}"));
+    let q: Vec<f64> = turn.split_whitespace().map(|v| v.parse().unwrap()).collect();
+    // About MagicaVoxel's z (world y) only, by about the 40° dragged.
+    assert!(q[0].abs() < 1e-9 && q[1].abs() < 1e-9, "about z: {turn}");
+    let degrees = (2.0 * q[2].atan2(q[3])).to_degrees().abs();
+    assert!((30.0..=50.0).contains(&degrees), "turned {degrees}° ({turn})");
+}
