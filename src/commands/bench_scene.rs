@@ -132,27 +132,35 @@ fn tree_model() -> Model {
     Model { size: [15, 15, 27], tree }
 }
 
-/// How the trees of [`forest`] stand: by quarter turns only, or leaning
-/// by free turns too; still, or keyed to move over [`MOVING_FRAMES`].
+/// How the trees of [`forest`] stand: by quarter turns only, or turned by
+/// free angles too (about the up axis, and leaning 12° where `lean`); still,
+/// or keyed to move over [`MOVING_FRAMES`].
 #[derive(Clone, Copy, PartialEq, Eq)]
 pub(super) struct Stand {
     pub turned: bool,
+    pub lean: bool,
     pub moving: bool,
 }
 
+impl Stand {
+    pub const ALIGNED: Stand = Stand { turned: false, lean: false, moving: false };
+}
+
 /// A tree's free turn at a key (`_ov_turn`): about MagicaVoxel's up axis
-/// by its own angle (`spin` more at the loop's middle) and leaning 12°.
-fn lean(k: u32, spin: f64) -> String {
+/// by its own angle (`spin` more at the loop's middle), and leaning 12°
+/// where `lean`.
+fn free_turn(k: u32, spin: f64, lean: bool) -> String {
     let about_up = (f64::from(k * 37 % 90) + 5.0 + spin).to_radians();
-    let q = glam::DQuat::from_rotation_z(about_up) * glam::DQuat::from_rotation_x(12f64.to_radians());
+    let tilt = if lean { 12f64.to_radians() } else { 0.0 };
+    let q = glam::DQuat::from_rotation_z(about_up) * glam::DQuat::from_rotation_x(tilt);
     format!("{} {} {} {}", q.x, q.y, q.z, q.w)
 }
 
 /// 2,000 placements of one model on a 50 × 40 grid, each turned by one of
-/// the eight rotations that keep z up, and where `stand.turned` leaning by
-/// a free turn; where `stand.moving`, each also keyed to rise and come
-/// back over [`MOVING_FRAMES`] frames (turning 40° and back, where
-/// turned), looping (`bench anim`).
+/// the eight rotations that keep z up, and where `stand.turned` by a free
+/// turn too; where `stand.moving`, each also keyed to rise and come back
+/// over [`MOVING_FRAMES`] frames (turning 40° and back, where turned),
+/// looping (`bench anim`).
 pub(super) fn forest(count: u32, stand: Stand) -> anyhow::Result<Scene> {
     let moving = stand.moving;
     let upright: Vec<u8> =
@@ -180,7 +188,7 @@ pub(super) fn forest(count: u32, stand: Stand) -> anyhow::Result<Scene> {
             ]
             .into();
             if stand.turned {
-                key.insert(octovox::scene::graph::TURN_KEY.to_owned(), lean(k, spin));
+                key.insert(octovox::scene::graph::TURN_KEY.to_owned(), free_turn(k, spin, stand.lean));
             }
             key
         };
@@ -228,7 +236,7 @@ fn timed(runs: usize, mut f: impl FnMut() -> anyhow::Result<()>) -> anyhow::Resu
 pub fn bench_scene(quick: bool) -> anyhow::Result<(String, String)> {
     let count = if quick { 200 } else { 2000 };
     let (width, height, frames, loads) = if quick { (320, 180, 3, 1) } else { (1280, 720, 9, 3) };
-    let scene = forest(count, Stand { turned: false, moving: false })?;
+    let scene = forest(count, Stand::ALIGNED)?;
     let objects = scene.objects().context("a scene of objects")?;
     let forest_bytes = encode_objects(&scene.palette, objects)?;
     let merged_bytes = encode_vox(&scene.palette, &scene.voxels())?;

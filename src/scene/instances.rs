@@ -103,13 +103,14 @@ impl Turned {
     }
 
     /// Whether a ray in the model's frame (`model_ray`) misses the solid
-    /// box, grown by [`SOLID_BOX_SLACK`], after `t_min`. Twin of
-    /// `misses_solid` in shaders/instances.wgsl.
-    pub fn misses_solid(&self, ray: &crate::trace::Ray, t_min: f32) -> bool {
+    /// box, grown by [`SOLID_BOX_SLACK`], after `t_min`, or enters it
+    /// past `until` (where no hit of it can win). Twin of `misses_solid`
+    /// in shaders/instances.wgsl.
+    pub fn misses_solid(&self, ray: &crate::trace::Ray, t_min: f32, until: f32) -> bool {
         let Some((lo, hi)) = self.solid else { return false };
         let slack = Vec3::splat(SOLID_BOX_SLACK);
         let (enter, exit, _) = ray.slab(lo.as_vec3() - slack, (hi + IVec3::ONE).as_vec3() + slack);
-        !(enter <= exit && exit >= t_min.max(0.0))
+        !(enter <= exit && exit >= t_min.max(0.0) && enter <= until)
     }
 
     /// `rows · v`, each row's products summed left to right (as the shader).
