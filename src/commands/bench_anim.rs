@@ -35,6 +35,9 @@ struct AnimRow {
     /// The same frame of the forest standing still: the upload (nothing)
     /// and the preview.
     frame_ms_still: f64,
+    /// The playing forest's frame drawn again with nothing changed: the
+    /// same frame standing still.
+    frame_ms_held: f64,
     /// The still forest's frame with its trees by quarter turns only (no
     /// free turn: the integer instance path).
     frame_ms_aligned: f64,
@@ -87,7 +90,7 @@ pub fn bench_anim(quick: bool) -> anyhow::Result<(String, String)> {
     aligned_renderer.render(&aligned, &camera, (width, height), &settings, None)?;
     upright_renderer.render(&upright, &camera, (width, height), &settings, None)?;
     let (mut playing_ms, mut still_ms, mut show_ms, mut bytes) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    let (mut aligned_ms, mut upright_ms) = (Vec::new(), Vec::new());
+    let (mut aligned_ms, mut upright_ms, mut held_ms) = (Vec::new(), Vec::new(), Vec::new());
     for frame in 1..=rounds {
         let start = Instant::now();
         playing.play_frame(frame)?;
@@ -95,6 +98,11 @@ pub fn bench_anim(quick: bool) -> anyhow::Result<(String, String)> {
         bytes.push(playing_renderer.sync(&mut playing.scene).bytes);
         playing_renderer.render(&playing.scene, &camera, (width, height), &settings, None)?;
         playing_ms.push(start.elapsed().as_secs_f64() * 1e3);
+        // The same frame again, standing still: nothing to show or send.
+        let start = Instant::now();
+        playing_renderer.sync(&mut playing.scene);
+        playing_renderer.render(&playing.scene, &camera, (width, height), &settings, None)?;
+        held_ms.push(start.elapsed().as_secs_f64() * 1e3);
         let start = Instant::now();
         still_renderer.sync(&mut still);
         still_renderer.render(&still, &camera, (width, height), &settings, None)?;
@@ -123,6 +131,7 @@ pub fn bench_anim(quick: bool) -> anyhow::Result<(String, String)> {
         drawn_as: if playing.scene.instanced().is_some() { "instances" } else { "composed" },
         frame_ms_playing: median(playing_ms),
         frame_ms_still: median(still_ms),
+        frame_ms_held: median(held_ms),
         frame_ms_aligned: median(aligned_ms),
         frame_ms_upright: median(upright_ms),
         show_ms: median(show_ms),
@@ -182,7 +191,8 @@ fn report(r: &AnimRow) -> String {
          (`_ov_turn`, traced exactly in its own frame), keyed to rise 1 to 8 voxels and turn 40° (slerp) and come \
          back over {} frames, looping. A playing frame is the window's (`Editor::play_frame`: every key sampled; \
          a scene drawn as instances composes its CPU octree, which picking and checks read, only once playing \
-         stops), the upload and the preview; a still frame is the same forest without keys, upload and preview; \
+         stops), the upload and the preview; a still frame is the same forest without keys (standing as at frame \
+         0), upload and preview, and a held frame the playing frame drawn again with nothing changed; \
          an axis-aligned frame is the forest by quarter turns only (the integer instance path), an upright one \
          the forest turned by the same free angles about the up axis but not leaning. Median of {} frames, the \
          four alternating after one warm-up each.\n\n",
@@ -194,6 +204,12 @@ fn report(r: &AnimRow) -> String {
         r.frame_ms_playing,
         r.frame_ms_still,
         r.frame_ms_playing / r.frame_ms_still.max(1e-9)
+    );
+    md += &format!(
+        "| frame ms, against the same frame drawn again standing still | {:.2} | {:.2} | {:.2} | ≤ 1.1 |\n",
+        r.frame_ms_playing,
+        r.frame_ms_held,
+        r.frame_ms_playing / r.frame_ms_held.max(1e-9)
     );
     md += &format!(
         "| still: leaning free turns against axis-aligned, frame ms | {:.2} | {:.2} | {:.2} | ≤ 1.3 |\n",
