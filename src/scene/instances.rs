@@ -498,3 +498,28 @@ fn changed_runs(old: &[u32], new: &[u32]) -> Vec<(u64, Vec<u8>)> {
     }
     runs.into_iter().map(|(a, b)| (4 * a as u64, bytemuck::cast_slice(&new[a..b]).to_vec())).collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Changed words closer than [`RUN_GAP`] go up as one write, the
+    /// unchanged ones between them sent again; farther ones stay apart;
+    /// every changed word is sent with its new value.
+    #[test]
+    fn changed_runs_merge_near_changes_and_keep_far_ones_apart() {
+        let old = vec![0u32; 200];
+        let mut new = old.clone();
+        for i in [3, 4, 10, 30, 31, 150] {
+            new[i] = i as u32 + 1;
+        }
+        let runs = changed_runs(&old, &new);
+        let spans: Vec<(u64, usize)> = runs.iter().map(|(at, bytes)| (at / 4, bytes.len() / 4)).collect();
+        assert_eq!(spans, [(3, 29), (150, 1)], "3..=31 in one write (gaps under {RUN_GAP} words), 150 alone");
+        for (at, bytes) in &runs {
+            let words: &[u32] = bytemuck::cast_slice(bytes);
+            assert_eq!(words, &new[*at as usize / 4..*at as usize / 4 + words.len()]);
+        }
+        assert!(changed_runs(&old, &old).is_empty(), "nothing changed, nothing sent");
+    }
+}
