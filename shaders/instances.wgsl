@@ -91,15 +91,15 @@ fn model_ray(inst: Instance, r: Ray) -> Ray {
     return Ray(s * o + vec3<f32>(inst.offset), s * d, s * inv);
 }
 
-// Whether a turned instance's model ray misses its solid box after t_min,
-// or enters it past `until` (twin of `Turned::misses_solid`; an instance
-// with no box is walked).
-fn misses_solid(inst: Instance, mr: Ray, t_min: f32, until: f32) -> bool {
+// Whether a turned instance's model ray misses its solid box, or enters
+// it past `until` (twin of `Turned::misses_solid`; an instance with no box
+// is walked).
+fn misses_solid(inst: Instance, mr: Ray, until: f32) -> bool {
     if (!inst.turned || any(inst.solid_lo > inst.solid_hi)) {
         return false;
     }
     let s = slab(mr, inst.solid_lo, inst.solid_hi);
-    return !(s.t_enter <= s.t_exit && s.t_exit >= max(t_min, 0.0) && s.t_enter <= until);
+    return !(s.t_enter <= s.t_exit && s.t_exit >= 0.0 && s.t_enter <= until);
 }
 
 // The code of the axis nearest `n` (twin of `nearest_axis`).
@@ -257,7 +257,7 @@ fn trace_scene(r: Ray, t_min: f32, medium: u32, inside: u32, lod: vec2<f32>) -> 
             let mr = model_ray(inst, r);
             // A turned object's solid box, tighter than its scene box;
             // glass the ray is in is left at its tree's face: walked.
-            if (index == inside || !misses_solid(inst, mr, 0.0, reach(best))) {
+            if (index == inside || !misses_solid(inst, mr, reach(best))) {
                 let h = cross_tree(inst.tree, mr, t_min, select(0u, medium, index == inside), lod);
                 iterations += h.iterations;
                 gave_up = gave_up || (!h.found && h.iterations >= inst.tree.max_iterations);

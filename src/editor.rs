@@ -304,20 +304,25 @@ impl Editor {
     /// is not the picked one already (what a click runs before its edit).
     /// A scene of one object has none to pick: its edits go to it.
     pub fn object_line_at(&self, voxel: IVec3) -> Option<Line> {
-        let objects = self.scene.pickable_objects()?;
-        let owner = objects.owner_at(voxel).filter(|&i| objects.selected != Some(i) && !objects.locked(i))?;
-        Some(Line::Object(ObjectLine::Pick(ObjectRef::Index(owner))))
+        self.pick_line(|objects| objects.owner_at(voxel))
     }
 
     /// The `object N` line a click on `picked` runs before its edit: the
     /// turned object whose model cell it hit, or the object drawn at its
     /// voxel ([`Editor::object_line_at`]).
     pub fn object_line_for(&self, picked: &crate::trace::pick::Picked) -> Option<Line> {
-        let Some(model) = picked.model else { return self.object_line_at(picked.voxel) };
+        match picked.model {
+            Some(model) => self.pick_line(|_| Some(model.object)),
+            None => self.object_line_at(picked.voxel),
+        }
+    }
+
+    /// The `object N` line that picks the object `owner` names, unless it
+    /// is picked already or locked (or the scene has no objects to pick).
+    fn pick_line(&self, owner: impl FnOnce(&Objects) -> Option<usize>) -> Option<Line> {
         let objects = self.scene.pickable_objects()?;
-        let index = model.object;
-        (objects.selected != Some(index) && !objects.locked(index))
-            .then_some(Line::Object(ObjectLine::Pick(ObjectRef::Index(index))))
+        let owner = owner(objects).filter(|&i| objects.selected != Some(i) && !objects.locked(i))?;
+        Some(Line::Object(ObjectLine::Pick(ObjectRef::Index(owner))))
     }
 
     /// The objects of a scene of several, or why an `object`/`layer` line

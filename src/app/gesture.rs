@@ -79,8 +79,7 @@ impl Stroke {
         if self.last_center == Some(center) {
             return None;
         }
-        let model = pick.model.map(|m| (m.cell, m.normal));
-        let line = octovox::script::click_command(self.tool, pick.voxel, pick.normal, model);
+        let line = octovox::script::click_command(self.tool, pick);
         Some(StrokeStep { line, layer, center, first: self.last_center.is_none() })
     }
 

@@ -16,6 +16,7 @@ use serde::Serialize;
 use octovox::camera::Camera;
 use octovox::editor::Editor;
 use octovox::gpu::Renderer;
+use octovox::scene::Scene;
 use octovox::settings::RenderSettings;
 
 use super::bench::{header, median};
@@ -80,15 +81,19 @@ pub fn bench_anim(quick: bool) -> anyhow::Result<(String, String)> {
     let (lo, hi) = still.solid_bounds().context("an empty forest")?;
     let camera = Camera::framing(lo, hi + glam::IVec3::new(0, 8, 0), 50.0);
     let settings = RenderSettings { shadows: false, ..RenderSettings::default() };
-    playing_renderer.sync(&mut playing.scene);
-    still_renderer.sync(&mut still);
-    aligned_renderer.sync(&mut aligned);
-    upright_renderer.sync(&mut upright);
+    // Milliseconds of a frame of `scene` standing still: the upload
+    // (nothing after the first) and the preview.
+    let still_frame = |renderer: &mut Renderer, scene: &mut Scene| -> anyhow::Result<f64> {
+        let start = Instant::now();
+        renderer.sync(scene);
+        renderer.render(scene, &camera, (width, height), &settings, None)?;
+        Ok(start.elapsed().as_secs_f64() * 1e3)
+    };
     // One warm-up frame each, then the four alternate, frame by frame.
-    playing_renderer.render(&playing.scene, &camera, (width, height), &settings, None)?;
-    still_renderer.render(&still, &camera, (width, height), &settings, None)?;
-    aligned_renderer.render(&aligned, &camera, (width, height), &settings, None)?;
-    upright_renderer.render(&upright, &camera, (width, height), &settings, None)?;
+    still_frame(&mut playing_renderer, &mut playing.scene)?;
+    still_frame(&mut still_renderer, &mut still)?;
+    still_frame(&mut aligned_renderer, &mut aligned)?;
+    still_frame(&mut upright_renderer, &mut upright)?;
     let (mut playing_ms, mut still_ms, mut show_ms, mut bytes) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let (mut aligned_ms, mut upright_ms, mut held_ms) = (Vec::new(), Vec::new(), Vec::new());
     for frame in 1..=rounds {
@@ -99,22 +104,10 @@ pub fn bench_anim(quick: bool) -> anyhow::Result<(String, String)> {
         playing_renderer.render(&playing.scene, &camera, (width, height), &settings, None)?;
         playing_ms.push(start.elapsed().as_secs_f64() * 1e3);
         // The same frame again, standing still: nothing to show or send.
-        let start = Instant::now();
-        playing_renderer.sync(&mut playing.scene);
-        playing_renderer.render(&playing.scene, &camera, (width, height), &settings, None)?;
-        held_ms.push(start.elapsed().as_secs_f64() * 1e3);
-        let start = Instant::now();
-        still_renderer.sync(&mut still);
-        still_renderer.render(&still, &camera, (width, height), &settings, None)?;
-        still_ms.push(start.elapsed().as_secs_f64() * 1e3);
-        let start = Instant::now();
-        aligned_renderer.sync(&mut aligned);
-        aligned_renderer.render(&aligned, &camera, (width, height), &settings, None)?;
-        aligned_ms.push(start.elapsed().as_secs_f64() * 1e3);
-        let start = Instant::now();
-        upright_renderer.sync(&mut upright);
-        upright_renderer.render(&upright, &camera, (width, height), &settings, None)?;
-        upright_ms.push(start.elapsed().as_secs_f64() * 1e3);
+        held_ms.push(still_frame(&mut playing_renderer, &mut playing.scene)?);
+        still_ms.push(still_frame(&mut still_renderer, &mut still)?);
+        aligned_ms.push(still_frame(&mut aligned_renderer, &mut aligned)?);
+        upright_ms.push(still_frame(&mut upright_renderer, &mut upright)?);
     }
     // Stopped halfway, where every tree stands furthest from where the
     // composed octree holds it (the loop's last frame is its first again).
@@ -183,6 +176,11 @@ fn render_shard(
     Ok(Command::new(exe).args(args).args(extra).output()?.status)
 }
 
+/// A table row of two times, their ratio and the ratio's target.
+fn ratio_row(what: &str, a: f64, b: f64, target: f64) -> String {
+    format!("| {what} | {a:.2} | {b:.2} | {:.2} | ≤ {target} |\n", a / b.max(1e-9))
+}
+
 fn report(r: &AnimRow) -> String {
     let mut md = header(&format!("Playing an animation of {} references", r.objects));
     md += &format!(
@@ -199,29 +197,24 @@ fn report(r: &AnimRow) -> String {
         r.adapter, r.width, r.height, r.objects, r.drawn_as, MOVING_FRAMES, r.frames
     );
     md += "| measure | playing | still | playing / still | target |\n|---|---|---|---|---|\n";
-    md += &format!(
-        "| frame ms | {:.2} | {:.2} | {:.2} | ≤ 1.1 |\n",
-        r.frame_ms_playing,
-        r.frame_ms_still,
-        r.frame_ms_playing / r.frame_ms_still.max(1e-9)
-    );
-    md += &format!(
-        "| frame ms, against the same frame drawn again standing still | {:.2} | {:.2} | {:.2} | ≤ 1.1 |\n",
+    md += &ratio_row("frame ms", r.frame_ms_playing, r.frame_ms_still, 1.1);
+    md += &ratio_row(
+        "frame ms, against the same frame drawn again standing still",
         r.frame_ms_playing,
         r.frame_ms_held,
-        r.frame_ms_playing / r.frame_ms_held.max(1e-9)
+        1.1,
     );
-    md += &format!(
-        "| still: leaning free turns against axis-aligned, frame ms | {:.2} | {:.2} | {:.2} | ≤ 1.3 |\n",
+    md += &ratio_row(
+        "still: leaning free turns against axis-aligned, frame ms",
         r.frame_ms_still,
         r.frame_ms_aligned,
-        r.frame_ms_still / r.frame_ms_aligned.max(1e-9)
+        1.3,
     );
-    md += &format!(
-        "| still: upright free turns against axis-aligned, frame ms | {:.2} | {:.2} | {:.2} | ≤ 1.3 |\n",
+    md += &ratio_row(
+        "still: upright free turns against axis-aligned, frame ms",
         r.frame_ms_upright,
         r.frame_ms_aligned,
-        r.frame_ms_upright / r.frame_ms_aligned.max(1e-9)
+        1.3,
     );
     md += &format!("| of which showing the frame, ms | {:.2} | | | |\n", r.show_ms);
     md += &format!(

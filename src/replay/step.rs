@@ -185,8 +185,7 @@ fn host_line(host: &mut impl Host, base: &Path, line: &Line) -> Result<StepResul
             if let Some(line) = &picked {
                 host.editor().run(line)?;
             }
-            let model = hit.model.map(|m| (m.cell, m.normal));
-            return Ok(match step(host, base, &click_command(*tool, hit.voxel, hit.normal, model))? {
+            return Ok(match step(host, base, &click_command(*tool, &hit))? {
                 StepResult::Ran(ran) => StepResult::Ran(Ran { picked, ..ran }),
                 other => other,
             });

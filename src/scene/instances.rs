@@ -1,8 +1,9 @@
 //! The top level of two-level ray tracing: one record per placed object
 //! (its model, and the signed permutation and integer offset that take
 //! scene cells to the model's cells, or for a free turn the rigid map of
-//! points, [`Turned`]) and a bounding-volume tree over their boxes. The GPU reads both as words ([`InstanceTable::words`]); the CPU
-//! reference walks the same records (`crate::trace::instanced`).
+//! points, [`Turned`]) and a bounding-volume tree over their boxes. The
+//! GPU reads both as words ([`InstanceTable::words`]); the CPU reference
+//! walks the same records (`crate::trace::instanced`).
 //!
 //! The tree is balanced over the objects in walk order: its shape depends
 //! only on how many objects there are, so moving, turning or hiding one
@@ -103,14 +104,14 @@ impl Turned {
     }
 
     /// Whether a ray in the model's frame (`model_ray`) misses the solid
-    /// box, grown by [`SOLID_BOX_SLACK`], after `t_min`, or enters it
-    /// past `until` (where no hit of it can win). Twin of `misses_solid`
-    /// in shaders/instances.wgsl.
-    pub fn misses_solid(&self, ray: &crate::trace::Ray, t_min: f32, until: f32) -> bool {
+    /// box, grown by [`SOLID_BOX_SLACK`], or enters it past `until` (where
+    /// no hit of it can win). Twin of `misses_solid` in
+    /// shaders/instances.wgsl.
+    pub fn misses_solid(&self, ray: &crate::trace::Ray, until: f32) -> bool {
         let Some((lo, hi)) = self.solid else { return false };
         let slack = Vec3::splat(SOLID_BOX_SLACK);
         let (enter, exit, _) = ray.slab(lo.as_vec3() - slack, (hi + IVec3::ONE).as_vec3() + slack);
-        !(enter <= exit && exit >= t_min.max(0.0) && enter <= until)
+        !(enter <= exit && exit >= 0.0 && enter <= until)
     }
 
     /// `rows · v`, each row's products summed left to right (as the shader).
@@ -207,16 +208,17 @@ impl InstanceTable {
                 let object = &objects.list()[i];
                 let model = object.placement.model;
                 let tree_origin = objects.models[model].tree.origin();
+                let placing = objects.map(i);
+                let bounds = model_bounds[model]
+                    .filter(|_| !object.hidden)
+                    .map(|(lo, hi)| placing.cover_box(lo, hi))
+                    .map(|(lo, hi)| (lo - origin, hi - origin));
                 let mut instance =
-                    Instance { model, src: [0; 3], sign: [1; 3], offset: IVec3::ZERO, bounds: None, turned: None };
-                let map = match objects.map(i) {
+                    Instance { model, src: [0; 3], sign: [1; 3], offset: IVec3::ZERO, bounds, turned: None };
+                let map = match placing {
                     Placing::Cells(map) => map,
                     Placing::Turned(map) => {
                         instance.turned = Some(Turned::new(map.to_model(), origin, tree_origin, model_bounds[model]));
-                        instance.bounds = model_bounds[model]
-                            .filter(|_| !object.hidden)
-                            .map(|(lo, hi)| map.cover_box(lo, hi))
-                            .map(|(lo, hi)| (lo - origin, hi - origin));
                         return instance;
                     }
                 };
@@ -228,10 +230,6 @@ impl InstanceTable {
                     instance.sign[axis] = sign;
                     instance.offset[axis] = sign * (origin[row] - offset - corner) - tree_origin[axis];
                 }
-                instance.bounds = model_bounds[model]
-                    .filter(|_| !object.hidden)
-                    .map(|(lo, hi)| map.apply_box(lo, hi))
-                    .map(|(lo, hi)| (lo - origin, hi - origin));
                 instance
             })
             .collect();

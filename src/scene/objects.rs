@@ -1183,13 +1183,6 @@ impl GraphChange {
     }
 }
 
-/// Writes the solid cells of `from` inside its box `lo..=hi` into `to`
-/// (which holds where they go), each cell `p` at `map(p)`, over what is
-/// there; `map` is a signed permutation and a shift (a cell map or a chain
-/// of them). The part of a uniform cell in the box goes in as one box (a
-/// signed permutation maps a box onto a box), so a solid region costs its
-/// surface; single voxels go in batches of at most [`PLACED_BATCH`], so
-/// memory stays small whatever the model.
 /// Composes a freely turned model into the world cells `lo..=hi`: every
 /// world cell takes the model cell that holds its centre's preimage. Each
 /// uniform cell of the model gives the world cells of its turned cube's
@@ -1222,6 +1215,13 @@ fn resample_cells(model: &Octree, map: &TurnedMap, (lo, hi): (IVec3, IVec3), to:
     to.insert_voxels(&batch);
 }
 
+/// Writes the solid cells of `from` inside its box `lo..=hi` into `to`
+/// (which holds where they go), each cell `p` at `map(p)`, over what is
+/// there; `map` is a signed permutation and a shift (a cell map or a chain
+/// of them). The part of a uniform cell in the box goes in as one box (a
+/// signed permutation maps a box onto a box), so a solid region costs its
+/// surface; single voxels go in batches of at most [`PLACED_BATCH`], so
+/// memory stays small whatever the model.
 fn copy_cells(from: &Octree, (lo, hi): (IVec3, IVec3), to: &mut Octree, map: impl Fn(IVec3) -> IVec3) {
     let mut batch: Vec<(IVec3, u8)> = Vec::new();
     from.for_each_solid_cell_in(lo, hi, |min, size, value| {

@@ -491,7 +491,7 @@ impl TurnedMap {
     /// The world cells whose centres the turned cubes of model cells
     /// `lo..=hi` may hold (the box around the turned box).
     pub fn apply_box(&self, lo: IVec3, hi: IVec3) -> (IVec3, IVec3) {
-        let (min, max) = image_box(|x| self.world_unshifted(x), lo.as_dvec3(), (hi + IVec3::ONE).as_dvec3());
+        let (min, max) = self.turned_points(lo, hi);
         // A centre c in min..=max: c − ½ is a whole number there. Widened
         // by TIE_SLACK: a centre on the box's face to rounding may go to a
         // model cell inside (`invert` rounds the other way round), and a
@@ -505,9 +505,15 @@ impl TurnedMap {
     /// into: the cells around the turned box of points, which an exact
     /// tracer's box must hold (wider than [`TurnedMap::apply_box`]).
     pub fn cover_box(&self, lo: IVec3, hi: IVec3) -> (IVec3, IVec3) {
-        let (min, max) = image_box(|x| self.world_unshifted(x), lo.as_dvec3(), (hi + IVec3::ONE).as_dvec3());
+        let (min, max) = self.turned_points(lo, hi);
         let (lo, hi) = (min.floor().as_ivec3(), max.ceil().as_ivec3() - IVec3::ONE);
         (lo.saturating_add(self.shift), hi.saturating_add(self.shift))
+    }
+
+    /// The box of points (less the whole shift) around the turned cubes of
+    /// model cells `lo..=hi`.
+    fn turned_points(&self, lo: IVec3, hi: IVec3) -> (DVec3, DVec3) {
+        image_box(|x| self.world_unshifted(x), lo.as_dvec3(), (hi + IVec3::ONE).as_dvec3())
     }
 
     /// The map from model grid points to world points: world point
@@ -583,6 +589,16 @@ impl Placing {
         match self {
             Placing::Cells(map) => map.apply_box(lo, hi),
             Placing::Turned(map) => map.apply_box(lo, hi),
+        }
+    }
+
+    /// The world cells the placed model cells `lo..=hi` reach into: the
+    /// cells they land on exactly, or the cells around a turned box (what
+    /// a tracer's box must hold).
+    pub fn cover_box(&self, lo: IVec3, hi: IVec3) -> (IVec3, IVec3) {
+        match self {
+            Placing::Cells(map) => map.apply_box(lo, hi),
+            Placing::Turned(map) => map.cover_box(lo, hi),
         }
     }
 

@@ -433,16 +433,14 @@ pub struct Script {
     pub lines: Vec<NumberedLine>,
 }
 
-/// The line a click with `tool` on a voxel and face runs: the edit of
-/// the world cell it names ([`edit_command`]), or on a freely turned
-/// object the edit of the model cell under the cursor (`model`: the cell
-/// and its face's normal, in the model's cells).
-pub fn click_command(tool: Tool, voxel: IVec3, normal: IVec3, model: Option<(IVec3, IVec3)>) -> Line {
-    match model {
-        Some((cell, normal)) => {
-            Line::Object(ObjectLine::Cell { tool, at: crate::edit::brush::click_target(tool, cell, normal) })
-        }
-        None => edit_command(tool, crate::edit::brush::click_target(tool, voxel, normal)),
+/// The line a click with `tool` on `picked` runs: the edit of the world
+/// cell it names ([`edit_command`]), or on a freely turned object the edit
+/// of the model cell under the cursor, in the model's cells.
+pub fn click_command(tool: Tool, picked: &crate::trace::pick::Picked) -> Line {
+    use crate::edit::brush::click_target;
+    match picked.model {
+        Some(model) => Line::Object(ObjectLine::Cell { tool, at: click_target(tool, model.cell, model.normal) }),
+        None => edit_command(tool, click_target(tool, picked.voxel, picked.normal)),
     }
 }
 

@@ -6,7 +6,7 @@ use std::fmt;
 use glam::IVec3;
 
 use super::{AnimLine, LayerLine, Line, ObjectLine, ObjectRef, PaletteLine};
-use crate::edit::brush::{Brush, Tool};
+use crate::edit::brush::Brush;
 
 /// Writes a command back as a script line (what `--record` produces).
 impl fmt::Display for Line {
@@ -109,13 +109,9 @@ impl fmt::Display for Line {
             Line::Object(ObjectLine::Turn { axis, degrees }) => {
                 write!(f, "object turn {} {}", ["x", "y", "z"][*axis], degrees.0)
             }
+            // The same word as the world cell's edit (`place`, `remove`, `paint`).
             Line::Object(ObjectLine::Cell { tool, at }) => {
-                let word = match tool {
-                    Tool::Attach => "place",
-                    Tool::Erase => "remove",
-                    Tool::Paint => "paint",
-                };
-                write!(f, "object {word} {}", v(*at))
+                write!(f, "object {} {}", super::edit_command(*tool, *at).word(), v(*at))
             }
             Line::Frame(n) => write!(f, "frame {n}"),
             Line::Anim(AnimLine::Range(a, b)) => write!(f, "anim range {a} {b}"),

@@ -71,8 +71,8 @@ impl<'a> Traced<'a> {
                 let model_ray = model_ray(instance, ray);
                 // A turned object's solid box, tighter than its scene box;
                 // glass the ray is in is left at its tree's face: walked.
-                let misses = inside != Some(index)
-                    && instance.turned.is_some_and(|t| t.misses_solid(&model_ray, 0.0, reach(best)));
+                let misses =
+                    inside != Some(index) && instance.turned.is_some_and(|t| t.misses_solid(&model_ray, reach(best)));
                 if !misses {
                     let c = svo::cross(tree, &model_ray, m, footprint);
                     iterations = iterations.saturating_add(c.hit.iterations);

@@ -90,9 +90,11 @@ fn through_turn(scene: &Scene, index: usize, face: TurnedFace, value: u8) -> Opt
 /// neighbour of it that does, else the one holding its centre.
 fn owned_cell(map: &TurnedMap, m: IVec3) -> IVec3 {
     let near = map.apply(m);
-    let mut steps: Vec<IVec3> = (0..27).map(|k| IVec3::new(k % 3 - 1, k / 3 % 3 - 1, k / 9 - 1)).collect();
-    steps.sort_by_key(|s| s.length_squared());
-    steps.into_iter().map(|s| near + s).find(|&w| map.invert(w) == m).unwrap_or(near)
+    (0..27)
+        .map(|k| IVec3::new(k % 3 - 1, k / 3 % 3 - 1, k / 9 - 1))
+        .filter(|&step| map.invert(near + step) == m)
+        .min_by_key(|step| step.length_squared())
+        .map_or(near, |step| near + step)
 }
 
 /// [`pick`], and where `ground` is on and the ray comes down through the

@@ -43,19 +43,33 @@ fn pixels_of(scene: &octovox::scene::Scene, camera: &Camera, owner: usize) -> Ve
         .collect()
 }
 
-#[test]
-fn a_click_picks_the_object_it_hits_and_edits_its_model() {
-    let (dir, file, scene) = groups_document();
-    let objects = scene.objects().expect("test_groups.vox is a scene of objects");
+/// The framing camera of `scene`, and a pixel that steadily shows a face
+/// of an object that is not the last one (so that a pick is not the
+/// default target by chance): the pixel and that object.
+fn object_pixel(scene: &octovox::scene::Scene) -> (Camera, u32, u32, usize) {
+    let objects = scene.objects().expect("a scene of objects");
     let (lo, hi) = scene.solid_bounds().unwrap();
     let camera = Camera::framing(lo, hi, 50.0);
-    // A pixel on a face of an object that is not the last one (so that
-    // the pick is not the default target by chance).
     let last = objects.list().len() - 1;
     let (x, y, voxel, _) =
         stable_pixel_left_of(OUTLINER_X, scene.drawn(), &camera, |v, _| objects.owner_at(v).is_some_and(|o| o != last));
-    let owner = objects.owner_at(voxel).unwrap();
-    let model = objects.list()[owner].placement.model;
+    (camera, x, y, objects.owner_at(voxel).unwrap())
+}
+
+/// Tab into object mode and a click at (x, y), which picks `owner`.
+fn pick_in_object_mode(display: &str, window: &str, lines: &mut Lines, (x, y): (u32, u32), owner: usize) {
+    xdotool(display, &["key", "Tab"]);
+    xdotool(display, &["mousemove", "--window", window, &x.to_string(), &y.to_string()]);
+    std::thread::sleep(Duration::from_millis(300));
+    xdotool(display, &["click", "1"]);
+    assert_eq!(lines.wait_for("ran: object", Duration::from_secs(30)), format!("ran: object {owner}"));
+}
+
+#[test]
+fn a_click_picks_the_object_it_hits_and_edits_its_model() {
+    let (dir, file, scene) = groups_document();
+    let (camera, x, y, owner) = object_pixel(&scene);
+    let model = scene.objects().unwrap().list()[owner].placement.model;
     let before = model_sizes(&file);
 
     let (_xvfb, display) = start_xvfb();
@@ -156,12 +170,7 @@ fn object_edits_survive_a_kill() {
 fn tab_object_mode_picks_moves_drags_turns_and_deletes_objects() {
     let (dir, file, scene) = groups_document();
     let objects = scene.objects().unwrap();
-    let (lo, hi) = scene.solid_bounds().unwrap();
-    let camera = Camera::framing(lo, hi, 50.0);
-    let last = objects.list().len() - 1;
-    let (x, y, voxel, _) =
-        stable_pixel_left_of(OUTLINER_X, scene.drawn(), &camera, |v, _| objects.owner_at(v).is_some_and(|o| o != last));
-    let owner = objects.owner_at(voxel).unwrap();
+    let (camera, x, y, owner) = object_pixel(&scene);
     let node = objects.list()[owner].transform_node.expect("a transform above the object") as usize;
     let translation = |file: &std::path::Path| -> [i32; 3] {
         let data = dot_vox::load_bytes(&std::fs::read(file).unwrap()).unwrap();
@@ -174,11 +183,7 @@ fn tab_object_mode_picks_moves_drags_turns_and_deletes_objects() {
 
     let (_xvfb, display) = start_xvfb();
     let (_app, mut lines, window) = open_ready(&display, dir.path(), &document_args(&file, &camera, &[]));
-    xdotool(&display, &["key", "Tab"]);
-    xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y.to_string()]);
-    std::thread::sleep(Duration::from_millis(300));
-    xdotool(&display, &["click", "1"]);
-    assert_eq!(lines.wait_for("ran: object", Duration::from_secs(30)), format!("ran: object {owner}"));
+    pick_in_object_mode(&display, &window, &mut lines, (x, y), owner);
     for _ in 0..2 {
         xdotool(&display, &["key", "Right"]);
         // A move composes the cells the object left and reached: `object: N bytes written`.
@@ -561,12 +566,7 @@ fn a_click_on_a_turned_object_attaches_across_its_model_face() {
 fn the_ring_turns_the_picked_object_freely_and_k_keys_it() {
     let (dir, file, scene) = groups_document();
     let objects = scene.objects().unwrap();
-    let (lo, hi) = scene.solid_bounds().unwrap();
-    let camera = Camera::framing(lo, hi, 50.0);
-    let last = objects.list().len() - 1;
-    let (x, y, voxel, _) =
-        stable_pixel_left_of(OUTLINER_X, scene.drawn(), &camera, |v, _| objects.owner_at(v).is_some_and(|o| o != last));
-    let owner = objects.owner_at(voxel).unwrap();
+    let (camera, x, y, owner) = object_pixel(&scene);
     let node = objects.list()[owner].transform_node.expect("a transform above the object") as usize;
     // The ring as the window draws it: about the picked box's centre on
     // screen, 16 pixels past its farthest corner.
@@ -589,11 +589,7 @@ fn the_ring_turns_the_picked_object_freely_and_k_keys_it() {
 
     let (_xvfb, display) = start_xvfb();
     let (_app, mut lines, window) = open_ready(&display, dir.path(), &document_args(&file, &camera, &[]));
-    xdotool(&display, &["key", "Tab"]);
-    xdotool(&display, &["mousemove", "--window", &window, &x.to_string(), &y.to_string()]);
-    std::thread::sleep(Duration::from_millis(300));
-    xdotool(&display, &["click", "1"]);
-    assert_eq!(lines.wait_for("ran: object", Duration::from_secs(30)), format!("ran: object {owner}"));
+    pick_in_object_mode(&display, &window, &mut lines, (x, y), owner);
     let (gx, gy) = on_ring(0.0);
     xdotool(&display, &["mousemove", "--window", &window, &gx.to_string(), &gy.to_string()]);
     std::thread::sleep(Duration::from_millis(300));

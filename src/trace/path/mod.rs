@@ -192,7 +192,6 @@ impl PathScene<'_> {
             if c.hit.gave_up {
                 return radiance + beta * GAVE_UP_COLOR;
             }
-            let lift = lift_of(&c, &ray);
             let Some((p, n, surface)) = self.surface(&ray, &c) else {
                 if c.found {
                     // The ray started inside a solid voxel: nothing to see.
@@ -200,6 +199,7 @@ impl PathScene<'_> {
                 }
                 return radiance + beta * self.environment(ray.dir, lights_counted);
             };
+            let lift = lift_of(&c, p);
             let d = ray.dir.normalize();
             let material = self.materials[surface];
             if first {
@@ -432,11 +432,10 @@ fn emitter_point(light: &Emitter, p: Vec3, u1: f32, u2: f32, u3: f32) -> Option<
     Some((q, axis, faces))
 }
 
-/// How far a ray leaving the face `c` found starts off it: [`TURNED_LIFT`]
-/// of the hit point's size on a turned face, none on any other. Twin of
-/// `lift_of` in `shaders/path.wgsl`.
-fn lift_of(c: &Crossing, ray: &Ray) -> f32 {
-    let p = ray.origin + ray.dir * c.t;
+/// How far a ray leaving the face `c` found, at `p`, starts off it:
+/// [`TURNED_LIFT`] of the point's size on a turned face, none on any
+/// other. Twin of `lift_of` in `shaders/path.wgsl`.
+fn lift_of(c: &Crossing, p: Vec3) -> f32 {
     if c.hit.turned.is_some() { TURNED_LIFT * p.abs().max_element().max(1.0) } else { 0.0 }
 }
 
