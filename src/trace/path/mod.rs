@@ -199,7 +199,9 @@ impl PathScene<'_> {
                 }
                 return radiance + beta * self.environment(ray.dir, lights_counted);
             };
-            let lift = lift_of(&c, p);
+            // The ground in front of a turned face is no turned face (the
+            // shader's landed hit is the ground's alone).
+            let lift = if surface == GROUND_SURFACE { 0.0 } else { lift_of(&c, p) };
             let d = ray.dir.normalize();
             let material = self.materials[surface];
             if first {
