@@ -12,6 +12,7 @@
 
 use glam::{DMat3, DVec3, IVec3, Vec3};
 
+use super::hull::HULL_BLOCKS;
 use super::objects::{Model, Objects};
 use super::transform::Placing;
 use crate::gpu_pool::{BRICK_BYTES, NODE_BYTES, PoolTooLarge};
@@ -203,6 +204,8 @@ impl InstanceTable {
     /// world cell `origin`.
     pub fn build(objects: &Objects, origin: IVec3) -> InstanceTable {
         let model_bounds: Vec<Option<(IVec3, IVec3)>> = objects.models.iter().map(|m| m.tree.solid_bounds()).collect();
+        // Hulls only of the models something turns freely, once each.
+        let mut hulls: Vec<Option<Vec<(IVec3, IVec3)>>> = vec![None; objects.models.len()];
         let instances: Vec<Instance> = (0..objects.list().len())
             .map(|i| {
                 let object = &objects.list()[i];
@@ -211,7 +214,12 @@ impl InstanceTable {
                 let placing = objects.map(i);
                 let bounds = model_bounds[model]
                     .filter(|_| !object.hidden)
-                    .map(|(lo, hi)| placing.cover_box(lo, hi))
+                    .map(|(lo, hi)| match &placing {
+                        Placing::Cells(map) => map.apply_box(lo, hi),
+                        Placing::Turned(map) => map.cover_blocks(
+                            hulls[model].get_or_insert_with(|| objects.models[model].tree.hull(HULL_BLOCKS)),
+                        ),
+                    })
                     .map(|(lo, hi)| (lo - origin, hi - origin));
                 let mut instance =
                     Instance { model, src: [0; 3], sign: [1; 3], offset: IVec3::ZERO, bounds, turned: None };

@@ -6,6 +6,7 @@ pub mod build;
 pub mod counts;
 pub mod demo;
 pub mod graph;
+pub mod hull;
 pub mod instances;
 pub mod lod;
 pub mod objects;

@@ -501,11 +501,19 @@ impl TurnedMap {
         (lo.saturating_add(self.shift), hi.saturating_add(self.shift))
     }
 
-    /// The world cells the turned cubes of model cells `lo..=hi` reach
-    /// into: the cells around the turned box of points, which an exact
-    /// tracer's box must hold (wider than [`TurnedMap::apply_box`]).
-    pub fn cover_box(&self, lo: IVec3, hi: IVec3) -> (IVec3, IVec3) {
-        let (min, max) = self.turned_points(lo, hi);
+    /// The world cells the turned cubes of the model cells in `blocks`
+    /// (inclusive boxes: a model's hull) reach into: the cells around
+    /// their turned boxes of points, which an exact tracer's box must hold
+    /// (wider than [`TurnedMap::apply_box`]).
+    pub fn cover_blocks(&self, blocks: &[(IVec3, IVec3)]) -> (IVec3, IVec3) {
+        let spread = DMat3::from_cols(self.a.x_axis.abs(), self.a.y_axis.abs(), self.a.z_axis.abs());
+        let (min, max) = blocks.iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(min, max), &(lo, hi)| {
+            // A box of points c ± h turns to a box around a·c ± |a|·h.
+            let (a, b) = (lo.as_dvec3(), (hi + IVec3::ONE).as_dvec3());
+            let centre = self.world_unshifted((a + b) * 0.5);
+            let half = spread * ((b - a) * 0.5);
+            (min.min(centre - half), max.max(centre + half))
+        });
         let (lo, hi) = (min.floor().as_ivec3(), max.ceil().as_ivec3() - IVec3::ONE);
         (lo.saturating_add(self.shift), hi.saturating_add(self.shift))
     }
@@ -589,16 +597,6 @@ impl Placing {
         match self {
             Placing::Cells(map) => map.apply_box(lo, hi),
             Placing::Turned(map) => map.apply_box(lo, hi),
-        }
-    }
-
-    /// The world cells the placed model cells `lo..=hi` reach into: the
-    /// cells they land on exactly, or the cells around a turned box (what
-    /// a tracer's box must hold).
-    pub fn cover_box(&self, lo: IVec3, hi: IVec3) -> (IVec3, IVec3) {
-        match self {
-            Placing::Cells(map) => map.apply_box(lo, hi),
-            Placing::Turned(map) => map.cover_box(lo, hi),
         }
     }
 

@@ -556,3 +556,29 @@ fn a_sparse_model_turns_by_its_cells() {
         assert!(exact.cells.contains(&cell), "world cell {w} holds model point {p:?}, no voxel");
     }
 }
+
+/// A freely turned ball's box in the tree of boxes is the box of the
+/// turned ball (its hull), not of its turned cube, whose corners the ball
+/// does not fill: looser boxes made leaning trees draw 1.36× as long as
+/// upright ones (docs/bench/anim.md). Traced hits stay exact (the tests
+/// above walk the same boxes).
+#[test]
+fn a_turned_ball_is_boxed_as_a_ball() {
+    let voxels = (0..15u8)
+        .flat_map(|x| (0..15u8).flat_map(move |y| (0..15u8).map(move |z| [x, y, z])))
+        .filter(|p| p.iter().map(|&c| (i32::from(c) - 7).pow(2)).sum::<i32>() <= 49)
+        .map(|[x, y, z]| Voxel { x, y, z, i: 4 });
+    let mut editor = Editor::default();
+    editor
+        .set_scene(load(&scene_of(Model { size: Size { x: 15, y: 15, z: 15 }, voxels: voxels.collect() }, [0, 0, 0])));
+    run(&mut editor, "object block\nobject turn y 45\nobject turn x 12").unwrap();
+    let objects = editor.scene.instanced().expect("a freely turned object is drawn as an instance");
+    let table = octovox::scene::instances::InstanceTable::build(objects, glam::IVec3::ZERO);
+    let (lo, hi) = table.instances[0].bounds.unwrap();
+    let width = hi - lo + glam::IVec3::ONE;
+    // The turned cube would be 15 · (cos 45° + sin 45°) ≈ 21 cells wide.
+    assert!(width.cmple(glam::IVec3::splat(18)).all(), "box {lo}..={hi}, {width} wide: the turned cube's");
+    let counts = check(&editor, &all_rays(&editor, [15.0; 3]));
+    assert!(counts.violations.is_empty(), "{:#?}", &counts.violations[..counts.violations.len().min(5)]);
+    assert!(counts.hits > 0);
+}
