@@ -52,8 +52,9 @@ struct Emitter {
     size: u32,
     cdf: f32,
     index: u32,
-    _pad0: u32,
-    _pad1: u32,
+    // The freely turned object whose model cell this is, or NO_INSTANCE.
+    instance: u32,
+    _pad: u32,
 }
 
 @group(0) @binding(BINDING_PATH_CONSTANTS) var<storage, read> path_constants: PathUniforms;
@@ -269,6 +270,9 @@ fn lobe_eval(lobe: Lobe, n: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
     return fresnel * (ggx * g / (4.0 * cos_v * cos_l));
 }
 
+// One sample of an emissive cell: a cell picked by power, one of its faces
+// that faces p, a point on it. A turned lamp's cell is sampled in its
+// model's frame (a rigid map: the same distances). Twin of `emitter_light`.
 fn emitter_light(p: vec3<f32>, n: vec3<f32>, lobe: Lobe) -> vec3<f32> {
     let u0 = rng_next();
     let u1 = rng_next();
@@ -276,10 +280,17 @@ fn emitter_light(p: vec3<f32>, n: vec3<f32>, lobe: Lobe) -> vec3<f32> {
     let u3 = rng_next();
     let i = pick_emitter(u0);
     let e = emitters[i];
+    let turned = e.instance != NO_INSTANCE;
+    var inst: Instance;
+    var at = p;
+    if (turned) {
+        inst = load_instance(e.instance);
+        at = p * inst.rows + inst.t;
+    }
     let lo = vec3<f32>(e.min);
     let hi = lo + vec3<f32>(f32(e.size));
-    let below = p < lo;
-    let above = p > hi;
+    let below = at < lo;
+    let above = at > hi;
     let facing = below | above;
     let faces = u32(facing.x) + u32(facing.y) + u32(facing.z);
     if (faces == 0u) {
@@ -303,17 +314,31 @@ fn emitter_light(p: vec3<f32>, n: vec3<f32>, lobe: Lobe) -> vec3<f32> {
     q[axis] = select(hi[axis], lo[axis], below[axis]);
     q[b] = lo[b] + u2 * (hi[b] - lo[b]);
     q[c] = lo[c] + u3 * (hi[c] - lo[c]);
-    let w = q - p;
+    let w = q - at;
     let dist2 = dot(w, w);
-    let l = w / sqrt(dist2);
+    let towards = w / sqrt(dist2);
+    var l = towards;
+    if (turned) {
+        l = inst.rows * towards;
+    }
     let cos_s = dot(n, l);
-    let cos_l = abs(l[axis]);
+    let cos_l = abs(towards[axis]);
     if (cos_s <= 0.0 || dist2 <= 0.0) {
         return vec3<f32>(0.0);
     }
     let shadow = trace_scene(make_ray(p, l), 0.0, 0u, NO_INSTANCE, vec2<f32>(0.0));
-    let rel = shadow.voxel - e.min;
-    if (!shadow.found || any(rel < vec3<i32>(0)) || any(rel >= vec3<i32>(i32(e.size)))) {
+    var reached = false;
+    if (turned) {
+        // The hit in the model's frame, in the sampled cell (twin of `holds_point`).
+        let m = at + towards * shadow.t;
+        let slack = vec3<f32>(TURNED_EMITTER_SLACK);
+        let same = shadow.instance == e.instance && shadow.value == e.index;
+        reached = shadow.found && same && all(m >= lo - slack) && all(m <= hi + slack);
+    } else {
+        let rel = shadow.voxel - e.min;
+        reached = shadow.found && all(rel >= vec3<i32>(0)) && all(rel < vec3<i32>(i32(e.size)));
+    }
+    if (!reached) {
         return vec3<f32>(0.0);
     }
     let before = select(emitters[max(i, 1u) - 1u].cdf, 0.0, i == 0u);
@@ -457,7 +482,9 @@ fn radiance(ray_in: Ray) -> vec3<f32> {
         // Leaving glass (into empty space or other glass), or entering it.
         let leaving = GLASS && medium != 0u && (value == 0u || is_glass(value));
         if (!leaving && EMIT && m.kind == MATERIAL_EMIT) {
-            if (!lights_counted) {
+            // Counted by light sampling, unless no list of lights (too
+            // many) sampled it.
+            if (!lights_counted || pu.emitter_count == 0u) {
                 radiance += beta * surface_albedo(value) * m.emission;
             }
             return radiance;

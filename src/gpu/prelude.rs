@@ -55,6 +55,7 @@ pub fn shared_constants() -> String {
     line("R2_SHIFT_SEED", "u32", format!("{:#x}u", path::rng::R2_SHIFT_SEED));
     line("MAX_TRANSMISSIONS", "u32", format!("{}u", path::MAX_TRANSMISSIONS));
     line("TURNED_LIFT", "f32", format!("{:?}", path::TURNED_LIFT));
+    line("TURNED_EMITTER_SLACK", "f32", format!("{:?}", path::lights::TURNED_EMITTER_SLACK));
     line("MIN_SAMPLED_ALPHA", "f32", format!("{:?}", path::MIN_SAMPLED_ALPHA));
     line("MATERIAL_DIFFUSE", "u32", format!("{}u", materials::MATERIAL_DIFFUSE));
     line("MATERIAL_METAL", "u32", format!("{}u", materials::MATERIAL_METAL));

@@ -430,7 +430,7 @@ impl Renderer {
         let send_scene =
             restart || resized || acc.key.is_none_or(|k| k.effects != effects || k.revision != key.revision);
         if send_scene {
-            let lights = if effects.emit { lights::emitters(scene.drawn(), &scene.palette) } else { Vec::new() };
+            let lights = if effects.emit { lights::emitters(scene) } else { Vec::new() };
             self.path.upload_scene(gpu, &self.buffers, &material_table(&scene.palette), &lights);
             acc.lights = lights.len();
         }

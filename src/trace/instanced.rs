@@ -40,6 +40,15 @@ impl<'a> Traced<'a> {
         }
     }
 
+    /// The free turn of instance `instance` (none for [`NO_INSTANCE`], an
+    /// instance placed by cells, or a scene of one model).
+    pub fn turned(&self, instance: u32) -> Option<&Turned> {
+        match self {
+            Traced::Tree(_) => None,
+            Traced::Objects { table, .. } => table.instances.get(instance as usize)?.turned.as_ref(),
+        }
+    }
+
     /// The first solid voxel along `ray` under `footprint`.
     pub fn trace(&self, ray: &Ray, footprint: Footprint) -> Hit {
         self.trace_through(ray, 0, None, footprint).hit

@@ -92,7 +92,7 @@ impl PathScene<'_> {
     pub fn new<'a>(scene: &'a Scene, settings: &PathSettings) -> PathScene<'a> {
         let palette = &scene.palette;
         let effects = effects_for(scene, settings);
-        let lights = if effects.emit { lights::emitters(scene.drawn(), palette) } else { Vec::new() };
+        let lights = if effects.emit { lights::emitters(scene) } else { Vec::new() };
         let mut materials = materials::material_table(palette);
         let mut albedo: Vec<Vec3> = (0..=255u8).map(|i| materials::albedo(palette, i)).collect();
         materials.push(GpuMaterial::default());
@@ -213,7 +213,9 @@ impl PathScene<'_> {
             // Leaving glass (into empty space or other glass), or entering it.
             let leaving = self.effects.glass && medium != 0 && (surface == 0 || glass(surface));
             if !leaving && self.effects.emit && material.kind == MATERIAL_EMIT {
-                if !lights_counted {
+                // Counted by light sampling, unless no list of lights
+                // (too many) sampled it.
+                if !lights_counted || self.lights.is_empty() {
                     radiance += beta * self.albedo[surface] * material.emission;
                 }
                 return radiance;
@@ -331,22 +333,33 @@ impl PathScene<'_> {
     }
 
     /// One sample of an emissive cell: a cell picked by power, one of its
-    /// faces that faces `p`, a point on it.
+    /// faces that faces `p`, a point on it. A turned lamp's cell is
+    /// sampled in its model's frame (a rigid map: the same distances).
     fn emitter_light(&self, p: Vec3, n: Vec3, lobe: &Lobe, rng: &mut Rng) -> Vec3 {
         let (u0, u1, u2, u3) = (rng.uniform(), rng.uniform(), rng.uniform(), rng.uniform());
         let i = lights::pick(&self.lights, u0);
         let light = self.lights[i];
-        let Some((q, face_axis, faces)) = emitter_point(&light, p, u1, u2, u3) else { return Vec3::ZERO };
-        let w = q - p;
+        let turned = self.traced.turned(light.instance);
+        let at = turned.map_or(p, |t| t.model_point(p));
+        let Some((q, face_axis, faces)) = emitter_point(&light, at, u1, u2, u3) else { return Vec3::ZERO };
+        let w = q - at;
         let dist2 = w.length_squared();
-        let l = w / dist2.sqrt();
+        let towards = w / dist2.sqrt();
+        let l = turned.map_or(towards, |t| t.scene_dir(towards));
         let cos_s = n.dot(l);
-        let cos_l = l[face_axis].abs();
+        let cos_l = towards[face_axis].abs();
         if cos_s <= 0.0 || dist2 <= 0.0 {
             return Vec3::ZERO;
         }
         let c = self.cross(&Ray::new(p, l), 0, None);
-        if !c.found || !lights::contains(&light, c.hit.voxel) {
+        let reached = match turned {
+            None => c.found && lights::contains(&light, c.hit.voxel),
+            Some(_) => {
+                let same = c.instance == Some(light.instance) && u32::from(c.hit.value) == light.index;
+                c.found && same && lights::holds_point(&light, at + towards * c.t)
+            }
+        };
+        if !reached {
             return Vec3::ZERO;
         }
         let size = light.size as f32;
