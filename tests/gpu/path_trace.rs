@@ -918,3 +918,32 @@ fn a_turned_lamp_lights_the_floor_as_its_turned_cube() {
         .collect();
     check("CPU, no light sampling", &pixels, 0.03);
 }
+
+/// Over 4096 lamps (a checkerboard of 4,141 lamp voxels, no two in one
+/// cell) leave no list of lights: the floor under them is lit by the
+/// bounces that find them, on the GPU as on the CPU (both counted such a
+/// bounce as sampled, and drew the floor black).
+#[test]
+fn a_floor_under_too_many_lamps_to_sample_is_lit_by_its_bounces() {
+    let mut voxels: Vec<(IVec3, u8)> =
+        (0..91).flat_map(|x| (0..91).map(move |z| (IVec3::new(x, 0, z), WHITE))).collect();
+    voxels.extend(
+        (0..91)
+            .flat_map(|x| (0..91).map(move |z| (x, z)))
+            .filter(|(x, z)| (x + z) % 2 == 0)
+            .map(|(x, z)| (IVec3::new(x, 6, z), SPECIAL)),
+    );
+    let mut palette = palette();
+    palette.materials[usize::from(SPECIAL)] = material(MaterialKind::Emit, &[("_emit", "1")]);
+    let mut scene = Scene::new(palette, Octree::from_voxels(&voxels).unwrap());
+    let (lights, max) = (octovox::trace::path::lights::emitters(&scene), octovox::trace::path::lights::MAX_EMITTERS);
+    assert!(lights.is_empty(), "{} lights listed, at most {max}", lights.len());
+    // Under the lamps, looking down at the floor between them.
+    let camera = look(DVec3::new(40.0, 4.5, 40.0), DVec3::new(50.0, 0.0, 45.0));
+    let settings = PathSettings { bounces: 1, sun: false, sky: Sky::Black, ..PathSettings::default() };
+    let (size, spp) = ((32, 24), 8);
+    let cpu = render_cpu(&scene, &camera, size, &settings, spp).pixels;
+    assert!(mean(&cpu).min_element() > 0.05, "the floor is lit: {}", mean(&cpu));
+    let (gpu, _) = render_gpu(&mut scene, &camera, size, &settings, spp);
+    assert_alike("GPU, no list of lights", &cpu, &gpu);
+}
