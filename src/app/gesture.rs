@@ -45,17 +45,23 @@ pub(super) enum SelectDrag {
 /// on, and the last brush centre applied.
 pub(super) struct Stroke {
     pub tool: Tool,
-    pub plane: Option<(IVec3, i32)>,
-    pub last_center: Option<IVec3>,
+    pub plane: Option<Layer>,
+    pub last_center: Option<(Option<usize>, IVec3)>,
 }
+
+/// A face layer a stroke stays on: in the scene's cells, or (a freely
+/// turned object's face) in that object's model cells, the stroke's steps
+/// following its turned face. The frame (`None`: the scene's), the face's
+/// normal and its depth along the normal.
+pub(super) type Layer = (Option<usize>, IVec3, i32);
 
 /// A step a stroke takes: the line it runs, the face layer it is on, and
 /// whether it is the stroke's first (which picks the object it hits).
 #[derive(Debug, PartialEq)]
 pub(super) struct StrokeStep {
     pub line: octovox::script::Line,
-    pub layer: (IVec3, i32),
-    pub center: IVec3,
+    pub layer: Layer,
+    pub center: (Option<usize>, IVec3),
     pub first: bool,
 }
 
@@ -65,17 +71,22 @@ impl Stroke {
     /// and Erase) off the face the stroke started on by more than the
     /// reach (the cells a stroke reveals or creates would otherwise be
     /// picked next, and it would dig or pile up toward the camera), or
-    /// where Attach has no face (the camera inside a voxel).
+    /// where Attach has no face (the camera inside a voxel). Over a freely
+    /// turned object both are of its model cells, as the click's line is.
     pub fn step_at(&self, pick: &Pick, reach: i32) -> Option<StrokeStep> {
         if self.tool == Tool::Attach && pick.normal == IVec3::ZERO {
             return None;
         }
-        let layer = (pick.normal, pick.voxel.dot(pick.normal));
-        let off_layer = |(normal, depth): (IVec3, i32)| normal != layer.0 || (layer.1 - depth).abs() > reach;
+        let (frame, cell, normal) = match pick.model {
+            Some(m) => (Some(m.object), m.cell, m.normal),
+            None => (None, pick.voxel, pick.normal),
+        };
+        let layer = (frame, normal, cell.dot(normal));
+        let off_layer = |(on, along, depth): Layer| on != frame || along != normal || (layer.2 - depth).abs() > reach;
         if self.tool != Tool::Paint && self.plane.is_some_and(off_layer) {
             return None;
         }
-        let center = octovox::edit::brush::click_target(self.tool, pick.voxel, pick.normal);
+        let center = (frame, octovox::edit::brush::click_target(self.tool, cell, normal));
         if self.last_center == Some(center) {
             return None;
         }
@@ -269,6 +280,33 @@ mod tests {
         assert_eq!(editor.scene.palette.color(5)[..3], [20, 0, 0]);
         editor.run(&Line::Undo(1)).unwrap();
         assert_eq!(*editor.scene.palette.material(5), *diffuse, "one undo puts the entry back");
+    }
+
+    /// Over a freely turned object a stroke follows the turned face by its
+    /// model cells: the face's world cells climb and its nearest axis
+    /// changes as the pointer moves along it, which stopped an Attach drag
+    /// after its first step (off the layer it started on); the model cells
+    /// stay on one layer of the model's face. A pick of the scene's own
+    /// cells is off that layer.
+    #[test]
+    fn a_stroke_over_a_turned_face_steps_by_its_model_cells() {
+        use octovox::trace::pick::ModelCell;
+        let on_face = |x: i32| Pick {
+            voxel: IVec3::new(x, x / 2, 0),
+            normal: if x % 3 == 0 { IVec3::X } else { IVec3::Y },
+            value: 1,
+            model: Some(ModelCell { object: 0, cell: IVec3::new(x, 2, 3), normal: IVec3::Z }),
+        };
+        let mut open = Stroke { tool: Tool::Attach, plane: None, last_center: None };
+        let mut lines = Vec::new();
+        for pick in [on_face(0), on_face(0), on_face(1), on_face(2), on_face(5)] {
+            if let Some(step) = open.step_at(&pick, 0) {
+                lines.push(step.line.to_string());
+                open.stepped(&step);
+            }
+        }
+        assert_eq!(lines, ["object place 0 2 4", "object place 1 2 4", "object place 2 2 4", "object place 5 2 4"]);
+        assert!(open.step_at(&top(3, 3), 0).is_none(), "the scene's cells are off the turned face's layer");
     }
 
     /// An Erase drag digs one layer, and a Paint drag follows the pointer
