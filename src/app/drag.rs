@@ -5,7 +5,7 @@
 //! tests here need no window.
 
 use glam::{DVec2, IVec3, Vec3};
-use octovox::camera::RayBasis;
+use octovox::camera::{Camera, RayBasis};
 use octovox::edit::selection::Region;
 
 /// The whole voxel steps along `normal` that a drag from window pixel
@@ -79,6 +79,17 @@ pub(super) fn ring(basis: &RayBasis, lo: IVec3, hi: IVec3, scale: f64) -> Option
 /// of pixel `at` about `centre`.
 pub(super) fn screen_angle(centre: DVec2, at: (f64, f64)) -> f64 {
     (-(at.1 - centre.y)).atan2(at.0 - centre.x).to_degrees()
+}
+
+/// Whether `camera` sees the plane across `axis` at `middle` (the picked
+/// box's middle) from the axis' negative side: a perspective eye below it,
+/// or looking toward the positive axis (orthographic, or no box). Seen
+/// from there, counter-clockwise on screen turns the other way.
+pub(super) fn seen_from_below(camera: &Camera, axis: usize, middle: Option<f64>) -> bool {
+    match (camera.ortho, middle) {
+        (None, Some(middle)) => camera.eye[axis] < middle,
+        _ => camera.target[axis] > camera.eye[axis],
+    }
 }
 
 /// `by` degrees brought into −180..180 (a drag across the ring's left
@@ -172,5 +183,31 @@ mod tests {
             Camera { eye: DVec3::new(30.0, 0.5, 4.5), target: DVec3::new(4.0, 0.5, 4.5), fov_y_deg: 50.0, ortho: None };
         let edge_on = level.basis(SIZE.0, SIZE.1, IVec3::ZERO);
         assert_eq!(ground_steps(&edge_on, at, (400.0, 300.0), (450.0, 300.0)), None);
+    }
+
+    /// The ring's turn is seen from the side of its axis the eye is on: a
+    /// perspective eye by where it stands against the picked box's middle,
+    /// an orthographic one (or one with no box) by the way it looks.
+    #[test]
+    fn the_ring_is_seen_from_the_eyes_side_of_its_axis() {
+        let at = |eye: [f64; 3], ortho| Camera {
+            eye: DVec3::from_array(eye),
+            target: DVec3::new(4.0, 4.0, 4.0),
+            fov_y_deg: 50.0,
+            ortho,
+        };
+        let above = at([4.0, 20.0, 9.0], None);
+        assert!(!seen_from_below(&above, 1, Some(4.0)), "from above, about y");
+        assert!(seen_from_below(&above, 1, Some(30.0)), "an eye below a tall object's middle");
+        // About x from the eye's side of x = 4 (the eye at x = 4.5 is on
+        // the positive side of the middle, x = 4).
+        let right = at([4.5, 5.0, 20.0], None);
+        assert!(!seen_from_below(&right, 0, Some(4.0)));
+        assert!(seen_from_below(&right, 0, Some(5.0)));
+        assert!(seen_from_below(&right, 2, Some(30.0)) && !seen_from_below(&right, 2, Some(4.0)));
+        // Orthographic, or nothing picked: by the way it looks.
+        let looking_down_z = at([4.0, 4.0, -20.0], Some(10.0));
+        assert!(seen_from_below(&looking_down_z, 2, Some(100.0)) && !seen_from_below(&looking_down_z, 0, Some(0.0)));
+        assert!(seen_from_below(&at([4.0, -9.0, 4.0], None), 1, None), "looking up");
     }
 }

@@ -78,7 +78,7 @@ impl Session {
         let commands = ui::show(ui, state, tools, ui_state, &info);
         let view = ui.available_rect_before_wrap();
         ui::draw_ground(ui, state, &info);
-        ui::draw_selection(ui, state, &info);
+        ui::draw_selection(ui, state, &info, ui_state.outliner.turn.axis);
         if let Some((voxels, normal, layers)) = info.extrude {
             ui::draw_extrude(ui, state, &info, voxels, normal, layers);
         } else if let Some(pick) = pick.filter(|_| state.mode.uses_brush() && info.fill.is_none()) {

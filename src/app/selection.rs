@@ -154,33 +154,29 @@ impl Session {
         (off <= super::drag::RING_GRAB * self.view.scale_factor).then_some(centre)
     }
 
-    /// Turns the picked object about the world's up axis by the whole
-    /// degrees the pointer has gone round the ring since the press:
-    /// counter-clockwise on screen is counter-clockwise seen from above
-    /// (from below when the eye is below the object's middle).
+    /// Turns the picked object about the ring's axis (the Turn row's, y
+    /// unless Shift+X or Shift+Z chose another) by the whole degrees the
+    /// pointer has gone round the ring since the press: counter-clockwise
+    /// on screen is counter-clockwise seen from the axis' positive side
+    /// (from its negative side when the eye is there).
     fn drag_ring(&mut self, x: f64, y: f64) {
         let Gesture::Ring { centre, last, dragged, turned } = self.gesture else { return };
         let angle = super::drag::screen_angle(centre, (x, y));
         let dragged = dragged + super::drag::wrapped(angle - last);
-        // Seen from below the ring's plane (the picked box's middle), or
-        // orthographically looking up, counter-clockwise turns the other way.
+        let axis = self.ui.outliner.turn.axis;
         let objects = self.doc.editor.scene.pickable_objects();
         let middle = objects
             .and_then(|o| o.selected.and_then(|i| o.world_box(i)))
-            .map(|(lo, hi)| f64::from(lo.y + hi.y + 1) * 0.5);
-        let camera = &self.state.camera;
-        let from_below = match (camera.ortho, middle) {
-            (None, Some(y)) => camera.eye.y < y,
-            _ => camera.target.y > camera.eye.y,
-        };
-        let target = (if from_below { -dragged } else { dragged }).round() as i64;
+            .map(|(lo, hi)| f64::from(lo[axis] + hi[axis] + 1) * 0.5);
+        let sign = if super::drag::seen_from_below(&self.state.camera, axis, middle) { -1.0 } else { 1.0 };
+        let target = (sign * dragged).round() as i64;
         if let Gesture::Ring { last, dragged: so_far, .. } = &mut self.gesture {
             (*last, *so_far) = (angle, dragged);
         }
         if target == turned {
             return;
         }
-        let turn = ObjectLine::Turn { axis: 1, degrees: octovox::script::Degrees((target - turned) as f64) };
+        let turn = ObjectLine::Turn { axis, degrees: octovox::script::Degrees((target - turned) as f64) };
         if let Err(err) = self.run_line(&Line::Object(turn)) {
             return self.ui.error(format!("object refused: {err}"));
         }

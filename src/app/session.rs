@@ -313,8 +313,13 @@ impl Session {
             AppCommand::Turn { axis, flip: false } if self.state.mode == Mode::Object => {
                 self.act(octovox::script::Line::Object(octovox::script::ObjectLine::Rotate(axis)), "object")
             }
-            AppCommand::Turn { flip: true, .. } if self.state.mode == Mode::Object => {
-                self.ui.info("an object turns (X, Y, Z) but does not flip");
+            // An object does not flip: Shift picks the axis the ring and the
+            // Turn row turn it about.
+            AppCommand::Turn { axis, flip: true } if self.state.mode == Mode::Object => {
+                self.ui.outliner.turn.axis = axis;
+                let said = format!("the ring turns the object about {}", ["x", "y", "z"][axis]);
+                report!("{said}");
+                self.ui.info(said);
             }
             AppCommand::DeleteSelection => self.act(octovox::script::Line::Delete, "delete"),
             AppCommand::PasteAtCursor => self.paste_at_cursor(),

@@ -1016,14 +1016,15 @@ pub fn draw_ground(ui: &egui::Ui, state: &EditorState, info: &Info) {
 }
 
 /// Outlines the selected box (or the one being dragged); in select mode
-/// with a dot on each face, the handle that resizes it.
-pub fn draw_selection(ui: &egui::Ui, state: &EditorState, info: &Info) {
+/// with a dot on each face, the handle that resizes it. In object mode the
+/// ring around the picked object, which turns it about `ring_axis`.
+pub fn draw_selection(ui: &egui::Ui, state: &EditorState, info: &Info, ring_axis: usize) {
     if let Some(objects) = info.objects
         && let Some(bounds) = objects.selected.and_then(|i| objects.world_box(i))
     {
         outline_box(ui, state, info, bounds, super::outliner::PICKED, false);
         if state.mode == Mode::Object {
-            draw_ring(ui, state, info, bounds);
+            draw_ring(ui, state, info, bounds, ring_axis);
         }
     }
     if let Some(region) = info.selection {
@@ -1039,17 +1040,22 @@ pub fn draw_selection(ui: &egui::Ui, state: &EditorState, info: &Info) {
 }
 
 /// Object mode: the rotation ring around the picked object's box, which a
-/// drag turns about the world's up axis (`Session::ring`, the same circle
-/// in window pixels).
-fn draw_ring(ui: &egui::Ui, state: &EditorState, info: &Info, (lo, hi): (IVec3, IVec3)) {
+/// drag turns about world axis `axis` (`Session::ring`, the same circle in
+/// window pixels), named at its top.
+fn draw_ring(ui: &egui::Ui, state: &EditorState, info: &Info, (lo, hi): (IVec3, IVec3), axis: usize) {
     let screen = ui.ctx().content_rect();
     let basis =
         state.camera.basis(screen.width().max(1.0) as u32, screen.height().max(1.0) as u32, info.scene.origin());
     let origin = info.scene.origin();
     if let Some((centre, radius)) = super::drag::ring(&basis, lo - origin, hi - origin, 1.0) {
         let centre = egui::pos2(centre.x as f32, centre.y as f32);
-        let stroke = Stroke::new(2.0, super::outliner::PICKED.gamma_multiply(0.8));
-        scene_painter(ui.ctx()).circle_stroke(centre, radius as f32, stroke);
+        let color = super::outliner::PICKED.gamma_multiply(0.8);
+        let painter = scene_painter(ui.ctx());
+        painter.circle_stroke(centre, radius as f32, Stroke::new(2.0, color));
+        let top = centre - egui::vec2(0.0, radius as f32 + 4.0);
+        let name = ["about x", "about y", "about z"][axis];
+        let font = egui::FontId::proportional(14.0);
+        painter.text(top, egui::Align2::CENTER_BOTTOM, name, font, super::outliner::PICKED);
     }
 }
 

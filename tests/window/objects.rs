@@ -564,6 +564,27 @@ fn a_click_on_a_turned_object_attaches_across_its_model_face() {
 /// on the object's key, the angle the drag went round.
 #[test]
 fn the_ring_turns_the_picked_object_freely_and_k_keys_it() {
+    let (q, turn) = ring_turn(None);
+    // About MagicaVoxel's z (world y) only, by about the 40° dragged.
+    assert!(q[0].abs() < 1e-9 && q[1].abs() < 1e-9, "about z: {turn}");
+    let degrees = (2.0 * q[2].atan2(q[3])).to_degrees().abs();
+    assert!((30.0..=50.0).contains(&degrees), "turned {degrees}° ({turn})");
+}
+
+/// Shift+X in object mode sets the ring's axis: the same drag turns the
+/// object about world x (MagicaVoxel's x) instead.
+#[test]
+fn shift_x_makes_the_ring_turn_about_x() {
+    let (q, turn) = ring_turn(Some("shift+x"));
+    assert!(q[1].abs() < 1e-9 && q[2].abs() < 1e-9, "about x: {turn}");
+    let degrees = (2.0 * q[0].atan2(q[3])).to_degrees().abs();
+    assert!((30.0..=50.0).contains(&degrees), "turned {degrees}° ({turn})");
+}
+
+/// Picks an object in object mode, presses `axis_key` (if any), drags 40°
+/// round the ring, keys (K) and saves: the saved `_ov_turn` quaternion of
+/// the object's key, and its text.
+fn ring_turn(axis_key: Option<&str>) -> (Vec<f64>, String) {
     let (dir, file, scene) = groups_document();
     let objects = scene.objects().unwrap();
     let (camera, x, y, owner) = object_pixel(&scene);
@@ -590,6 +611,10 @@ fn the_ring_turns_the_picked_object_freely_and_k_keys_it() {
     let (_xvfb, display) = start_xvfb();
     let (_app, mut lines, window) = open_ready(&display, dir.path(), &document_args(&file, &camera, &[]));
     pick_in_object_mode(&display, &window, &mut lines, (x, y), owner);
+    if let Some(key) = axis_key {
+        xdotool(&display, &["key", key]);
+        lines.wait_for("the ring turns the object about", Duration::from_secs(30));
+    }
     let (gx, gy) = on_ring(0.0);
     xdotool(&display, &["mousemove", "--window", &window, &gx.to_string(), &gy.to_string()]);
     std::thread::sleep(Duration::from_millis(300));
@@ -608,10 +633,6 @@ fn the_ring_turns_the_picked_object_freely_and_k_keys_it() {
     save(&display, &mut lines, &file);
     let data = dot_vox::load_bytes(&std::fs::read(&file).unwrap()).unwrap();
     let dot_vox::SceneNode::Transform { frames, .. } = &data.scenes[node] else { panic!("node {node}") };
-    let turn = frames[0].attributes.get("_ov_turn").unwrap_or_else(|| panic!("a free turn in {frames:?}"));
-    let q: Vec<f64> = turn.split_whitespace().map(|v| v.parse().unwrap()).collect();
-    // About MagicaVoxel's z (world y) only, by about the 40° dragged.
-    assert!(q[0].abs() < 1e-9 && q[1].abs() < 1e-9, "about z: {turn}");
-    let degrees = (2.0 * q[2].atan2(q[3])).to_degrees().abs();
-    assert!((30.0..=50.0).contains(&degrees), "turned {degrees}° ({turn})");
+    let turn = frames[0].attributes.get("_ov_turn").unwrap_or_else(|| panic!("a free turn in {frames:?}")).clone();
+    (turn.split_whitespace().map(|v| v.parse().unwrap()).collect(), turn)
 }
