@@ -50,20 +50,32 @@ fn is_filtered(code: u32) -> bool {
     return (code & GUIDE_FILTERED) != 0u;
 }
 
-fn normal_of(code: u32) -> u32 {
-    return code & 7u;
+fn sign_not_zero(v: f32) -> f32 {
+    return select(1.0, -1.0, v < 0.0);
 }
 
+// The face's unit normal: its axis, or a freely turned face's own from
+// its octahedral coordinates (twin of `Guide::normal`).
+fn normal_of(code: u32) -> vec3<f32> {
+    let axis_code = code & 7u;
+    if ((code & GUIDE_TURNED) == 0u) {
+        let on_axis = vec3<u32>(0u, 1u, 2u) == vec3<u32>((axis_code - 1u) / 2u);
+        return select(vec3<f32>(0.0), vec3<f32>(select(-1.0, 1.0, axis_code % 2u == 1u)), on_axis);
+    }
+    let bits = code >> GUIDE_NORMAL_SHIFT;
+    let uv = vec2<f32>(vec2<u32>(bits & 0xfffu, (bits >> 12u) & 0xfffu)) / GUIDE_NORMAL_STEPS * 2.0 - 1.0;
+    let z = 1.0 - abs(uv.x) - abs(uv.y);
+    var xy = uv;
+    if (z < 0.0) {
+        xy = vec2<f32>((1.0 - abs(uv.y)) * sign_not_zero(uv.x), (1.0 - abs(uv.x)) * sign_not_zero(uv.y));
+    }
+    return normalize(vec3<f32>(xy, z));
+}
+
+// Facing the same way: the same nearest axis (a test at every tap, kept to
+// one comparison; the plane test reads a turned face's own normal).
 fn same_surface(p: u32, q: u32) -> bool {
-    return is_filtered(q) && normal_of(q) == normal_of(p);
-}
-
-
-// Twin of `normal_from_code`.
-fn normal_vector(code: u32) -> vec3<f32> {
-    let on_axis = vec3<u32>(0u, 1u, 2u) == vec3<u32>((code - 1u) / 2u);
-    let valid = code != 0u && code <= 6u;
-    return select(vec3<f32>(0.0), vec3<f32>(select(-1.0, 1.0, code % 2u == 1u)), on_axis & vec3<bool>(valid));
+    return is_filtered(q) && (q & 7u) == (p & 7u);
 }
 
 fn count_of(i: u32) -> f32 {
@@ -215,7 +227,7 @@ fn atrous(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let luminance = dot(light_in[i].rgb, LUMINANCE);
     let point = point_of(i);
-    let normal = normal_vector(normal_of(p));
+    let normal = normal_of(p);
     let pixel_width = du.at_start + du.per_t * max(dot(point - du.eye, du.forward), 0.0);
     let step = i32(du.step);
     let plane_scale = SIGMA_PLANE * pixel_width * f32(step);

@@ -560,9 +560,31 @@ fn write_guide(px: vec2<u32>, pixel: u32) {
     let hit = ground_landing(r, trace_scene(r, 0.0, 0u, NO_INSTANCE, vec2<f32>(0.0)));
     var guide = vec4<u32>(0u);
     if (hit.found && hit.normal_code != 0u && !left_to_samples(material_of(hit.value).kind)) {
-        guide = vec4<u32>(bitcast<vec3<u32>>(surface_point(r, hit)), hit.normal_code | GUIDE_FILTERED);
+        // The nearest axis, and a turned face's own normal.
+        var code = GUIDE_FILTERED | hit.normal_code;
+        if (hit.turned) {
+            code |= GUIDE_TURNED | (pack_normal(hit.turned_normal) << GUIDE_NORMAL_SHIFT);
+        }
+        guide = vec4<u32>(bitcast<vec3<u32>>(surface_point(r, hit)), code);
     }
     guides[pixel] = guide;
+}
+
+// -1 for a negative number, else 1.
+fn sign_not_zero(v: f32) -> f32 {
+    return select(1.0, -1.0, v < 0.0);
+}
+
+// A unit normal's octahedral coordinates, GUIDE_NORMAL_STEPS steps each,
+// in 24 bits (twin of `pack_normal` in src/trace/denoise.rs).
+fn pack_normal(normal: vec3<f32>) -> u32 {
+    let n = normal / (abs(normal.x) + abs(normal.y) + abs(normal.z));
+    var uv = n.xy;
+    if (n.z < 0.0) {
+        uv = vec2<f32>((1.0 - abs(n.y)) * sign_not_zero(n.x), (1.0 - abs(n.x)) * sign_not_zero(n.y));
+    }
+    let steps = vec2<u32>(floor((uv + 1.0) * 0.5 * GUIDE_NORMAL_STEPS + 0.5));
+    return steps.x | (steps.y << 12u);
 }
 
 @compute @workgroup_size(8, 8)

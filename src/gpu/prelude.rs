@@ -62,6 +62,9 @@ pub fn shared_constants() -> String {
     line("MATERIAL_GLASS", "u32", format!("{}u", materials::MATERIAL_GLASS));
     line("MATERIAL_EMIT", "u32", format!("{}u", materials::MATERIAL_EMIT));
     line("GUIDE_FILTERED", "u32", format!("{:#x}u", denoise::GUIDE_FILTERED));
+    line("GUIDE_NORMAL_SHIFT", "u32", format!("{}u", denoise::GUIDE_NORMAL_SHIFT));
+    line("GUIDE_NORMAL_STEPS", "f32", format!("{:?}", denoise::GUIDE_NORMAL_STEPS as f32));
+    line("GUIDE_TURNED", "u32", format!("{:#x}u", denoise::GUIDE_TURNED));
     line("DENOISE_ITERATIONS", "u32", format!("{}u", denoise::ITERATIONS));
     line("SIGMA_LIGHT", "f32", format!("{:?}", denoise::SIGMA_LIGHT));
     line("SIGMA_PLANE", "f32", format!("{:?}", denoise::SIGMA_PLANE));

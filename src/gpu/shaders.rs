@@ -152,7 +152,7 @@ mod tests {
                 [eye, width, forward, height, at_start, per_t, step, light,]
             ),
             twin!(Module::Path, "Material", GpuMaterial, [kind, roughness, metalness, ior, transparency, emission]),
-            twin!(Module::Path, "Emitter", Emitter, [min, size, cdf, index]),
+            twin!(Module::Path, "Emitter", Emitter, [min, size, cdf, index, instance]),
         ]
     }
 

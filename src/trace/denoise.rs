@@ -50,6 +50,15 @@ pub const MIN_ALBEDO: f32 = 1.0 / 255.0;
 
 /// Bit of [`Guide::code`] set where the filter may change the pixel.
 pub const GUIDE_FILTERED: u32 = 1 << 3;
+/// Bit of [`Guide::code`] set where the face is a freely turned one, whose
+/// own normal follows from [`GUIDE_NORMAL_SHIFT`].
+pub const GUIDE_TURNED: u32 = 1 << 4;
+/// Where a freely turned face's normal starts in [`Guide::code`]: its
+/// octahedral coordinates, 12 bits each.
+pub const GUIDE_NORMAL_SHIFT: u32 = 8;
+/// Steps of each octahedral coordinate across −1..=1: an even count, so
+/// that 0 and ±1 are exact.
+pub const GUIDE_NORMAL_STEPS: u32 = 4094;
 
 /// The first hit of a pixel's centre ray. Twin of the guide `vec4<f32>` the
 /// path kernel writes: `point` in tree-local voxels, then `code` as bits.
@@ -57,8 +66,9 @@ pub const GUIDE_FILTERED: u32 = 1 << 3;
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct Guide {
     pub point: [f32; 3],
-    /// The face's normal code (`crate::trace::normal_code`) in bits 0..3,
-    /// and [`GUIDE_FILTERED`].
+    /// The face's nearest axis' code (1..=6: +x, −x, +y, −y, +z, −z) in
+    /// bits 0..3, [`GUIDE_FILTERED`], and on a freely turned face
+    /// [`GUIDE_TURNED`] and its own normal from [`GUIDE_NORMAL_SHIFT`].
     pub code: u32,
 }
 
@@ -66,18 +76,66 @@ impl Guide {
     /// A pixel the filter leaves alone (sky, lamp, glass, metal).
     pub const LEFT: Guide = Guide { point: [0.0; 3], code: 0 };
 
-    /// A filtered pixel whose centre ray enters a face at `point`.
-    pub fn filtered(point: Vec3, normal_code: u32) -> Guide {
-        Guide { point: point.to_array(), code: normal_code | GUIDE_FILTERED }
+    /// A filtered pixel whose centre ray enters a face of normal `normal`
+    /// at `point`: a face of the grid (an axis), or a freely turned one.
+    pub fn filtered(point: Vec3, normal: Vec3, turned: bool) -> Guide {
+        let mut code = GUIDE_FILTERED | axis_code(crate::trace::nearest_axis(normal));
+        if turned {
+            code |= GUIDE_TURNED | pack_normal(normal) << GUIDE_NORMAL_SHIFT;
+        }
+        Guide { point: point.to_array(), code }
     }
 
     pub fn is_filtered(&self) -> bool {
         self.code & GUIDE_FILTERED != 0
     }
 
-    pub fn normal_code(&self) -> u32 {
+    /// The nearest axis' code.
+    pub fn axis_code(&self) -> u32 {
         self.code & 7
     }
+
+    /// The face's unit normal.
+    pub fn normal(&self) -> Vec3 {
+        match self.code & GUIDE_TURNED {
+            0 => crate::trace::normal_from_code(self.axis_code()).as_vec3(),
+            _ => unpack_normal(self.code >> GUIDE_NORMAL_SHIFT),
+        }
+    }
+}
+
+/// An axis' code: 1..=6 for +x, −x, +y, −y, +z, −z.
+fn axis_code(axis: glam::IVec3) -> u32 {
+    let a = (0..3).find(|&a| axis[a] != 0).unwrap_or(0);
+    1 + 2 * a as u32 + u32::from(axis[a] < 0)
+}
+
+/// −1 for a negative number, else 1.
+fn sign_not_zero(v: f32) -> f32 {
+    if v < 0.0 { -1.0 } else { 1.0 }
+}
+
+/// A unit normal's octahedral coordinates, [`GUIDE_NORMAL_STEPS`] steps
+/// each, in 24 bits (twin of `pack_normal` in shaders/path.wgsl).
+fn pack_normal(n: Vec3) -> u32 {
+    let n = n / (n.x.abs() + n.y.abs() + n.z.abs());
+    let (mut u, mut v) = (n.x, n.y);
+    if n.z < 0.0 {
+        (u, v) = ((1.0 - n.y.abs()) * sign_not_zero(n.x), (1.0 - n.x.abs()) * sign_not_zero(n.y));
+    }
+    let step = |c: f32| ((c + 1.0) * 0.5 * GUIDE_NORMAL_STEPS as f32 + 0.5).floor() as u32;
+    step(u) | step(v) << 12
+}
+
+/// The unit normal of [`pack_normal`]'s bits (twin of `unpack_normal` in
+/// shaders/denoise.wgsl).
+fn unpack_normal(bits: u32) -> Vec3 {
+    let coordinate = |b: u32| (b & 0xfff) as f32 / GUIDE_NORMAL_STEPS as f32 * 2.0 - 1.0;
+    let (u, v) = (coordinate(bits), coordinate(bits >> 12));
+    let z = 1.0 - u.abs() - v.abs();
+    let (x, y) =
+        if z < 0.0 { ((1.0 - v.abs()) * sign_not_zero(u), (1.0 - u.abs()) * sign_not_zero(v)) } else { (u, v) };
+    Vec3::new(x, y, z).normalize()
 }
 
 /// One pixel of the accumulation: the sums of the samples, of their
@@ -183,9 +241,11 @@ fn taps(frame: &Frame, x: u32, y: u32, radius: i32, step: i32) -> impl Iterator<
     })
 }
 
-/// Whether `q` may be averaged into `p`: both filtered, facing the same way.
+/// Whether `q` may be averaged into `p`: both filtered, facing the same way
+/// (the same nearest axis: a test at every tap, kept to one comparison;
+/// the plane test reads a turned face's own normal).
 fn same_surface(p: &Guide, q: &Guide) -> bool {
-    q.is_filtered() && q.normal_code() == p.normal_code()
+    q.is_filtered() && q.axis_code() == p.axis_code()
 }
 
 /// Demodulated light and its variance per pixel; below
@@ -248,7 +308,7 @@ fn atrous(frame: &Frame, guides: &[Guide], light: &[Light], step: u32) -> Vec<Li
             let variance_p = if step == 1 { blurred_variance(frame, guides, light, x, y) } else { light[i].variance };
             let luminance = light[i].rgb.dot(LUMINANCE);
             let point = Vec3::from(p.point);
-            let normal = crate::trace::normal_from_code(p.normal_code()).as_vec3();
+            let normal = p.normal();
             let plane_scale = SIGMA_PLANE * frame.pixel_width(point) * step as f32;
             let (mut rgb, mut variance, mut weight) = (Vec3::ZERO, 0.0f32, 0.0f32);
             for (q, dx, dy) in taps(frame, x, y, 1, step as i32).filter(|&(q, _, _)| same_surface(p, &guides[q])) {
@@ -343,7 +403,7 @@ mod tests {
             .map(|i| {
                 let (x, y) = (i % W, i / W);
                 let albedo = Vec3::from(colour(x, y).map(|c| f32::from(c) / 255.0));
-                (Guide::filtered(Vec3::new(x as f32 * 0.1, 0.0, y as f32 * 0.1), 3), albedo)
+                (Guide::filtered(Vec3::new(x as f32 * 0.1, 0.0, y as f32 * 0.1), Vec3::Y, false), albedo)
             })
             .unzip()
     }

@@ -126,19 +126,6 @@ impl Hit {
 /// get it from `crate::gpu::prelude`).
 pub const GAVE_UP_RECORD: u32 = 0xffff;
 
-/// 0 = none, 1..=6 = +x, −x, +y, −y, +z, −z.
-pub fn normal_code(n: IVec3) -> u32 {
-    for axis in 0..3 {
-        if n[axis] > 0 {
-            return 1 + 2 * axis as u32;
-        }
-        if n[axis] < 0 {
-            return 2 + 2 * axis as u32;
-        }
-    }
-    0
-}
-
 /// The unit axis vector nearest `n` (ties to x, then y): a turned face's
 /// normal as a code. Twin of `nearest_axis_code` in shaders/instances.wgsl.
 pub fn nearest_axis(n: Vec3) -> IVec3 {

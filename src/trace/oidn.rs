@@ -76,11 +76,7 @@ mod library {
         let normal = guides
             .iter()
             .flat_map(|g| {
-                let n = if g.is_filtered() {
-                    crate::trace::normal_from_code(g.normal_code()).as_vec3()
-                } else {
-                    Vec3::ZERO
-                };
+                let n = if g.is_filtered() { g.normal() } else { Vec3::ZERO };
                 n.to_array()
             })
             .collect();

@@ -788,24 +788,39 @@ fn gpu_and_cpu_path_trace_turned_instances_alike() {
 /// oblique unit quaternion `turn` (MagicaVoxel's `_ov_turn`): a scene of
 /// two objects drawn as instances.
 fn turned_lamp_over_a_floor(turn: &str) -> Scene {
-    use octovox::scene::graph::{Attributes, Layer, Node, NodeKind, SceneGraph};
-    use octovox::scene::objects::{Model, Objects};
+    use octovox::scene::objects::Model;
     let floor: Vec<(IVec3, u8)> = (0..41).flat_map(|x| (0..41).map(move |y| (IVec3::new(x, y, 0), WHITE))).collect();
     let floor = Model { size: [41, 41, 1], tree: Octree::from_voxels(&floor).unwrap() };
     let lamp = Model { size: [1, 1, 1], tree: Octree::from_voxels(&[(IVec3::ZERO, SPECIAL)]).unwrap() };
+    let mut palette = palette();
+    palette.materials[usize::from(SPECIAL)] = material(MaterialKind::Emit, &[("_emit", "1")]);
+    objects_scene(vec![floor, lamp], &[("0 0 0", None), ("0 0 9", Some(turn))], palette)
+}
+
+/// Model k placed at MagicaVoxel's `_t` and free turn `_ov_turn` of
+/// `placements[k]`, each an object under the root's group: a scene drawn
+/// as instances where any is turned.
+pub(crate) fn objects_scene(
+    models: Vec<octovox::scene::objects::Model>,
+    placements: &[(&str, Option<&str>)],
+    palette: Palette,
+) -> Scene {
+    use octovox::scene::graph::{Attributes, Layer, Node, NodeKind, SceneGraph};
+    use octovox::scene::objects::Objects;
+    let children = (0..placements.len() as u32).map(|k| 2 + 2 * k).collect();
     let mut nodes = vec![
         Node {
             id: 0,
             attributes: Attributes::new(),
             kind: NodeKind::Transform { child: 1, reserved: u32::MAX, layer: 0, frames: vec![] },
         },
-        Node { id: 1, attributes: Attributes::new(), kind: NodeKind::Group { children: vec![2, 4] } },
+        Node { id: 1, attributes: Attributes::new(), kind: NodeKind::Group { children } },
     ];
-    for (k, (t, turn)) in [("0 0 0", None), ("0 0 9", Some(turn))].into_iter().enumerate() {
+    for (k, (t, turn)) in placements.iter().enumerate() {
         let id = 2 + 2 * k as u32;
-        let mut frame: Attributes = [("_t".to_owned(), t.to_owned())].into();
+        let mut frame: Attributes = [("_t".to_owned(), (*t).to_owned())].into();
         if let Some(turn) = turn {
-            frame.insert("_ov_turn".to_owned(), turn.to_owned());
+            frame.insert("_ov_turn".to_owned(), (*turn).to_owned());
         }
         let transform = NodeKind::Transform { child: id + 1, reserved: u32::MAX, layer: 0, frames: vec![frame] };
         nodes.push(Node { id, attributes: Attributes::new(), kind: transform });
@@ -814,9 +829,7 @@ fn turned_lamp_over_a_floor(turn: &str) -> Scene {
     }
     let layers = vec![Layer { id: 0, attributes: Attributes::new(), reserved: u32::MAX }];
     let graph = SceneGraph { nodes, layers, ..SceneGraph::default() };
-    let objects = Objects::new(Some(graph), vec![floor, lamp], Vec::new(), 0, usize::MAX).unwrap();
-    let mut palette = palette();
-    palette.materials[usize::from(SPECIAL)] = material(MaterialKind::Emit, &[("_emit", "1")]);
+    let objects = Objects::new(Some(graph), models, Vec::new(), 0, usize::MAX).unwrap();
     Scene::compose(palette, objects).unwrap()
 }
 

@@ -29,7 +29,7 @@ use super::ground::{self, GROUND_ALBEDO, Landing};
 use super::instanced::Traced;
 use super::render::GAVE_UP_COLOR;
 use super::svo::Crossing;
-use super::{Hit, Ray, argmin, nearest_axis, normal_code};
+use super::{Hit, Ray, argmin};
 use crate::camera::{Camera, RayBasis};
 use crate::scene::Scene;
 use crate::settings::{EffectsChoice, PathSettings, SUN_DIR};
@@ -170,7 +170,8 @@ impl PathScene<'_> {
         let c = self.cross(&ray, 0, None);
         match self.surface(&ray, &c) {
             Some((p, n, surface)) if !self.left_to_samples(self.materials[surface].kind) => {
-                Guide::filtered(p, normal_code(nearest_axis(n)))
+                // The ground in front of a turned face is no turned face.
+                Guide::filtered(p, n, c.hit.turned.is_some() && surface != GROUND_SURFACE)
             }
             _ => Guide::LEFT,
         }
