@@ -528,3 +528,31 @@ fn a_move_outside_a_loop_keys_the_frame_the_loop_shows() {
     run(&mut editor, "frame 25").unwrap();
     assert_eq!(cow(&editor), at4, "frame 25 still shows frame 4");
 }
+
+/// While frames play (the CPU's octree not composed yet), a pick sees the
+/// frame shown: it walks the objects as placed there, as the GPU draws
+/// them. A camera looking straight down on the top cell of a column that
+/// the shown frame fills and frame 0 does not fill as high picks that cell.
+#[test]
+fn a_pick_while_playing_sees_the_frame_shown() {
+    let data = herd(200);
+    let mut editor = Editor::default();
+    editor.set_scene(load(&bytes_of(&data)));
+    editor.play_frame(13).unwrap();
+    assert!(editor.scene.objects().unwrap().is_behind(), "played, not composed");
+    let (now, then) = (composed(&data, 13), composed(&data, 0));
+    let top = |cells: &Cells, x: i32, z: i32| cells.keys().filter(|c| c.0 == x && c.2 == z).map(|c| c.1).max();
+    let &(x, y, z) = now
+        .keys()
+        .find(|&&(x, y, z)| top(&now, x, z) == Some(y) && top(&then, x, z).is_none_or(|t| t < y))
+        .expect("a column the herd fills higher at frame 13 than at frame 0");
+    let centre = glam::DVec3::new(f64::from(x) + 0.5, f64::from(y) + 0.5, f64::from(z) + 0.5);
+    let camera = octovox::camera::Camera {
+        eye: centre + glam::DVec3::new(0.0, 40.0, 0.0),
+        target: centre,
+        fov_y_deg: 20.0,
+        ortho: None,
+    };
+    let picked = octovox::trace::pick::pick(&editor.scene, &camera, (101, 101), 50, 50).unwrap();
+    assert_eq!(picked.map(|p| p.voxel), Some(IVec3::new(x, y, z)), "the top cell of frame 13's column");
+}
