@@ -8,8 +8,7 @@ use std::collections::HashSet;
 
 use glam::IVec3;
 
-use super::octree::{Octree, octant_offset};
-use crate::gpu_pool::is_pointer;
+use super::octree::Octree;
 
 /// At most this many cells of one level are walked for a hull; only those
 /// of its shell are kept, as turning them is per object and per frame played.
@@ -24,44 +23,11 @@ impl Octree {
         let Some((lo, hi)) = self.solid_bounds() else { return Vec::new() };
         let mut hull = vec![(lo, hi)];
         for level in (0..self.depth()).rev() {
-            let mut blocks = Vec::new();
-            if !self.blocks_up_to(self.root_word(), self.origin(), self.depth(), level, max, &mut blocks) {
-                break;
-            }
-            hull = shell(blocks).map(|(min, max)| (min.max(lo), max.min(hi))).collect();
+            let Some(blocks) = self.blocks_at_most(level, max) else { break };
+            let cells = blocks.into_iter().map(|(min, _, level)| (min, min + IVec3::splat((1 << level) - 1)));
+            hull = shell(cells.collect()).map(|(min, max)| (min.max(lo), max.min(hi))).collect();
         }
         hull
-    }
-
-    /// Appends the non-empty cells of level `target` under `word` as
-    /// inclusive boxes; false (and stops) once there are more than `max`.
-    fn blocks_up_to(
-        &self,
-        word: u32,
-        min: IVec3,
-        level: u32,
-        target: u32,
-        max: usize,
-        out: &mut Vec<(IVec3, IVec3)>,
-    ) -> bool {
-        if word == 0 {
-            return true;
-        }
-        if level <= target {
-            out.push((min, min + IVec3::splat((1 << level) - 1)));
-            return out.len() <= max;
-        }
-        let half = 1 << (level - 1);
-        (0..8).all(|octant| {
-            // A uniform cell above the target level is cut into its cells;
-            // a brick's children are voxels (level 0).
-            let child = match (is_pointer(word), level) {
-                (false, _) => word,
-                (true, 1) => u32::from(self.brick(word)[octant]),
-                (true, _) => self.node(word)[octant],
-            };
-            self.blocks_up_to(child, min + octant_offset(octant) * half, level - 1, target, max, out)
-        })
     }
 }
 

@@ -270,25 +270,45 @@ impl Octree {
     /// deeper) as (min corner, child word, level), in octant order: what a
     /// saver walks to write the scene one block at a time.
     pub(crate) fn blocks(&self, level: u32) -> Vec<(IVec3, u32, u32)> {
-        let mut out = Vec::new();
-        self.collect_blocks(self.root, self.origin, self.depth, level, &mut out);
-        out
+        self.blocks_at_most(level, usize::MAX).unwrap_or_default()
     }
 
-    fn collect_blocks(&self, word: u32, min: IVec3, level: u32, target: u32, out: &mut Vec<(IVec3, u32, u32)>) {
+    /// [`Octree::blocks`], or `None` (and the walk stopped) once there are
+    /// more than `max` of them. At level 0 a block is a voxel, its word
+    /// the voxel's value.
+    pub(crate) fn blocks_at_most(&self, level: u32, max: usize) -> Option<Vec<(IVec3, u32, u32)>> {
+        let mut out = Vec::new();
+        self.collect_blocks(self.root, self.origin, self.depth, level, max, &mut out).then_some(out)
+    }
+
+    /// Appends the blocks under `word`; false once there are more than `max`.
+    fn collect_blocks(
+        &self,
+        word: u32,
+        min: IVec3,
+        level: u32,
+        target: u32,
+        max: usize,
+        out: &mut Vec<(IVec3, u32, u32)>,
+    ) -> bool {
         if word == 0 {
-            return;
+            return true;
         }
         if level <= target {
             out.push((min, word, level));
-            return;
+            return out.len() <= max;
         }
         let half = 1 << (level - 1);
-        for octant in 0..8 {
-            // A uniform cell above the block level is cut into its blocks.
-            let child = if is_pointer(word) { self.node(word)[octant] } else { word };
-            self.collect_blocks(child, min + octant_offset(octant) * half, level - 1, target, out);
-        }
+        (0..8).all(|octant| {
+            // A uniform cell above the block level is cut into its blocks;
+            // a brick's children are voxels.
+            let child = match (is_pointer(word), level) {
+                (false, _) => word,
+                (true, 1) => u32::from(self.brick(word)[octant]),
+                (true, _) => self.node(word)[octant],
+            };
+            self.collect_blocks(child, min + octant_offset(octant) * half, level - 1, target, max, out)
+        })
     }
 
     /// Visits the maximal uniform solid cells under one child word.

@@ -79,7 +79,7 @@ impl Guide {
     /// A filtered pixel whose centre ray enters a face of normal `normal`
     /// at `point`: a face of the grid (an axis), or a freely turned one.
     pub fn filtered(point: Vec3, normal: Vec3, turned: bool) -> Guide {
-        let mut code = GUIDE_FILTERED | axis_code(crate::trace::nearest_axis(normal));
+        let mut code = GUIDE_FILTERED | crate::trace::normal_code(crate::trace::nearest_axis(normal));
         if turned {
             code |= GUIDE_TURNED | pack_normal(normal) << GUIDE_NORMAL_SHIFT;
         }
@@ -102,12 +102,6 @@ impl Guide {
             _ => unpack_normal(self.code >> GUIDE_NORMAL_SHIFT),
         }
     }
-}
-
-/// An axis' code: 1..=6 for +x, −x, +y, −y, +z, −z.
-fn axis_code(axis: glam::IVec3) -> u32 {
-    let a = (0..3).find(|&a| axis[a] != 0).unwrap_or(0);
-    1 + 2 * a as u32 + u32::from(axis[a] < 0)
 }
 
 /// −1 for a negative number, else 1.

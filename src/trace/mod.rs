@@ -142,6 +142,20 @@ pub fn nearest_axis(n: Vec3) -> IVec3 {
     out
 }
 
+/// 0 = none, 1..=6 = +x, −x, +y, −y, +z, −z.
+pub fn normal_code(n: IVec3) -> u32 {
+    for axis in 0..3 {
+        if n[axis] > 0 {
+            return 1 + 2 * axis as u32;
+        }
+        if n[axis] < 0 {
+            return 2 + 2 * axis as u32;
+        }
+    }
+    0
+}
+
+/// The axis of [`normal_code`]'s code (zero for 0).
 pub fn normal_from_code(code: u32) -> IVec3 {
     if code == 0 || code > 6 {
         return IVec3::ZERO;

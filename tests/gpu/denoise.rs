@@ -331,7 +331,7 @@ fn ridge() -> Scene {
     let voxels: Vec<(IVec3, u8)> =
         (0..24).flat_map(|x| (0..24).flat_map(move |y| (0..24).map(move |z| (IVec3::new(x, y, z), 1)))).collect();
     let model = Model { size: [24, 24, 24], tree: Octree::from_voxels(&voxels).unwrap() };
-    let scene = crate::path_trace::objects_scene(vec![model], &[("0 0 0", None)], palette());
+    let scene = crate::path_trace::objects_scene(vec![model], &[(0, vec![("_t", "0 0 0")])], palette());
     let mut editor = octovox::editor::Editor::default();
     editor.set_scene(scene);
     let script = "object 0\nobject turn z 45\nobject turn y 45\n";

@@ -650,44 +650,19 @@ pub(crate) fn instanced_material_scene() -> Scene {
 /// [`instanced_material_scene`] with free turns (`_ov_turn` quaternions)
 /// on the placements that have one.
 pub(crate) fn turned_material_scene(turns: [Option<&str>; 3]) -> Scene {
-    use octovox::scene::graph::{Attributes, Layer, Node, NodeKind, SceneGraph};
-    use octovox::scene::objects::{Model, Objects};
+    use octovox::scene::objects::Model;
     let single = material_scene();
     // MagicaVoxel's axes: z up, world (x, y, z) is model (x, −z, y).
     let voxels: Vec<(IVec3, u8)> = single.voxels().into_iter().map(|(p, v)| (IVec3::new(p.x, -p.z, p.y), v)).collect();
     let tree = Octree::from_voxels(&voxels).unwrap();
     let (lo, hi) = tree.solid_bounds().unwrap();
     let model = Model { size: (hi - lo + IVec3::ONE).as_uvec3().to_array(), tree };
-    let placements = [("0 0 0", "4"), ("40 0 0", "17"), ("0 44 0", "20")];
-    let mut nodes = vec![
-        Node {
-            id: 0,
-            attributes: Attributes::new(),
-            kind: NodeKind::Transform { child: 1, reserved: u32::MAX, layer: 0, frames: vec![] },
-        },
-        Node { id: 1, attributes: Attributes::new(), kind: NodeKind::Group { children: vec![2, 4, 6] } },
-    ];
-    for (k, ((t, r), turn)) in placements.into_iter().zip(turns).enumerate() {
-        let id = 2 + 2 * k as u32;
-        let mut frame: Attributes = [("_t".to_owned(), t.to_owned()), ("_r".to_owned(), r.to_owned())].into();
-        if let Some(turn) = turn {
-            frame.insert("_ov_turn".to_owned(), turn.to_owned());
-        }
-        let transform = NodeKind::Transform { child: id + 1, reserved: u32::MAX, layer: 0, frames: vec![frame] };
-        nodes.push(Node { id, attributes: Attributes::new(), kind: transform });
-        let shape = NodeKind::Shape { models: vec![(0, Attributes::new())] };
-        nodes.push(Node { id: id + 1, attributes: Attributes::new(), kind: shape });
-    }
-    let layers = vec![Layer { id: 0, attributes: Attributes::new(), reserved: u32::MAX }];
-    let objects = Objects::new(
-        Some(SceneGraph { nodes, layers, ..SceneGraph::default() }),
-        vec![model],
-        Vec::new(),
-        0,
-        usize::MAX,
-    )
-    .unwrap();
-    let mut scene = Scene::compose(single.palette.clone(), objects).unwrap();
+    let placements: Vec<(u32, Vec<(&str, &str)>)> = [("0 0 0", "4"), ("40 0 0", "17"), ("0 44 0", "20")]
+        .into_iter()
+        .zip(turns)
+        .map(|((t, r), turn)| (0, [("_t", t), ("_r", r)].into_iter().chain(turn.map(|q| ("_ov_turn", q))).collect()))
+        .collect();
+    let mut scene = objects_scene(vec![model], &placements, single.palette.clone());
     scene.set_instancing(octovox::scene::Instancing::References);
     assert!(scene.instanced().is_some());
     scene
@@ -794,15 +769,15 @@ fn turned_lamp_over_a_floor(turn: &str) -> Scene {
     let lamp = Model { size: [1, 1, 1], tree: Octree::from_voxels(&[(IVec3::ZERO, SPECIAL)]).unwrap() };
     let mut palette = palette();
     palette.materials[usize::from(SPECIAL)] = material(MaterialKind::Emit, &[("_emit", "1")]);
-    objects_scene(vec![floor, lamp], &[("0 0 0", None), ("0 0 9", Some(turn))], palette)
+    let placements = [(0, vec![("_t", "0 0 0")]), (1, vec![("_t", "0 0 9"), ("_ov_turn", turn)])];
+    objects_scene(vec![floor, lamp], &placements, palette)
 }
 
-/// Model k placed at MagicaVoxel's `_t` and free turn `_ov_turn` of
-/// `placements[k]`, each an object under the root's group: a scene drawn
-/// as instances where any is turned.
+/// One object per entry of `placements` under the root's group: the model
+/// it places and its keyframe's keys (`_t`, `_r`, `_ov_turn`).
 pub(crate) fn objects_scene(
     models: Vec<octovox::scene::objects::Model>,
-    placements: &[(&str, Option<&str>)],
+    placements: &[(u32, Vec<(&str, &str)>)],
     palette: Palette,
 ) -> Scene {
     use octovox::scene::graph::{Attributes, Layer, Node, NodeKind, SceneGraph};
@@ -816,15 +791,12 @@ pub(crate) fn objects_scene(
         },
         Node { id: 1, attributes: Attributes::new(), kind: NodeKind::Group { children } },
     ];
-    for (k, (t, turn)) in placements.iter().enumerate() {
+    for (k, (model, keys)) in placements.iter().enumerate() {
         let id = 2 + 2 * k as u32;
-        let mut frame: Attributes = [("_t".to_owned(), (*t).to_owned())].into();
-        if let Some(turn) = turn {
-            frame.insert("_ov_turn".to_owned(), (*turn).to_owned());
-        }
+        let frame: Attributes = keys.iter().map(|(key, value)| ((*key).to_owned(), (*value).to_owned())).collect();
         let transform = NodeKind::Transform { child: id + 1, reserved: u32::MAX, layer: 0, frames: vec![frame] };
         nodes.push(Node { id, attributes: Attributes::new(), kind: transform });
-        let shape = NodeKind::Shape { models: vec![(k as u32, Attributes::new())] };
+        let shape = NodeKind::Shape { models: vec![(*model, Attributes::new())] };
         nodes.push(Node { id: id + 1, attributes: Attributes::new(), kind: shape });
     }
     let layers = vec![Layer { id: 0, attributes: Attributes::new(), reserved: u32::MAX }];
